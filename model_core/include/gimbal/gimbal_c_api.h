@@ -1,0 +1,49 @@
+/* C interface of the dynamics core, used by the FMI wrapper in fmu_src/.
+ * The core knows variables, physics and integration; the wrapper knows the FMI state machine. */
+#ifndef GIMBAL_C_API_H
+#define GIMBAL_C_API_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct GimbalCore GimbalCore;
+
+typedef enum { GIMBAL_OK = 0, GIMBAL_WARNING = 1, GIMBAL_DISCARD = 2, GIMBAL_ERROR = 3 } GimbalStatus;
+typedef enum { GIMBAL_PARAMETER = 0, GIMBAL_INPUT = 1, GIMBAL_OUTPUT = 2 } GimbalCausality;
+typedef enum { GIMBAL_FIXED = 0, GIMBAL_TUNABLE = 1, GIMBAL_CONTINUOUS = 2 } GimbalVariability;
+typedef enum { GIMBAL_INITIAL_NONE = 0, GIMBAL_INITIAL_EXACT = 1, GIMBAL_INITIAL_CALCULATED = 2 } GimbalInitial;
+
+/* category is one of the logCategories of modelDescription.xml. */
+typedef void (*GimbalLogFunction)(void* context, GimbalStatus status, const char* category, const char* message);
+
+typedef struct GimbalVariableInfo {
+    const char* name;
+    GimbalCausality causality;
+    GimbalVariability variability;
+    GimbalInitial initial;
+} GimbalVariableInfo;
+
+unsigned gimbal_real_variable_count(void);
+/* Returns 0 when vr is not a Real variable of the model. */
+int gimbal_real_variable_info(unsigned vr, GimbalVariableInfo* info);
+
+GimbalCore* gimbal_core_create(GimbalLogFunction log, void* log_context);
+void gimbal_core_destroy(GimbalCore* core);
+/* Back to the state right after creation: start values, no integrator. */
+void gimbal_core_reset(GimbalCore* core);
+
+GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value);
+GimbalStatus gimbal_core_get_real(const GimbalCore* core, unsigned vr, double* value);
+
+/* Validates parameters and start values, and sets up the integrator at start_time. */
+GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time);
+/* Integrates from current_time to current_time + step_size with the inputs held. On failure the
+ * state is rolled back to current_time and GIMBAL_DISCARD or GIMBAL_ERROR is returned. */
+GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double step_size);
+double gimbal_core_time(const GimbalCore* core);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

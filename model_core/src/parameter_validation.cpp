@@ -1,0 +1,134 @@
+#include "gimbal/parameter_validation.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <sstream>
+
+namespace gimbal {
+namespace {
+
+struct Checker {
+    const double (&values)[kRealVariableCount];
+    std::string& error;
+
+    double get(RealVariable vr) const { return values[vr]; }
+
+    bool fail(const std::string& message) {
+        error = message;
+        return false;
+    }
+
+    bool require(RealVariable vr, bool ok, const char* rule) {
+        if (ok) return true;
+        std::ostringstream s;
+        s << kRealVariables[vr].name << " = " << values[vr] << " is invalid: " << rule;
+        return fail(s.str());
+    }
+    bool non_negative(RealVariable vr) { return require(vr, values[vr] >= 0.0, "it must be >= 0"); }
+    bool positive(RealVariable vr) { return require(vr, values[vr] > 0.0, "it must be > 0"); }
+};
+
+Vec3 vector_at(const double (&values)[kRealVariableCount], RealVariable first) {
+    return Vec3(values[first], values[first + 1], values[first + 2]);
+}
+
+struct BodyVariables {
+    RealVariable mass, inertia_xx, centre_of_mass, viscous;
+    const char* prefix;
+};
+
+// Each body's inertia block is laid out I_xx, I_yy, I_zz, I_xy, I_xz, I_yz in the variable table.
+const BodyVariables kBodyVariables[4] = {
+    {vr_body1_m, vr_body1_I_xx, vr_body1_d_bc_1, vr_body1_c_visc, "body1"},
+    {vr_rotor1_m, vr_rotor1_I_xx, vr_rotor1_d_be_1, vr_rotor1_c_visc, "rotor1"},
+    {vr_body2_m, vr_body2_I_xx, vr_body2_d_bd_1, vr_body2_c_visc, "body2"},
+    {vr_rotor2_m, vr_rotor2_I_xx, vr_rotor2_d_bf_1, vr_rotor2_c_visc, "rotor2"},
+};
+
+bool build_inertia(Checker& check, const BodyVariables& body, Mat3& inertia) {
+    const double* i = &check.values[body.inertia_xx];
+    inertia << i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2];
+    const Eigen::SelfAdjointEigenSolver<Mat3> solver(inertia, Eigen::EigenvaluesOnly);
+    const Vec3 principal = solver.eigenvalues();  // ascending
+    std::ostringstream s;
+    s << body.prefix << ".I_xx .. " << body.prefix << ".I_yz";
+    if (principal[0] <= 0.0) {
+        s << " is invalid: the inertia tensor must be positive definite (principal moments " << principal.transpose()
+          << ")";
+        return check.fail(s.str());
+    }
+    // Triangle inequality of a real mass distribution; a flat body sits exactly on it.
+    if (principal[0] + principal[1] < principal[2] * (1.0 - 1e-12)) {
+        s << " is invalid: the principal moments " << principal.transpose()
+          << " violate the triangle inequality I1 + I2 >= I3";
+        return check.fail(s.str());
+    }
+    return true;
+}
+
+}  // namespace
+
+bool build_model_parameters(const double (&values)[kRealVariableCount], ModelParameters& params, std::string& error) {
+    Checker check{values, error};
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
+        if (kRealVariables[vr].causality == Causality::parameter &&
+            !check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "it must be finite"))
+            return false;
+    }
+
+    for (int k = 0; k < 4; ++k) {
+        const BodyVariables& vars = kBodyVariables[k];
+        RigidBody& body = params.multibody.bodies[k];
+        if (!check.non_negative(vars.mass) || !check.non_negative(vars.viscous)) return false;
+        if (!build_inertia(check, vars, body.inertia)) return false;
+        body.mass = values[vars.mass];
+        body.centre_of_mass = vector_at(values, vars.centre_of_mass);
+        params.viscous_friction[k] = values[vars.viscous];
+    }
+    params.multibody.d_ab = vector_at(values, vr_base_d_ab_1);
+    if (!check.non_negative(vr_g)) return false;
+    params.multibody.gravity = values[vr_g];
+
+    struct MotorVariables { RealVariable R, L, k_torque, k_emf, U_L; };
+    const MotorVariables motors[2] = {
+        {vr_motor1_R, vr_motor1_L, vr_motor1_k_torque, vr_motor1_k_emf, vr_motor1_U_L},
+        {vr_motor2_R, vr_motor2_L, vr_motor2_k_torque, vr_motor2_k_emf, vr_motor2_U_L},
+    };
+    struct GearVariables { RealVariable N, k_s, c_s; };
+    const GearVariables gears[2] = {{vr_gear1_N, vr_gear1_k_s, vr_gear1_c_s}, {vr_gear2_N, vr_gear2_k_s, vr_gear2_c_s}};
+    for (int j = 0; j < 2; ++j) {
+        const MotorVariables& m = motors[j];
+        if (!check.positive(m.R) || !check.positive(m.L) || !check.non_negative(m.k_torque) ||
+            !check.non_negative(m.k_emf) || !check.positive(m.U_L))
+            return false;
+        params.motor[j] = MotorParameters{values[m.R], values[m.L], values[m.k_torque], values[m.k_emf], 0.0,
+                                          values[m.U_L]};
+        const GearVariables& g = gears[j];
+        if (!check.require(g.N, values[g.N] != 0.0, "a gear ratio must not be 0") || !check.non_negative(g.k_s) ||
+            !check.non_negative(g.c_s))
+            return false;
+        params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], 0.0};
+    }
+
+    if (!check.require(vr_solver_rtol, values[vr_solver_rtol] > 0.0 && values[vr_solver_rtol] < 1.0,
+                       "it must lie in (0, 1)") ||
+        !check.positive(vr_solver_atol))
+        return false;
+    params.relative_tolerance = values[vr_solver_rtol];
+    params.absolute_tolerance = values[vr_solver_atol];
+    return true;
+}
+
+bool validate_start_state(const double (&values)[kRealVariableCount], const ModelParameters&, std::string& error) {
+    Checker check{values, error};
+    for (unsigned vr = vr_alpha; vr <= vr_theta_b2; ++vr)
+        if (!check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "a start value must be finite"))
+            return false;
+    if (!check.require(vr_theta_b1, values[vr_theta_b1] == 0.0, "gear 1 has no backlash, so its start value must be 0") ||
+        !check.require(vr_theta_b2, values[vr_theta_b2] == 0.0, "gear 2 has no backlash, so its start value must be 0"))
+        return false;
+    return true;
+}
+
+}  // namespace gimbal

@@ -1,0 +1,128 @@
+// Writes the parts of modelDescription.xml that follow from the variable table, so that the names,
+// value references, units and start values the FMU serves can never drift from what it declares.
+// Usage: gimbal_model_description_generator <units.xml> <variables.xml> <structure.xml>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "gimbal/variables.hpp"
+
+namespace {
+
+// Only the table is needed here, not the core library: instantiate it from the same list.
+const gimbal::RealVariableInfo kTable[] = {
+#define X(id, name, causality, variability, initial, unit, display_unit, start, description)          \
+    {name, gimbal::Causality::causality, gimbal::Variability::variability, gimbal::Initial::initial, unit, \
+     display_unit, start, description},
+#include "gimbal/real_variables.def"
+#undef X
+};
+
+struct UnitDefinition {
+    const char* name;
+    const char* base_unit;  // attributes of <BaseUnit>
+    const char* display;    // extra <DisplayUnit> elements
+};
+
+const UnitDefinition kUnits[] = {
+    {"1", "", ""},
+    {"rad", "rad=\"1\"", "<DisplayUnit name=\"deg\" factor=\"57.29577951308232\"/>"},
+    {"rad/s", "s=\"-1\" rad=\"1\"", "<DisplayUnit name=\"deg/s\" factor=\"57.29577951308232\"/>"},
+    {"rad/s2", "s=\"-2\" rad=\"1\"", "<DisplayUnit name=\"deg/s2\" factor=\"57.29577951308232\"/>"},
+    {"m", "m=\"1\"", ""},
+    {"m/s", "m=\"1\" s=\"-1\"", ""},
+    {"m/s2", "m=\"1\" s=\"-2\"", ""},
+    {"kg", "kg=\"1\"", ""},
+    {"kg.m2", "kg=\"1\" m=\"2\"", ""},
+    {"V", "kg=\"1\" m=\"2\" s=\"-3\" A=\"-1\"", ""},
+    {"A", "A=\"1\"", ""},
+    {"Ohm", "kg=\"1\" m=\"2\" s=\"-3\" A=\"-2\"", ""},
+    {"H", "kg=\"1\" m=\"2\" s=\"-2\" A=\"-2\"", ""},
+    {"N.m", "kg=\"1\" m=\"2\" s=\"-2\"", ""},
+    {"J", "kg=\"1\" m=\"2\" s=\"-2\"", ""},
+    {"N.m/A", "kg=\"1\" m=\"2\" s=\"-2\" A=\"-1\"", ""},
+    {"V.s/rad", "kg=\"1\" m=\"2\" s=\"-2\" A=\"-1\" rad=\"-1\"", ""},
+    {"N.m/rad", "kg=\"1\" m=\"2\" s=\"-2\" rad=\"-1\"", ""},
+    {"N.m.s/rad", "kg=\"1\" m=\"2\" s=\"-1\" rad=\"-1\"", ""},
+};
+
+const char* to_string(gimbal::Causality c) {
+    switch (c) {
+        case gimbal::Causality::parameter: return "parameter";
+        case gimbal::Causality::input: return "input";
+        case gimbal::Causality::output: return "output";
+    }
+    return "";
+}
+
+const char* to_string(gimbal::Variability v) {
+    switch (v) {
+        case gimbal::Variability::fixed: return "fixed";
+        case gimbal::Variability::tunable: return "tunable";
+        case gimbal::Variability::continuous: return "continuous";
+    }
+    return "";
+}
+
+std::string number(double value) {
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "%.17g", value);
+    return buffer;
+}
+
+bool write(const char* path, const std::string& text) {
+    std::ofstream out(path);
+    out << text;
+    return static_cast<bool>(out);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 4) {
+        std::cerr << "usage: " << argv[0] << " <units.xml> <variables.xml> <structure.xml>\n";
+        return 2;
+    }
+    std::set<std::string> used_units, known_units;
+    for (const auto& u : kUnits) known_units.insert(u.name);
+
+    std::ostringstream variables, outputs, initial_unknowns;
+    unsigned index = 0;
+    for (const auto& v : kTable) {
+        ++index;
+        const unsigned vr = index - 1;
+        if (known_units.count(v.unit) == 0) {
+            std::cerr << "variable " << v.name << " uses undefined unit " << v.unit << "\n";
+            return 1;
+        }
+        used_units.insert(v.unit);
+        variables << "    <!-- index " << index << " -->\n"
+                  << "    <ScalarVariable name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
+                  << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
+        if (v.initial == gimbal::Initial::exact) variables << " initial=\"exact\"";
+        if (v.initial == gimbal::Initial::calculated) variables << " initial=\"calculated\"";
+        variables << "\n      description=\"" << v.description << "\">\n      <Real unit=\"" << v.unit << "\"";
+        if (v.display_unit[0] != '\0') variables << " displayUnit=\"" << v.display_unit << "\"";
+        if (v.initial != gimbal::Initial::calculated) variables << " start=\"" << number(v.start) << "\"";
+        variables << "/>\n    </ScalarVariable>\n";
+        if (v.causality == gimbal::Causality::output) {
+            outputs << "      <Unknown index=\"" << index << "\"/>\n";
+            if (v.initial == gimbal::Initial::calculated) initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
+        }
+    }
+
+    std::ostringstream units;
+    for (const auto& u : kUnits) {
+        if (used_units.count(u.name) == 0) continue;
+        units << "    <Unit name=\"" << u.name << "\">";
+        if (u.base_unit[0] != '\0') units << "<BaseUnit " << u.base_unit << "/>";
+        units << u.display << "</Unit>\n";
+    }
+    std::ostringstream structure;
+    structure << "    <Outputs>\n" << outputs.str() << "    </Outputs>\n"
+              << "    <InitialUnknowns>\n" << initial_unknowns.str() << "    </InitialUnknowns>\n";
+    return write(argv[1], units.str()) && write(argv[2], variables.str()) && write(argv[3], structure.str()) ? 0 : 1;
+}

@@ -1,0 +1,31 @@
+"""Shared fixtures: where the build lives and the artefacts the tests drive."""
+import os
+import pathlib
+
+import pytest
+
+REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
+BUILD_DIR = pathlib.Path(os.environ.get("GIMBAL_BUILD_DIR", REPO_ROOT / "build")).resolve()
+
+
+@pytest.fixture(scope="session")
+def build_dir() -> pathlib.Path:
+    if not BUILD_DIR.is_dir():
+        pytest.fail(f"build directory {BUILD_DIR} does not exist: build the project first (scripts/test.sh does)")
+    return BUILD_DIR
+
+
+@pytest.fixture(scope="session")
+def fmu_path(build_dir) -> pathlib.Path:
+    path = build_dir / "Gimbal2Axis.fmu"
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: the build did not package the FMU")
+    return path
+
+
+@pytest.fixture(scope="session")
+def probe_lib_path(build_dir) -> pathlib.Path:
+    path = build_dir / "libgimbal_probe.so"
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: the build did not produce the test probe library")
+    return path
