@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs what a fresh machine lacks (Debian packages, a Python virtual environment), then
+# configures and builds the FMU. Safe to run again: it only does what is missing.
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="${GIMBAL_BUILD_DIR:-$repo/build}"
+
+need_apt=()
+dpkg -s libsundials-dev >/dev/null 2>&1 || need_apt+=(libsundials-dev)
+dpkg -s libeigen3-dev >/dev/null 2>&1 || need_apt+=(libeigen3-dev)
+command -v ninja >/dev/null 2>&1 || need_apt+=(ninja-build)
+if [ ${#need_apt[@]} -gt 0 ]; then
+  echo "[setup] installing Debian packages: ${need_apt[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${need_apt[@]}" >/dev/null
+fi
+
+venv="$repo/.venv"
+if [ ! -x "$venv/bin/python" ]; then
+  echo "[setup] creating the Python virtual environment in .venv"
+  python3 -m venv "$venv"
+fi
+if ! "$venv/bin/python" -c "import fmpy, numpy, scipy, sympy, matplotlib, pytest" >/dev/null 2>&1 ||
+   [ "$repo/requirements.txt" -nt "$venv/.requirements-installed" ]; then
+  echo "[setup] installing Python packages (requirements.txt)"
+  "$venv/bin/pip" install -q --disable-pip-version-check -r "$repo/requirements.txt"
+  touch "$venv/.requirements-installed"
+fi
+
+echo "[setup] building in $build_dir"
+cmake -S "$repo" -B "$build_dir" -G Ninja -DPython3_EXECUTABLE="$venv/bin/python" >/dev/null
+cmake --build "$build_dir"
+echo "[setup] FMU ready: $build_dir/Gimbal2Axis.fmu"
