@@ -36,11 +36,28 @@ class LoadedFMU:
     def cleanup(self) -> None:
         shutil.rmtree(self.unzipdir, ignore_errors=True)
 
-    def instantiate(self, name: str = "instance") -> FMU2Slave:
+    def instantiate(self, name: str = "instance", log: list | None = None, logging_on: bool = False) -> FMU2Slave:
+        """A new instance; with `log`, every message the FMU logs is appended to it as (status, category, text)."""
         slave = FMU2Slave(guid=self.model_description.guid, unzipDirectory=self.unzipdir,
                           modelIdentifier=self.model_description.coSimulation.modelIdentifier, instanceName=name)
-        slave.instantiate()
+        slave.instantiate(callbacks=None if log is None else _capturing_callbacks(slave, log), loggingOn=logging_on)
         return slave
+
+
+def _capturing_callbacks(slave: FMU2Slave, log: list):
+    from fmpy import fmi2
+
+    # fmpy's native logger proxy keeps one process-wide target, so it is not used here: the FMU only
+    # ever passes fully formatted messages, with '%' escaped as the format-string contract requires.
+    def logger(environment, instance_name, status, category, message):
+        log.append((int(status), category.decode(), message.decode().replace("%%", "%")))
+
+    callbacks = fmi2.fmi2CallbackFunctions()
+    callbacks.logger = fmi2.fmi2CallbackLoggerTYPE(logger)
+    callbacks.allocateMemory = fmi2.defaultCallbacks.allocateMemory
+    callbacks.freeMemory = fmi2.defaultCallbacks.freeMemory
+    slave._capturing_callbacks = callbacks  # must outlive the instance
+    return callbacks
 
 
 InputFunction = Callable[[float, dict], dict]

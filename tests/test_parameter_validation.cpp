@@ -1,0 +1,72 @@
+// Every refusal names the variable and the rule; the defaults are valid.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "check.hpp"
+#include "gimbal/parameter_validation.hpp"
+
+using namespace gimbal;
+
+namespace {
+
+struct Values {
+    double v[kRealVariableCount];
+    Values() {
+        for (unsigned i = 0; i < kRealVariableCount; ++i) v[i] = kRealVariables[i].start;
+    }
+};
+
+// Sets one value away from the defaults and returns the refusal message ("" if accepted).
+std::string refusal(RealVariable vr, double value) {
+    Values values;
+    values.v[vr] = value;
+    ModelParameters params;
+    std::string error;
+    if (build_model_parameters(values.v, params, error) && validate_start_state(values.v, params, error)) return "";
+    return error;
+}
+
+bool names(const std::string& message, const char* name) { return message.find(name) != std::string::npos; }
+
+}  // namespace
+
+int main() {
+    {
+        Values values;
+        ModelParameters params;
+        std::string error;
+        CHECK(build_model_parameters(values.v, params, error));
+        CHECK(error.empty());
+        CHECK_NEAR(params.multibody.bodies[kElevationBody].inertia(0, 1), kRealVariables[vr_body2_I_xy].start, 0.0);
+        CHECK_NEAR(params.gear[1].ratio, kRealVariables[vr_gear2_N].start, 0.0);
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+
+    std::string m = refusal(vr_body1_m, -1.0);
+    CHECK(names(m, "body1.m") && names(m, ">= 0"));
+    m = refusal(vr_gear2_N, 0.0);
+    CHECK(names(m, "gear2.N") && names(m, "must not be 0"));
+    m = refusal(vr_gear1_k_s, -5.0);
+    CHECK(names(m, "gear1.k_s"));
+    m = refusal(vr_motor2_L, 0.0);
+    CHECK(names(m, "motor2.L") && names(m, "> 0"));
+    m = refusal(vr_motor1_R, nan);
+    CHECK(names(m, "motor1.R") && names(m, "finite"));
+    m = refusal(vr_solver_rtol, 2.0);
+    CHECK(names(m, "solver.rtol"));
+    m = refusal(vr_alpha_dot, std::numeric_limits<double>::infinity());
+    CHECK(names(m, "alpha_dot"));
+    // Not positive definite: a negative principal moment.
+    m = refusal(vr_rotor1_I_zz, -1e-5);
+    CHECK(names(m, "rotor1.I_xx") && names(m, "positive definite"));
+    // Positive definite but no real body: I_zz > I_xx + I_yy.
+    m = refusal(vr_body2_I_zz, 0.2);
+    CHECK(names(m, "body2.I_xx") && names(m, "triangle inequality"));
+    // A product of inertia large enough to break definiteness.
+    m = refusal(vr_body1_I_xy, 0.2);
+    CHECK(names(m, "body1.I_xx") && names(m, "positive definite"));
+    // Inputs are not parameters: any finite value is accepted here.
+    CHECK(refusal(vr_u_R1, 1e9).empty());
+    return check_report("parameter_validation");
+}
