@@ -255,7 +255,7 @@ fmi2Status fmi2Reset(fmi2Component c) {
 
 /* ---------------------------------------------------------------- getting and setting values */
 
-static int real_settable(Instance* instance, const GimbalVariableInfo* info) {
+static int settable(Instance* instance, const GimbalVariableInfo* info) {
     switch (instance->state) {
         case STATE_INSTANTIATED:
         case STATE_INITIALIZATION:
@@ -268,24 +268,41 @@ static int real_settable(Instance* instance, const GimbalVariableInfo* info) {
     }
 }
 
-fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SetReal", SET_STATES)) return fmi2Error;
-    if (nvr == 0) return fmi2OK;
-    if (!not_null(instance, "fmi2SetReal", vr, "vr") || !not_null(instance, "fmi2SetReal", value, "value"))
-        return fmi2Error;
+static const char* const kTypeName[] = {"Real", "Integer", "Boolean"};
+
+/* Common checks of every fmi2Set*: state, pointers, value reference, and the variable's settability. */
+static int check_set(Instance* instance, const char* function, GimbalType type, const fmi2ValueReference vr[],
+                     size_t nvr, const void* value) {
+    if (!allowed(instance, function, SET_STATES)) return 0;
+    if (nvr == 0) return 1;
+    if (!not_null(instance, function, vr, "vr") || !not_null(instance, function, value, "value")) return 0;
     for (size_t i = 0; i < nvr; ++i) {
         GimbalVariableInfo info;
-        if (!gimbal_real_variable_info(vr[i], &info)) {
-            log_message(instance, fmi2Error, "logStatusError", "fmi2SetReal: value reference %u is not a Real variable",
-                        (unsigned)vr[i]);
-            return fmi2Error;
+        if (!gimbal_variable_info(type, vr[i], &info)) {
+            log_message(instance, fmi2Error, "logStatusError", "%s: value reference %u is not a%s %s variable", function,
+                        (unsigned)vr[i], type == GIMBAL_INTEGER ? "n" : "", kTypeName[type]);
+            return 0;
         }
-        if (!real_settable(instance, &info)) {
-            log_message(instance, fmi2Error, "logStatusError", "fmi2SetReal: %s cannot be set in state '%s'",
-                        info.name, state_name(instance->state));
-            return fmi2Error;
+        if (!settable(instance, &info)) {
+            log_message(instance, fmi2Error, "logStatusError", "%s: %s cannot be set in state '%s'", function, info.name,
+                        state_name(instance->state));
+            return 0;
         }
+    }
+    return 1;
+}
+
+static int check_get(Instance* instance, const char* function, const fmi2ValueReference vr[], size_t nvr,
+                     const void* value) {
+    if (!allowed(instance, function, GET_STATES)) return 0;
+    if (nvr == 0) return 1;
+    return not_null(instance, function, vr, "vr") && not_null(instance, function, value, "value");
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    Instance* instance = (Instance*)c;
+    if (!check_set(instance, "fmi2SetReal", GIMBAL_REAL, vr, nvr, value)) return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
         const fmi2Status status = from_core(gimbal_core_set_real(instance->core, vr[i], value[i]));
         if (status > fmi2Warning) return status;
     }
@@ -294,10 +311,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2GetReal", GET_STATES)) return fmi2Error;
-    if (nvr == 0) return fmi2OK;
-    if (!not_null(instance, "fmi2GetReal", vr, "vr") || !not_null(instance, "fmi2GetReal", value, "value"))
-        return fmi2Error;
+    if (!check_get(instance, "fmi2GetReal", vr, nvr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         const fmi2Status status = from_core(gimbal_core_get_real(instance->core, vr[i], &value[i]));
         if (status > fmi2Warning) return status;
@@ -305,40 +319,69 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     return fmi2OK;
 }
 
-/* The model has no Integer, Boolean or String variables: any value reference is refused. */
-static fmi2Status no_such_variables(Instance* instance, const char* function, size_t nvr, const fmi2ValueReference vr[],
-                                    int states) {
-    if (!allowed(instance, function, states)) return fmi2Error;
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+    Instance* instance = (Instance*)c;
+    if (!check_set(instance, "fmi2SetInteger", GIMBAL_INTEGER, vr, nvr, value)) return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        const fmi2Status status = from_core(gimbal_core_set_integer(instance->core, vr[i], value[i]));
+        if (status > fmi2Warning) return status;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+    Instance* instance = (Instance*)c;
+    if (!check_get(instance, "fmi2GetInteger", vr, nvr, value)) return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        int v = 0;
+        const fmi2Status status = from_core(gimbal_core_get_integer(instance->core, vr[i], &v));
+        if (status > fmi2Warning) return status;
+        value[i] = v;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
+    Instance* instance = (Instance*)c;
+    if (!check_set(instance, "fmi2SetBoolean", GIMBAL_BOOLEAN, vr, nvr, value)) return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        const fmi2Status status = from_core(gimbal_core_set_boolean(instance->core, vr[i], value[i] != fmi2False));
+        if (status > fmi2Warning) return status;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+    Instance* instance = (Instance*)c;
+    if (!check_get(instance, "fmi2GetBoolean", vr, nvr, value)) return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        int v = 0;
+        const fmi2Status status = from_core(gimbal_core_get_boolean(instance->core, vr[i], &v));
+        if (status > fmi2Warning) return status;
+        value[i] = v ? fmi2True : fmi2False;
+    }
+    return fmi2OK;
+}
+
+/* The model has no String variables: any value reference is refused. */
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    Instance* instance = (Instance*)c;
+    if (!check_get(instance, "fmi2GetString", vr, nvr, value)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
-    if (!not_null(instance, function, vr, "vr")) return fmi2Error;
-    log_message(instance, fmi2Error, "logStatusError", "%s: value reference %u is not a variable of this type", function,
+    log_message(instance, fmi2Error, "logStatusError", "fmi2GetString: value reference %u is not a String variable",
                 (unsigned)vr[0]);
     return fmi2Error;
 }
 
-fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-    (void)value;
-    return no_such_variables((Instance*)c, "fmi2GetInteger", nvr, vr, GET_STATES);
-}
-fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
-    (void)value;
-    return no_such_variables((Instance*)c, "fmi2GetBoolean", nvr, vr, GET_STATES);
-}
-fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    (void)value;
-    return no_such_variables((Instance*)c, "fmi2GetString", nvr, vr, GET_STATES);
-}
-fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-    (void)value;
-    return no_such_variables((Instance*)c, "fmi2SetInteger", nvr, vr, SET_STATES);
-}
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
-    (void)value;
-    return no_such_variables((Instance*)c, "fmi2SetBoolean", nvr, vr, SET_STATES);
-}
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    (void)value;
-    return no_such_variables((Instance*)c, "fmi2SetString", nvr, vr, SET_STATES);
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetString", SET_STATES)) return fmi2Error;
+    if (nvr == 0) return fmi2OK;
+    if (!not_null(instance, "fmi2SetString", vr, "vr") || !not_null(instance, "fmi2SetString", value, "value"))
+        return fmi2Error;
+    log_message(instance, fmi2Error, "logStatusError", "fmi2SetString: value reference %u is not a String variable",
+                (unsigned)vr[0]);
+    return fmi2Error;
 }
 
 /* ---------------------------------------------------------------- capabilities not offered (yet) */

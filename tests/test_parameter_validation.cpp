@@ -12,8 +12,10 @@ namespace {
 
 struct Values {
     double v[kRealVariableCount];
+    bool flags[kBooleanVariableCount];
     Values() {
         for (unsigned i = 0; i < kRealVariableCount; ++i) v[i] = kRealVariables[i].start;
+        for (unsigned i = 0; i < kBooleanVariableCount; ++i) flags[i] = kBooleanVariables[i].start != 0.0;
     }
 };
 
@@ -23,7 +25,7 @@ std::string refusal(RealVariable vr, double value) {
     values.v[vr] = value;
     ModelParameters params;
     std::string error;
-    if (build_model_parameters(values.v, params, error) && validate_start_state(values.v, params, error)) return "";
+    if (build_model_parameters(values.v, values.flags, params, error) && validate_start_state(values.v, params, error)) return "";
     return error;
 }
 
@@ -36,7 +38,7 @@ int main() {
         Values values;
         ModelParameters params;
         std::string error;
-        CHECK(build_model_parameters(values.v, params, error));
+        CHECK(build_model_parameters(values.v, values.flags, params, error));
         CHECK(error.empty());
         CHECK_NEAR(params.multibody.bodies[kElevationBody].inertia(0, 1), kRealVariables[vr_body2_I_xy].start, 0.0);
         CHECK_NEAR(params.gear[1].ratio, kRealVariables[vr_gear2_N].start, 0.0);
@@ -66,6 +68,19 @@ int main() {
     // A product of inertia large enough to break definiteness.
     m = refusal(vr_body1_I_xy, 0.2);
     CHECK(names(m, "body1.I_xx") && names(m, "positive definite"));
+    m = refusal(vr_rotor1_T_din, 0.01);  // above T_max
+    CHECK(names(m, "rotor1.T_din") && names(m, "T_max"));
+    m = refusal(vr_rotor2_w_min, 0.0);
+    CHECK(names(m, "rotor2.w_min") && names(m, "dry friction"));
+    m = refusal(vr_motor1_i_L, 0.0);
+    CHECK(names(m, "motor1.i_L"));
+    m = refusal(vr_gear2_eta, -1e-4);
+    CHECK(names(m, "gear2.eta"));
+    m = refusal(vr_i_R2, 3.5);  // default i_L of motor 2 is 3 A
+    CHECK(names(m, "i_R2") && names(m, "current limit"));
+    m = refusal(vr_theta_b1, 3e-4);  // default eta of gear 1 is 2e-4 rad
+    CHECK(names(m, "theta_b1") && names(m, "eta"));
+    CHECK(refusal(vr_theta_b1, -2e-4).empty());  // exactly at a stop is valid
     // Inputs are not parameters: any finite value is accepted here.
     CHECK(refusal(vr_u_R1, 1e9).empty());
     return check_report("parameter_validation");

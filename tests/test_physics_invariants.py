@@ -5,7 +5,9 @@ import pytest
 from fmu_driver import STATE_NAMES, simulate
 
 CONSERVATIVE = {
-    # Fixed base, no friction, no damping, motors that exert no torque: only gravity and gear springs act.
+    # Fixed base, no friction, no damping, motors that exert no torque: only gravity and gear springs act
+    # (the gears keep their backlash: with c_s = 0 it is a lossless dead zone).
+    "rotor1.T_din": 0.0, "rotor1.T_max": 0.0, "rotor2.T_din": 0.0, "rotor2.T_max": 0.0,
     "body1.c_visc": 0.0, "rotor1.c_visc": 0.0, "body2.c_visc": 0.0, "rotor2.c_visc": 0.0,
     "gear1.c_s": 0.0, "gear2.c_s": 0.0, "motor1.k_torque": 0.0, "motor2.k_torque": 0.0,
     "solver.rtol": 1e-12, "solver.atol": 1e-14,

@@ -6,16 +6,19 @@
 #include "gimbal/gimbal_instance.hpp"
 
 struct GimbalCore {
+    explicit GimbalCore(gimbal::GimbalInstance::Logger logger) : instance(std::move(logger)) {}
     gimbal::GimbalInstance instance;
 };
 
 extern "C" {
 
-unsigned gimbal_real_variable_count(void) { return gimbal::kRealVariableCount; }
-
-int gimbal_real_variable_info(unsigned vr, GimbalVariableInfo* info) {
-    if (vr >= gimbal::kRealVariableCount || info == nullptr) return 0;
-    const gimbal::RealVariableInfo& v = gimbal::kRealVariables[vr];
+int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info) {
+    const gimbal::VariableInfo* table = gimbal::kRealVariables;
+    unsigned count = gimbal::kRealVariableCount;
+    if (type == GIMBAL_INTEGER) table = gimbal::kIntegerVariables, count = gimbal::kIntegerVariableCount;
+    if (type == GIMBAL_BOOLEAN) table = gimbal::kBooleanVariables, count = gimbal::kBooleanVariableCount;
+    if (vr >= count || info == nullptr) return 0;
+    const gimbal::VariableInfo& v = table[vr];
     info->name = v.name;
     info->causality = static_cast<GimbalCausality>(v.causality);
     info->variability = static_cast<GimbalVariability>(v.variability);
@@ -28,7 +31,7 @@ GimbalCore* gimbal_core_create(GimbalLogFunction log, void* log_context) {
         auto logger = [log, log_context](GimbalStatus status, const char* category, const std::string& message) {
             if (log != nullptr) log(log_context, status, category, message.c_str());
         };
-        return new (std::nothrow) GimbalCore{gimbal::GimbalInstance(logger)};
+        return new (std::nothrow) GimbalCore{logger};
     } catch (...) {
         return nullptr;
     }
@@ -44,6 +47,25 @@ GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value) {
 
 GimbalStatus gimbal_core_get_real(const GimbalCore* core, unsigned vr, double* value) {
     return core->instance.get_real(vr, *value);
+}
+
+GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value) {
+    return core->instance.set_integer(vr, value);
+}
+
+GimbalStatus gimbal_core_get_integer(const GimbalCore* core, unsigned vr, int* value) {
+    return core->instance.get_integer(vr, *value);
+}
+
+GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value) {
+    return core->instance.set_boolean(vr, value != 0);
+}
+
+GimbalStatus gimbal_core_get_boolean(const GimbalCore* core, unsigned vr, int* value) {
+    bool flag = false;
+    const GimbalStatus status = core->instance.get_boolean(vr, flag);
+    *value = flag ? 1 : 0;
+    return status;
 }
 
 GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time) {

@@ -1,5 +1,6 @@
 #include "gimbal/gimbal_instance.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -20,10 +21,13 @@ Vec3 vector_at(const double* values, unsigned first) { return Vec3(values[first]
 GimbalInstance::GimbalInstance(Logger logger) : logger_(std::move(logger)) { reset(); }
 
 void GimbalInstance::reset() {
-    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) values_[vr] = kRealVariables[vr].start;
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) reals_[vr] = kRealVariables[vr].start;
+    for (unsigned vr = 0; vr < kIntegerVariableCount; ++vr) integers_[vr] = static_cast<int>(kIntegerVariables[vr].start);
+    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans_[vr] = kBooleanVariables[vr].start != 0.0;
     integrator_.reset();
+    system_.reset();
     integrator_running_ = false;
-    state_.setZero();
+    std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
 }
 
@@ -41,7 +45,7 @@ GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
         s << "fmi2SetReal: " << kRealVariables[vr].name << " = " << value << " refused: values must be finite";
         return refuse(GIMBAL_ERROR, s.str());
     }
-    values_[vr] = value;
+    reals_[vr] = value;
     return GIMBAL_OK;
 }
 
@@ -49,77 +53,159 @@ GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) const {
     if (vr >= kRealVariableCount) {
         return refuse(GIMBAL_ERROR, "fmi2GetReal: value reference " + std::to_string(vr) + " is not a Real variable");
     }
-    value = values_[vr];
+    value = reals_[vr];
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::set_integer(unsigned vr, int value) {
+    if (vr >= kIntegerVariableCount) {
+        return refuse(GIMBAL_ERROR, "fmi2SetInteger: value reference " + std::to_string(vr) + " is not an Integer variable");
+    }
+    integers_[vr] = value;
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) const {
+    if (vr >= kIntegerVariableCount) {
+        return refuse(GIMBAL_ERROR, "fmi2GetInteger: value reference " + std::to_string(vr) + " is not an Integer variable");
+    }
+    value = integers_[vr];
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::set_boolean(unsigned vr, bool value) {
+    if (vr >= kBooleanVariableCount) {
+        return refuse(GIMBAL_ERROR, "fmi2SetBoolean: value reference " + std::to_string(vr) + " is not a Boolean variable");
+    }
+    booleans_[vr] = value;
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::get_boolean(unsigned vr, bool& value) const {
+    if (vr >= kBooleanVariableCount) {
+        return refuse(GIMBAL_ERROR, "fmi2GetBoolean: value reference " + std::to_string(vr) + " is not a Boolean variable");
+    }
+    value = booleans_[vr];
     return GIMBAL_OK;
 }
 
 StepInputs GimbalInstance::read_step_inputs(double step_start) const {
     StepInputs inputs;
-    inputs.voltage[0] = clamp_voltage(params_.motor[0], values_[vr_u_R1]);
-    inputs.voltage[1] = clamp_voltage(params_.motor[1], values_[vr_u_R2]);
-    inputs.base.attitude = vector_at(values_, vr_base_delta);
-    inputs.base.attitude_rate = vector_at(values_, vr_base_delta_dot);
-    inputs.base.attitude_accel = vector_at(values_, vr_base_delta_ddot);
-    inputs.base.velocity_a = vector_at(values_, vr_base_v_a_1);
-    inputs.base.acceleration_a = vector_at(values_, vr_base_a_a_1);
+    inputs.voltage[0] = clamp_voltage(params_.motor[0], reals_[vr_u_R1]);
+    inputs.voltage[1] = clamp_voltage(params_.motor[1], reals_[vr_u_R2]);
+    inputs.base.attitude = vector_at(reals_, vr_base_delta);
+    inputs.base.attitude_rate = vector_at(reals_, vr_base_delta_dot);
+    inputs.base.attitude_accel = vector_at(reals_, vr_base_delta_ddot);
+    inputs.base.velocity_a = vector_at(reals_, vr_base_v_a_1);
+    inputs.base.acceleration_a = vector_at(reals_, vr_base_a_a_1);
     inputs.step_start_time = step_start;
     return inputs;
 }
 
-void GimbalInstance::publish_outputs(const StepInputs& inputs) {
-    for (int k = 0; k < kStateSize; ++k) values_[vr_alpha + k] = state_[k];
-    const ModelOutputs out = evaluate_outputs(params_, inputs, time_, state_);
-    values_[vr_T_E1] = out.shaft_torque[0];
-    values_[vr_T_E2] = out.shaft_torque[1];
-    for (int k = 0; k < 3; ++k) values_[vr_los_omega_1 + k] = out.payload_angular_velocity[k];
-    values_[vr_energy_kinetic] = out.kinetic_energy;
-    values_[vr_energy_potential] = out.potential_energy;
-    values_[vr_energy_spring] = out.spring_energy;
+void GimbalInstance::publish_outputs() {
+    for (int k = 0; k < kStateSize; ++k) reals_[vr_alpha + k] = state_[k];
+    const Modes& modes = system_->modes();
+    const ModelOutputs out = evaluate_outputs(params_, system_->inputs(), modes, time_, state_);
+    reals_[vr_T_E1] = out.shaft_torque[0];
+    reals_[vr_T_E2] = out.shaft_torque[1];
+    for (int k = 0; k < 3; ++k) reals_[vr_los_omega_1 + k] = out.payload_angular_velocity[k];
+    reals_[vr_energy_kinetic] = out.kinetic_energy;
+    reals_[vr_energy_potential] = out.potential_energy;
+    reals_[vr_energy_spring] = out.spring_energy;
+    reals_[vr_energy_magnetic] = out.magnetic_energy;
+    const double* flows = state_ + kEnergyFlows;
+    const bool accounting = params_.energy_accounting;
+    reals_[vr_energy_electrical_in] = accounting ? flows[kElectricalIn] : 0.0;
+    reals_[vr_energy_resistive] = accounting ? flows[kResistive] : 0.0;
+    reals_[vr_energy_viscous] = accounting ? flows[kViscous] : 0.0;
+    reals_[vr_energy_shaft_damping] = accounting ? flows[kShaftDamping] : 0.0;
+    reals_[vr_energy_dry_friction] = accounting ? flows[kDryFriction] : 0.0;
+
+    integers_[vi_gear1_contact] = modes.gear_contact[0];
+    integers_[vi_gear2_contact] = modes.gear_contact[1];
+    integers_[vi_motor1_limited] = modes.motor_limited[0];
+    integers_[vi_motor2_limited] = modes.motor_limited[1];
+    for (int body = 0; body < 4; ++body)
+        integers_[vi_body1_stick_slip + body] = friction_mode_indicator(modes.friction[body], state_[kRates + body]);
+    const EventCounters& events = system_->counters();
+    const IntegratorStatistics stats = integrator_->statistics();
+    reals_[vr_events_last_time] = events.last_event_time;
+    integers_[vi_events_total] = static_cast<int>(events.total);
+    integers_[vi_events_backlash1] = static_cast<int>(events.backlash[0]);
+    integers_[vi_events_backlash2] = static_cast<int>(events.backlash[1]);
+    integers_[vi_events_current_limit1] = static_cast<int>(events.current_limit[0]);
+    integers_[vi_events_current_limit2] = static_cast<int>(events.current_limit[1]);
+    integers_[vi_events_stick_slip] = static_cast<int>(events.stick_slip);
+    integers_[vi_events_zeno_guard] = static_cast<int>(stats.zeno_holds);
+    integers_[vi_solver_steps] = static_cast<int>(std::min<long>(stats.steps, 2147483647L));
+    integers_[vi_solver_rhs_evaluations] = static_cast<int>(std::min<long>(stats.rhs_evaluations, 2147483647L));
+    integers_[vi_solver_jacobian_evaluations] = static_cast<int>(std::min<long>(stats.jacobian_evaluations, 2147483647L));
 }
 
 GimbalStatus GimbalInstance::initialize(double start_time) {
     std::string error;
     ModelParameters params;
-    if (!build_model_parameters(values_, params, error) || !validate_start_state(values_, params, error)) {
+    if (!build_model_parameters(reals_, booleans_, params, error) || !validate_start_state(reals_, params, error)) {
         return refuse(GIMBAL_ERROR, error);
     }
     params_ = params;
-    for (int k = 0; k < kStateSize; ++k) state_[k] = values_[vr_alpha + k];
+    std::fill(state_, state_ + kMaxStateSize, 0.0);
+    for (int k = 0; k < kStateSize; ++k) state_[k] = reals_[vr_alpha + k];
     time_ = start_time;
-    integrator_ = std::make_unique<CvodeIntegrator>(
-        params_, [this](const std::string& message) { logger_(GIMBAL_WARNING, "logSolver", message); });
+    system_ = std::make_unique<GimbalHybridSystem>(params_);
+    system_->set_inputs(read_step_inputs(time_));
+    system_->update_modes(time_, state_, nullptr);
+    EventCounters none;
+    none.last_event_time = time_;
+    system_->restore(system_->modes(), none);  // the initial choice of modes is not an event
+    IntegratorSettings settings;
+    settings.relative_tolerance = params_.relative_tolerance;
+    settings.absolute_tolerance = params_.absolute_tolerance;
+    integrator_ = std::make_unique<HybridCvodeIntegrator>(
+        *system_, settings, [this](const std::string& message) { logger_(GIMBAL_WARNING, "logSolver", message); },
+        [this](const std::string& message) { logger_(GIMBAL_OK, "logEvents", message); });
     integrator_running_ = false;
-    publish_outputs(read_step_inputs(time_));
+    publish_outputs();
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     if (!integrator_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance is not initialized");
-    const StepInputs inputs = read_step_inputs(current_time);
+    StepInputs inputs = read_step_inputs(current_time);
+    const StepInputs& running = system_->inputs();
     // The right-hand side is continuous across the step boundary only if the held voltages are the same
-    // and the base motion continues the previous step's constant-acceleration arc; otherwise restart.
-    const bool continuous = integrator_running_ && inputs.voltage[0] == previous_inputs_.voltage[0] &&
-                            inputs.voltage[1] == previous_inputs_.voltage[1] &&
-                            same_base_motion(inputs.base, previous_inputs_.base.advanced(previous_step_size_));
-    const StateVector step_start_state = state_;
-    if (!continuous && !integrator_->restart(current_time, state_)) {
-        return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not be restarted");
+    // and the base motion continues the running constant-acceleration arc; otherwise restart.
+    const bool continuous = integrator_running_ && inputs.voltage[0] == running.voltage[0] &&
+                            inputs.voltage[1] == running.voltage[1] &&
+                            same_base_motion(inputs.base, running.base.advanced(current_time - running.step_start_time));
+    double step_start_state[kMaxStateSize];
+    std::copy(state_, state_ + kMaxStateSize, step_start_state);
+    const Modes step_start_modes = system_->modes();
+    const EventCounters step_start_counters = system_->counters();
+
+    if (continuous) {
+        inputs = running;
+    } else {
+        system_->set_inputs(inputs);
+        // New inputs may cross a switching surface at once (e.g. the voltage reverses while limited).
+        system_->update_modes(current_time, state_, nullptr);
+        if (!integrator_->restart(current_time, state_)) {
+            return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not be restarted");
+        }
     }
-    StepInputs held = inputs;
-    if (continuous) held.step_start_time = previous_inputs_.step_start_time, held.base = previous_inputs_.base;
-    if (!integrator_->advance(held, current_time + step_size, state_)) {
-        state_ = step_start_state;
+    if (!integrator_->advance(current_time + step_size, state_)) {
+        std::copy(step_start_state, step_start_state + kMaxStateSize, state_);
+        system_->restore(step_start_modes, step_start_counters);
         integrator_running_ = false;
         std::ostringstream s;
+        s.precision(17);
         s << "fmi2DoStep: integration from t = " << current_time << " over h = " << step_size
           << " failed; state rolled back to t = " << current_time;
         return refuse(GIMBAL_DISCARD, s.str());
     }
-    previous_inputs_ = held;
-    previous_step_size_ = current_time + step_size - held.step_start_time;
     integrator_running_ = true;
     time_ = current_time + step_size;
-    publish_outputs(held);
+    publish_outputs();
     return GIMBAL_OK;
 }
 

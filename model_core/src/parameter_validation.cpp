@@ -34,16 +34,16 @@ Vec3 vector_at(const double (&values)[kRealVariableCount], RealVariable first) {
 }
 
 struct BodyVariables {
-    RealVariable mass, inertia_xx, centre_of_mass, viscous;
+    RealVariable mass, inertia_xx, centre_of_mass, viscous, slip_torque;  // slip_torque: T_din, T_max, w_min, mu
     const char* prefix;
 };
 
 // Each body's inertia block is laid out I_xx, I_yy, I_zz, I_xy, I_xz, I_yz in the variable table.
 const BodyVariables kBodyVariables[4] = {
-    {vr_body1_m, vr_body1_I_xx, vr_body1_d_bc_1, vr_body1_c_visc, "body1"},
-    {vr_rotor1_m, vr_rotor1_I_xx, vr_rotor1_d_be_1, vr_rotor1_c_visc, "rotor1"},
-    {vr_body2_m, vr_body2_I_xx, vr_body2_d_bd_1, vr_body2_c_visc, "body2"},
-    {vr_rotor2_m, vr_rotor2_I_xx, vr_rotor2_d_bf_1, vr_rotor2_c_visc, "rotor2"},
+    {vr_body1_m, vr_body1_I_xx, vr_body1_d_bc_1, vr_body1_c_visc, vr_body1_T_din, "body1"},
+    {vr_rotor1_m, vr_rotor1_I_xx, vr_rotor1_d_be_1, vr_rotor1_c_visc, vr_rotor1_T_din, "rotor1"},
+    {vr_body2_m, vr_body2_I_xx, vr_body2_d_bd_1, vr_body2_c_visc, vr_body2_T_din, "body2"},
+    {vr_rotor2_m, vr_rotor2_I_xx, vr_rotor2_d_bf_1, vr_rotor2_c_visc, vr_rotor2_T_din, "rotor2"},
 };
 
 bool build_inertia(Checker& check, const BodyVariables& body, Mat3& inertia) {
@@ -69,7 +69,8 @@ bool build_inertia(Checker& check, const BodyVariables& body, Mat3& inertia) {
 
 }  // namespace
 
-bool build_model_parameters(const double (&values)[kRealVariableCount], ModelParameters& params, std::string& error) {
+bool build_model_parameters(const double (&values)[kRealVariableCount], const bool (&flags)[kBooleanVariableCount],
+                            ModelParameters& params, std::string& error) {
     Checker check{values, error};
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
         if (kRealVariables[vr].causality == Causality::parameter &&
@@ -85,30 +86,42 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], ModelPar
         body.mass = values[vars.mass];
         body.centre_of_mass = vector_at(values, vars.centre_of_mass);
         params.viscous_friction[k] = values[vars.viscous];
+
+        const RealVariable slip = vars.slip_torque;
+        const auto breakaway = static_cast<RealVariable>(slip + 1), stick_speed = static_cast<RealVariable>(slip + 2),
+                   damping = static_cast<RealVariable>(slip + 3);
+        if (!check.non_negative(slip) || !check.non_negative(breakaway) || !check.non_negative(damping) ||
+            !check.require(slip, values[slip] <= values[breakaway], "T_din must not exceed T_max") ||
+            (values[breakaway] > 0.0 && !check.require(stick_speed, values[stick_speed] > 0.0,
+                                                       "it must be > 0 when the body has dry friction (T_max > 0)")))
+            return false;
+        params.dry_friction[k] = DryFrictionParameters{values[slip], values[breakaway], values[stick_speed], values[damping]};
     }
+    params.energy_accounting = flags[vb_energy_accounting];
     params.multibody.d_ab = vector_at(values, vr_base_d_ab_1);
     if (!check.non_negative(vr_g)) return false;
     params.multibody.gravity = values[vr_g];
 
-    struct MotorVariables { RealVariable R, L, k_torque, k_emf, U_L; };
+    struct MotorVariables { RealVariable R, L, k_torque, k_emf, i_L, U_L; };
     const MotorVariables motors[2] = {
-        {vr_motor1_R, vr_motor1_L, vr_motor1_k_torque, vr_motor1_k_emf, vr_motor1_U_L},
-        {vr_motor2_R, vr_motor2_L, vr_motor2_k_torque, vr_motor2_k_emf, vr_motor2_U_L},
+        {vr_motor1_R, vr_motor1_L, vr_motor1_k_torque, vr_motor1_k_emf, vr_motor1_i_L, vr_motor1_U_L},
+        {vr_motor2_R, vr_motor2_L, vr_motor2_k_torque, vr_motor2_k_emf, vr_motor2_i_L, vr_motor2_U_L},
     };
-    struct GearVariables { RealVariable N, k_s, c_s; };
-    const GearVariables gears[2] = {{vr_gear1_N, vr_gear1_k_s, vr_gear1_c_s}, {vr_gear2_N, vr_gear2_k_s, vr_gear2_c_s}};
+    struct GearVariables { RealVariable N, k_s, c_s, eta; };
+    const GearVariables gears[2] = {{vr_gear1_N, vr_gear1_k_s, vr_gear1_c_s, vr_gear1_eta},
+                                    {vr_gear2_N, vr_gear2_k_s, vr_gear2_c_s, vr_gear2_eta}};
     for (int j = 0; j < 2; ++j) {
         const MotorVariables& m = motors[j];
         if (!check.positive(m.R) || !check.positive(m.L) || !check.non_negative(m.k_torque) ||
-            !check.non_negative(m.k_emf) || !check.positive(m.U_L))
+            !check.non_negative(m.k_emf) || !check.positive(m.i_L) || !check.positive(m.U_L))
             return false;
-        params.motor[j] = MotorParameters{values[m.R], values[m.L], values[m.k_torque], values[m.k_emf], 0.0,
-                                          values[m.U_L]};
+        params.motor[j] = MotorParameters{values[m.R], values[m.L], values[m.k_torque], values[m.k_emf],
+                                          values[m.i_L], values[m.U_L]};
         const GearVariables& g = gears[j];
         if (!check.require(g.N, values[g.N] != 0.0, "a gear ratio must not be 0") || !check.non_negative(g.k_s) ||
-            !check.non_negative(g.c_s))
+            !check.non_negative(g.c_s) || !check.non_negative(g.eta))
             return false;
-        params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], 0.0};
+        params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], values[g.eta]};
     }
 
     if (!check.require(vr_solver_rtol, values[vr_solver_rtol] > 0.0 && values[vr_solver_rtol] < 1.0,
@@ -120,14 +133,19 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], ModelPar
     return true;
 }
 
-bool validate_start_state(const double (&values)[kRealVariableCount], const ModelParameters&, std::string& error) {
+bool validate_start_state(const double (&values)[kRealVariableCount], const ModelParameters& params, std::string& error) {
     Checker check{values, error};
     for (unsigned vr = vr_alpha; vr <= vr_theta_b2; ++vr)
         if (!check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "a start value must be finite"))
             return false;
-    if (!check.require(vr_theta_b1, values[vr_theta_b1] == 0.0, "gear 1 has no backlash, so its start value must be 0") ||
-        !check.require(vr_theta_b2, values[vr_theta_b2] == 0.0, "gear 2 has no backlash, so its start value must be 0"))
-        return false;
+    const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
+    for (int j = 0; j < 2; ++j) {
+        if (!check.require(currents[j], std::fabs(values[currents[j]]) <= params.motor[j].current_limit,
+                           "a start current must not exceed the current limit i_L") ||
+            !check.require(backlash[j], std::fabs(values[backlash[j]]) <= params.gear[j].half_backlash,
+                           "a start backlash state must lie within +-eta"))
+            return false;
+    }
     return true;
 }
 

@@ -12,15 +12,6 @@
 
 namespace {
 
-// Only the table is needed here, not the core library: instantiate it from the same list.
-const gimbal::RealVariableInfo kTable[] = {
-#define X(id, name, causality, variability, initial, unit, display_unit, start, description)          \
-    {name, gimbal::Causality::causality, gimbal::Variability::variability, gimbal::Initial::initial, unit, \
-     display_unit, start, description},
-#include "gimbal/real_variables.def"
-#undef X
-};
-
 struct UnitDefinition {
     const char* name;
     const char* base_unit;  // attributes of <BaseUnit>
@@ -32,6 +23,7 @@ const UnitDefinition kUnits[] = {
     {"rad", "rad=\"1\"", "<DisplayUnit name=\"deg\" factor=\"57.29577951308232\"/>"},
     {"rad/s", "s=\"-1\" rad=\"1\"", "<DisplayUnit name=\"deg/s\" factor=\"57.29577951308232\"/>"},
     {"rad/s2", "s=\"-2\" rad=\"1\"", "<DisplayUnit name=\"deg/s2\" factor=\"57.29577951308232\"/>"},
+    {"s", "s=\"1\"", ""},
     {"m", "m=\"1\"", ""},
     {"m/s", "m=\"1\" s=\"-1\"", ""},
     {"m/s2", "m=\"1\" s=\"-2\"", ""},
@@ -62,6 +54,7 @@ const char* to_string(gimbal::Variability v) {
     switch (v) {
         case gimbal::Variability::fixed: return "fixed";
         case gimbal::Variability::tunable: return "tunable";
+        case gimbal::Variability::discrete: return "discrete";
         case gimbal::Variability::continuous: return "continuous";
     }
     return "";
@@ -71,6 +64,20 @@ std::string number(double value) {
     char buffer[40];
     std::snprintf(buffer, sizeof buffer, "%.17g", value);
     return buffer;
+}
+
+std::string xml_escape(const char* text) {
+    std::string out;
+    for (const char* c = text; *c != '\0'; ++c) {
+        switch (*c) {
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '&': out += "&amp;"; break;
+            case '"': out += "&quot;"; break;
+            default: out += *c;
+        }
+    }
+    return out;
 }
 
 bool write(const char* path, const std::string& text) {
@@ -91,26 +98,43 @@ int main(int argc, char** argv) {
 
     std::ostringstream variables, outputs, initial_unknowns;
     unsigned index = 0;
-    for (const auto& v : kTable) {
-        ++index;
-        const unsigned vr = index - 1;
-        if (known_units.count(v.unit) == 0) {
-            std::cerr << "variable " << v.name << " uses undefined unit " << v.unit << "\n";
-            return 1;
-        }
-        used_units.insert(v.unit);
-        variables << "    <!-- index " << index << " -->\n"
-                  << "    <ScalarVariable name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
-                  << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
-        if (v.initial == gimbal::Initial::exact) variables << " initial=\"exact\"";
-        if (v.initial == gimbal::Initial::calculated) variables << " initial=\"calculated\"";
-        variables << "\n      description=\"" << v.description << "\">\n      <Real unit=\"" << v.unit << "\"";
-        if (v.display_unit[0] != '\0') variables << " displayUnit=\"" << v.display_unit << "\"";
-        if (v.initial != gimbal::Initial::calculated) variables << " start=\"" << number(v.start) << "\"";
-        variables << "/>\n    </ScalarVariable>\n";
-        if (v.causality == gimbal::Causality::output) {
-            outputs << "      <Unknown index=\"" << index << "\"/>\n";
-            if (v.initial == gimbal::Initial::calculated) initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
+    struct Table {
+        const gimbal::VariableInfo* variables;
+        unsigned count;
+        const char* type;
+    };
+    const Table tables[] = {{gimbal::kRealVariables, gimbal::kRealVariableCount, "Real"},
+                            {gimbal::kIntegerVariables, gimbal::kIntegerVariableCount, "Integer"},
+                            {gimbal::kBooleanVariables, gimbal::kBooleanVariableCount, "Boolean"}};
+    for (const Table& table : tables) {
+        const bool real = std::string(table.type) == "Real";
+        for (unsigned vr = 0; vr < table.count; ++vr) {
+            const gimbal::VariableInfo& v = table.variables[vr];
+            ++index;
+            if (real && known_units.count(v.unit) == 0) {
+                std::cerr << "variable " << v.name << " uses undefined unit " << v.unit << "\n";
+                return 1;
+            }
+            if (real) used_units.insert(v.unit);
+            variables << "    <!-- index " << index << " -->\n"
+                      << "    <ScalarVariable name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
+                      << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
+            if (v.initial == gimbal::Initial::exact) variables << " initial=\"exact\"";
+            if (v.initial == gimbal::Initial::calculated) variables << " initial=\"calculated\"";
+            variables << "\n      description=\"" << xml_escape(v.description) << "\">\n      <" << table.type;
+            if (real) variables << " unit=\"" << v.unit << "\"";
+            if (v.display_unit[0] != '\0') variables << " displayUnit=\"" << v.display_unit << "\"";
+            if (v.initial != gimbal::Initial::calculated) {
+                if (std::string(table.type) == "Boolean") variables << " start=\"" << (v.start != 0.0 ? "true" : "false") << "\"";
+                else if (real) variables << " start=\"" << number(v.start) << "\"";
+                else variables << " start=\"" << static_cast<long>(v.start) << "\"";
+            }
+            variables << "/>\n    </ScalarVariable>\n";
+            if (v.causality == gimbal::Causality::output) {
+                outputs << "      <Unknown index=\"" << index << "\"/>\n";
+                if (v.initial == gimbal::Initial::calculated)
+                    initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
+            }
         }
     }
 

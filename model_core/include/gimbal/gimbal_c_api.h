@@ -24,9 +24,10 @@ typedef struct GimbalVariableInfo {
     GimbalInitial initial;
 } GimbalVariableInfo;
 
-unsigned gimbal_real_variable_count(void);
-/* Returns 0 when vr is not a Real variable of the model. */
-int gimbal_real_variable_info(unsigned vr, GimbalVariableInfo* info);
+typedef enum { GIMBAL_REAL = 0, GIMBAL_INTEGER = 1, GIMBAL_BOOLEAN = 2 } GimbalType;
+
+/* Returns 0 when vr is not a variable of that type. */
+int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info);
 
 GimbalCore* gimbal_core_create(GimbalLogFunction log, void* log_context);
 void gimbal_core_destroy(GimbalCore* core);
@@ -35,6 +36,10 @@ void gimbal_core_reset(GimbalCore* core);
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value);
 GimbalStatus gimbal_core_get_real(const GimbalCore* core, unsigned vr, double* value);
+GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value);
+GimbalStatus gimbal_core_get_integer(const GimbalCore* core, unsigned vr, int* value);
+GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value);
+GimbalStatus gimbal_core_get_boolean(const GimbalCore* core, unsigned vr, int* value);
 
 /* Validates parameters and start values, and sets up the integrator at start_time. */
 GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time);

@@ -1,21 +1,26 @@
-// The constant model (parameters) and the continuous dynamics of the 12-state gimbal.
+// The constant model (parameters), the discrete modes, and the dynamics of the gimbal within a mode.
 #pragma once
 
-#include <string>
+#include <cstdint>
 
 #include "gimbal/drive_train.hpp"
 #include "gimbal/rigid_body.hpp"
 
 namespace gimbal {
 
-// Layout of the state vector (MODEL.md section 4).
+// Layout of the state vector (MODEL.md section 4), then the optional energy accumulators.
 enum StateIndex : int {
     kAngles = 0,      // alpha, alpha_m, beta, beta_m
     kRates = 4,       // their time derivatives
     kCurrents = 8,    // i_R1, i_R2
     kBacklash = 10,   // theta_b1, theta_b2
-    kStateSize = 12
+    kStateSize = 12,
+    kEnergyFlows = 12,  // electrical in, resistive, viscous, shaft damping, dry friction
+    kEnergyFlowCount = 5,
+    kMaxStateSize = kStateSize + kEnergyFlowCount
 };
+
+enum EnergyFlow : int { kElectricalIn = 0, kResistive, kViscous, kShaftDamping, kDryFriction };
 
 using StateVector = Eigen::Matrix<double, kStateSize, 1>;
 
@@ -24,8 +29,37 @@ struct ModelParameters {
     MotorParameters motor[2];
     GearParameters gear[2];
     double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
+    DryFrictionParameters dry_friction[4];
+    bool energy_accounting = false;
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;
+
+    int state_size() const { return energy_accounting ? kMaxStateSize : kStateSize; }
+};
+
+// Rotor coordinate of axis j in q order (alpha_m, beta_m) and its load coordinate (alpha, beta).
+constexpr int rotor_index(int axis) { return axis == 0 ? 1 : 3; }
+constexpr int load_index(int axis) { return axis == 0 ? 0 : 2; }
+
+// Dry friction regime of one body. |qd| < w_min is the low-speed (stick candidate) region.
+enum class FrictionMode : std::int8_t {
+    none,               // body without dry friction
+    slip_positive,      // qd >= w_min: T_as = -T_din
+    slip_negative,      // qd <= -w_min: T_as = +T_din
+    hold,               // low speed, T_as = -T_outros - c_num qd within +-T_max (stuck)
+    at_max_positive,    // low speed, T_as = +T_max (break-away, or the hold torque clipped)
+    at_max_negative,    // low speed, T_as = -T_max
+};
+
+inline bool low_speed(FrictionMode mode) {
+    return mode == FrictionMode::hold || mode == FrictionMode::at_max_positive || mode == FrictionMode::at_max_negative;
+}
+
+// Discrete state: constant between events, so that the right-hand side is smooth within a mode.
+struct Modes {
+    int gear_contact[2] = {0, 0};    // -1 at -eta, 0 in the gap (or no backlash), +1 at +eta
+    int motor_limited[2] = {0, 0};   // -1 held at -i_L, 0 free, +1 held at +i_L
+    FrictionMode friction[4] = {FrictionMode::none, FrictionMode::none, FrictionMode::none, FrictionMode::none};
 };
 
 // Inputs held over one communication step.
@@ -35,6 +69,38 @@ struct StepInputs {
     double step_start_time = 0.0;
 };
 
+// Everything the right-hand side, the event functions and the outputs need, at one (t, x, modes).
+struct Dynamics {
+    Vec4 acceleration;
+    double current_rate[2];
+    double backlash_rate[2];
+    double free_backlash_rate[2];   // X of (2.81)
+    double deflection[2];
+    double deflection_rate[2];
+    double shaft_torque[2];
+    double steady_current[2];       // (u - k_emf w) / R
+    Vec4 friction_torque;           // T_as
+    Vec4 other_torque;              // T_outros, meaningful for low-speed bodies only
+    Vec4 generalized_force;         // everything but dry friction and the bias
+    Vec4 bias;                      // f of (2.54)
+};
+
+// Gears whose damping is 0 are pure dead zones: theta_b follows theta_d inside the gap.
+inline bool dead_zone_gear(const GearParameters& gear) { return gear.half_backlash > 0.0 && gear.damping == 0.0; }
+
+void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, const BaseKinematics& base,
+                       const double* state, const Modes& modes, Dynamics& out);
+
+// Solves (2.106) with the columns of the low-speed bodies replaced by unit vectors: T_outros.
+Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Modes& modes,
+                   const ModelParameters& params);
+
+BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
+
+// dx/dt within the current modes; false if it is not finite.
+bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
+                               double time, const double* state, double* derivative);
+
 // Quantities derived from the state for outputs and diagnostics.
 struct ModelOutputs {
     double shaft_torque[2] = {0, 0};
@@ -42,16 +108,10 @@ struct ModelOutputs {
     double kinetic_energy = 0.0;
     double potential_energy = 0.0;
     double spring_energy = 0.0;
+    double magnetic_energy = 0.0;
 };
 
-// Rotor coordinate of axis j in q order (alpha_m, beta_m) and its load coordinate (alpha, beta).
-constexpr int rotor_index(int axis) { return axis == 0 ? 1 : 3; }
-constexpr int load_index(int axis) { return axis == 0 ? 0 : 2; }
-
-void evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, double time,
-                               const StateVector& state, StateVector& derivative);
-
-ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& inputs, double time,
-                              const StateVector& state);
+ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
+                              double time, const double* state);
 
 }  // namespace gimbal

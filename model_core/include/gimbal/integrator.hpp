@@ -1,15 +1,17 @@
-// SUNDIALS CVODE (BDF, Newton, dense linear solver) over the continuous dynamics.
+// SUNDIALS CVODE (BDF, Newton, dense linear solver) under a hybrid system: root finding locates each
+// mode change, the system switches its modes, and the integrator restarts from the switching point.
 #pragma once
 
 #include <functional>
 #include <string>
-
-#include "gimbal/gimbal_model.hpp"
+#include <vector>
 
 #include <sundials/sundials_context.h>
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
 #include <sundials/sundials_nvector.h>
+
+#include "gimbal/hybrid_system.hpp"
 
 namespace gimbal {
 
@@ -17,39 +19,61 @@ struct IntegratorStatistics {
     long steps = 0;
     long rhs_evaluations = 0;
     long jacobian_evaluations = 0;
+    long events = 0;       // located mode changes
+    long zeno_holds = 0;   // times the chattering guard engaged
 };
 
-class CvodeIntegrator {
+struct IntegratorSettings {
+    double relative_tolerance = 1e-6;
+    double absolute_tolerance = 1e-8;
+    // Chattering guard: this many events in a row, each within `zeno_window` of the previous one
+    // (relative to max(1, |t|)), freeze the event functions for `zeno_dwell`; modes are then
+    // re-selected from the state. Switches further apart than the window are never affected.
+    int zeno_event_limit = 50;
+    double zeno_window = 1e-12;
+    double zeno_dwell = 1e-10;
+};
+
+class HybridCvodeIntegrator {
 public:
-    using ErrorSink = std::function<void(const std::string&)>;
+    using MessageSink = std::function<void(const std::string&)>;
 
-    CvodeIntegrator(const ModelParameters& params, ErrorSink error_sink);
-    ~CvodeIntegrator();
-    CvodeIntegrator(const CvodeIntegrator&) = delete;
-    CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
+    HybridCvodeIntegrator(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
+                          MessageSink event_sink);
+    ~HybridCvodeIntegrator();
+    HybridCvodeIntegrator(const HybridCvodeIntegrator&) = delete;
+    HybridCvodeIntegrator& operator=(const HybridCvodeIntegrator&) = delete;
 
-    // Starts integration afresh at (time, state): needed after any discontinuity of the right-hand side.
-    bool restart(double time, const StateVector& state);
+    // Starts afresh at (time, state): after any discontinuity of the right-hand side.
+    bool restart(double time, const double* state);
 
-    // Integrates to exactly end_time under inputs held over the step. False on failure, with the
-    // reason sent to the error sink; the state is then unspecified and the caller must roll back.
-    bool advance(const StepInputs& inputs, double end_time, StateVector& state);
+    // Integrates to exactly end_time, switching modes at every located event. False on failure, with
+    // the reason sent to the error sink; the state is then unspecified and the caller must roll back.
+    bool advance(double end_time, double* state);
 
     IntegratorStatistics statistics() const;
 
 private:
     static int right_hand_side(sunrealtype time, N_Vector y, N_Vector ydot, void* user_data);
+    static int event_functions(sunrealtype time, N_Vector y, sunrealtype* values, void* user_data);
     static void forward_error(int code, const char* module, const char* function, char* message, void* user_data);
+    void accumulate_statistics();
 
-    const ModelParameters& params_;
-    ErrorSink error_sink_;
-    StepInputs inputs_;
+    HybridSystem& system_;
+    IntegratorSettings settings_;
+    MessageSink error_sink_, event_sink_;
+    int size_;
     SUNContext context_ = nullptr;
     N_Vector y_ = nullptr;
     SUNMatrix jacobian_ = nullptr;
     SUNLinearSolver linear_solver_ = nullptr;
     void* cvode_ = nullptr;
     bool initialized_ = false;
+    std::vector<int> root_directions_;
+    IntegratorStatistics totals_;     // of finished CVODE runs (counters reset at each restart)
+    double last_event_time_ = -1e300;
+    int rapid_events_ = 0;
+    double dwell_until_ = -1e300;
 };
 
 }  // namespace gimbal

@@ -1,0 +1,50 @@
+// The gimbal as a hybrid system: modes of MODEL.md sections 3-4 (backlash contact side, current
+// limiter, stick/slip), their event functions and their switching rules.
+#pragma once
+
+#include "gimbal/gimbal_model.hpp"
+#include "gimbal/hybrid_system.hpp"
+
+namespace gimbal {
+
+struct EventCounters {
+    long total = 0;
+    long backlash[2] = {0, 0};
+    long current_limit[2] = {0, 0};
+    long stick_slip = 0;
+    double last_event_time = 0.0;
+};
+
+class GimbalHybridSystem final : public HybridSystem {
+public:
+    // Fixed slots, so that the integrator sees one event vector whatever the modes; slots a mode
+    // does not use hold a constant 1.
+    static constexpr int kGearSlots = 2, kMotorSlots = 2, kFrictionSlots = 6;
+    static constexpr int kEventCount = 2 * kGearSlots + 2 * kMotorSlots + 4 * kFrictionSlots;
+
+    explicit GimbalHybridSystem(const ModelParameters& params) : params_(params) {}
+
+    int state_size() const override { return params_.state_size(); }
+    int event_count() const override { return kEventCount; }
+    bool derivative(double time, const double* state, double* derivative) override;
+    void event_functions(double time, const double* state, double* values) override;
+    int update_modes(double time, double* state, const int* directions) override;
+
+    void set_inputs(const StepInputs& inputs) { inputs_ = inputs; }
+    const StepInputs& inputs() const { return inputs_; }
+    const Modes& modes() const { return modes_; }
+    const EventCounters& counters() const { return counters_; }
+    // For rolling a failed step back.
+    void restore(const Modes& modes, const EventCounters& counters) { modes_ = modes, counters_ = counters; }
+
+private:
+    const ModelParameters& params_;
+    StepInputs inputs_;
+    Modes modes_;
+    EventCounters counters_;
+};
+
+// Friction mode as the FMU reports it: 0 stuck, +-1 breaking away, +-2 slipping (sign = motion).
+int friction_mode_indicator(FrictionMode mode, double rate);
+
+}  // namespace gimbal

@@ -1,0 +1,23 @@
+// What a hybrid (mode-switching) system offers an integrator: a right-hand side that is smooth
+// within the current modes, event functions whose sign changes mark mode changes, and the mode
+// update at an event. Independent of the integrator behind it (CVODE today, ARKODE next).
+#pragma once
+
+namespace gimbal {
+
+class HybridSystem {
+public:
+    virtual ~HybridSystem() = default;
+    virtual int state_size() const = 0;
+    virtual int event_count() const = 0;
+    // dx/dt under the current modes; false if it cannot be evaluated (non-finite values).
+    virtual bool derivative(double time, const double* state, double* derivative) = 0;
+    virtual void event_functions(double time, const double* state, double* values) = 0;
+    // Re-selects the modes at `time`. `directions[k]` is +1 / -1 when event function k has just
+    // crossed zero upward / downward, 0 otherwise; nullptr when re-selecting after an input change.
+    // May project the state onto the new modes' constraints (e.g. theta_b = eta at contact).
+    // Returns the number of mode changes.
+    virtual int update_modes(double time, double* state, const int* directions) = 0;
+};
+
+}  // namespace gimbal

@@ -1,0 +1,191 @@
+#include "gimbal/gimbal_hybrid_system.hpp"
+
+#include <algorithm>
+
+namespace gimbal {
+namespace {
+
+constexpr int gear_slot(int axis) { return GimbalHybridSystem::kGearSlots * axis; }
+constexpr int motor_slot(int axis) { return 2 * GimbalHybridSystem::kGearSlots + GimbalHybridSystem::kMotorSlots * axis; }
+constexpr int friction_slot(int body) {
+    return 2 * GimbalHybridSystem::kGearSlots + 2 * GimbalHybridSystem::kMotorSlots +
+           GimbalHybridSystem::kFrictionSlots * body;
+}
+
+int sign(double value) { return value > 0.0 ? 1 : (value < 0.0 ? -1 : 0); }
+
+// Sign of an event function at a mode decision. Right after a located crossing the function may sit
+// exactly on zero or a rounding error short of it: the crossing direction then decides.
+int side(double value, const int* directions, int slot) {
+    if (directions != nullptr && slot >= 0 && directions[slot] != 0) return directions[slot];
+    return sign(value);
+}
+
+// Contact rule of (2.81) at one side: at the stop, and not pulled back into the gap.
+int select_contact(bool at_plus_stop, bool at_minus_stop, int pull_sign, int current) {
+    if (at_plus_stop && (pull_sign > 0 || (pull_sign == 0 && current == 1))) return 1;
+    if (at_minus_stop && (pull_sign < 0 || (pull_sign == 0 && current == -1))) return -1;
+    return 0;
+}
+
+}  // namespace
+
+int friction_mode_indicator(FrictionMode mode, double rate) {
+    switch (mode) {
+        case FrictionMode::slip_positive: return 2;
+        case FrictionMode::slip_negative: return -2;
+        case FrictionMode::hold: return 0;
+        case FrictionMode::at_max_positive: return -1;  // friction pushes +: the body is driven -
+        case FrictionMode::at_max_negative: return 1;
+        case FrictionMode::none: break;
+    }
+    return rate >= 0.0 ? 2 : -2;
+}
+
+bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
+    return evaluate_state_derivative(params_, inputs_, modes_, time, state, derivative);
+}
+
+void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
+    std::fill(values, values + kEventCount, 1.0);
+    Dynamics d;
+    evaluate_dynamics(params_, inputs_, base_kinematics_at(params_, inputs_, time), state, modes_, d);
+
+    for (int axis = 0; axis < 2; ++axis) {
+        const GearParameters& gear = params_.gear[axis];
+        double* g = values + gear_slot(axis);
+        const double eta = gear.half_backlash;
+        if (eta == 0.0) continue;
+        if (dead_zone_gear(gear)) {
+            g[0] = d.deflection[axis] - eta;
+            g[1] = d.deflection[axis] + eta;
+        } else if (modes_.gear_contact[axis] == 0) {
+            g[0] = state[kBacklash + axis] - eta;
+            g[1] = state[kBacklash + axis] + eta;
+        } else {
+            g[0] = d.free_backlash_rate[axis];
+        }
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        const double limit = params_.motor[axis].current_limit;
+        double* g = values + motor_slot(axis);
+        const int limited = modes_.motor_limited[axis];
+        if (limited == 0) {
+            g[0] = state[kCurrents + axis] - limit;
+            g[1] = state[kCurrents + axis] + limit;
+        } else {
+            g[0] = d.steady_current[axis] - limited * limit;
+        }
+    }
+    for (int body = 0; body < 4; ++body) {
+        const DryFrictionParameters& friction = params_.dry_friction[body];
+        if (!friction.present()) continue;
+        double* g = values + friction_slot(body);
+        const double rate = state[kRates + body];
+        g[0] = rate - friction.stick_speed;
+        g[1] = rate + friction.stick_speed;
+        if (low_speed(modes_.friction[body])) {
+            const double other = d.other_torque[body];
+            const double hold = -other - friction.numerical_damping() * rate;
+            g[2] = other - friction.breakaway_torque;
+            g[3] = other + friction.breakaway_torque;
+            g[4] = hold - friction.breakaway_torque;
+            g[5] = hold + friction.breakaway_torque;
+        }
+    }
+}
+
+int GimbalHybridSystem::update_modes(double time, double* state, const int* directions) {
+    const Modes previous = modes_;
+    Dynamics d;
+    const BaseKinematics base = base_kinematics_at(params_, inputs_, time);
+    evaluate_dynamics(params_, inputs_, base, state, modes_, d);
+
+    for (int axis = 0; axis < 2; ++axis) {
+        const GearParameters& gear = params_.gear[axis];
+        const double eta = gear.half_backlash;
+        const int slot = gear_slot(axis);
+        const int current = previous.gear_contact[axis];
+        double& backlash = state[kBacklash + axis];
+        int contact = 0;
+        if (eta == 0.0) {
+            backlash = 0.0;
+        } else if (dead_zone_gear(gear)) {
+            const int above = side(d.deflection[axis] - eta, directions, slot);
+            const int below = side(d.deflection[axis] + eta, directions, slot + 1);
+            if (above > 0 || (above == 0 && current == 1)) contact = 1;
+            else if (below < 0 || (below == 0 && current == -1)) contact = -1;
+            backlash = std::clamp(d.deflection[axis], -eta, eta);
+        } else {
+            const bool in_gap = current == 0;
+            const bool at_plus = !in_gap ? current == 1 : (side(backlash - eta, directions, slot) >= 0);
+            const bool at_minus = !in_gap ? current == -1 : (side(backlash + eta, directions, slot + 1) <= 0);
+            const int pull = side(d.free_backlash_rate[axis], directions, in_gap ? -1 : slot);
+            contact = select_contact(at_plus, at_minus, pull, current);
+            backlash = contact != 0 ? contact * eta : std::clamp(backlash, -eta, eta);
+        }
+        modes_.gear_contact[axis] = contact;
+    }
+
+    for (int axis = 0; axis < 2; ++axis) {
+        const double limit = params_.motor[axis].current_limit;
+        const int slot = motor_slot(axis);
+        const int current = previous.motor_limited[axis];
+        double& armature_current = state[kCurrents + axis];
+        const bool at_plus = current == 1 || (current == 0 && side(armature_current - limit, directions, slot) >= 0);
+        const bool at_minus = current == -1 || (current == 0 && side(armature_current + limit, directions, slot + 1) <= 0);
+        int push = 0;
+        if (at_plus) push = side(d.steady_current[axis] - limit, directions, current == 1 ? slot : -1);
+        if (at_minus && !at_plus) push = side(d.steady_current[axis] + limit, directions, current == -1 ? slot : -1);
+        const int limited = select_contact(at_plus, at_minus, push, current);
+        modes_.motor_limited[axis] = limited;
+        armature_current = limited != 0 ? limited * limit : std::clamp(armature_current, -limit, limit);
+    }
+
+    // Low-speed set first: the other torques depend on which bodies are held, not on how.
+    for (int body = 0; body < 4; ++body) {
+        const DryFrictionParameters& friction = params_.dry_friction[body];
+        if (!friction.present()) {
+            modes_.friction[body] = FrictionMode::none;
+            continue;
+        }
+        const int slot = friction_slot(body);
+        const double rate = state[kRates + body];
+        const int above = side(rate - friction.stick_speed, directions, slot);
+        const int below = side(rate + friction.stick_speed, directions, slot + 1);
+        if (above >= 0) modes_.friction[body] = FrictionMode::slip_positive;
+        else if (below <= 0) modes_.friction[body] = FrictionMode::slip_negative;
+        else if (!low_speed(previous.friction[body])) modes_.friction[body] = FrictionMode::hold;
+        else modes_.friction[body] = previous.friction[body];
+    }
+    evaluate_dynamics(params_, inputs_, base, state, modes_, d);
+    for (int body = 0; body < 4; ++body) {
+        if (!low_speed(modes_.friction[body])) continue;
+        const DryFrictionParameters& friction = params_.dry_friction[body];
+        // Event slots 2..5 carried these functions only if the body was already at low speed.
+        const int slot = low_speed(previous.friction[body]) ? friction_slot(body) : -1000;
+        const double other = d.other_torque[body];
+        const double hold = -other - friction.numerical_damping() * state[kRates + body];
+        const double limit = friction.breakaway_torque;
+        FrictionMode mode = FrictionMode::hold;
+        // (2.99): break away when |T_outros| >= T_max (a tie breaks away); (2.102): clip the hold torque.
+        if (side(other - limit, directions, slot + 2) >= 0) mode = FrictionMode::at_max_negative;
+        else if (side(other + limit, directions, slot + 3) <= 0) mode = FrictionMode::at_max_positive;
+        else if (side(hold - limit, directions, slot + 4) > 0) mode = FrictionMode::at_max_positive;
+        else if (side(hold + limit, directions, slot + 5) < 0) mode = FrictionMode::at_max_negative;
+        modes_.friction[body] = mode;
+    }
+
+    int changes = 0;
+    for (int axis = 0; axis < 2; ++axis) {
+        if (modes_.gear_contact[axis] != previous.gear_contact[axis]) ++counters_.backlash[axis], ++changes;
+        if (modes_.motor_limited[axis] != previous.motor_limited[axis]) ++counters_.current_limit[axis], ++changes;
+    }
+    for (int body = 0; body < 4; ++body)
+        if (modes_.friction[body] != previous.friction[body]) ++counters_.stick_slip, ++changes;
+    counters_.total += changes;
+    if (changes > 0) counters_.last_event_time = time;
+    return changes;
+}
+
+}  // namespace gimbal
