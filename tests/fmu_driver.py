@@ -26,12 +26,32 @@ class LoadedFMU:
     unzipdir: str
     model_description: object
     vr: dict = field(default_factory=dict)
+    types: dict = field(default_factory=dict)
 
     @classmethod
     def load(cls, path: pathlib.Path) -> "LoadedFMU":
         md = read_model_description(str(path))
         unzipdir = extract(str(path), unzipdir=tempfile.mkdtemp(prefix="gimbal_fmu_"))
-        return cls(path, unzipdir, md, {v.name: v.valueReference for v in md.modelVariables})
+        return cls(path, unzipdir, md, {v.name: v.valueReference for v in md.modelVariables},
+                   {v.name: v.type for v in md.modelVariables})
+
+    def set_values(self, slave: FMU2Slave, values: dict) -> None:
+        """Sets Real, Integer and Boolean variables by name."""
+        by_type = {"Real": ({}, slave.setReal, float), "Integer": ({}, slave.setInteger, int),
+                   "Boolean": ({}, slave.setBoolean, bool)}
+        for name, value in values.items():
+            by_type[self.types[name]][0][self.vr[name]] = value
+        for selected, setter, cast in by_type.values():
+            if selected:
+                setter(list(selected), [cast(v) for v in selected.values()])
+
+    def get_values(self, slave: FMU2Slave, names: list) -> list:
+        """Reads Real and Integer variables by name, as floats, in the order given."""
+        reals = [n for n in names if self.types[n] == "Real"]
+        integers = [n for n in names if self.types[n] == "Integer"]
+        values = dict(zip(reals, slave.getReal([self.vr[n] for n in reals]) if reals else []))
+        values.update(zip(integers, slave.getInteger([self.vr[n] for n in integers]) if integers else []))
+        return [float(values[n]) for n in names]
 
     def cleanup(self) -> None:
         shutil.rmtree(self.unzipdir, ignore_errors=True)
@@ -68,31 +88,29 @@ def simulate(fmu: LoadedFMU, stop_time: float, step_size: float, start_values: d
              instance_name: str = "instance") -> dict:
     """Runs one simulation; returns {'time': array, name: array, ...} sampled at every communication point.
 
+    Start values and inputs may be Real, Integer or Boolean; outputs Real or Integer (returned as floats).
+
     `inputs(t, latest_outputs)` returns the input values to hold over the step starting at t.
     """
     outputs = list(outputs)
     slave = fmu.instantiate(instance_name)
     try:
         slave.setupExperiment(startTime=0.0)
-        start_values = start_values or {}
-        if start_values:
-            slave.setReal([fmu.vr[n] for n in start_values], [float(v) for v in start_values.values()])
+        fmu.set_values(slave, start_values or {})
         slave.enterInitializationMode()
         slave.exitInitializationMode()
-        out_vrs = [fmu.vr[n] for n in outputs]
         n_steps = int(round(stop_time / step_size))
         record = np.empty((n_steps + 1, len(outputs)))
-        record[0] = slave.getReal(out_vrs)
+        record[0] = fmu.get_values(slave, outputs)
         times = np.arange(n_steps + 1) * step_size
         latest = dict(zip(outputs, record[0]))
         for k in range(n_steps):
             t = k * step_size
             if inputs is not None:
                 values = inputs(t, latest)
-                if values:
-                    slave.setReal([fmu.vr[n] for n in values], [float(v) for v in values.values()])
+                fmu.set_values(slave, values or {})
             slave.doStep(currentCommunicationPoint=t, communicationStepSize=step_size)
-            record[k + 1] = slave.getReal(out_vrs)
+            record[k + 1] = fmu.get_values(slave, outputs)
             latest = dict(zip(outputs, record[k + 1]))
         slave.terminate()
     finally:

@@ -4,6 +4,10 @@
 #include "check.hpp"
 #include "gimbal/base_kinematics.hpp"
 #include "gimbal/drive_train.hpp"
+#include "gimbal/gimbal_hybrid_system.hpp"
+#include "gimbal/gimbal_model.hpp"
+
+#include <Eigen/Dense>
 
 using namespace gimbal;
 
@@ -25,6 +29,49 @@ int main() {
     // ...and (2.77) gives a positive torque on the load (it is dragged along), -T_E/N on the rotor.
     CHECK_NEAR(gear_shaft_torque(gear, deflection, 0.2, 0.0, 0.0), 1000.0 * 0.01 + 2.0 * 0.2, 1e-12);
     CHECK_NEAR(gear_shaft_torque(gear, 0.01, 0.0, 0.004, 0.0), 1000.0 * 0.006, 1e-12);
+
+    // (2.81): inside the gap theta_b relaxes towards theta_d; at a stop only motion back into the gap is allowed.
+    GearParameters backlash_gear{50.0, 1000.0, 2.0, 1e-3};
+    const double pulling_out = free_backlash_rate(backlash_gear, 2e-3, 0.0, 1e-3);  // theta_d beyond +eta
+    CHECK_NEAR(pulling_out, 1000.0 / 2.0 * 1e-3, 1e-12);
+    CHECK_NEAR(backlash_rate(backlash_gear, 2e-3, 0.0, 1e-3, +1), 0.0, 0.0);          // held at +eta
+    CHECK_NEAR(backlash_rate(backlash_gear, 2e-3, 0.0, 1e-3, 0), pulling_out, 0.0);   // free in the gap
+    CHECK(backlash_rate(backlash_gear, 0.0, -1.0, 1e-3, +1) < 0.0);                   // released back into the gap
+    CHECK_NEAR(backlash_rate(backlash_gear, -2e-3, 0.0, -1e-3, -1), 0.0, 0.0);        // held at -eta
+    CHECK(backlash_rate(backlash_gear, 0.0, 1.0, -1e-3, -1) > 0.0);
+    // At contact the shaft torque is c_s X, so its sign is the side's: (2.77) with dtheta_b = 0.
+    CHECK_NEAR(gear_shaft_torque(backlash_gear, 2e-3, 0.0, 1e-3, 0.0), 2.0 * pulling_out, 1e-12);
+    // Limiter (2.63): the steady current the free circuit heads for.
+    CHECK_NEAR(unlimited_steady_current(motor, 10.0, 50.0), (10.0 - 0.04 * 50.0) / 2.0, 1e-15);
+
+    // T_outros (2.106): with body 0 held and body 2 slipping, the other torque on body 0 is what the
+    // free bodies' accelerations leave unbalanced: F_0 - J_0F qdd_F, with J_FF qdd_F = F_F + T_slip_F.
+    {
+        Eigen::Matrix4d a = Eigen::Matrix4d::Random();
+        const Mat4 mass_matrix = a * a.transpose() + 4.0 * Mat4::Identity();
+        const Vec4 applied(0.3, -1.2, 0.8, 0.05);
+        ModelParameters params;
+        params.dry_friction[2] = DryFrictionParameters{0.2, 0.3, 0.01, 0.1};
+        Modes modes;
+        modes.friction[0] = FrictionMode::hold;
+        modes.friction[2] = FrictionMode::slip_positive;
+        const Vec4 other = other_torques(mass_matrix, applied, modes, params);
+        const int free_bodies[3] = {1, 2, 3};
+        Eigen::Matrix3d block;
+        Eigen::Vector3d rhs;
+        for (int r = 0; r < 3; ++r) {
+            rhs[r] = applied[free_bodies[r]] - (free_bodies[r] == 2 ? 0.2 : 0.0);
+            for (int c = 0; c < 3; ++c) block(r, c) = mass_matrix(free_bodies[r], free_bodies[c]);
+        }
+        const Eigen::Vector3d free_acceleration = block.ldlt().solve(rhs);
+        double expected = applied[0];
+        for (int c = 0; c < 3; ++c) expected -= mass_matrix(0, free_bodies[c]) * free_acceleration[c];
+        CHECK_NEAR(other[0], expected, 1e-12);
+    }
+    CHECK(friction_mode_indicator(FrictionMode::hold, 1e-4) == 0);
+    CHECK(friction_mode_indicator(FrictionMode::at_max_negative, 0.0) == 1);  // friction -T_max: driven +
+    CHECK(friction_mode_indicator(FrictionMode::slip_negative, -1.0) == -2);
+    CHECK(friction_mode_indicator(FrictionMode::none, -3.0) == -2);
 
     // Base kinematics: the time derivative of w0 matches a central difference of (2.13) along the arc.
     BaseMotion base;
