@@ -100,6 +100,7 @@ bool HybridCvodeIntegrator::restart(double time, const double* state) {
             flag = CVodeSStolerances(cvode_, settings_.relative_tolerance, settings_.absolute_tolerance);
         if (flag == CV_SUCCESS) flag = CVodeSetLinearSolver(cvode_, linear_solver_, jacobian_);
         if (flag == CV_SUCCESS) flag = CVodeSetMaxNumSteps(cvode_, 200000);
+        if (flag == CV_SUCCESS && settings_.max_step > 0.0) flag = CVodeSetMaxStep(cvode_, settings_.max_step);
         if (flag == CV_SUCCESS && !root_directions_.empty())
             flag = CVodeRootInit(cvode_, static_cast<int>(root_directions_.size()), event_functions);
         // A mode switch can leave an event function at zero: CVODE must not stop there again.
@@ -154,9 +155,13 @@ bool HybridCvodeIntegrator::advance(double end_time, double* state) {
               << " events without progress in time (chattering); modes held until t = " << dwell_until_;
             event_sink_(s.str());
         }
-        // The modes (and possibly the projected state) changed the right-hand side: restart there.
-        if (!restart(reached, state)) return false;
-        if (reached >= end_time) return true;
+        if (reached >= end_time) {
+            if (changes > 0 && !restart(reached, state)) return false;
+            return true;
+        }
+        // New modes change the right-hand side: restart there, from the (possibly projected) state. A
+        // root that changed no mode (a grazing touch) needs no restart: CVODE carries on.
+        if (changes > 0 && !restart(reached, state)) return false;
     }
 }
 

@@ -1,0 +1,158 @@
+// The hybrid integrator on small systems with known event times, independent of the gimbal.
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "check.hpp"
+#include "gimbal/integrator.hpp"
+
+using namespace gimbal;
+
+namespace {
+
+// A ball dropped from height h0 onto a floor, restitution e: bounce k happens at a known time, and
+// the bounces accumulate at t_inf = t1 (1 + e) / (1 - e) (Zeno).
+class BouncingBall final : public HybridSystem {
+public:
+    explicit BouncingBall(double restitution) : restitution_(restitution) {}
+    int state_size() const override { return 2; }
+    int event_count() const override { return 1; }
+    bool derivative(double, const double* x, double* dx) override {
+        dx[0] = x[1];
+        dx[1] = -9.81;
+        return true;
+    }
+    void event_functions(double, const double* x, double* g) override { g[0] = x[0]; }
+    int update_modes(double, double* x, const int* directions) override {
+        if (directions == nullptr || directions[0] >= 0 || x[1] >= 0.0) return 0;
+        x[0] = 0.0;
+        x[1] = -restitution_ * x[1];
+        ++bounces;
+        return 1;
+    }
+    int bounces = 0;
+
+private:
+    double restitution_;
+};
+
+// A switch that chatters: its event function oscillates with the given period, whatever the state.
+class Chatter final : public HybridSystem {
+public:
+    explicit Chatter(double period) : period_(period) {}
+    int state_size() const override { return 1; }
+    int event_count() const override { return 1; }
+    bool derivative(double, const double*, double* dx) override {
+        dx[0] = 1.0;
+        return true;
+    }
+    void event_functions(double time, const double*, double* g) override {
+        g[0] = std::sin(2.0 * M_PI * time / period_);
+    }
+    int update_modes(double, double*, const int* directions) override {
+        if (directions == nullptr) return 0;
+        ++switches;
+        return 1;
+    }
+    long switches = 0;
+
+private:
+    double period_;
+};
+
+// Two independent decays crossing thresholds at the same instant.
+class TwinDecay final : public HybridSystem {
+public:
+    int state_size() const override { return 2; }
+    int event_count() const override { return 2; }
+    bool derivative(double, const double* x, double* dx) override {
+        dx[0] = -x[0];
+        dx[1] = -x[1];
+        return true;
+    }
+    void event_functions(double, const double* x, double* g) override {
+        g[0] = x[0] - 0.5;
+        g[1] = x[1] - 0.5;
+    }
+    int update_modes(double time, double*, const int* directions) override {
+        if (directions == nullptr) return 0;
+        int changes = 0;
+        for (int k = 0; k < 2; ++k)
+            if (directions[k] != 0) ++changes, crossing_time[k] = time;
+        return changes;
+    }
+    double crossing_time[2] = {-1.0, -1.0};
+};
+
+}  // namespace
+
+int main() {
+    IntegratorSettings settings;
+    settings.relative_tolerance = 1e-10;
+    settings.absolute_tolerance = 1e-12;
+    auto quiet = [](const std::string&) {};
+    {
+        BouncingBall ball(0.5);
+        HybridCvodeIntegrator integrator(ball, settings, quiet, quiet);
+        double x[2] = {1.0, 0.0};
+        CHECK(integrator.restart(0.0, x));
+        const double first = std::sqrt(2.0 / 9.81);
+        // Before the first bounce, exactly at it (an event on a communication point), then after.
+        CHECK(integrator.advance(0.5 * first, x));
+        CHECK(ball.bounces == 0);
+        CHECK(integrator.advance(first, x));
+        CHECK(integrator.advance(first + 0.1, x));
+        CHECK(ball.bounces == 1);
+        // After the bounce the ball rises with half the impact speed.
+        CHECK_NEAR(x[1], 0.5 * 9.81 * first - 9.81 * 0.1, 1e-8);
+        // Located bounces are real: after bounce k the next comes (1 + e) v_k / g later; the k-th time is
+        // t1 (1 + 2 e (1 - e^(k-1)) / (1 - e)). Re-run and check the third bounce time.
+        BouncingBall again(0.5);
+        HybridCvodeIntegrator second(again, settings, quiet, quiet);
+        double y[2] = {1.0, 0.0};
+        CHECK(second.restart(0.0, y));
+        const double third = first * (1.0 + 2.0 * 0.5 * (1.0 - 0.25) / 0.5);
+        CHECK(second.advance(third - 1e-6, y));
+        CHECK(again.bounces == 2);
+        CHECK(second.advance(third + 1e-6, y));
+        CHECK(again.bounces == 3);
+    }
+    {
+        // Chatter at 2e10 switches per second: the guard holds the modes and time goes on.
+        Chatter fast(1e-10);
+        IntegratorSettings fine = settings;
+        fine.max_step = 2e-11;  // so that every sign change is seen
+        HybridCvodeIntegrator integrator(fast, fine, quiet, quiet);
+        double x[1] = {0.0};
+        CHECK(integrator.restart(1e-11, x));
+        CHECK(integrator.advance(2e-5, x));
+        CHECK_NEAR(x[0], 2e-5 - 1e-11, 1e-12);
+        const IntegratorStatistics stats = integrator.statistics();
+        CHECK(stats.zeno_holds >= 10);
+        CHECK(fast.switches < 20000);  // instead of 400000
+    }
+    {
+        // Switches 2 ns apart are real: every one of them is located.
+        Chatter slow(4e-9);
+        IntegratorSettings fine = settings;
+        fine.max_step = 1e-9;
+        HybridCvodeIntegrator integrator(slow, fine, quiet, quiet);
+        double x[1] = {0.0};
+        CHECK(integrator.restart(1e-10, x));
+        CHECK(integrator.advance(1e-6 + 1e-9, x));
+        CHECK(integrator.statistics().zeno_holds == 0);
+        CHECK(slow.switches == 500);
+    }
+    {
+        TwinDecay twins;
+        HybridCvodeIntegrator integrator(twins, settings, quiet, quiet);
+        double x[2] = {1.0, 1.0};
+        CHECK(integrator.restart(0.0, x));
+        CHECK(integrator.advance(1.0, x));
+        // Simultaneous events are reported together, both at ln 2.
+        CHECK(twins.crossing_time[0] == twins.crossing_time[1]);
+        CHECK_NEAR(twins.crossing_time[0], std::log(2.0), 1e-8);
+        CHECK(integrator.statistics().events == 2);
+    }
+    return check_report("hybrid_integrator");
+}
