@@ -14,7 +14,7 @@ def main(path: str) -> None:
             if v.causality != causality:
                 continue
             start = "" if v.start is None else v.start
-            unit = v.unit + (f" (shown in {v.displayUnit})" if v.displayUnit else "")
+            unit = (v.unit or v.type) + (f" (shown in {v.displayUnit})" if v.displayUnit else "")
             print(f"| `{v.name}` | {unit} | {start} | {v.description} |")
 
 
