@@ -1,6 +1,7 @@
 /* FMI 2.0 Co-Simulation wrapper: the state machine, argument checks and logging of the standard,
  * over the C interface of the dynamics core (model_core/include/gimbal/gimbal_c_api.h). */
 #include <math.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -394,36 +395,138 @@ static fmi2Status unsupported(fmi2Component c, const char* function, const char*
     return fmi2Error;
 }
 
+/* An FMU state: the wrapper's own fields, then the core's snapshot bytes. Serialized as is. */
+typedef struct {
+    uint32_t magic;
+    uint32_t size; /* of the whole record */
+    char guid[64];
+    int state;
+    double time;
+    double stop_time;
+    int stop_time_defined;
+    double last_successful_time;
+    int last_step_status;
+} StateHeader;
+
+#define STATE_MAGIC 0x46535441u /* "FSTA" */
+#define STATE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
+
+static size_t state_record_size(void) { return sizeof(StateHeader) + gimbal_core_snapshot_size(); }
+
+static int valid_state_record(Instance* instance, const char* function, const void* record, size_t size) {
+    const StateHeader* header = (const StateHeader*)record;
+    if (size != state_record_size() || header->magic != STATE_MAGIC || header->size != state_record_size() ||
+        strncmp(header->guid, GIMBAL_GUID, sizeof header->guid) != 0) {
+        log_message(instance, fmi2Error, "logStatusError",
+                    "%s: the FMU state was not saved by this FMU (GUID %s, %u bytes expected)", function, GIMBAL_GUID,
+                    (unsigned)state_record_size());
+        return 0;
+    }
+    return 1;
+}
+
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
-    (void)FMUstate;
-    return unsupported(c, "fmi2GetFMUstate", "canGetAndSetFMUstate");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetFMUstate", STATE_STATES)) return fmi2Error;
+    if (!not_null(instance, "fmi2GetFMUstate", FMUstate, "FMUstate")) return fmi2Error;
+    /* Reuse the host's previous state object when it hands one back, as the standard allows. */
+    unsigned char* record = (unsigned char*)*FMUstate;
+    if (record != NULL && !valid_state_record(instance, "fmi2GetFMUstate", record, state_record_size())) return fmi2Error;
+    if (record == NULL) record = (unsigned char*)calloc(1, state_record_size());
+    if (record == NULL) {
+        log_message(instance, fmi2Error, "logStatusError", "fmi2GetFMUstate: out of memory");
+        return fmi2Error;
+    }
+    StateHeader* header = (StateHeader*)record;
+    memset(header, 0, sizeof *header);
+    header->magic = STATE_MAGIC;
+    header->size = (uint32_t)state_record_size();
+    strncpy(header->guid, GIMBAL_GUID, sizeof header->guid - 1);
+    header->state = (int)instance->state;
+    header->time = instance->time;
+    header->stop_time = instance->stop_time;
+    header->stop_time_defined = instance->stop_time_defined;
+    header->last_successful_time = instance->last_successful_time;
+    header->last_step_status = (int)instance->last_step_status;
+    gimbal_core_save(instance->core, record + sizeof(StateHeader));
+    *FMUstate = record;
+    return fmi2OK;
 }
+
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
-    (void)FMUstate;
-    return unsupported(c, "fmi2SetFMUstate", "canGetAndSetFMUstate");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetFMUstate", STATE_STATES)) return fmi2Error;
+    if (!not_null(instance, "fmi2SetFMUstate", FMUstate, "FMUstate")) return fmi2Error;
+    if (!valid_state_record(instance, "fmi2SetFMUstate", FMUstate, state_record_size())) return fmi2Error;
+    const StateHeader* header = (const StateHeader*)FMUstate;
+    const fmi2Status status =
+        from_core(gimbal_core_restore(instance->core, (const unsigned char*)FMUstate + sizeof(StateHeader)));
+    if (status > fmi2Warning) {
+        instance->state = STATE_ERROR;
+        return status;
+    }
+    instance->state = (InstanceState)header->state;
+    instance->time = header->time;
+    instance->stop_time = header->stop_time;
+    instance->stop_time_defined = header->stop_time_defined;
+    instance->last_successful_time = header->last_successful_time;
+    instance->last_step_status = (fmi2Status)header->last_step_status;
+    return fmi2OK;
 }
+
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
-    (void)FMUstate;
-    return unsupported(c, "fmi2FreeFMUstate", "canGetAndSetFMUstate");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2FreeFMUstate", ANY_STATE)) return fmi2Error;
+    if (FMUstate == NULL) return fmi2OK;
+    free(*FMUstate);
+    *FMUstate = NULL;
+    return fmi2OK;
 }
+
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size) {
-    (void)FMUstate;
-    (void)size;
-    return unsupported(c, "fmi2SerializedFMUstateSize", "canSerializeFMUstate");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SerializedFMUstateSize", ANY_STATE)) return fmi2Error;
+    if (!not_null(instance, "fmi2SerializedFMUstateSize", FMUstate, "FMUstate") ||
+        !not_null(instance, "fmi2SerializedFMUstateSize", size, "size"))
+        return fmi2Error;
+    *size = state_record_size();
+    return fmi2OK;
 }
+
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
-    (void)FMUstate;
-    (void)serializedState;
-    (void)size;
-    return unsupported(c, "fmi2SerializeFMUstate", "canSerializeFMUstate");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SerializeFMUstate", ANY_STATE)) return fmi2Error;
+    if (!not_null(instance, "fmi2SerializeFMUstate", FMUstate, "FMUstate") ||
+        !not_null(instance, "fmi2SerializeFMUstate", serializedState, "serializedState"))
+        return fmi2Error;
+    if (!valid_state_record(instance, "fmi2SerializeFMUstate", FMUstate, state_record_size())) return fmi2Error;
+    if (size < state_record_size()) {
+        log_message(instance, fmi2Error, "logStatusError", "fmi2SerializeFMUstate: size %u is below the %u bytes needed",
+                    (unsigned)size, (unsigned)state_record_size());
+        return fmi2Error;
+    }
+    memcpy(serializedState, FMUstate, state_record_size());
+    return fmi2OK;
 }
+
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate* FMUstate) {
-    (void)serializedState;
-    (void)size;
-    (void)FMUstate;
-    return unsupported(c, "fmi2DeSerializeFMUstate", "canSerializeFMUstate");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2DeSerializeFMUstate", ANY_STATE)) return fmi2Error;
+    if (!not_null(instance, "fmi2DeSerializeFMUstate", serializedState, "serializedState") ||
+        !not_null(instance, "fmi2DeSerializeFMUstate", FMUstate, "FMUstate"))
+        return fmi2Error;
+    if (!valid_state_record(instance, "fmi2DeSerializeFMUstate", serializedState, size)) return fmi2Error;
+    void* record = malloc(size);
+    if (record == NULL) {
+        log_message(instance, fmi2Error, "logStatusError", "fmi2DeSerializeFMUstate: out of memory");
+        return fmi2Error;
+    }
+    memcpy(record, serializedState, size);
+    *FMUstate = record;
+    return fmi2OK;
 }
+
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[]) {

@@ -8,6 +8,7 @@ build_dir="${GIMBAL_BUILD_DIR:-$repo/build}"
 need_apt=()
 dpkg -s libsundials-dev >/dev/null 2>&1 || need_apt+=(libsundials-dev)
 dpkg -s libeigen3-dev >/dev/null 2>&1 || need_apt+=(libeigen3-dev)
+dpkg -s libtbb12 >/dev/null 2>&1 || need_apt+=(libtbb12)
 command -v ninja >/dev/null 2>&1 || need_apt+=(ninja-build)
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "[setup] installing Debian packages: ${need_apt[*]}"
@@ -22,10 +23,12 @@ if [ ! -x "$venv/bin/python" ]; then
   echo "[setup] creating the Python virtual environment in .venv"
   python3 -m venv "$venv"
 fi
-if ! "$venv/bin/python" -c "import fmpy, numpy, scipy, sympy, matplotlib, pytest" >/dev/null 2>&1 ||
+if ! "$venv/bin/python" -c "import fmpy, numpy, scipy, sympy, matplotlib, pytest, libcosimpy, ecospy" >/dev/null 2>&1 ||
    [ "$repo/requirements.txt" -nt "$venv/.requirements-installed" ]; then
   echo "[setup] installing Python packages (requirements.txt)"
   "$venv/bin/pip" install -q --disable-pip-version-check -r "$repo/requirements.txt"
+  # ecospy's wheel ships its proxyfmu server without the executable bit.
+  chmod +x "$venv"/lib/python3*/site-packages/ecospy/binaries/proxyfmu "$venv"/lib/python3*/site-packages/ecospy/binaries/ecos 2>/dev/null || true
   touch "$venv/.requirements-installed"
 fi
 

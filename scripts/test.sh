@@ -1,9 +1,28 @@
 #!/usr/bin/env bash
-# Install what is missing, build, and run every test (C++ through CTest, then Python through pytest).
+# Install what is missing, build, and run every test: C++ through CTest, Python through pytest,
+# then the same again on an AddressSanitizer + UndefinedBehaviorSanitizer build
+# (set GIMBAL_SKIP_SANITIZERS=1 to skip that second pass on a quick local run).
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${GIMBAL_BUILD_DIR:-$repo/build}"
 bash "$repo/scripts/setup.sh"
-ctest --test-dir "$build_dir" --output-on-failure
 cd "$repo"
+
+if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
+  asan_dir="${build_dir}-asan"
+  echo "[test] sanitizer build in $asan_dir"
+  cmake -S "$repo" -B "$asan_dir" -G Ninja -DGIMBAL_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        -DPython3_EXECUTABLE="$repo/.venv/bin/python" >/dev/null
+  cmake --build "$asan_dir"
+  # Python itself leaks by design: leak checking would only report the interpreter.
+  export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  ctest --test-dir "$asan_dir" --output-on-failure
+  LD_PRELOAD="$(gcc -print-file-name=libasan.so)" GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
+    "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider
+  unset ASAN_OPTIONS UBSAN_OPTIONS
+  echo "[test] sanitizer pass clean; now the release build"
+fi
+
+ctest --test-dir "$build_dir" --output-on-failure
 GIMBAL_BUILD_DIR="$build_dir" "$repo/.venv/bin/python" -m pytest tests "$@"

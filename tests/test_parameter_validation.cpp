@@ -13,7 +13,9 @@ namespace {
 struct Values {
     double v[kRealVariableCount];
     bool flags[kBooleanVariableCount];
+    int integers[kIntegerVariableCount];
     Values() {
+        for (unsigned i = 0; i < kIntegerVariableCount; ++i) integers[i] = static_cast<int>(kIntegerVariables[i].start);
         for (unsigned i = 0; i < kRealVariableCount; ++i) v[i] = kRealVariables[i].start;
         for (unsigned i = 0; i < kBooleanVariableCount; ++i) flags[i] = kBooleanVariables[i].start != 0.0;
     }
@@ -25,7 +27,7 @@ std::string refusal(RealVariable vr, double value) {
     values.v[vr] = value;
     ModelParameters params;
     std::string error;
-    if (build_model_parameters(values.v, values.flags, params, error) && validate_start_state(values.v, params, error)) return "";
+    if (build_model_parameters(values.v, values.integers, values.flags, params, error) && validate_start_state(values.v, params, error)) return "";
     return error;
 }
 
@@ -38,7 +40,7 @@ int main() {
         Values values;
         ModelParameters params;
         std::string error;
-        CHECK(build_model_parameters(values.v, values.flags, params, error));
+        CHECK(build_model_parameters(values.v, values.integers, values.flags, params, error));
         CHECK(error.empty());
         CHECK_NEAR(params.multibody.bodies[kElevationBody].inertia(0, 1), kRealVariables[vr_body2_I_xy].start, 0.0);
         CHECK_NEAR(params.gear[1].ratio, kRealVariables[vr_gear2_N].start, 0.0);

@@ -45,7 +45,7 @@ GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value) {
     return core->instance.set_real(vr, value);
 }
 
-GimbalStatus gimbal_core_get_real(const GimbalCore* core, unsigned vr, double* value) {
+GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value) {
     return core->instance.get_real(vr, *value);
 }
 
@@ -53,7 +53,7 @@ GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value) {
     return core->instance.set_integer(vr, value);
 }
 
-GimbalStatus gimbal_core_get_integer(const GimbalCore* core, unsigned vr, int* value) {
+GimbalStatus gimbal_core_get_integer(GimbalCore* core, unsigned vr, int* value) {
     return core->instance.get_integer(vr, *value);
 }
 
@@ -61,7 +61,7 @@ GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value) {
     return core->instance.set_boolean(vr, value != 0);
 }
 
-GimbalStatus gimbal_core_get_boolean(const GimbalCore* core, unsigned vr, int* value) {
+GimbalStatus gimbal_core_get_boolean(GimbalCore* core, unsigned vr, int* value) {
     bool flag = false;
     const GimbalStatus status = core->instance.get_boolean(vr, flag);
     *value = flag ? 1 : 0;
@@ -85,5 +85,20 @@ GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double s
 }
 
 double gimbal_core_time(const GimbalCore* core) { return core->instance.time(); }
+
+size_t gimbal_core_snapshot_size(void) { return gimbal::GimbalInstance::snapshot_size(); }
+
+GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer) {
+    core->instance.save(buffer);
+    return GIMBAL_OK;
+}
+
+GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer) {
+    try {
+        return core->instance.restore(buffer);
+    } catch (const std::bad_alloc&) {
+        return GIMBAL_ERROR;
+    }
+}
 
 }  // extern "C"

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
+#include <type_traits>
 
 #include "gimbal/parameter_validation.hpp"
 
@@ -16,6 +19,27 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 
 Vec3 vector_at(const double* values, unsigned first) { return Vec3(values[first], values[first + 1], values[first + 2]); }
 
+constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
+constexpr std::uint32_t kSnapshotVersion = 1;
+
+struct Snapshot {
+    std::uint32_t magic;
+    std::uint32_t version;
+    double reals[kRealVariableCount];
+    int integers[kIntegerVariableCount];
+    bool booleans[kBooleanVariableCount];
+    bool initialized;
+    double time;
+    double state[kMaxStateSize];
+    Modes modes;
+    EventCounters counters;
+    IntegratorStatistics statistics;
+    double voltage[2];
+    double base[15];  // attitude, rate, accel, v_a, a_a at the arc start
+    double arc_start_time;
+};
+static_assert(std::is_trivially_copyable<Snapshot>::value, "snapshots are copied as bytes");
+
 }  // namespace
 
 GimbalInstance::GimbalInstance(Logger logger) : logger_(std::move(logger)) { reset(); }
@@ -27,6 +51,7 @@ void GimbalInstance::reset() {
     integrator_.reset();
     system_.reset();
     integrator_running_ = false;
+    preview_current_ = false;
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
 }
@@ -46,12 +71,17 @@ GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
         return refuse(GIMBAL_ERROR, s.str());
     }
     reals_[vr] = value;
+    preview_current_ = false;
     return GIMBAL_OK;
 }
 
-GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) const {
+GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
     if (vr >= kRealVariableCount) {
         return refuse(GIMBAL_ERROR, "fmi2GetReal: value reference " + std::to_string(vr) + " is not a Real variable");
+    }
+    if (!system_ && kRealVariables[vr].initial == Initial::calculated) {
+        const GimbalStatus status = preview_outputs("fmi2GetReal", kRealVariables[vr].name);
+        if (status != GIMBAL_OK) return status;
     }
     value = reals_[vr];
     return GIMBAL_OK;
@@ -62,12 +92,17 @@ GimbalStatus GimbalInstance::set_integer(unsigned vr, int value) {
         return refuse(GIMBAL_ERROR, "fmi2SetInteger: value reference " + std::to_string(vr) + " is not an Integer variable");
     }
     integers_[vr] = value;
+    preview_current_ = false;
     return GIMBAL_OK;
 }
 
-GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) const {
+GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) {
     if (vr >= kIntegerVariableCount) {
         return refuse(GIMBAL_ERROR, "fmi2GetInteger: value reference " + std::to_string(vr) + " is not an Integer variable");
+    }
+    if (!system_ && kIntegerVariables[vr].initial == Initial::calculated) {
+        const GimbalStatus status = preview_outputs("fmi2GetInteger", kIntegerVariables[vr].name);
+        if (status != GIMBAL_OK) return status;
     }
     value = integers_[vr];
     return GIMBAL_OK;
@@ -78,6 +113,7 @@ GimbalStatus GimbalInstance::set_boolean(unsigned vr, bool value) {
         return refuse(GIMBAL_ERROR, "fmi2SetBoolean: value reference " + std::to_string(vr) + " is not a Boolean variable");
     }
     booleans_[vr] = value;
+    preview_current_ = false;
     return GIMBAL_OK;
 }
 
@@ -142,12 +178,51 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_solver_jacobian_evaluations] = static_cast<int>(std::min<long>(stats.jacobian_evaluations, 2147483647L));
 }
 
+bool GimbalInstance::build_parameters(ModelParameters& params, std::string& error) const {
+    return build_model_parameters(reals_, integers_, booleans_, params, error) &&
+           validate_start_state(reals_, params, error);
+}
+
+void GimbalInstance::create_integrator() {
+    IntegratorSettings settings;
+    settings.relative_tolerance = params_.relative_tolerance;
+    settings.absolute_tolerance = params_.absolute_tolerance;
+    settings.max_steps = params_.max_steps;
+    integrator_ = std::make_unique<HybridCvodeIntegrator>(
+        *system_, settings,
+        [this](const std::string& message) {
+            last_integrator_error_ = message;
+            logger_(GIMBAL_WARNING, "logSolver", message);
+        },
+        [this](const std::string& message) { logger_(GIMBAL_OK, "logEvents", message); });
+    integrator_running_ = false;
+}
+
+GimbalStatus GimbalInstance::preview_outputs(const char* function, const char* name) {
+    if (preview_current_) return GIMBAL_OK;
+    std::string error;
+    if (!build_parameters(params_, error)) {
+        return refuse(GIMBAL_ERROR, std::string(function) + ": " + name +
+                                        " cannot be computed from the current values: " + error);
+    }
+    std::fill(state_, state_ + kMaxStateSize, 0.0);
+    for (int k = 0; k < kStateSize; ++k) state_[k] = reals_[vr_alpha + k];
+    system_ = std::make_unique<GimbalHybridSystem>(params_);
+    system_->set_inputs(read_step_inputs(time_));
+    system_->update_modes(time_, state_, nullptr);
+    create_integrator();
+    publish_outputs();
+    // The preview must not count as initialization: forget the integrator again.
+    integrator_.reset();
+    system_.reset();
+    preview_current_ = true;
+    return GIMBAL_OK;
+}
+
 GimbalStatus GimbalInstance::initialize(double start_time) {
     std::string error;
     ModelParameters params;
-    if (!build_model_parameters(reals_, booleans_, params, error) || !validate_start_state(reals_, params, error)) {
-        return refuse(GIMBAL_ERROR, error);
-    }
+    if (!build_parameters(params, error)) return refuse(GIMBAL_ERROR, error);
     params_ = params;
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     for (int k = 0; k < kStateSize; ++k) state_[k] = reals_[vr_alpha + k];
@@ -158,14 +233,72 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     EventCounters none;
     none.last_event_time = time_;
     system_->restore(system_->modes(), none);  // the initial choice of modes is not an event
-    IntegratorSettings settings;
-    settings.relative_tolerance = params_.relative_tolerance;
-    settings.absolute_tolerance = params_.absolute_tolerance;
-    integrator_ = std::make_unique<HybridCvodeIntegrator>(
-        *system_, settings, [this](const std::string& message) { logger_(GIMBAL_WARNING, "logSolver", message); },
-        [this](const std::string& message) { logger_(GIMBAL_OK, "logEvents", message); });
-    integrator_running_ = false;
+    create_integrator();
     publish_outputs();
+    return GIMBAL_OK;
+}
+
+std::size_t GimbalInstance::snapshot_size() { return sizeof(Snapshot); }
+
+void GimbalInstance::save(void* buffer) {
+    Snapshot snap;
+    std::memset(static_cast<void*>(&snap), 0, sizeof snap);  // no stray padding bytes in a serialized state
+    snap.magic = kSnapshotMagic;
+    snap.version = kSnapshotVersion;
+    std::copy(reals_, reals_ + kRealVariableCount, snap.reals);
+    std::copy(integers_, integers_ + kIntegerVariableCount, snap.integers);
+    std::copy(booleans_, booleans_ + kBooleanVariableCount, snap.booleans);
+    snap.initialized = integrator_ != nullptr;
+    snap.time = time_;
+    std::copy(state_, state_ + kMaxStateSize, snap.state);
+    if (snap.initialized) {
+        snap.modes = system_->modes();
+        snap.counters = system_->counters();
+        snap.statistics = integrator_->statistics();
+        const StepInputs& in = system_->inputs();
+        snap.voltage[0] = in.voltage[0];
+        snap.voltage[1] = in.voltage[1];
+        const Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel,
+                                &in.base.velocity_a, &in.base.acceleration_a};
+        for (int p = 0; p < 5; ++p)
+            for (int k = 0; k < 3; ++k) snap.base[3 * p + k] = (*parts[p])[k];
+        snap.arc_start_time = in.step_start_time;
+        integrator_running_ = false;  // replayable from here: see the header
+    }
+    std::memcpy(buffer, &snap, sizeof snap);
+}
+
+GimbalStatus GimbalInstance::restore(const void* buffer) {
+    Snapshot snap;
+    std::memcpy(&snap, buffer, sizeof snap);
+    if (snap.magic != kSnapshotMagic || snap.version != kSnapshotVersion) {
+        return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: the state was not saved by this version of Gimbal2Axis");
+    }
+    std::copy(snap.reals, snap.reals + kRealVariableCount, reals_);
+    std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers_);
+    std::copy(snap.booleans, snap.booleans + kBooleanVariableCount, booleans_);
+    preview_current_ = false;
+    integrator_.reset();
+    system_.reset();
+    time_ = snap.time;
+    std::copy(snap.state, snap.state + kMaxStateSize, state_);
+    if (!snap.initialized) return GIMBAL_OK;
+
+    std::string error;
+    if (!build_parameters(params_, error)) return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
+    system_ = std::make_unique<GimbalHybridSystem>(params_);
+    StepInputs in;
+    in.voltage[0] = snap.voltage[0];
+    in.voltage[1] = snap.voltage[1];
+    Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel, &in.base.velocity_a,
+                      &in.base.acceleration_a};
+    for (int p = 0; p < 5; ++p)
+        for (int k = 0; k < 3; ++k) (*parts[p])[k] = snap.base[3 * p + k];
+    in.step_start_time = snap.arc_start_time;
+    system_->set_inputs(in);
+    system_->restore(snap.modes, snap.counters);
+    create_integrator();
+    integrator_->set_statistics(snap.statistics);
     return GIMBAL_OK;
 }
 
@@ -193,14 +326,15 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
             return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not be restarted");
         }
     }
+    last_integrator_error_.clear();
     if (!integrator_->advance(current_time + step_size, state_)) {
         std::copy(step_start_state, step_start_state + kMaxStateSize, state_);
         system_->restore(step_start_modes, step_start_counters);
         integrator_running_ = false;
         std::ostringstream s;
         s.precision(17);
-        s << "fmi2DoStep: integration from t = " << current_time << " over h = " << step_size
-          << " failed; state rolled back to t = " << current_time;
+        s << "fmi2DoStep: integration from t = " << current_time << " over h = " << step_size << " failed ("
+          << last_integrator_error_ << "); state rolled back to t = " << current_time;
         return refuse(GIMBAL_DISCARD, s.str());
     }
     integrator_running_ = true;

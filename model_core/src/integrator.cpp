@@ -99,7 +99,7 @@ bool HybridCvodeIntegrator::restart(double time, const double* state) {
         if (flag == CV_SUCCESS)
             flag = CVodeSStolerances(cvode_, settings_.relative_tolerance, settings_.absolute_tolerance);
         if (flag == CV_SUCCESS) flag = CVodeSetLinearSolver(cvode_, linear_solver_, jacobian_);
-        if (flag == CV_SUCCESS) flag = CVodeSetMaxNumSteps(cvode_, 200000);
+        if (flag == CV_SUCCESS) flag = CVodeSetMaxNumSteps(cvode_, settings_.max_steps);
         if (flag == CV_SUCCESS && settings_.max_step > 0.0) flag = CVodeSetMaxStep(cvode_, settings_.max_step);
         if (flag == CV_SUCCESS && !root_directions_.empty())
             flag = CVodeRootInit(cvode_, static_cast<int>(root_directions_.size()), event_functions);

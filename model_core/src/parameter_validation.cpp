@@ -69,8 +69,8 @@ bool build_inertia(Checker& check, const BodyVariables& body, Mat3& inertia) {
 
 }  // namespace
 
-bool build_model_parameters(const double (&values)[kRealVariableCount], const bool (&flags)[kBooleanVariableCount],
-                            ModelParameters& params, std::string& error) {
+bool build_model_parameters(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
+                            const bool (&flags)[kBooleanVariableCount], ModelParameters& params, std::string& error) {
     Checker check{values, error};
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
         if (kRealVariables[vr].causality == Causality::parameter &&
@@ -128,6 +128,11 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const bo
                        "it must lie in (0, 1)") ||
         !check.positive(vr_solver_atol))
         return false;
+    if (integers[vi_solver_max_steps] <= 0) {
+        error = "solver.max_steps = " + std::to_string(integers[vi_solver_max_steps]) + " is invalid: it must be > 0";
+        return false;
+    }
+    params.max_steps = integers[vi_solver_max_steps];
     params.relative_tolerance = values[vr_solver_rtol];
     params.absolute_tolerance = values[vr_solver_atol];
     return true;

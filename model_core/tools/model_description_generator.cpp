@@ -131,7 +131,8 @@ int main(int argc, char** argv) {
             }
             variables << "/>\n    </ScalarVariable>\n";
             if (v.causality == gimbal::Causality::output) {
-                outputs << "      <Unknown index=\"" << index << "\"/>\n";
+                // Outputs are computed in fmi2DoStep: setting an input changes none before the next step.
+                outputs << "      <Unknown index=\"" << index << "\" dependencies=\"\"/>\n";
                 if (v.initial == gimbal::Initial::calculated)
                     initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
             }

@@ -3,6 +3,8 @@
 #ifndef GIMBAL_C_API_H
 #define GIMBAL_C_API_H
 
+#include <stddef.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -35,11 +37,11 @@ void gimbal_core_destroy(GimbalCore* core);
 void gimbal_core_reset(GimbalCore* core);
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value);
-GimbalStatus gimbal_core_get_real(const GimbalCore* core, unsigned vr, double* value);
+GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value);
 GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value);
-GimbalStatus gimbal_core_get_integer(const GimbalCore* core, unsigned vr, int* value);
+GimbalStatus gimbal_core_get_integer(GimbalCore* core, unsigned vr, int* value);
 GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value);
-GimbalStatus gimbal_core_get_boolean(const GimbalCore* core, unsigned vr, int* value);
+GimbalStatus gimbal_core_get_boolean(GimbalCore* core, unsigned vr, int* value);
 
 /* Validates parameters and start values, and sets up the integrator at start_time. */
 GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time);
@@ -47,6 +49,12 @@ GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time);
  * state is rolled back to current_time and GIMBAL_DISCARD or GIMBAL_ERROR is returned. */
 GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double step_size);
 double gimbal_core_time(const GimbalCore* core);
+
+/* Snapshots for fmi2GetFMUstate / fmi2SetFMUstate and their serialization: plain bytes of a fixed size. */
+size_t gimbal_core_snapshot_size(void);
+/* Saving ends the current integration segment, so that restoring it later replays bit for bit. */
+GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer);
+GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
 
 #ifdef __cplusplus
 }

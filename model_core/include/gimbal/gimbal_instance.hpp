@@ -24,17 +24,28 @@ public:
 
     void reset();
     GimbalStatus set_real(unsigned vr, double value);
-    GimbalStatus get_real(unsigned vr, double& value) const;
+    GimbalStatus get_real(unsigned vr, double& value);
     GimbalStatus set_integer(unsigned vr, int value);
-    GimbalStatus get_integer(unsigned vr, int& value) const;
+    GimbalStatus get_integer(unsigned vr, int& value);
     GimbalStatus set_boolean(unsigned vr, bool value);
     GimbalStatus get_boolean(unsigned vr, bool& value) const;
     GimbalStatus initialize(double start_time);
+
+    // Everything a rollback needs, as plain bytes (fmi2GetFMUstate / serialization). Saving ends the
+    // current integration segment: the next step restarts the integrator, so that a rollback to this
+    // point replays bit for bit.
+    static std::size_t snapshot_size();
+    void save(void* buffer);
+    GimbalStatus restore(const void* buffer);
     GimbalStatus do_step(double current_time, double step_size);
     double time() const { return time_; }
 
 private:
     StepInputs read_step_inputs(double step_start) const;
+    bool build_parameters(ModelParameters& params, std::string& error) const;
+    void create_integrator();
+    // Before initialization ends, calculated outputs follow from the start values on request.
+    GimbalStatus preview_outputs(const char* function, const char* name);
     void publish_outputs();
     GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
 
@@ -47,6 +58,8 @@ private:
     std::unique_ptr<GimbalHybridSystem> system_;
     std::unique_ptr<HybridCvodeIntegrator> integrator_;
     bool integrator_running_ = false;  // false: the next step must restart the integrator
+    bool preview_current_ = false;
+    std::string last_integrator_error_;     // the calculated outputs reflect the current start values
     double time_ = 0.0;
 };
 

@@ -33,6 +33,7 @@ struct ModelParameters {
     bool energy_accounting = false;
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;
+    long max_steps = 100000;  // per communication step
 
     int state_size() const { return energy_accounting ? kMaxStateSize : kStateSize; }
 };

@@ -26,6 +26,7 @@ struct IntegratorStatistics {
 struct IntegratorSettings {
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;
+    long max_steps = 100000;  // internal steps per call of advance
     double max_step = 0.0;  // 0: unlimited. Root finding sees only sign changes between steps.
     // Chattering guard: this many located roots in a row, each within `zeno_window` of the previous
     // one (relative to max(1, |t|)), freeze the event functions for `zeno_dwell` (same scale); modes
@@ -54,6 +55,8 @@ public:
     bool advance(double end_time, double* state);
 
     IntegratorStatistics statistics() const;
+    // For restoring a saved instance: counts continue from these.
+    void set_statistics(const IntegratorStatistics& totals) { totals_ = totals; }
 
 private:
     static int right_hand_side(sunrealtype time, N_Vector y, N_Vector ydot, void* user_data);

@@ -9,8 +9,8 @@
 namespace gimbal {
 
 // On failure returns false and a message naming the variable(s) and the rule broken.
-bool build_model_parameters(const double (&values)[kRealVariableCount], const bool (&flags)[kBooleanVariableCount],
-                            ModelParameters& params, std::string& error);
+bool build_model_parameters(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
+                            const bool (&flags)[kBooleanVariableCount], ModelParameters& params, std::string& error);
 
 // Start values of the state must be consistent with the parameters (MODEL.md section 4).
 bool validate_start_state(const double (&values)[kRealVariableCount], const ModelParameters& params, std::string& error);
