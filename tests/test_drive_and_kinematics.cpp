@@ -55,7 +55,7 @@ int main() {
         Modes modes;
         modes.friction[0] = FrictionMode::hold;
         modes.friction[2] = FrictionMode::slip_positive;
-        const Vec4 other = other_torques(mass_matrix, applied, modes, params);
+        const Vec4 other = other_torques(mass_matrix, applied, modes, params.dry_friction);
         const int free_bodies[3] = {1, 2, 3};
         Eigen::Matrix3d block;
         Eigen::Vector3d rhs;

@@ -55,13 +55,13 @@ void GimbalHybridSystem::event_functions(double time, const double* state, doubl
         const GearParameters& gear = params_.gear[axis];
         double* g = values + gear_slot(axis);
         const double eta = gear.half_backlash;
-        if (eta == 0.0) continue;
+        if (params_.fidelity.gear[axis] != GearModel::backlash || eta == 0.0) continue;
         if (dead_zone_gear(gear)) {
             g[0] = d.deflection[axis] - eta;
             g[1] = d.deflection[axis] + eta;
         } else if (modes_.gear_contact[axis] == 0) {
-            g[0] = state[kBacklash + axis] - eta;
-            g[1] = state[kBacklash + axis] + eta;
+            g[0] = d.full.backlash[axis] - eta;
+            g[1] = d.full.backlash[axis] + eta;
         } else {
             g[0] = d.free_backlash_rate[axis];
         }
@@ -70,18 +70,21 @@ void GimbalHybridSystem::event_functions(double time, const double* state, doubl
         const double limit = params_.motor[axis].current_limit;
         double* g = values + motor_slot(axis);
         const int limited = modes_.motor_limited[axis];
+        // A quasi-static motor's current is the steady current itself: the same functions apply.
+        const double free_current =
+            params_.layout.current_slot[axis] >= 0 ? d.full.current[axis] : d.steady_current[axis];
         if (limited == 0) {
-            g[0] = state[kCurrents + axis] - limit;
-            g[1] = state[kCurrents + axis] + limit;
+            g[0] = free_current - limit;
+            g[1] = free_current + limit;
         } else {
             g[0] = d.steady_current[axis] - limited * limit;
         }
     }
     for (int body = 0; body < 4; ++body) {
-        const DryFrictionParameters& friction = params_.dry_friction[body];
+        const DryFrictionParameters& friction = params_.coordinate_friction[body];
         if (!friction.present()) continue;
         double* g = values + friction_slot(body);
-        const double rate = state[kRates + body];
+        const double rate = d.full.rate[body];
         g[0] = rate - friction.stick_speed;
         g[1] = rate + friction.stick_speed;
         if (low_speed(modes_.friction[body])) {
@@ -106,8 +109,13 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
         const double eta = gear.half_backlash;
         const int slot = gear_slot(axis);
         const int current = previous.gear_contact[axis];
-        double& backlash = state[kBacklash + axis];
+        const int backlash_slot = params_.layout.backlash_slot[axis];
         int contact = 0;
+        if (backlash_slot < 0) {
+            modes_.gear_contact[axis] = 0;
+            continue;
+        }
+        double& backlash = state[backlash_slot];
         if (eta == 0.0) {
             backlash = 0.0;
         } else if (dead_zone_gear(gear)) {
@@ -131,26 +139,28 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
         const double limit = params_.motor[axis].current_limit;
         const int slot = motor_slot(axis);
         const int current = previous.motor_limited[axis];
-        double& armature_current = state[kCurrents + axis];
-        const bool at_plus = current == 1 || (current == 0 && side(armature_current - limit, directions, slot) >= 0);
-        const bool at_minus = current == -1 || (current == 0 && side(armature_current + limit, directions, slot + 1) <= 0);
+        const int current_slot = params_.layout.current_slot[axis];
+        const double free_current = current_slot >= 0 ? state[current_slot] : d.steady_current[axis];
+        const bool at_plus = current == 1 || (current == 0 && side(free_current - limit, directions, slot) >= 0);
+        const bool at_minus = current == -1 || (current == 0 && side(free_current + limit, directions, slot + 1) <= 0);
         int push = 0;
         if (at_plus) push = side(d.steady_current[axis] - limit, directions, current == 1 ? slot : -1);
         if (at_minus && !at_plus) push = side(d.steady_current[axis] + limit, directions, current == -1 ? slot : -1);
         const int limited = select_contact(at_plus, at_minus, push, current);
         modes_.motor_limited[axis] = limited;
-        armature_current = limited != 0 ? limited * limit : std::clamp(armature_current, -limit, limit);
+        if (current_slot >= 0)
+            state[current_slot] = limited != 0 ? limited * limit : std::clamp(state[current_slot], -limit, limit);
     }
 
     // Low-speed set first: the other torques depend on which bodies are held, not on how.
     for (int body = 0; body < 4; ++body) {
-        const DryFrictionParameters& friction = params_.dry_friction[body];
+        const DryFrictionParameters& friction = params_.coordinate_friction[body];
         if (!friction.present()) {
             modes_.friction[body] = FrictionMode::none;
             continue;
         }
         const int slot = friction_slot(body);
-        const double rate = state[kRates + body];
+        const double rate = d.full.rate[body];
         const int above = side(rate - friction.stick_speed, directions, slot);
         const int below = side(rate + friction.stick_speed, directions, slot + 1);
         if (above >= 0) modes_.friction[body] = FrictionMode::slip_positive;
@@ -161,11 +171,11 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
     evaluate_dynamics(params_, inputs_, base, state, modes_, d);
     for (int body = 0; body < 4; ++body) {
         if (!low_speed(modes_.friction[body])) continue;
-        const DryFrictionParameters& friction = params_.dry_friction[body];
+        const DryFrictionParameters& friction = params_.coordinate_friction[body];
         // Event slots 2..5 carried these functions only if the body was already at low speed.
         const int slot = low_speed(previous.friction[body]) ? friction_slot(body) : -1000;
         const double other = d.other_torque[body];
-        const double hold = -other - friction.numerical_damping() * state[kRates + body];
+        const double hold = -other - friction.numerical_damping() * d.full.rate[body];
         const double limit = friction.breakaway_torque;
         FrictionMode mode = FrictionMode::hold;
         // (2.99): break away when |T_outros| >= T_max (a tie breaks away); (2.102): clip the hold torque.

@@ -139,9 +139,16 @@ StepInputs GimbalInstance::read_step_inputs(double step_start) const {
 }
 
 void GimbalInstance::publish_outputs() {
-    for (int k = 0; k < kStateSize; ++k) reals_[vr_alpha + k] = state_[k];
     const Modes& modes = system_->modes();
     const ModelOutputs out = evaluate_outputs(params_, system_->inputs(), modes, time_, state_);
+    for (int k = 0; k < 4; ++k) {
+        reals_[vr_alpha + k] = out.full.angle[k];
+        reals_[vr_alpha_dot + k] = out.full.rate[k];
+    }
+    reals_[vr_i_R1] = out.full.current[0];
+    reals_[vr_i_R2] = out.full.current[1];
+    reals_[vr_theta_b1] = out.full.backlash[0];
+    reals_[vr_theta_b2] = out.full.backlash[1];
     reals_[vr_T_E1] = out.shaft_torque[0];
     reals_[vr_T_E2] = out.shaft_torque[1];
     for (int k = 0; k < 3; ++k) reals_[vr_los_omega_1 + k] = out.payload_angular_velocity[k];
@@ -149,8 +156,8 @@ void GimbalInstance::publish_outputs() {
     reals_[vr_energy_potential] = out.potential_energy;
     reals_[vr_energy_spring] = out.spring_energy;
     reals_[vr_energy_magnetic] = out.magnetic_energy;
-    const double* flows = state_ + kEnergyFlows;
-    const bool accounting = params_.energy_accounting;
+    const bool accounting = params_.layout.energy_slot >= 0;
+    const double* flows = state_ + (accounting ? params_.layout.energy_slot : 0);
     reals_[vr_energy_electrical_in] = accounting ? flows[kElectricalIn] : 0.0;
     reals_[vr_energy_resistive] = accounting ? flows[kResistive] : 0.0;
     reals_[vr_energy_viscous] = accounting ? flows[kViscous] : 0.0;
@@ -162,7 +169,7 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_motor1_limited] = modes.motor_limited[0];
     integers_[vi_motor2_limited] = modes.motor_limited[1];
     for (int body = 0; body < 4; ++body)
-        integers_[vi_body1_stick_slip + body] = friction_mode_indicator(modes.friction[body], state_[kRates + body]);
+        integers_[vi_body1_stick_slip + body] = friction_mode_indicator(modes.friction[body], out.full.rate[body]);
     const EventCounters& events = system_->counters();
     const IntegratorStatistics stats = integrator_->statistics();
     reals_[vr_events_last_time] = events.last_event_time;
@@ -173,9 +180,46 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_events_current_limit2] = static_cast<int>(events.current_limit[1]);
     integers_[vi_events_stick_slip] = static_cast<int>(events.stick_slip);
     integers_[vi_events_zeno_guard] = static_cast<int>(stats.zeno_holds);
+    integers_[vi_solver_states] = params_.layout.size;
     integers_[vi_solver_steps] = static_cast<int>(std::min<long>(stats.steps, 2147483647L));
     integers_[vi_solver_rhs_evaluations] = static_cast<int>(std::min<long>(stats.rhs_evaluations, 2147483647L));
     integers_[vi_solver_jacobian_evaluations] = static_cast<int>(std::min<long>(stats.jacobian_evaluations, 2147483647L));
+}
+
+void GimbalInstance::load_start_state() {
+    const StateLayout& layout = params_.layout;
+    std::fill(state_, state_ + kMaxStateSize, 0.0);
+    for (int body = 0; body < 4; ++body) {
+        if (!layout.independent(body)) continue;
+        state_[layout.angle_slot[body]] = reals_[vr_alpha + body];
+        state_[layout.rate_slot[body]] = reals_[vr_alpha_dot + body];
+    }
+    const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
+    for (int axis = 0; axis < 2; ++axis) {
+        if (layout.current_slot[axis] >= 0) state_[layout.current_slot[axis]] = reals_[currents[axis]];
+        if (layout.backlash_slot[axis] >= 0) state_[layout.backlash_slot[axis]] = reals_[backlash[axis]];
+        const int rotor = rotor_index(axis), load = load_index(axis);
+        const double ratio = params_.gear[axis].ratio;
+        if (!layout.independent(rotor) && (reals_[vr_alpha + rotor] != ratio * reals_[vr_alpha + load] ||
+                                           reals_[vr_alpha_dot + rotor] != ratio * reals_[vr_alpha_dot + load])) {
+            logger_(GIMBAL_WARNING, "logStatusWarning",
+                    std::string("rigid gear ") + std::to_string(axis + 1) + ": the start values of " +
+                        kRealVariables[vr_alpha + rotor].name + " and its rate are replaced by N times the load's");
+        }
+    }
+}
+
+GimbalStatus GimbalInstance::check_fixed_base(const char* function) const {
+    if (!params_.fidelity.fixed_base) return GIMBAL_OK;
+    for (unsigned vr = vr_base_delta; vr <= vr_base_a_a_3; ++vr) {
+        if (reals_[vr] != 0.0) {
+            std::ostringstream s;
+            s << function << ": " << kRealVariables[vr].name << " = " << reals_[vr]
+              << " refused: base.fixed = true, so every base input must be 0";
+            return refuse(GIMBAL_ERROR, s.str());
+        }
+    }
+    return GIMBAL_OK;
 }
 
 bool GimbalInstance::build_parameters(ModelParameters& params, std::string& error) const {
@@ -205,8 +249,7 @@ GimbalStatus GimbalInstance::preview_outputs(const char* function, const char* n
         return refuse(GIMBAL_ERROR, std::string(function) + ": " + name +
                                         " cannot be computed from the current values: " + error);
     }
-    std::fill(state_, state_ + kMaxStateSize, 0.0);
-    for (int k = 0; k < kStateSize; ++k) state_[k] = reals_[vr_alpha + k];
+    load_start_state();
     system_ = std::make_unique<GimbalHybridSystem>(params_);
     system_->set_inputs(read_step_inputs(time_));
     system_->update_modes(time_, state_, nullptr);
@@ -224,8 +267,9 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     ModelParameters params;
     if (!build_parameters(params, error)) return refuse(GIMBAL_ERROR, error);
     params_ = params;
-    std::fill(state_, state_ + kMaxStateSize, 0.0);
-    for (int k = 0; k < kStateSize; ++k) state_[k] = reals_[vr_alpha + k];
+    const GimbalStatus base_status = check_fixed_base("fmi2ExitInitializationMode");
+    if (base_status != GIMBAL_OK) return base_status;
+    load_start_state();
     time_ = start_time;
     system_ = std::make_unique<GimbalHybridSystem>(params_);
     system_->set_inputs(read_step_inputs(time_));
@@ -304,6 +348,8 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
 
 GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     if (!integrator_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance is not initialized");
+    const GimbalStatus base_status = check_fixed_base("fmi2DoStep");
+    if (base_status != GIMBAL_OK) return base_status;
     StepInputs inputs = read_step_inputs(current_time);
     const StepInputs& running = system_->inputs();
     // The right-hand side is continuous across the step boundary only if the held voltages are the same

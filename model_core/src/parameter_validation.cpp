@@ -133,6 +133,27 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         return false;
     }
     params.max_steps = integers[vi_solver_max_steps];
+
+    const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
+    const IntegerVariable motor_models[2] = {vi_motor1_model, vi_motor2_model};
+    for (int j = 0; j < 2; ++j) {
+        const int gear_model = integers[gear_models[j]], motor_model = integers[motor_models[j]];
+        if (gear_model < 0 || gear_model > 2) {
+            error = std::string(kIntegerVariables[gear_models[j]].name) + " = " + std::to_string(gear_model) +
+                    " is invalid: it must be 0 (rigid), 1 (compliant) or 2 (compliant with backlash)";
+            return false;
+        }
+        if (motor_model < 0 || motor_model > 1) {
+            error = std::string(kIntegerVariables[motor_models[j]].name) + " = " + std::to_string(motor_model) +
+                    " is invalid: it must be 0 (quasi-static) or 1 (with inductance)";
+            return false;
+        }
+        params.fidelity.gear[j] = static_cast<GearModel>(gear_model);
+        params.fidelity.motor[j] = static_cast<MotorModel>(motor_model);
+    }
+    params.fidelity.dry_friction = flags[vb_dry_friction];
+    params.fidelity.fixed_base = flags[vb_base_fixed];
+    params.finalize();
     params.relative_tolerance = values[vr_solver_rtol];
     params.absolute_tolerance = values[vr_solver_atol];
     return true;
@@ -145,8 +166,12 @@ bool validate_start_state(const double (&values)[kRealVariableCount], const Mode
             return false;
     const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
     for (int j = 0; j < 2; ++j) {
-        if (!check.require(currents[j], std::fabs(values[currents[j]]) <= params.motor[j].current_limit,
-                           "a start current must not exceed the current limit i_L") ||
+        // States a reduced fidelity removed are derived, and their start values are not used.
+        if (params.layout.current_slot[j] >= 0 &&
+            !check.require(currents[j], std::fabs(values[currents[j]]) <= params.motor[j].current_limit,
+                           "a start current must not exceed the current limit i_L"))
+            return false;
+        if (params.layout.backlash_slot[j] >= 0 &&
             !check.require(backlash[j], std::fabs(values[backlash[j]]) <= params.gear[j].half_backlash,
                            "a start backlash state must lie within +-eta"))
             return false;

@@ -43,6 +43,8 @@ public:
 private:
     StepInputs read_step_inputs(double step_start) const;
     bool build_parameters(ModelParameters& params, std::string& error) const;
+    void load_start_state();
+    GimbalStatus check_fixed_base(const char* function) const;
     void create_integrator();
     // Before initialization ends, calculated outputs follow from the start values on request.
     GimbalStatus preview_outputs(const char* function, const char* name);

@@ -1,4 +1,5 @@
-// The constant model (parameters), the discrete modes, and the dynamics of the gimbal within a mode.
+// The constant model (parameters, fidelity, state layout), the discrete modes, and the dynamics of
+// the gimbal within a mode.
 #pragma once
 
 #include <cstdint>
@@ -8,43 +9,73 @@
 
 namespace gimbal {
 
-// Layout of the state vector (MODEL.md section 4), then the optional energy accumulators.
+// Layout of the full state vector (MODEL.md section 4). Reduced fidelities drop entries: see StateLayout.
 enum StateIndex : int {
     kAngles = 0,      // alpha, alpha_m, beta, beta_m
     kRates = 4,       // their time derivatives
     kCurrents = 8,    // i_R1, i_R2
     kBacklash = 10,   // theta_b1, theta_b2
     kStateSize = 12,
-    kEnergyFlows = 12,  // electrical in, resistive, viscous, shaft damping, dry friction
-    kEnergyFlowCount = 5,
+    kEnergyFlowCount = 5,  // electrical in, resistive, viscous, shaft damping, dry friction
     kMaxStateSize = kStateSize + kEnergyFlowCount
 };
 
 enum EnergyFlow : int { kElectricalIn = 0, kResistive, kViscous, kShaftDamping, kDryFriction };
 
-using StateVector = Eigen::Matrix<double, kStateSize, 1>;
+// "Model only what a scene needs" (MODEL.md section 5): each reduction removes states.
+enum class GearModel : int { rigid = 0, compliant = 1, backlash = 2 };
+enum class MotorModel : int { quasi_static = 0, inductive = 1 };
 
-struct ModelParameters {
-    MultibodyModel multibody;
-    MotorParameters motor[2];
-    GearParameters gear[2];
-    double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
-    DryFrictionParameters dry_friction[4];
-    bool energy_accounting = false;
-    double relative_tolerance = 1e-6;
-    double absolute_tolerance = 1e-8;
-    long max_steps = 100000;  // per communication step
-
-    int state_size() const { return energy_accounting ? kMaxStateSize : kStateSize; }
+struct Fidelity {
+    GearModel gear[2] = {GearModel::backlash, GearModel::backlash};
+    MotorModel motor[2] = {MotorModel::inductive, MotorModel::inductive};
+    bool dry_friction = true;
+    bool fixed_base = false;
 };
 
 // Rotor coordinate of axis j in q order (alpha_m, beta_m) and its load coordinate (alpha, beta).
 constexpr int rotor_index(int axis) { return axis == 0 ? 1 : 3; }
 constexpr int load_index(int axis) { return axis == 0 ? 0 : 2; }
 
-// Dry friction regime of one body. |qd| < w_min is the low-speed (stick candidate) region.
+// Where each quantity lives in the integrated state vector; -1 when the fidelity removed it.
+// Coordinates are "padded": a rigid axis's rotor keeps its index 0..3 in the equations of motion
+// but has no state (q_m = N q_l).
+struct StateLayout {
+    int angle_slot[4];
+    int rate_slot[4];
+    int current_slot[2];
+    int backlash_slot[2];
+    int energy_slot;  // first of kEnergyFlowCount, or -1
+    int size;
+
+    static StateLayout from(const Fidelity& fidelity, bool energy_accounting);
+    bool independent(int body) const { return angle_slot[body] >= 0; }
+};
+
+struct ModelParameters {
+    MultibodyModel multibody;
+    MotorParameters motor[2];
+    GearParameters gear[2];
+    double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
+    DryFrictionParameters dry_friction[4];      // per body, as given
+    Fidelity fidelity;
+    bool energy_accounting = false;
+    double relative_tolerance = 1e-6;
+    double absolute_tolerance = 1e-8;
+    long max_steps = 100000;  // per communication step
+
+    // Derived by finalize(): the layout, dry friction per padded coordinate (a rigid axis merges its
+    // rotor's friction into the load's), and the share of a merged element attributed to the rotor.
+    StateLayout layout;
+    DryFrictionParameters coordinate_friction[4];
+    double rotor_friction_share[2] = {0, 0};
+    void finalize();
+    int state_size() const { return layout.size; }
+};
+
+// Dry friction regime of one coordinate. |qd| < w_min is the low-speed (stick candidate) region.
 enum class FrictionMode : std::int8_t {
-    none,               // body without dry friction
+    none,               // coordinate without dry friction
     slip_positive,      // qd >= w_min: T_as = -T_din
     slip_negative,      // qd <= -w_min: T_as = +T_din
     hold,               // low speed, T_as = -T_outros - c_num qd within +-T_max (stuck)
@@ -70,9 +101,18 @@ struct StepInputs {
     double step_start_time = 0.0;
 };
 
+// The state in full form, whatever the fidelity.
+struct FullState {
+    Vec4 angle, rate;
+    double current[2];   // the armature current (algebraic for a quasi-static motor, held at +-i_L when limited)
+    double backlash[2];  // 0 without backlash
+};
+
 // Everything the right-hand side, the event functions and the outputs need, at one (t, x, modes).
 struct Dynamics {
-    Vec4 acceleration;
+    FullState full;
+    Vec4 acceleration;              // padded coordinates (0 for a rigid axis's rotor)
+    Vec4 full_acceleration;         // all four bodies
     double current_rate[2];
     double backlash_rate[2];
     double free_backlash_rate[2];   // X of (2.81)
@@ -80,21 +120,22 @@ struct Dynamics {
     double deflection_rate[2];
     double shaft_torque[2];
     double steady_current[2];       // (u - k_emf w) / R
-    Vec4 friction_torque;           // T_as
-    Vec4 other_torque;              // T_outros, meaningful for low-speed bodies only
-    Vec4 generalized_force;         // everything but dry friction and the bias
-    Vec4 bias;                      // f of (2.54)
+    Vec4 friction_torque;           // T_as per padded coordinate
+    Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
 };
 
 // Gears whose damping is 0 are pure dead zones: theta_b follows theta_d inside the gap.
 inline bool dead_zone_gear(const GearParameters& gear) { return gear.half_backlash > 0.0 && gear.damping == 0.0; }
 
+FullState expand_state(const ModelParameters& params, const Modes& modes, const StepInputs& inputs,
+                       const double* state);
+
 void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, const BaseKinematics& base,
                        const double* state, const Modes& modes, Dynamics& out);
 
-// Solves (2.106) with the columns of the low-speed bodies replaced by unit vectors: T_outros.
+// Solves (2.106) with the columns of the low-speed coordinates replaced by unit vectors: T_outros.
 Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Modes& modes,
-                   const ModelParameters& params);
+                   const DryFrictionParameters (&friction)[4]);
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
 
@@ -104,6 +145,7 @@ bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& 
 
 // Quantities derived from the state for outputs and diagnostics.
 struct ModelOutputs {
+    FullState full;
     double shaft_torque[2] = {0, 0};
     Vec3 payload_angular_velocity = Vec3::Zero();
     double kinetic_energy = 0.0;

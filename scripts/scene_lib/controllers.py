@@ -1,0 +1,184 @@
+"""Digital controllers of the master: none (constant voltages), PID per axis, state feedback.
+
+A controller is called once per communication step with the measured signals at t_k and returns
+the voltages (u_R1, u_R2) computed from them; the master applies them later (one-sample delay,
+seed section 2.5). Axis 1 is the azimuth (alpha, motor 1), axis 2 the elevation (beta, motor 2).
+
+Angle references: per axis from references.py, or `reference = "target"` in [controller]: both
+set points by inverse kinematics of the line-of-sight target for the measured base attitude.
+
+Rate signals: the payload gyro los.omega (frame 2) gives the inertial rate about the elevation
+axis, w[1], and the cross-elevation rate w[3]; w[3] / cos(beta) is the azimuth rate that moves
+the line of sight (secant correction). On a fixed base these equal beta_dot and alpha_dot.
+"""
+from __future__ import annotations
+
+import math
+
+from . import geometry
+from .errors import SceneError, check_keys, number
+from .references import Reference
+
+AXES = ("azimuth", "elevation")
+PID_KEYS = {"kp", "ki", "kd", "k_gyro", "d_filter_s", "i_limit_V", "reference"}
+
+
+def gyro_axis_rates(gyro, beta: float):
+    """(azimuth, elevation) inertial rates of the line of sight from the payload gyro."""
+    return gyro[2] / max(math.cos(beta), 0.2), gyro[0]
+
+
+class Controller:
+    """Base: constant voltages (type 'none'); subclasses close the loop."""
+    kind = "none"
+
+    def __init__(self, voltage=(0.0, 0.0), u_limit=(math.inf, math.inf)):
+        self.voltage = tuple(voltage)
+        self.u_limit = tuple(u_limit)
+        self.reference = (math.nan, math.nan)   # last set points, for the record
+
+    def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude) -> tuple:
+        return self.voltage
+
+    def clamp(self, u: float, axis: int) -> float:
+        limit = self.u_limit[axis]
+        return min(max(u, -limit), limit)
+
+
+class _ReferenceMixin:
+    def _setup_references(self, spec: dict, target):
+        self.target = target
+        self.refs = []
+        for axis in AXES:
+            sub = spec.get(axis, {}).get("reference", spec.get("reference"))
+            if sub == "target":
+                if target is None:
+                    raise SceneError(f"[controller.{axis}] reference 'target' needs a [target] table")
+                self.refs.append("target")
+            elif isinstance(sub, dict):
+                self.refs.append(Reference(f"controller.{axis}.reference", sub))
+            else:
+                raise SceneError(f"[controller.{axis}] needs a reference: 'target' or a table "
+                                 "{type = 'constant'|'step'|'ramp'|'sine', ...}, got {sub!r}")
+
+    def _references(self, t, alpha, base_attitude):
+        if "target" in self.refs:
+            a_t, b_t = geometry.gimbal_angles_for(self.target, *base_attitude, alpha_near=alpha)
+        r1 = a_t if self.refs[0] == "target" else self.refs[0].at(t)
+        r2 = b_t if self.refs[1] == "target" else self.refs[1].at(t)
+        return r1, r2
+
+
+class AxisPID:
+    """u = kp e + ki int(e) + kd de/dt - k_gyro w, e = reference - encoder angle, de/dt a backward
+    difference through a first-order filter (time constant d_filter_s), w the gyro rate about the
+    axis. Anti-windup: the integral stops while the output is saturated in the direction of e,
+    and ki*int(e) is kept within +-i_limit_V."""
+
+    def __init__(self, where: str, spec: dict, u_limit: float):
+        check_keys(where, spec, PID_KEYS)
+        self.kp, self.ki, self.kd, self.k_gyro = (number(f"{where}.{k}", spec.get(k, 0.0))
+                                                  for k in ("kp", "ki", "kd", "k_gyro"))
+        self.tau = number(f"{where}.d_filter_s", spec.get("d_filter_s", 0.0))
+        self.i_limit = number(f"{where}.i_limit_V", spec.get("i_limit_V", u_limit))
+        self.u_limit = u_limit
+        self.integral = 0.0
+        self.e_prev = None
+        self.d = 0.0
+        self.saturated = 0
+
+    def __call__(self, e: float, rate: float, h: float) -> float:
+        if self.e_prev is not None:
+            raw = (e - self.e_prev) / h
+            self.d += (h / (self.tau + h)) * (raw - self.d)
+        self.e_prev = e
+        if self.ki != 0.0 and not (self.saturated * e > 0):
+            self.integral += e * h
+            if abs(self.ki * self.integral) > self.i_limit:
+                self.integral = math.copysign(self.i_limit / abs(self.ki), self.integral)
+        u = self.kp * e + self.ki * self.integral + self.kd * self.d - self.k_gyro * rate
+        self.saturated = 1 if u > self.u_limit else -1 if u < -self.u_limit else 0
+        return min(max(u, -self.u_limit), self.u_limit)
+
+
+class PID(Controller, _ReferenceMixin):
+    kind = "pid"
+
+    def __init__(self, spec: dict, target, u_limit):
+        super().__init__(u_limit=u_limit)
+        self._setup_references(spec, target)
+        self.axes = [AxisPID(f"controller.{axis}", {k: v for k, v in spec.get(axis, {}).items()}, u_limit[i])
+                     for i, axis in enumerate(AXES)]
+
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude):
+        r1, r2 = self._references(t, alpha, base_attitude)
+        self.reference = (r1, r2)
+        w_az, w_el = gyro_axis_rates(gyro, beta)
+        return self.axes[0](r1 - alpha, w_az, h), self.axes[1](r2 - beta, w_el, h)
+
+
+class StateFeedback(Controller, _ReferenceMixin):
+    """u = -K x + ki * int(reference - angle), x = [alpha - alpha_ref, beta - beta_ref, w_az, w_el],
+    K a 2x4 matrix [V/rad, V s/rad]; rates from the gyro (rate_source = "gyro") or from backward
+    differences of the encoder angles ("encoder")."""
+    kind = "state_feedback"
+
+    def __init__(self, spec: dict, target, u_limit):
+        super().__init__(u_limit=u_limit)
+        self._setup_references(spec, target)
+        K = spec.get("K")
+        if not (isinstance(K, list) and len(K) == 2 and all(isinstance(r, list) and len(r) == 4 for r in K)):
+            raise SceneError("[controller] state_feedback needs K = [[4 numbers], [4 numbers]] "
+                             "(rows u_R1, u_R2; columns alpha error, beta error, azimuth rate, elevation rate)")
+        self.K = [[number("controller.K", v) for v in row] for row in K]
+        ki = spec.get("ki", [0.0, 0.0])
+        self.ki = [number("controller.ki", v) for v in ki]
+        self.rate_source = spec.get("rate_source", "gyro")
+        if self.rate_source not in ("gyro", "encoder"):
+            raise SceneError("[controller] rate_source must be 'gyro' or 'encoder'")
+        self.integral = [0.0, 0.0]
+        self.prev = None
+
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude):
+        r1, r2 = self._references(t, alpha, base_attitude)
+        self.reference = (r1, r2)
+        if self.rate_source == "gyro":
+            w_az, w_el = gyro_axis_rates(gyro, beta)
+        else:
+            w_az, w_el = (0.0, 0.0) if self.prev is None else ((alpha - self.prev[0]) / h, (beta - self.prev[1]) / h)
+            self.prev = (alpha, beta)
+        x = (alpha - r1, beta - r2, w_az, w_el)
+        u = []
+        for i in range(2):
+            v = -sum(k * xi for k, xi in zip(self.K[i], x)) + self.ki[i] * self.integral[i]
+            limited = self.clamp(v, i)
+            if self.ki[i] != 0.0 and limited == v:      # anti-windup: integrate only when unsaturated
+                self.integral[i] += -x[i] * h
+            u.append(limited)
+        return tuple(u)
+
+
+CONTROLLER_KEYS = {"type", "delay_steps", "reference", "voltage_V", "K", "ki", "rate_source"} | set(AXES)
+
+
+def make_controller(spec: dict | None, target, u_limit) -> Controller:
+    """Builds the controller of a scene's [controller] table; `target` a unit vector in G or None,
+    `u_limit` the motors' voltage limits (the controller output saturates there, like a DAC)."""
+    spec = dict(spec or {"type": "none"})
+    check_keys("controller", spec, CONTROLLER_KEYS)
+    kind = spec.get("type", "none")
+    if kind == "none":
+        check_keys("controller", spec, {"type", "delay_steps", "voltage_V"})
+        v = spec.get("voltage_V", [0.0, 0.0])
+        if not (isinstance(v, list) and len(v) == 2):
+            raise SceneError("[controller] voltage_V must be [u_R1, u_R2]")
+        return Controller([number("controller.voltage_V", x) for x in v], u_limit)
+    if kind == "pid":
+        check_keys("controller", spec, {"type", "delay_steps", "reference"} | set(AXES))
+        return PID(spec, target, u_limit)
+    if kind == "state_feedback":
+        check_keys("controller", spec, {"type", "delay_steps", "reference", "K", "ki", "rate_source"} | set(AXES))
+        for axis in AXES:
+            check_keys(f"controller.{axis}", spec.get(axis, {}), {"reference"})
+        return StateFeedback(spec, target, u_limit)
+    raise SceneError(f"[controller] type must be 'none', 'pid' or 'state_feedback', got {kind!r}")

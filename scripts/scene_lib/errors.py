@@ -1,0 +1,27 @@
+"""The one error type of scene handling, and small validation helpers shared by the modules."""
+from __future__ import annotations
+
+import math
+
+
+class SceneError(ValueError):
+    """A scene that cannot be run; the message says where and why."""
+
+
+def check_keys(where: str, table: dict, allowed: set) -> None:
+    unknown = set(table) - set(allowed)
+    if unknown:
+        raise SceneError(f"[{where}]: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+
+
+def number(where: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise SceneError(f"{where} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def positive(where: str, value) -> float:
+    value = number(where, value)
+    if not value > 0:
+        raise SceneError(f"{where} must be positive, got {value!r}")
+    return value
