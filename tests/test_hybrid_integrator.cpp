@@ -86,14 +86,16 @@ public:
 
 }  // namespace
 
-int main() {
+void check_method(IntegrationMethod method) {
     IntegratorSettings settings;
+    settings.method = method;
     settings.relative_tolerance = 1e-10;
     settings.absolute_tolerance = 1e-12;
     auto quiet = [](const std::string&) {};
     {
         BouncingBall ball(0.5);
-        HybridCvodeIntegrator integrator(ball, settings, quiet, quiet);
+        auto integrator_owner = HybridIntegrator::create(ball, settings, quiet, quiet);
+        HybridIntegrator& integrator = *integrator_owner;
         double x[2] = {1.0, 0.0};
         CHECK(integrator.restart(0.0, x));
         const double first = std::sqrt(2.0 / 9.81);
@@ -108,7 +110,8 @@ int main() {
         // Located bounces are real: after bounce k the next comes (1 + e) v_k / g later; the k-th time is
         // t1 (1 + 2 e (1 - e^(k-1)) / (1 - e)). Re-run and check the third bounce time.
         BouncingBall again(0.5);
-        HybridCvodeIntegrator second(again, settings, quiet, quiet);
+        auto second_owner = HybridIntegrator::create(again, settings, quiet, quiet);
+        HybridIntegrator& second = *second_owner;
         double y[2] = {1.0, 0.0};
         CHECK(second.restart(0.0, y));
         const double third = first * (1.0 + 2.0 * 0.5 * (1.0 - 0.25) / 0.5);
@@ -122,7 +125,8 @@ int main() {
         Chatter fast(1e-10);
         IntegratorSettings fine = settings;
         fine.max_step = 2e-11;  // so that every sign change is seen
-        HybridCvodeIntegrator integrator(fast, fine, quiet, quiet);
+        auto integrator_owner = HybridIntegrator::create(fast, fine, quiet, quiet);
+        HybridIntegrator& integrator = *integrator_owner;
         double x[1] = {0.0};
         CHECK(integrator.restart(1e-11, x));
         CHECK(integrator.advance(2e-5, x));
@@ -136,7 +140,8 @@ int main() {
         Chatter slow(4e-9);
         IntegratorSettings fine = settings;
         fine.max_step = 1e-9;
-        HybridCvodeIntegrator integrator(slow, fine, quiet, quiet);
+        auto integrator_owner = HybridIntegrator::create(slow, fine, quiet, quiet);
+        HybridIntegrator& integrator = *integrator_owner;
         double x[1] = {0.0};
         CHECK(integrator.restart(1e-10, x));
         CHECK(integrator.advance(1e-6 + 1e-9, x));
@@ -145,7 +150,8 @@ int main() {
     }
     {
         TwinDecay twins;
-        HybridCvodeIntegrator integrator(twins, settings, quiet, quiet);
+        auto integrator_owner = HybridIntegrator::create(twins, settings, quiet, quiet);
+        HybridIntegrator& integrator = *integrator_owner;
         double x[2] = {1.0, 1.0};
         CHECK(integrator.restart(0.0, x));
         CHECK(integrator.advance(1.0, x));
@@ -153,6 +159,16 @@ int main() {
         CHECK(twins.crossing_time[0] == twins.crossing_time[1]);
         CHECK_NEAR(twins.crossing_time[0], std::log(2.0), 1e-8);
         CHECK(integrator.statistics().events == 2);
+    }
+}
+
+int main() {
+    // The same hybrid layer over every backend.
+    for (IntegrationMethod method : {IntegrationMethod::bdf_difference_jacobian, IntegrationMethod::adams,
+                                     IntegrationMethod::explicit_runge_kutta}) {
+        const int before = check::failures;
+        check_method(method);
+        if (check::failures != before) std::fprintf(stderr, "  (method %d)\n", static_cast<int>(method));
     }
     return check_report("hybrid_integrator");
 }

@@ -46,6 +46,11 @@ bool GimbalHybridSystem::derivative(double time, const double* state, double* de
     return evaluate_state_derivative(params_, inputs_, modes_, time, state, derivative);
 }
 
+bool GimbalHybridSystem::jacobian(double time, const double* state, double* column_major) {
+    evaluate_jacobian(params_, inputs_, modes_, time, state, column_major);
+    return true;
+}
+
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     std::fill(values, values + kEventCount, 1.0);
     Dynamics d;

@@ -232,7 +232,8 @@ void GimbalInstance::create_integrator() {
     settings.relative_tolerance = params_.relative_tolerance;
     settings.absolute_tolerance = params_.absolute_tolerance;
     settings.max_steps = params_.max_steps;
-    integrator_ = std::make_unique<HybridCvodeIntegrator>(
+    settings.method = static_cast<IntegrationMethod>(params_.method);
+    integrator_ = HybridIntegrator::create(
         *system_, settings,
         [this](const std::string& message) {
             last_integrator_error_ = message;

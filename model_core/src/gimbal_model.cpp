@@ -190,6 +190,8 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     }
     out.acceleration = reduced_mass.llt().solve(applied + out.friction_torque);
     out.full_acceleration = reduction * out.acceleration;
+    out.reduced_mass = reduced_mass;
+    out.reduction = reduction;
 
     // A rigid gear still transmits a torque: the one that makes the rotor follow, from its own equation.
     for (int axis = 0; axis < 2; ++axis) {
@@ -199,6 +201,120 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
         const double rotor_friction = params.rotor_friction_share[axis] * out.friction_torque[load] / ratio;
         const double inertial = mass_matrix.row(rotor).dot(out.full_acceleration);
         out.shaft_torque[axis] = ratio * (force[rotor] + bias[rotor] + rotor_friction - inertial);
+    }
+}
+
+void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
+                       const double* state, double* column_major) {
+    using Mat4x12 = Eigen::Matrix<double, 4, 12>;
+    const StateLayout& layout = params.layout;
+    const int n = layout.size;
+    Dynamics d;
+    evaluate_dynamics(params, inputs, base_kinematics_at(params, inputs, time), state, modes, d);
+
+    // Derivatives of the full generalized forces: columns q (0-3), qd (4-7), currents (8-9), theta_b (10-11).
+    Mat4x12 force = Mat4x12::Zero();
+    for (int body = 0; body < 4; ++body) force(body, 4 + body) -= params.viscous_friction[body];
+    for (int axis = 0; axis < 2; ++axis) {
+        const GearParameters& gear = params.gear[axis];
+        const MotorParameters& motor = params.motor[axis];
+        const int rotor = rotor_index(axis), load = load_index(axis);
+        const GearModel model = params.fidelity.gear[axis];
+        const int contact = modes.gear_contact[axis];
+        double stiffness = 0.0, damping = 0.0, backlash = 0.0;  // d T_E / d(theta_d, dtheta_d, theta_b)
+        if (model == GearModel::compliant || (model == GearModel::backlash && gear.half_backlash == 0.0)) {
+            stiffness = gear.stiffness, damping = gear.damping;
+        } else if (model == GearModel::backlash && contact != 0) {
+            stiffness = gear.stiffness;
+            damping = dead_zone_gear(gear) ? 0.0 : gear.damping;
+            backlash = dead_zone_gear(gear) ? 0.0 : -gear.stiffness;
+        }
+        Eigen::Matrix<double, 1, 12> torque = Eigen::Matrix<double, 1, 12>::Zero();
+        torque(rotor) = stiffness / gear.ratio;
+        torque(load) = -stiffness;
+        torque(4 + rotor) = damping / gear.ratio;
+        torque(4 + load) = -damping;
+        torque(10 + axis) = backlash;
+        force.row(load) += torque;
+        force.row(rotor) -= torque / gear.ratio;
+        if (modes.motor_limited[axis] == 0) {
+            if (layout.current_slot[axis] >= 0) {
+                force(rotor, 8 + axis) += motor.torque_constant;
+            } else {
+                force(rotor, 4 + rotor) -= motor.torque_constant * motor.back_emf_constant / motor.resistance;
+            }
+        }
+    }
+    // To padded coordinates: q_full = T q_padded, forces projected with T^T.
+    const Mat4& T = d.reduction;
+    Mat4x12 applied;
+    applied.block<4, 4>(0, 0) = T.transpose() * force.block<4, 4>(0, 0) * T;
+    applied.block<4, 4>(0, 4) = T.transpose() * force.block<4, 4>(0, 4) * T;
+    applied.block<4, 4>(0, 8) = T.transpose() * force.block<4, 4>(0, 8);
+
+    // A held coordinate's friction cancels the other torques (2.101), which depend on the state too.
+    Mat4x12 friction = Mat4x12::Zero();
+    bool any_hold = false;
+    for (int k = 0; k < 4; ++k) any_hold = any_hold || modes.friction[k] == FrictionMode::hold;
+    if (any_hold) {
+        Mat4 modified = d.reduced_mass;
+        for (int k = 0; k < 4; ++k)
+            if (low_speed(modes.friction[k])) modified.col(k) = Vec4::Unit(k);
+        const Mat4x12 other = modified.partialPivLu().solve(applied);
+        for (int k = 0; k < 4; ++k) {
+            if (modes.friction[k] != FrictionMode::hold) continue;
+            friction.row(k) = -other.row(k);
+            friction(k, 4 + k) -= params.coordinate_friction[k].numerical_damping();
+        }
+    }
+    const Mat4x12 acceleration = d.reduced_mass.llt().solve(applied + friction);
+
+    // Column of the padded-derivative matrices that a state slot stands for.
+    int column_of_slot[kMaxStateSize];
+    for (int k = 0; k < n; ++k) column_of_slot[k] = -1;
+    for (int body = 0; body < 4; ++body) {
+        if (!layout.independent(body)) continue;
+        column_of_slot[layout.angle_slot[body]] = body;
+        column_of_slot[layout.rate_slot[body]] = 4 + body;
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        if (layout.current_slot[axis] >= 0) column_of_slot[layout.current_slot[axis]] = 8 + axis;
+        if (layout.backlash_slot[axis] >= 0) column_of_slot[layout.backlash_slot[axis]] = 10 + axis;
+    }
+    Eigen::Map<Eigen::MatrixXd> jac(column_major, n, n);
+    jac.setZero();
+    auto fill_row = [&](int row, const Eigen::Matrix<double, 1, 12>& derivative) {
+        for (int slot = 0; slot < n; ++slot)
+            if (column_of_slot[slot] >= 0) jac(row, slot) = derivative(column_of_slot[slot]);
+    };
+    for (int body = 0; body < 4; ++body) {
+        if (!layout.independent(body)) continue;
+        jac(layout.angle_slot[body], layout.rate_slot[body]) = 1.0;
+        fill_row(layout.rate_slot[body], acceleration.row(body));
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        const GearParameters& gear = params.gear[axis];
+        const MotorParameters& motor = params.motor[axis];
+        const int rotor = rotor_index(axis), load = load_index(axis);
+        // theta_d = (e_r / N - e_l) q_full = (e_r / N - e_l) T q_padded, likewise its rate.
+        const Eigen::Matrix<double, 1, 4> deflection =
+            (Vec4::Unit(rotor) / gear.ratio - Vec4::Unit(load)).transpose() * T;
+        if (layout.current_slot[axis] >= 0 && modes.motor_limited[axis] == 0) {
+            Eigen::Matrix<double, 1, 12> row = Eigen::Matrix<double, 1, 12>::Zero();
+            row.segment<4>(4) = -motor.back_emf_constant / motor.inductance * T.row(rotor);
+            row(8 + axis) = -motor.resistance / motor.inductance;
+            fill_row(layout.current_slot[axis], row);
+        }
+        if (layout.backlash_slot[axis] >= 0 && modes.gear_contact[axis] == 0 && gear.half_backlash > 0.0) {
+            Eigen::Matrix<double, 1, 12> row = Eigen::Matrix<double, 1, 12>::Zero();
+            row.segment<4>(4) = deflection;
+            if (!dead_zone_gear(gear)) {
+                const double rate = gear.stiffness / gear.damping;
+                row.segment<4>(0) = rate * deflection;
+                row(10 + axis) = -rate;
+            }
+            fill_row(layout.backlash_slot[axis], row);
+        }
     }
 }
 

@@ -133,6 +133,13 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         return false;
     }
     params.max_steps = integers[vi_solver_max_steps];
+    if (integers[vi_solver_method] < 0 || integers[vi_solver_method] > 3) {
+        error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
+                " is invalid: it must be 0 (BDF, analytic Jacobian), 1 (BDF, difference quotients), 2 (Adams) or 3 "
+                "(explicit Runge-Kutta)";
+        return false;
+    }
+    params.method = integers[vi_solver_method];
 
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
     const IntegerVariable motor_models[2] = {vi_motor1_model, vi_motor2_model};

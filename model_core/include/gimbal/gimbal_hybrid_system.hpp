@@ -27,6 +27,8 @@ public:
     int state_size() const override { return params_.state_size(); }
     int event_count() const override { return kEventCount; }
     bool derivative(double time, const double* state, double* derivative) override;
+    bool has_jacobian() const override { return true; }
+    bool jacobian(double time, const double* state, double* column_major) override;
     void event_functions(double time, const double* state, double* values) override;
     int update_modes(double time, double* state, const int* directions) override;
 

@@ -58,7 +58,7 @@ private:
     ModelParameters params_;
     double state_[kMaxStateSize];
     std::unique_ptr<GimbalHybridSystem> system_;
-    std::unique_ptr<HybridCvodeIntegrator> integrator_;
+    std::unique_ptr<HybridIntegrator> integrator_;
     bool integrator_running_ = false;  // false: the next step must restart the integrator
     bool preview_current_ = false;
     std::string last_integrator_error_;     // the calculated outputs reflect the current start values

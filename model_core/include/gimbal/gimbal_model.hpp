@@ -63,6 +63,7 @@ struct ModelParameters {
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;
     long max_steps = 100000;  // per communication step
+    int method = 0;           // IntegrationMethod
 
     // Derived by finalize(): the layout, dry friction per padded coordinate (a rigid axis merges its
     // rotor's friction into the load's), and the share of a merged element attributed to the rotor.
@@ -122,6 +123,8 @@ struct Dynamics {
     double steady_current[2];       // (u - k_emf w) / R
     Vec4 friction_torque;           // T_as per padded coordinate
     Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
+    Mat4 reduced_mass;              // padded coordinates
+    Mat4 reduction;                 // q_full = reduction * q_padded
 };
 
 // Gears whose damping is 0 are pure dead zones: theta_b follows theta_d inside the gap.
@@ -136,6 +139,12 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
 // Solves (2.106) with the columns of the low-speed coordinates replaced by unit vectors: T_outros.
 Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Modes& modes,
                    const DryFrictionParameters (&friction)[4]);
+
+// d(dx/dt)/dx, column-major, exact for everything that makes the system stiff (gears, motor
+// circuits, backlash, viscous and stick damping) and leaving out the slow configuration dependence of
+// J and f (gravity, gyroscopic terms): the iteration matrix of Newton's method needs no more.
+void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
+                       const double* state, double* column_major);
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
 

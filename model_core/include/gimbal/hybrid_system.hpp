@@ -1,6 +1,6 @@
 // What a hybrid (mode-switching) system offers an integrator: a right-hand side that is smooth
 // within the current modes, event functions whose sign changes mark mode changes, and the mode
-// update at an event. Independent of the integrator behind it (CVODE today, ARKODE next).
+// update at an event. Independent of the integrator behind it.
 #pragma once
 
 namespace gimbal {
@@ -12,6 +12,14 @@ public:
     virtual int event_count() const = 0;
     // dx/dt under the current modes; false if it cannot be evaluated (non-finite values).
     virtual bool derivative(double time, const double* state, double* derivative) = 0;
+    // d(dx/dt)/dx under the current modes, column-major (size x size), or false if the system offers
+    // none (the integrator then uses difference quotients). It may approximate terms that do not
+    // make the system stiff: Newton's method only needs the iteration matrix to be close.
+    virtual bool has_jacobian() const { return false; }
+    virtual bool jacobian(double time, const double* state, double* column_major) {
+        (void)time, (void)state, (void)column_major;
+        return false;
+    }
     virtual void event_functions(double time, const double* state, double* values) = 0;
     // Re-selects the modes at `time`. `directions[k]` is +1 / -1 when event function k has just
     // crossed zero upward / downward, 0 otherwise; nullptr when re-selecting after an input change.

@@ -1,8 +1,11 @@
-// SUNDIALS CVODE (BDF, Newton, dense linear solver) under a hybrid system: root finding locates each
-// mode change, the system switches its modes, and the integrator restarts from the switching point.
+// Integrators under a hybrid system: root finding locates each mode change, the system switches its
+// modes, and the integrator restarts from the switching point. The event loop, the chattering guard
+// and the statistics are shared; SUNDIALS CVODE (BDF or Adams) and ARKODE (explicit Runge-Kutta)
+// are the backends.
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,7 +26,15 @@ struct IntegratorStatistics {
     long zeno_holds = 0;   // times the chattering guard engaged
 };
 
+enum class IntegrationMethod : int {
+    bdf_analytic_jacobian = 0,  // CVODE BDF, Newton with the system's Jacobian
+    bdf_difference_jacobian = 1,  // CVODE BDF, Newton with a difference-quotient Jacobian
+    adams = 2,                  // CVODE Adams-Moulton, Newton with a difference-quotient Jacobian
+    explicit_runge_kutta = 3,   // ARKODE ERKStep, Dormand-Prince 5(4), adaptive
+};
+
 struct IntegratorSettings {
+    IntegrationMethod method = IntegrationMethod::bdf_analytic_jacobian;
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;
     long max_steps = 100000;  // internal steps per call of advance
@@ -37,15 +48,15 @@ struct IntegratorSettings {
     double zeno_dwell = 1e-6;
 };
 
-class HybridCvodeIntegrator {
+class HybridIntegrator {
 public:
     using MessageSink = std::function<void(const std::string&)>;
 
-    HybridCvodeIntegrator(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
-                          MessageSink event_sink);
-    ~HybridCvodeIntegrator();
-    HybridCvodeIntegrator(const HybridCvodeIntegrator&) = delete;
-    HybridCvodeIntegrator& operator=(const HybridCvodeIntegrator&) = delete;
+    static std::unique_ptr<HybridIntegrator> create(HybridSystem& system, const IntegratorSettings& settings,
+                                                    MessageSink error_sink, MessageSink event_sink);
+    virtual ~HybridIntegrator();
+    HybridIntegrator(const HybridIntegrator&) = delete;
+    HybridIntegrator& operator=(const HybridIntegrator&) = delete;
 
     // Starts afresh at (time, state): after any discontinuity of the right-hand side.
     bool restart(double time, const double* state);
@@ -58,11 +69,24 @@ public:
     // For restoring a saved instance: counts continue from these.
     void set_statistics(const IntegratorStatistics& totals) { totals_ = totals; }
 
-private:
+protected:
+    enum class Outcome { reached_end, root, failure };
+
+    HybridIntegrator(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
+                     MessageSink event_sink);
+    bool create_vector();
+
+    // Backend: (re)initialize at (time, y_), integrate towards end_time stopping there exactly, report
+    // root directions, and count work since the last (re)initialization.
+    virtual bool backend_restart(double time) = 0;
+    virtual Outcome backend_advance(double end_time, double& reached) = 0;
+    virtual void backend_roots(int* directions) = 0;
+    virtual IntegratorStatistics backend_counters() const = 0;
+
+    // Callbacks with SUNDIALS signatures, shared by the backends (user data = this).
     static int right_hand_side(sunrealtype time, N_Vector y, N_Vector ydot, void* user_data);
     static int event_functions(sunrealtype time, N_Vector y, sunrealtype* values, void* user_data);
     static void forward_error(int code, const char* module, const char* function, char* message, void* user_data);
-    void accumulate_statistics();
 
     HybridSystem& system_;
     IntegratorSettings settings_;
@@ -70,12 +94,11 @@ private:
     int size_;
     SUNContext context_ = nullptr;
     N_Vector y_ = nullptr;
-    SUNMatrix jacobian_ = nullptr;
-    SUNLinearSolver linear_solver_ = nullptr;
-    void* cvode_ = nullptr;
     bool initialized_ = false;
     std::vector<int> root_directions_;
-    IntegratorStatistics totals_;     // of finished CVODE runs (counters reset at each restart)
+
+private:
+    IntegratorStatistics totals_;  // of finished backend runs (their counters reset at each restart)
     double last_event_time_ = -1e300;
     int rapid_events_ = 0;
     double dwell_until_ = -1e300;
