@@ -77,6 +77,13 @@ static void core_log(void* context, GimbalStatus status, const char* category, c
     log_message((const Instance*)context, kStatus[status], category, "%s", message);
 }
 
+static int core_log_enabled(void* context, const char* category) {
+    const Instance* instance = (const Instance*)context;
+    const int index = category_index(category);
+    return instance->logger != NULL &&
+           ((index >= 0 && instance->category_enabled[index]) || instance->category_enabled[LOG_CATEGORY_COUNT - 1]);
+}
+
 static fmi2Status from_core(GimbalStatus status) {
     switch (status) {
         case GIMBAL_OK: return fmi2OK;
@@ -175,7 +182,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     instance->environment = functions->componentEnvironment;
     instance->instance_name = name;
     for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
-    instance->core = gimbal_core_create(core_log, instance);
+    instance->core = gimbal_core_create(core_log, core_log_enabled, instance);
     if (instance->core == NULL) {
         log_message(instance, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
         free(name);

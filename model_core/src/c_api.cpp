@@ -6,7 +6,8 @@
 #include "gimbal/gimbal_instance.hpp"
 
 struct GimbalCore {
-    explicit GimbalCore(gimbal::GimbalInstance::Logger logger) : instance(std::move(logger)) {}
+    GimbalCore(gimbal::GimbalInstance::Logger logger, gimbal::GimbalInstance::LogFilter filter)
+        : instance(std::move(logger), std::move(filter)) {}
     gimbal::GimbalInstance instance;
 };
 
@@ -26,12 +27,15 @@ int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info)
     return 1;
 }
 
-GimbalCore* gimbal_core_create(GimbalLogFunction log, void* log_context) {
+GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction enabled, void* log_context) {
     try {
         auto logger = [log, log_context](GimbalStatus status, const char* category, const std::string& message) {
             if (log != nullptr) log(log_context, status, category, message.c_str());
         };
-        return new (std::nothrow) GimbalCore{logger};
+        auto wants = [enabled, log_context](const char* category) {
+            return enabled == nullptr || enabled(log_context, category) != 0;
+        };
+        return new (std::nothrow) GimbalCore{logger, wants};
     } catch (...) {
         return nullptr;
     }

@@ -42,7 +42,10 @@ static_assert(std::is_trivially_copyable<Snapshot>::value, "snapshots are copied
 
 }  // namespace
 
-GimbalInstance::GimbalInstance(Logger logger) : logger_(std::move(logger)) { reset(); }
+GimbalInstance::GimbalInstance(Logger logger, LogFilter filter)
+    : logger_(std::move(logger)), log_filter_(std::move(filter)) {
+    reset();
+}
 
 void GimbalInstance::reset() {
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) reals_[vr] = kRealVariables[vr].start;
@@ -233,6 +236,7 @@ void GimbalInstance::create_integrator() {
     settings.absolute_tolerance = params_.absolute_tolerance;
     settings.max_steps = params_.max_steps;
     settings.method = static_cast<IntegrationMethod>(params_.method);
+    settings.events_logged = [this] { return log_filter_("logEvents"); };
     integrator_ = HybridIntegrator::create(
         *system_, settings,
         [this](const std::string& message) {
@@ -385,8 +389,29 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
         return refuse(GIMBAL_DISCARD, s.str());
     }
     integrator_running_ = true;
+    double previous_reals[kRealVariableCount];
+    int previous_integers[kIntegerVariableCount];
+    std::copy(reals_, reals_ + kRealVariableCount, previous_reals);
+    std::copy(integers_, integers_ + kIntegerVariableCount, previous_integers);
     time_ = current_time + step_size;
     publish_outputs();
+    // Finite states can still give non-finite outputs from absurd inputs (a base velocity of 1e300
+    // makes the kinetic energy overflow): refuse rather than hand out garbage.
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
+        if (kRealVariables[vr].causality != Causality::output || std::isfinite(reals_[vr])) continue;
+        std::ostringstream s;
+        s.precision(17);
+        s << "fmi2DoStep: " << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
+          << ": an input or parameter lies beyond what the model can represent; state rolled back to t = "
+          << current_time;
+        std::copy(step_start_state, step_start_state + kMaxStateSize, state_);
+        system_->restore(step_start_modes, step_start_counters);
+        std::copy(previous_reals, previous_reals + kRealVariableCount, reals_);
+        std::copy(previous_integers, previous_integers + kIntegerVariableCount, integers_);
+        integrator_running_ = false;
+        time_ = current_time;
+        return refuse(GIMBAL_ERROR, s.str());
+    }
     return GIMBAL_OK;
 }
 

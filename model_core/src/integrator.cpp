@@ -95,7 +95,7 @@ bool HybridIntegrator::advance(double end_time, double* state) {
         backend_roots(root_directions_.data());
         const int changes = system_.update_modes(reached, state, root_directions_.data());
         totals_.events += changes;
-        if (changes > 0) {
+        if (changes > 0 && settings_.events_logged()) {
             std::ostringstream s;
             s.precision(17);
             s << "t = " << reached << ": " << changes << " mode change(s)";
@@ -108,11 +108,13 @@ bool HybridIntegrator::advance(double end_time, double* state) {
             dwell_until_ = reached + settings_.zeno_dwell * std::max(1.0, std::fabs(reached));
             rapid_events_ = 0;
             ++totals_.zeno_holds;
-            std::ostringstream s;
-            s.precision(17);
-            s << "t = " << reached << ": " << settings_.zeno_event_limit
-              << " events without progress in time (chattering); modes held until t = " << dwell_until_;
-            event_sink_(s.str());
+            if (settings_.events_logged()) {
+                std::ostringstream s;
+                s.precision(17);
+                s << "t = " << reached << ": " << settings_.zeno_event_limit
+                  << " events without progress in time (chattering); modes held until t = " << dwell_until_;
+                event_sink_(s.str());
+            }
         }
         // New modes change the right-hand side: restart there, from the (possibly projected) state. A
         // root that changed no mode (a grazing touch) needs no restart: the integrator carries on.

@@ -18,6 +18,8 @@ typedef enum { GIMBAL_INITIAL_NONE = 0, GIMBAL_INITIAL_EXACT = 1, GIMBAL_INITIAL
 
 /* category is one of the logCategories of modelDescription.xml. */
 typedef void (*GimbalLogFunction)(void* context, GimbalStatus status, const char* category, const char* message);
+/* Whether messages of a category would be logged: lets the core skip formatting them. */
+typedef int (*GimbalLogEnabledFunction)(void* context, const char* category);
 
 typedef struct GimbalVariableInfo {
     const char* name;
@@ -31,7 +33,7 @@ typedef enum { GIMBAL_REAL = 0, GIMBAL_INTEGER = 1, GIMBAL_BOOLEAN = 2 } GimbalT
 /* Returns 0 when vr is not a variable of that type. */
 int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info);
 
-GimbalCore* gimbal_core_create(GimbalLogFunction log, void* log_context);
+GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction enabled, void* log_context);
 void gimbal_core_destroy(GimbalCore* core);
 /* Back to the state right after creation: start values, no integrator. */
 void gimbal_core_reset(GimbalCore* core);

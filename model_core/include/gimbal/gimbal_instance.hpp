@@ -18,7 +18,9 @@ class GimbalInstance {
 public:
     using Logger = std::function<void(GimbalStatus, const char* category, const std::string& message)>;
 
-    explicit GimbalInstance(Logger logger);
+    using LogFilter = std::function<bool(const char* category)>;
+
+    GimbalInstance(Logger logger, LogFilter filter);
     GimbalInstance(const GimbalInstance&) = delete;
     GimbalInstance& operator=(const GimbalInstance&) = delete;
 
@@ -52,6 +54,7 @@ private:
     GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
 
     Logger logger_;
+    LogFilter log_filter_;
     double reals_[kRealVariableCount];
     int integers_[kIntegerVariableCount];
     bool booleans_[kBooleanVariableCount];

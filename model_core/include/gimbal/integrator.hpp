@@ -46,6 +46,8 @@ struct IntegratorSettings {
     int zeno_event_limit = 50;
     double zeno_window = 1e-9;
     double zeno_dwell = 1e-6;
+    // Whether anyone listens to event messages: they are only formatted (and allocated) if so.
+    std::function<bool()> events_logged = [] { return true; };
 };
 
 class HybridIntegrator {
