@@ -42,19 +42,38 @@ int friction_mode_indicator(FrictionMode mode, double rate) {
     return rate >= 0.0 ? 2 : -2;
 }
 
+const BaseKinematics& GimbalHybridSystem::base_at(double time) {
+    // The integrator asks for the same instant several times (right-hand side, events, Jacobian), and
+    // a fixed or non-rotating base never changes: evaluate its trigonometry once.
+    if (!base_cached_ || (time != base_time_ && !base_constant_)) {
+        base_ = base_kinematics_at(params_, inputs_, time);
+        base_time_ = time;
+        base_cached_ = true;
+    }
+    return base_;
+}
+
+void GimbalHybridSystem::set_inputs(const StepInputs& inputs) {
+    inputs_ = inputs;
+    base_cached_ = false;
+    const BaseMotion& b = inputs.base;
+    base_constant_ = params_.fidelity.fixed_base ||
+                     (b.attitude_rate.isZero(0.0) && b.attitude_accel.isZero(0.0) && b.acceleration_a.isZero(0.0));
+}
+
 bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
-    return evaluate_state_derivative(params_, inputs_, modes_, time, state, derivative);
+    return evaluate_state_derivative(params_, inputs_, modes_, base_at(time), state, derivative);
 }
 
 bool GimbalHybridSystem::jacobian(double time, const double* state, double* column_major) {
-    evaluate_jacobian(params_, inputs_, modes_, time, state, column_major);
+    evaluate_jacobian(params_, inputs_, modes_, base_at(time), state, column_major);
     return true;
 }
 
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     std::fill(values, values + kEventCount, 1.0);
     Dynamics d;
-    evaluate_dynamics(params_, inputs_, base_kinematics_at(params_, inputs_, time), state, modes_, d);
+    evaluate_dynamics(params_, inputs_, base_at(time), state, modes_, d);
 
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params_.gear[axis];
@@ -106,7 +125,7 @@ void GimbalHybridSystem::event_functions(double time, const double* state, doubl
 int GimbalHybridSystem::update_modes(double time, double* state, const int* directions) {
     const Modes previous = modes_;
     Dynamics d;
-    const BaseKinematics base = base_kinematics_at(params_, inputs_, time);
+    const BaseKinematics base = base_at(time);
     evaluate_dynamics(params_, inputs_, base, state, modes_, d);
 
     for (int axis = 0; axis < 2; ++axis) {

@@ -204,13 +204,13 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     }
 }
 
-void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
-                       const double* state, double* column_major) {
+void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
+                       const BaseKinematics& base, const double* state, double* column_major) {
     using Mat4x12 = Eigen::Matrix<double, 4, 12>;
     const StateLayout& layout = params.layout;
     const int n = layout.size;
     Dynamics d;
-    evaluate_dynamics(params, inputs, base_kinematics_at(params, inputs, time), state, modes, d);
+    evaluate_dynamics(params, inputs, base, state, modes, d);
 
     // Derivatives of the full generalized forces: columns q (0-3), qd (4-7), currents (8-9), theta_b (10-11).
     Mat4x12 force = Mat4x12::Zero();
@@ -319,10 +319,10 @@ void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, 
 }
 
 bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                               double time, const double* state, double* derivative) {
+                               const BaseKinematics& base, const double* state, double* derivative) {
     const StateLayout& layout = params.layout;
     Dynamics d;
-    evaluate_dynamics(params, inputs, base_kinematics_at(params, inputs, time), state, modes, d);
+    evaluate_dynamics(params, inputs, base, state, modes, d);
     for (int body = 0; body < 4; ++body) {
         if (!layout.independent(body)) continue;
         derivative[layout.angle_slot[body]] = d.full.rate[body];

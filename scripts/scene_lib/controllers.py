@@ -20,7 +20,7 @@ from .errors import SceneError, check_keys, number
 from .references import Reference
 
 AXES = ("azimuth", "elevation")
-PID_KEYS = {"kp", "ki", "kd", "k_gyro", "d_filter_s", "i_limit_V", "reference"}
+PID_KEYS = {"kp", "ki", "kd", "k_gyro", "k_ff", "d_filter_s", "i_limit_V", "reference"}
 
 
 def gyro_axis_rates(gyro, beta: float):
@@ -37,7 +37,7 @@ class Controller:
         self.u_limit = tuple(u_limit)
         self.reference = (math.nan, math.nan)   # last set points, for the record
 
-    def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude) -> tuple:
+    def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude, base_rates) -> tuple:
         return self.voltage
 
     def clamp(self, u: float, axis: int) -> float:
@@ -59,35 +59,48 @@ class _ReferenceMixin:
                 self.refs.append(Reference(f"controller.{axis}.reference", sub))
             else:
                 raise SceneError(f"[controller.{axis}] needs a reference: 'target' or a table "
-                                 "{type = 'constant'|'step'|'ramp'|'sine', ...}, got {sub!r}")
+                                 f"{{type = 'constant'|'step'|'ramp'|'sine', ...}}, got {sub!r}")
 
-    def _references(self, t, alpha, base_attitude):
+    def _references(self, t, alpha, base_attitude, base_rates=None, h=None):
+        """Set points (r1, r2) and, with base_rates and h, their rates: for 'target' the exact
+        derivative of the inverse kinematics along the measured base rates, else a difference
+        quotient of the reference over one step."""
         if "target" in self.refs:
             a_t, b_t = geometry.gimbal_angles_for(self.target, *base_attitude, alpha_near=alpha)
         r1 = a_t if self.refs[0] == "target" else self.refs[0].at(t)
         r2 = b_t if self.refs[1] == "target" else self.refs[1].at(t)
-        return r1, r2
+        if h is None:
+            return r1, r2
+        if "target" in self.refs:
+            eps = 1e-6
+            ahead = [q + eps * w for q, w in zip(base_attitude, base_rates)]
+            a_e, b_e = geometry.gimbal_angles_for(self.target, *ahead, alpha_near=a_t)
+            target_rates = ((a_e - a_t) / eps, (b_e - b_t) / eps)
+        rates = [target_rates[i] if ref == "target" else (ref.at(t + h) - r) / h
+                 for i, (ref, r) in enumerate(zip(self.refs, (r1, r2)))]
+        return r1, r2, rates[0], rates[1]
 
 
 class AxisPID:
-    """u = kp e + ki int(e) + kd de/dt - k_gyro w, e = reference - encoder angle, de/dt a backward
-    difference through a first-order filter (time constant d_filter_s), w the gyro rate about the
-    axis. Anti-windup: the integral stops while the output is saturated in the direction of e,
+    """u = kp e + ki int(e) + kd de/dt - k_gyro w + k_ff r_dot, e = reference - encoder angle, de/dt a
+    backward difference through a first-order filter (time constant d_filter_s), w the gyro rate
+    about the axis, r_dot the rate of the reference relative to the base (feed-forward: k_ff = N k_emf
+    cancels the motor's back-emf). Anti-windup: the integral stops while the output is saturated in the direction of e,
     and ki*int(e) is kept within +-i_limit_V."""
 
     def __init__(self, where: str, spec: dict, u_limit: float):
         check_keys(where, spec, PID_KEYS)
-        self.kp, self.ki, self.kd, self.k_gyro = (number(f"{where}.{k}", spec.get(k, 0.0))
-                                                  for k in ("kp", "ki", "kd", "k_gyro"))
+        self.kp, self.ki, self.kd, self.k_gyro, self.k_ff = (number(f"{where}.{k}", spec.get(k, 0.0))
+                                                             for k in ("kp", "ki", "kd", "k_gyro", "k_ff"))
         self.tau = number(f"{where}.d_filter_s", spec.get("d_filter_s", 0.0))
-        self.i_limit = number(f"{where}.i_limit_V", spec.get("i_limit_V", u_limit))
+        self.i_limit = number(f"{where}.i_limit_V", spec["i_limit_V"]) if "i_limit_V" in spec else u_limit
         self.u_limit = u_limit
         self.integral = 0.0
         self.e_prev = None
         self.d = 0.0
         self.saturated = 0
 
-    def __call__(self, e: float, rate: float, h: float) -> float:
+    def __call__(self, e: float, rate: float, h: float, ref_rate: float = 0.0) -> float:
         if self.e_prev is not None:
             raw = (e - self.e_prev) / h
             self.d += (h / (self.tau + h)) * (raw - self.d)
@@ -96,7 +109,7 @@ class AxisPID:
             self.integral += e * h
             if abs(self.ki * self.integral) > self.i_limit:
                 self.integral = math.copysign(self.i_limit / abs(self.ki), self.integral)
-        u = self.kp * e + self.ki * self.integral + self.kd * self.d - self.k_gyro * rate
+        u = self.kp * e + self.ki * self.integral + self.kd * self.d - self.k_gyro * rate + self.k_ff * ref_rate
         self.saturated = 1 if u > self.u_limit else -1 if u < -self.u_limit else 0
         return min(max(u, -self.u_limit), self.u_limit)
 
@@ -106,15 +119,14 @@ class PID(Controller, _ReferenceMixin):
 
     def __init__(self, spec: dict, target, u_limit):
         super().__init__(u_limit=u_limit)
+        self.axes = [AxisPID(f"controller.{axis}", spec.get(axis, {}), u_limit[i]) for i, axis in enumerate(AXES)]
         self._setup_references(spec, target)
-        self.axes = [AxisPID(f"controller.{axis}", {k: v for k, v in spec.get(axis, {}).items()}, u_limit[i])
-                     for i, axis in enumerate(AXES)]
 
-    def __call__(self, t, h, alpha, beta, gyro, base_attitude):
-        r1, r2 = self._references(t, alpha, base_attitude)
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates):
+        r1, r2, r1_dot, r2_dot = self._references(t, alpha, base_attitude, base_rates, h)
         self.reference = (r1, r2)
         w_az, w_el = gyro_axis_rates(gyro, beta)
-        return self.axes[0](r1 - alpha, w_az, h), self.axes[1](r2 - beta, w_el, h)
+        return self.axes[0](r1 - alpha, w_az, h, r1_dot), self.axes[1](r2 - beta, w_el, h, r2_dot)
 
 
 class StateFeedback(Controller, _ReferenceMixin):
@@ -139,7 +151,7 @@ class StateFeedback(Controller, _ReferenceMixin):
         self.integral = [0.0, 0.0]
         self.prev = None
 
-    def __call__(self, t, h, alpha, beta, gyro, base_attitude):
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates):
         r1, r2 = self._references(t, alpha, base_attitude)
         self.reference = (r1, r2)
         if self.rate_source == "gyro":

@@ -93,11 +93,22 @@ class Scene:
         return scene
 
 
-def _table(raw: dict, key: str) -> dict:
+def _table(raw: dict, key: str, flatten: bool = False) -> dict:
     value = raw.get(key, {})
     if not isinstance(value, dict):
         raise SceneError(f"'{key}' must be a table ([{key}])")
-    return value
+    return _flatten(value) if flatten else value
+
+
+def _flatten(table: dict, prefix: str = "") -> dict:
+    """FMU names have dots; unquoted in TOML (gear1.eta = 1e-3) they make nested tables: join them back."""
+    flat = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            flat[f"{prefix}{key}"] = value
+    return flat
 
 
 def load_scene(path: pathlib.Path | str) -> Scene:
@@ -127,8 +138,8 @@ def load_scene(path: pathlib.Path | str) -> Scene:
         scene = Scene(path=path, name=raw["name"], description=str(raw.get("description", "")),
                       stop_time=positive("stop_time", raw["stop_time"]), step_size=step,
                       output_interval=positive("output_interval", raw.get("output_interval", step)),
-                      fidelity=_table(raw, "fidelity"), parameters=_table(raw, "parameters"),
-                      initial=_table(raw, "initial"), base_motion_spec=_table(raw, "base_motion"),
+                      fidelity=_table(raw, "fidelity", True), parameters=_table(raw, "parameters", True),
+                      initial=_table(raw, "initial", True), base_motion_spec=_table(raw, "base_motion"),
                       target_spec=target, controller_spec=_table(raw, "controller"),
                       sensors_spec=_table(raw, "sensors"), requirements=_table(raw, "requirements"),
                       test=_table(raw, "test"), plot=_table(raw, "plot"), raw=raw)
@@ -190,7 +201,7 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
         raise SceneError(f"{scene.path}: {exc}") from None
 
 
-DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "alpha_ref", "beta_ref", "los_error",
+DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
                    "los_azimuth", "los_elevation", "heave"} | {f"base.{n}" for n in (
                        "delta", "psi", "gamma", "delta_dot", "psi_dot", "gamma_dot",
                        "delta_ddot", "psi_ddot", "gamma_ddot")}

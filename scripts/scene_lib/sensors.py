@@ -20,10 +20,10 @@ class Sensors:
         self.rng = np.random.default_rng(int(spec.get("seed", 0)))
         self.ideal = self.resolution == 0 and self.gyro_noise == 0 and self.imu_noise == 0
 
-    def measure(self, alpha: float, beta: float, gyro: list, base_attitude: list):
-        """(alpha, beta, [w1, w2, w3], [delta, psi, gamma]) as measured."""
+    def measure(self, alpha: float, beta: float, gyro: list, base_attitude: list, base_rates: list):
+        """(alpha, beta, [w1, w2, w3], [delta, psi, gamma], [their rates]) as measured."""
         if self.ideal:
-            return alpha, beta, gyro, base_attitude
+            return alpha, beta, gyro, base_attitude, base_rates
         if self.resolution > 0:
             alpha = self.resolution * round(alpha / self.resolution)
             beta = self.resolution * round(beta / self.resolution)
@@ -31,4 +31,4 @@ class Sensors:
             gyro = [w + n for w, n in zip(gyro, self.rng.normal(0.0, self.gyro_noise, 3))]
         if self.imu_noise > 0:
             base_attitude = [a + n for a, n in zip(base_attitude, self.rng.normal(0.0, self.imu_noise, 3))]
-        return alpha, beta, gyro, base_attitude
+        return alpha, beta, gyro, base_attitude, base_rates

@@ -32,7 +32,7 @@ public:
     void event_functions(double time, const double* state, double* values) override;
     int update_modes(double time, double* state, const int* directions) override;
 
-    void set_inputs(const StepInputs& inputs) { inputs_ = inputs; }
+    void set_inputs(const StepInputs& inputs);
     const StepInputs& inputs() const { return inputs_; }
     const Modes& modes() const { return modes_; }
     const EventCounters& counters() const { return counters_; }
@@ -40,8 +40,14 @@ public:
     void restore(const Modes& modes, const EventCounters& counters) { modes_ = modes, counters_ = counters; }
 
 private:
+    const BaseKinematics& base_at(double time);
+
     const ModelParameters& params_;
     StepInputs inputs_;
+    BaseKinematics base_;
+    double base_time_ = 0.0;
+    bool base_cached_ = false;
+    bool base_constant_ = false;
     Modes modes_;
     EventCounters counters_;
 };

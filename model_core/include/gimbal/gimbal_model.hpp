@@ -143,14 +143,14 @@ Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Mo
 // d(dx/dt)/dx, column-major, exact for everything that makes the system stiff (gears, motor
 // circuits, backlash, viscous and stick damping) and leaving out the slow configuration dependence of
 // J and f (gravity, gyroscopic terms): the iteration matrix of Newton's method needs no more.
-void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
-                       const double* state, double* column_major);
+void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
+                       const BaseKinematics& base, const double* state, double* column_major);
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
 
 // dx/dt within the current modes; false if it is not finite.
 bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                               double time, const double* state, double* derivative);
+                               const BaseKinematics& base, const double* state, double* derivative);
 
 // Quantities derived from the state for outputs and diagnostics.
 struct ModelOutputs {

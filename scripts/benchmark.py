@@ -1,0 +1,459 @@
+#!/usr/bin/env python3
+"""Work-precision benchmark of the Gimbal2Axis FMU (issue 6), in one command:
+
+    .venv/bin/python scripts/benchmark.py            # ~5-10 minutes on a 2-core machine
+
+It builds nothing: it runs the native driver build/benchmarks/gimbal_bench (benchmarks/bench_driver.cpp)
+on the FMU's shared object in build/fmu_staging (run `bash scripts/setup.sh` or `cmake --build build`
+first). Both are copied to a temporary directory first, so a rebuild during the benchmark does not
+disturb it. Steps:
+
+1. a reference trajectory per fidelity (full, reduced) of the ship-stabilization scene at very tight
+   tolerance (rtol 1e-12, atol 1e-14, method 0 or the FMU's default), and a second one with ARKODE's
+   explicit RK (method 3) at the same tolerance to show how far the reference itself can be trusted;
+2. the work-precision sweep: every integrator of `solver.method` (0 CVODE BDF analytic Jacobian,
+   1 CVODE BDF finite differences, 2 CVODE Adams, 3 ARKODE explicit Runge-Kutta) x fidelity x
+   rtol in 1e-4 ... 1e-10 (atol = rtol * 1e-2): CPU time and the max error of alpha, beta and
+   los.omega against the reference at every communication point;
+3. cost against simulated time (1, 10, 100, 1000 s) with the FMU's default integrator, full fidelity;
+4. the FMI overhead (doStep of a model at rest, 1 us steps) and the instance memory;
+5. heap allocations inside doStep and their call sites.
+
+Writes benchmarks/results/results.json and benchmarks/results/work_precision.png, prints a summary.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import pathlib
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+REPO = pathlib.Path(__file__).resolve().parent.parent
+METHOD_NAMES = {
+    None: "FMU default",
+    0: "CVODE BDF, analytic Jacobian",
+    1: "CVODE BDF, finite-difference Jacobian",
+    2: "CVODE Adams",
+    3: "ARKODE explicit RK",
+}
+FIDELITIES = ("full", "reduced")
+TARGET_BETA_ERROR = 1e-6
+TARGET_RTF = {"full": 1e3, "reduced": 1e4}
+TARGET_OVERHEAD_NS = 200.0
+
+
+def log(message: str) -> None:
+    print(message, flush=True)
+
+
+class Driver:
+    """Runs gimbal_bench on a private copy of the FMU."""
+
+    def __init__(self, bench: pathlib.Path, so: pathlib.Path, md: pathlib.Path, workdir: pathlib.Path,
+                 timeout: float):
+        self.dir = workdir / "fmu"
+        (self.dir / "binaries" / "linux64").mkdir(parents=True)
+        shutil.copy2(md, self.dir / "modelDescription.xml")
+        self.so = self.dir / "binaries" / "linux64" / so.name
+        shutil.copy2(so, self.so)
+        self.bench = workdir / "gimbal_bench"
+        shutil.copy2(bench, self.bench)
+        self.workdir = workdir
+        self.timeout = timeout
+        text = (self.dir / "modelDescription.xml").read_text()
+        self.has_method = 'name="solver.method"' in text
+        self.guid = text.split('guid="', 1)[1].split('"', 1)[0]
+        self.default_method = None
+        if self.has_method:
+            block = text.split('name="solver.method"', 1)[1].split("</ScalarVariable>", 1)[0]
+            if 'start="' in block:
+                self.default_method = int(block.split('start="', 1)[1].split('"', 1)[0])
+        self.count = 0
+
+    def run(self, *, method=None, fidelity="full", rtol=None, atol=None, duration=10.0, step=1e-3,
+            trajectory=False, overhead=False, overhead_steps=None, trace=False, timeout=None) -> dict:
+        cmd = [str(self.bench), "--fmu", str(self.so), "--json", "--fidelity", fidelity]
+        if not trace:
+            cmd.append("--no-trace")
+        if method is not None:
+            cmd += ["--method", str(method)]
+        if rtol is not None:
+            cmd += ["--rtol", repr(rtol)]
+        if atol is not None:
+            cmd += ["--atol", repr(atol)]
+        traj_path = None
+        if overhead:
+            cmd.append("--fmi-overhead")
+            if overhead_steps:
+                cmd += ["--overhead-steps", str(overhead_steps)]
+        else:
+            cmd += ["--duration", repr(duration), "--step", repr(step)]
+            if trajectory:
+                self.count += 1
+                traj_path = self.workdir / f"traj{self.count}.bin"
+                cmd += ["--trajectory", str(traj_path)]
+        try:
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout or self.timeout)
+        except subprocess.TimeoutExpired:
+            return {"failure": f"timeout after {timeout or self.timeout:.0f} s", "command": " ".join(cmd)}
+        lines = [line for line in proc.stdout.splitlines() if line.startswith("{")]
+        if not lines:
+            return {"failure": (proc.stderr.strip() or f"exit status {proc.returncode}")[-500:],
+                    "command": " ".join(cmd)}
+        result = json.loads(lines[-1])
+        if proc.stderr.strip():
+            result["stderr"] = proc.stderr.strip()[-500:]
+        if traj_path is not None and traj_path.exists():
+            result["_trajectory"] = np.fromfile(traj_path, dtype="<f8").reshape(-1, 6)
+            traj_path.unlink()
+        return result
+
+
+def errors_against(run: dict, reference: np.ndarray) -> dict:
+    """Max absolute errors at the communication points: alpha, beta [rad], los.omega [rad/s]."""
+    traj = run.get("_trajectory")
+    if traj is None or len(traj) != len(reference) or run.get("failure"):
+        return {"err_alpha": None, "err_beta": None, "err_omega": None}
+    d = np.abs(traj[:, 1:] - reference[:, 1:])
+    return {"err_alpha": float(d[:, 0].max()), "err_beta": float(d[:, 1].max()), "err_omega": float(d[:, 2:].max())}
+
+
+def machine_info() -> dict:
+    cpu = "?"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    compiler = "?"
+    cache = REPO / "build" / "CMakeCache.txt"
+    try:
+        cxx = "c++"
+        for line in cache.read_text().splitlines():
+            if line.startswith("CMAKE_CXX_COMPILER:"):
+                cxx = line.split("=", 1)[1]
+        compiler = subprocess.run([cxx, "--version"], capture_output=True, text=True).stdout.splitlines()[0]
+    except (OSError, IndexError):
+        pass
+
+    def git(*args):
+        try:
+            return subprocess.run(["git", *args], cwd=REPO, capture_output=True, text=True).stdout.strip()
+        except OSError:
+            return "?"
+
+    dirty = git("status", "--porcelain", "--untracked-files=no")
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "kernel": platform.release(),
+        "compiler": compiler,
+        "git_commit": git("rev-parse", "HEAD"),
+        "git_dirty": bool(dirty),
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "python": platform.python_version(),
+    }
+
+
+def strip(run: dict) -> dict:
+    return {k: v for k, v in run.items() if not k.startswith("_")}
+
+
+def fmt(x, spec=".3g"):
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build-dir", type=pathlib.Path, default=REPO / "build")
+    ap.add_argument("--bench", type=pathlib.Path, help="gimbal_bench executable (default BUILD/benchmarks/gimbal_bench)")
+    ap.add_argument("--duration", type=float, default=10.0, help="simulated time of the sweep runs [s] (default 10)")
+    ap.add_argument("--step", type=float, default=1e-3, help="communication step [s] (default 1e-3)")
+    ap.add_argument("--rtols", default="1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10")
+    ap.add_argument("--atol-factor", type=float, default=1e-2, help="atol = rtol * this (default 1e-2)")
+    ap.add_argument("--methods", default=None, help="comma-separated solver.method values (default 0,1,2,3 if offered)")
+    ap.add_argument("--fidelities", default="full,reduced")
+    ap.add_argument("--durations", default="1,10,100,1000", help="cost-vs-duration table [s]")
+    ap.add_argument("--duration-budget", type=float, default=90.0,
+                    help="CPU seconds allowed for the longest cost-vs-duration run (longer ones are shortened)")
+    ap.add_argument("--run-timeout", type=float, default=90.0, help="give up a single sweep run after this [s]")
+    ap.add_argument("--overhead-steps", type=int, default=200000)
+    ap.add_argument("--out", type=pathlib.Path, default=REPO / "benchmarks" / "results")
+    ap.add_argument("--quick", action="store_true", help="smoke test: 1 s runs, 3 tolerances, no long durations")
+    args = ap.parse_args()
+
+    if args.quick:
+        args.duration = 1.0
+        args.rtols = "1e-4,1e-6,1e-8"
+        args.durations = "1,2"
+        args.overhead_steps = 20000
+
+    build = args.build_dir.resolve()
+    bench = (args.bench or build / "benchmarks" / "gimbal_bench").resolve()
+    so = build / "fmu_staging" / "binaries" / "linux64" / "Gimbal2Axis.so"
+    md = build / "fmu_staging" / "modelDescription.xml"
+    missing = [p for p in (bench, so, md) if not p.exists()]
+    if missing:
+        print("benchmark: missing " + ", ".join(str(p) for p in missing) + ".\n"
+              "Build first: `bash scripts/setup.sh` (fresh machine) or `cmake --build build` "
+              "(the top-level CMakeLists.txt must contain add_subdirectory(benchmarks)).", file=sys.stderr)
+        return 2
+
+    t_start = time.time()
+    rtols = [float(x) for x in args.rtols.split(",")]
+    fidelities = [f for f in args.fidelities.split(",") if f]
+    results: dict = {"machine": machine_info(), "settings": {
+        "scene": "ship_stabilization (benchmarks/bench_driver.cpp: sea state seed 1, PD + gyro, one-step delay)",
+        "duration_s": args.duration, "step_s": args.step, "rtols": rtols, "atol_factor": args.atol_factor,
+        "reference": "rtol 1e-12, atol 1e-14", "error": "max abs over communication points"}}
+
+    with tempfile.TemporaryDirectory(prefix="gimbal_bench_") as tmp:
+        drv = Driver(bench, so, md, pathlib.Path(tmp), args.run_timeout)
+        results["fmu_guid"] = drv.guid
+        if args.methods is not None:
+            methods = [int(m) for m in args.methods.split(",")]
+            if not drv.has_method:
+                print("benchmark: --methods given but the FMU has no parameter solver.method", file=sys.stderr)
+                return 2
+        elif drv.has_method:
+            methods = [0, 1, 2, 3]
+        else:
+            methods = [None]
+            log("note: the FMU has no parameter 'solver.method': only its default integrator is measured")
+        results["methods"] = {str(m): METHOD_NAMES.get(m, f"method {m}") for m in methods}
+
+        # ---------------------------------------------------------------- references
+        references: dict = {}
+        results["references"] = {}
+        ref_method = 0 if drv.has_method else None
+        for fid in fidelities:
+            log(f"[reference] {fid}: rtol 1e-12, atol 1e-14, {args.duration:g} s ...")
+            ref = drv.run(method=ref_method, fidelity=fid, rtol=1e-12, atol=1e-14, duration=args.duration,
+                          step=args.step, trajectory=True, timeout=max(args.run_timeout, 600))
+            if ref.get("failure") or "_trajectory" not in ref:
+                log(f"  reference failed: {ref.get('failure')}")
+                return 1
+            references[fid] = ref["_trajectory"]
+            # A second solution to bound the reference's own error: another method, or rtol 1e-11.
+            # ARKODE's explicit RK (method 3) shares nothing with CVODE BDF but the model.
+            check_method = 3 if drv.has_method else None
+            check = drv.run(method=check_method, fidelity=fid, rtol=1e-12 if drv.has_method else 1e-11,
+                            atol=1e-14 if drv.has_method else 1e-13, duration=args.duration, step=args.step,
+                            trajectory=True, timeout=max(args.run_timeout, 600))
+            spread = errors_against(check, references[fid])
+            results["references"][fid] = {"run": strip(ref), "check_run": strip(check), "check_difference": spread}
+            log(f"  cpu {ref['cpu_s']:.2f} s; second solution differs by beta {fmt(spread['err_beta'])} rad, "
+                f"alpha {fmt(spread['err_alpha'])} rad, omega {fmt(spread['err_omega'])} rad/s")
+
+        # ---------------------------------------------------------------- work-precision sweep
+        sweep = []
+        for fid in fidelities:
+            for m in methods:
+                for rtol in rtols:
+                    atol = rtol * args.atol_factor
+                    run = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
+                                  step=args.step, trajectory=True)
+                    # Cheap runs are noisy: keep the fastest of up to three.
+                    if not run.get("failure") and run["cpu_s"] < 0.5:
+                        for _ in range(2):
+                            again = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
+                                            step=args.step)
+                            if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
+                                for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
+                                    run[key] = again[key]
+                    if not run.get("failure"):
+                        fmu_cpu = run["cpu_s"] - (run.get("master_cpu_s") or 0.0)
+                        run["fmu_cpu_s"] = fmu_cpu
+                        run["fmu_rtf"] = run["simulated"] / fmu_cpu if fmu_cpu > 0 else None
+                    point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol,
+                             **errors_against(run, references[fid]), **strip(run)}
+                    sweep.append(point)
+                    log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} rtol {rtol:.0e}: "
+                        + (f"FAILED {run['failure']}" if run.get("failure") else
+                           f"cpu {run['cpu_s']:.3f} s  rtf {run['rtf']:9.1f}  err beta {fmt(point['err_beta'])}  "
+                           f"alpha {fmt(point['err_alpha'])}  omega {fmt(point['err_omega'])}  "
+                           f"steps {run['solver_steps']}  rhs {run['rhs_evaluations']}  jac {run['jacobian_evaluations']}"))
+                    if run.get("failure", "").startswith("timeout"):
+                        log("  (tighter tolerances of this method skipped)")
+                        break
+        results["sweep"] = sweep
+
+        # Cheapest run meeting the beta target, per method and fidelity.
+        best = []
+        for fid in fidelities:
+            for m in methods:
+                ok = [p for p in sweep if p["fidelity"] == fid and p["method"] == m and p["err_beta"] is not None
+                      and p["err_beta"] <= TARGET_BETA_ERROR]
+                if ok:
+                    p = min(ok, key=lambda p: p["cpu_s"])
+                    best.append({"fidelity": fid, "method": m, "rtol": p["rtol"], "cpu_s": p["cpu_s"],
+                                 "rtf": p["rtf"], "fmu_rtf": p.get("fmu_rtf"),
+                                 "cpu_us_per_step": p["cpu_us_per_step"], "err_beta": p["err_beta"], "err_alpha": p["err_alpha"],
+                                 "err_omega": p["err_omega"], "target_rtf": TARGET_RTF.get(fid),
+                                 "meets_target": p["rtf"] >= TARGET_RTF.get(fid, 0)})
+                else:
+                    best.append({"fidelity": fid, "method": m, "rtol": None, "cpu_s": None, "rtf": None,
+                                 "err_beta": None, "target_rtf": TARGET_RTF.get(fid), "meets_target": False})
+        results["at_target_error"] = best
+
+        # ---------------------------------------------------------------- cost against duration
+        # The FMU's default integrator at the loosest swept tolerance that meets the beta target.
+        full_default = [p for p in best if p["fidelity"] == "full" and p["method"] == drv.default_method]
+        default_rtol = full_default[0]["rtol"] if full_default and full_default[0]["rtol"] else None
+        durations = [float(x) for x in args.durations.split(",")]
+        growth = []
+        rate = None
+        for d in durations:
+            planned = d
+            if rate is not None and d / rate > args.duration_budget:
+                planned = max(durations[0], math.floor(args.duration_budget * rate / 10.0) * 10.0)
+                log(f"[duration] {d:g} s would take ~{d / rate:.0f} s CPU: running {planned:g} s instead")
+            run = drv.run(fidelity="full", rtol=default_rtol, atol=None if default_rtol is None else default_rtol * args.atol_factor,
+                          duration=planned, step=args.step, timeout=max(args.run_timeout, 4 * args.duration_budget))
+            if run.get("failure"):
+                log(f"[duration] {planned:g} s: FAILED {run['failure']}")
+                growth.append({"requested_s": d, "simulated_s": planned, "failure": run["failure"]})
+                continue
+            rate = run["simulated"] / run["cpu_s"]
+            growth.append({"requested_s": d, "simulated_s": run["simulated"], "cpu_s": run["cpu_s"],
+                           "cpu_us_per_simulated_ms": 1e3 * run["cpu_s"] / run["simulated"], "rtf": run["rtf"],
+                           "solver_steps": run["solver_steps"], "rhs_evaluations": run["rhs_evaluations"],
+                           "events": run["events"], "dostep_allocations": run["dostep_allocations"]})
+            log(f"[duration] {run['simulated']:g} s: cpu {run['cpu_s']:.3f} s = "
+                f"{1e3 * run['cpu_s'] / run['simulated']:.2f} us per simulated ms, rtf {run['rtf']:.1f}")
+        results["cost_vs_duration"] = {"method": drv.default_method, "fidelity": "full", "rtol": default_rtol,
+                                       "runs": growth}
+
+        # ---------------------------------------------------------------- FMI overhead, allocations
+        overhead = {}
+        for fid in fidelities:
+            run = drv.run(fidelity=fid, overhead=True, overhead_steps=args.overhead_steps, trace=True)
+            overhead[fid] = strip(run)
+            if run.get("failure"):
+                log(f"[overhead] {fid}: FAILED {run['failure']}")
+            else:
+                log(f"[overhead] {fid}: {run['ns_per_dostep']:.0f} ns per doStep (CPU), "
+                    f"{run['rhs_evaluations'] / max(1, run['dostep_calls']):.2f} rhs per doStep; instance "
+                    f"{run['instance_bytes']} bytes in {run['instance_allocations']} allocations; "
+                    f"{run['dostep_allocations']} allocations in {run['dostep_calls']} doSteps")
+        results["fmi_overhead"] = overhead
+        alloc = {}
+        for fid in fidelities:
+            run = drv.run(fidelity=fid, duration=2.0, step=args.step, trace=True)
+            alloc[fid] = {k: run.get(k) for k in ("dostep_calls", "first_step_allocations", "dostep_allocations",
+                                                  "dostep_alloc_bytes", "events", "allocation_sites", "failure")}
+            log(f"[allocations] {fid}: {run.get('dostep_allocations')} allocations in "
+                f"{run.get('dostep_calls')} doSteps after the first ({run.get('events')} events)")
+        results["allocations_in_dostep"] = alloc
+
+    results["elapsed_s"] = round(time.time() - t_start, 1)
+    args.out.mkdir(parents=True, exist_ok=True)
+    out_json = args.out / "results.json"
+    out_json.write_text(json.dumps(results, indent=1) + "\n")
+    png = args.out / "work_precision.png"
+    plot(results, png, methods, fidelities, args.duration)
+    summary(results, methods, fidelities, args.duration)
+    log(f"\nwrote {out_json.relative_to(REPO) if out_json.is_relative_to(REPO) else out_json} and "
+        f"{png.relative_to(REPO) if png.is_relative_to(REPO) else png} in {results['elapsed_s']:.0f} s")
+    return 0
+
+
+def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    colors = {None: "k", 0: "tab:blue", 1: "tab:orange", 2: "tab:green", 3: "tab:red"}
+    styles = {"full": ("-", "o"), "reduced": ("--", "s")}
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.2), sharey=True)
+    for ax, key, label in ((axes[0], "err_beta", "max error of beta [rad]"),
+                           (axes[1], "err_omega", "max error of los.omega [rad/s]")):
+        for fid in fidelities:
+            for m in methods:
+                pts = [p for p in results["sweep"] if p["fidelity"] == fid and p["method"] == m
+                       and p.get(key) is not None and not p.get("failure")]
+                if not pts:
+                    continue
+                x = [max(p[key], 1e-16) for p in pts]
+                y = [1e3 * p["cpu_s"] / p["simulated"] for p in pts]
+                ls, mk = styles.get(fid, ("-", "o"))
+                ax.loglog(x, y, ls=ls, marker=mk, color=colors.get(m, "gray"), ms=4,
+                          label=f"{METHOD_NAMES.get(m, m)}, {fid}")
+                for p, xi, yi in zip(pts, x, y):
+                    ax.annotate(f"{p['rtol']:.0e}".replace("e-0", "e-"), (xi, yi), fontsize=6, alpha=0.6,
+                                xytext=(2, 2), textcoords="offset points")
+        ax.set_xlabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].axvline(TARGET_BETA_ERROR, color="gray", lw=0.8, ls=":")
+    for fid, rtf in TARGET_RTF.items():
+        if fid in fidelities:
+            for ax in axes:
+                ax.axhline(1e3 / rtf, color="gray", lw=0.8, ls=styles[fid][0])
+            axes[0].annotate(f"target {fid}: {rtf:.0f}x real time", (1e-15, 1e3 / rtf), fontsize=7, color="gray",
+                             xytext=(0, 2), textcoords="offset points")
+    axes[0].set_ylabel("CPU time per simulated ms [us]  (1000 / real-time factor)")
+    axes[1].legend(fontsize=7, loc="upper right")
+    m = results["machine"]
+    fig.suptitle(f"Gimbal2Axis work-precision, ship stabilization {duration:g} s at 1 kHz "
+                 f"(labels: rtol; atol = rtol/100)\n{m['cpu']}, {m['compiler']}, commit {m['git_commit'][:10]}"
+                 f"{' (dirty)' if m['git_dirty'] else ''}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def summary(results: dict, methods, fidelities, duration: float) -> None:
+    log("\n=== work precision (ship stabilization, %g s, 1 kHz; errors vs rtol 1e-12 reference) ===" % duration)
+    log(f"{'fidelity':8s} {'method':38s} {'rtol':>7s} {'cpu [s]':>9s} {'RTF':>10s} {'err beta':>9s} "
+        f"{'err alpha':>9s} {'err omega':>9s} {'steps':>8s} {'rhs':>9s} {'jac':>7s} {'events':>6s}")
+    for p in results["sweep"]:
+        if p.get("failure"):
+            log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {p['rtol']:7.0e}  FAILED: {p['failure'][:60]}")
+            continue
+        log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {p['rtol']:7.0e} {p['cpu_s']:9.3f} "
+            f"{p['rtf']:10.1f} {fmt(p['err_beta']):>9s} {fmt(p['err_alpha']):>9s} {fmt(p['err_omega']):>9s} "
+            f"{p['solver_steps']:8d} {p['rhs_evaluations']:9d} {p['jacobian_evaluations']:7d} {p['events']:6d}")
+    log(f"\n=== at max beta error <= {TARGET_BETA_ERROR:g} rad (cheapest tolerance of the sweep) ===")
+    log(f"{'fidelity':8s} {'method':38s} {'rtol':>7s} {'us/step':>8s} {'RTF':>9s} {'RTF FMU':>9s} {'target':>7s}  met")
+    for b in results["at_target_error"]:
+        log(f"{b['fidelity']:8s} {METHOD_NAMES.get(b['method'], b['method'])!s:38s} {fmt(b['rtol'], '.0e'):>7s} "
+            f"{fmt(b.get('cpu_us_per_step'), '.2f'):>8s} {fmt(b['rtf'], '.1f'):>9s} {fmt(b.get('fmu_rtf'), '.1f'):>9s} "
+            f"{fmt(b['target_rtf'], '.0f'):>7s}  {'yes' if b['meets_target'] else 'NO'}")
+    log("(RTF = simulated / CPU time of the whole master loop; RTF FMU leaves out the master's own share)")
+    log("\n=== cost against simulated time (FMU default integrator, full fidelity) ===")
+    for g in results["cost_vs_duration"]["runs"]:
+        if g.get("failure"):
+            log(f"{g['simulated_s']:8g} s  FAILED {g['failure']}")
+        else:
+            log(f"{g['simulated_s']:8g} s  cpu {g['cpu_s']:9.3f} s  {g['cpu_us_per_simulated_ms']:8.2f} us/ms  "
+                f"RTF {g['rtf']:9.1f}  steps {g['solver_steps']}")
+    log("\n=== FMI overhead (model at rest, fixed base, 1 us steps; target < 200 ns) ===")
+    for fid, o in results["fmi_overhead"].items():
+        if o.get("failure"):
+            log(f"{fid:8s} FAILED {o['failure']}")
+        else:
+            log(f"{fid:8s} {o['ns_per_dostep']:8.0f} ns per doStep; instance {o['instance_bytes']} bytes; "
+                f"{o['dostep_allocations']} allocations in {o['dostep_calls']} doSteps")
+    log("\n=== heap allocations in doStep after the first (ship stabilization 2 s) ===")
+    for fid, a in results["allocations_in_dostep"].items():
+        log(f"{fid:8s} {a['dostep_allocations']} allocations ({a['dostep_alloc_bytes']} bytes) in {a['dostep_calls']} doSteps")
+        for site in (a.get("allocation_sites") or [])[:6]:
+            lines = site.splitlines()
+            log("    " + lines[0] + (" " + lines[1].strip() if len(lines) > 1 else "")
+                + (" ... " + lines[-1].strip() if len(lines) > 2 else ""))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,35 @@
+"""Scenes for the Gimbal2Axis FMU: loading and validation (scene), base motions (base_motion),
+angle references (references), controllers (controllers), sensors (sensors), line-of-sight
+geometry (geometry), the FMU wrapper (fmu), the co-simulation master loop (master), results and
+metrics (results), plots (plotting), a progress bar (progress)."""
+from .errors import SceneError
+from .fmu import FMU
+from .master import run
+from .scene import Scene, check_against_fmu, load_scene
+
+__all__ = ["SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run", "run_scene_file"]
+
+
+def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_time: float | None = None):
+    """Runs one scene file and writes <out>/<name>.csv and .png; returns (result, csv, png)."""
+    import pathlib
+
+    from .plotting import plot
+    from .scene import parameter_value
+
+    scene = load_scene(scene_path)
+    out = pathlib.Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with FMU(fmu_path) as fmu:
+        result = run(scene, fmu, progress=progress, stop_time=stop_time)
+        limits = {}
+        for j in (1, 2):
+            i_l, eta = parameter_value(scene, fmu, f"motor{j}.i_L"), parameter_value(scene, fmu, f"gear{j}.eta")
+            if i_l is not None:
+                limits[f"i_R{j}"] = float(i_l)
+            if eta:
+                limits[f"theta_b{j}"] = float(eta)
+    csv_path, png_path = out / f"{scene.name}.csv", out / f"{scene.name}.png"
+    result.write_csv(csv_path)
+    plot(result, png_path, limits)
+    return result, csv_path, png_path
