@@ -310,6 +310,16 @@ static int check_get(Instance* instance, const char* function, const fmi2ValueRe
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     Instance* instance = (Instance*)c;
     if (!check_set(instance, "fmi2SetReal", GIMBAL_REAL, vr, nvr, value)) return fmi2Error;
+    /* All or nothing: a refused call must not leave some of its values applied. */
+    for (size_t i = 0; i < nvr; ++i) {
+        if (!isfinite(value[i])) {
+            GimbalVariableInfo info;
+            gimbal_variable_info(GIMBAL_REAL, vr[i], &info);
+            log_message(instance, fmi2Error, "logStatusError", "fmi2SetReal: %s = %g refused: values must be finite",
+                        info.name, value[i]);
+            return fmi2Error;
+        }
+    }
     for (size_t i = 0; i < nvr; ++i) {
         const fmi2Status status = from_core(gimbal_core_set_real(instance->core, vr[i], value[i]));
         if (status > fmi2Warning) return status;
@@ -547,12 +557,21 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 }
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-    (void)vr;
-    (void)nvr;
-    (void)order;
-    (void)value;
-    return unsupported(c, "fmi2SetRealInputDerivatives", "canInterpolateInputs");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetRealInputDerivatives", STATE_INITIALIZATION | STATE_STEP_COMPLETE)) return fmi2Error;
+    if (nvr == 0) return fmi2OK;
+    if (!not_null(instance, "fmi2SetRealInputDerivatives", vr, "vr") ||
+        !not_null(instance, "fmi2SetRealInputDerivatives", order, "order") ||
+        !not_null(instance, "fmi2SetRealInputDerivatives", value, "value"))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        const fmi2Status status =
+            from_core(gimbal_core_set_input_derivative(instance->core, vr[i], (int)order[i], value[i]));
+        if (status > fmi2Warning) return status;
+    }
+    return fmi2OK;
 }
+
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr;

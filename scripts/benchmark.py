@@ -30,6 +30,7 @@ import math
 import os
 import pathlib
 import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -192,7 +193,16 @@ def main() -> int:
     ap.add_argument("--overhead-steps", type=int, default=200000)
     ap.add_argument("--out", type=pathlib.Path, default=REPO / "benchmarks" / "results")
     ap.add_argument("--quick", action="store_true", help="smoke test: 1 s runs, 3 tolerances, no long durations")
+    ap.add_argument("--replot", action="store_true", help="only redraw the PNG and the tables from OUT/results.json")
     args = ap.parse_args()
+
+    if args.replot:
+        results = json.loads((args.out / "results.json").read_text())
+        methods = [None if m == "None" else int(m) for m in results["methods"]]
+        fidelities = list(results["references"])
+        plot(results, args.out / "work_precision.png", methods, fidelities, results["settings"]["duration_s"])
+        summary(results, methods, fidelities, results["settings"]["duration_s"])
+        return 0
 
     if args.quick:
         args.duration = 1.0
@@ -377,7 +387,7 @@ def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float
 
     colors = {None: "k", 0: "tab:blue", 1: "tab:orange", 2: "tab:green", 3: "tab:red"}
     styles = {"full": ("-", "o"), "reduced": ("--", "s")}
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5.2), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.8), sharey=True)
     for ax, key, label in ((axes[0], "err_beta", "max error of beta [rad]"),
                            (axes[1], "err_omega", "max error of los.omega [rad/s]")):
         for fid in fidelities:
@@ -401,15 +411,18 @@ def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float
         if fid in fidelities:
             for ax in axes:
                 ax.axhline(1e3 / rtf, color="gray", lw=0.8, ls=styles[fid][0])
-            axes[0].annotate(f"target {fid}: {rtf:.0f}x real time", (1e-15, 1e3 / rtf), fontsize=7, color="gray",
-                             xytext=(0, 2), textcoords="offset points")
+                ax.text(0.01, 1e3 / rtf * 1.08, f"target {fid}: {rtf:.0f}x real time", fontsize=7, color="gray",
+                        transform=ax.get_yaxis_transform())
+    axes[0].text(TARGET_BETA_ERROR * 0.9, 0.5, "beta bound 1e-6 rad", rotation=90, fontsize=7, color="gray",
+                 ha="right", transform=axes[0].get_xaxis_transform())
     axes[0].set_ylabel("CPU time per simulated ms [us]  (1000 / real-time factor)")
-    axes[1].legend(fontsize=7, loc="upper right")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=4, frameon=False)
     m = results["machine"]
     fig.suptitle(f"Gimbal2Axis work-precision, ship stabilization {duration:g} s at 1 kHz "
                  f"(labels: rtol; atol = rtol/100)\n{m['cpu']}, {m['compiler']}, commit {m['git_commit'][:10]}"
                  f"{' (dirty)' if m['git_dirty'] else ''}", fontsize=9)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
@@ -450,9 +463,11 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
     for fid, a in results["allocations_in_dostep"].items():
         log(f"{fid:8s} {a['dostep_allocations']} allocations ({a['dostep_alloc_bytes']} bytes) in {a['dostep_calls']} doSteps")
         for site in (a.get("allocation_sites") or [])[:6]:
-            lines = site.splitlines()
-            log("    " + lines[0] + (" " + lines[1].strip() if len(lines) > 1 else "")
-                + (" ... " + lines[-1].strip() if len(lines) > 2 else ""))
+            lines = [l for l in re.split(r"\n|\s{4,}(?=#\d)", site) if l.strip()]
+            # The first frames that are neither the allocator nor the C++ library say who allocates.
+            own = [l.strip().split(" ", 2)[-1] for l in lines[1:]
+                   if not any(x in l for x in ("operator new", "std::", " N_VNew", " N_VClone", "malloc"))]
+            log("    " + lines[0] + " " + " <- ".join(own[:3]))
 
 
 if __name__ == "__main__":

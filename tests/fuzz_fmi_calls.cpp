@@ -371,6 +371,7 @@ struct CallContext {
     int by_status[5] = {0, 0, 0, 0, 0};
     int bad_status = 0, null_arguments = 0, wrong_environment = 0, wrong_name = 0, conversions = 0;
     std::string first_refusal;
+    std::string first_conversion;
 };
 
 CallContext g_call;
@@ -406,7 +407,7 @@ void logger(fmi2ComponentEnvironment environment, fmi2String instance_name, fmi2
             else conversion = true;
         }
         if (conversion) {
-            ++call.conversions;
+            if (call.conversions++ == 0) call.first_conversion = message;
             std::snprintf(text, sizeof text, "(unformatted) %s", message);
         } else {
             va_list args;
@@ -431,6 +432,7 @@ struct Stats {
     long long successful_steps = 0, successful_initializations = 0, discarded_steps = 0;
     long long by_status[6] = {0, 0, 0, 0, 0, 0};
     double slowest_call = 0.0;
+    long long slow_calls = 0, very_slow_calls = 0;  // > 0.1 s, > 1 s
     std::string slowest_call_description;
     long long slowest_call_sequence = -1;
     int printed_failures = 0, printed_traces = 0;
@@ -485,9 +487,36 @@ struct Instance {
     double time = 0.0;  // the FMU's time as expected from the calls that succeeded
     bool stop_time_defined = false;
     double stop_time = 0.0;
-    std::vector<fmi2FMUstate> states;              // obtained from this instance, not yet freed
-    std::vector<std::vector<fmi2Byte>> serialized;  // serialized states of this instance
+    std::vector<struct SavedState> states;  // FMU states obtained from this instance, not yet freed
 };
+
+// What the master knows of an FMU state: the FMU's phase, time and stop time when it was taken.
+struct Snapshot {
+    Phase phase = Phase::instantiated;
+    double time = 0.0;
+    bool stop_time_defined = false;
+    double stop_time = 0.0;
+    bool known = true;  // false for states deserialized from corrupted bytes
+};
+
+struct SavedState {
+    fmi2FMUstate pointer = nullptr;
+    Snapshot snapshot;
+};
+
+struct SerializedState {
+    std::vector<fmi2Byte> bytes;
+    Snapshot snapshot;
+};
+
+Snapshot snapshot_of(const Instance& inst) {
+    Snapshot s;
+    s.phase = inst.phase;
+    s.time = inst.time;
+    s.stop_time_defined = inst.stop_time_defined;
+    s.stop_time = inst.stop_time;
+    return s;
+}
 
 int g_environment_probe = 0;  // componentEnvironment of instantiations that are expected to fail
 
@@ -527,6 +556,8 @@ void end_call(const CallScope& scope, const char* result) {
     dup2(g_saved_stderr, 2);
     g_call.active = false;
     const double elapsed = seconds_since(scope.start);
+    if (elapsed > 0.1) ++stats.slow_calls;
+    if (elapsed > 1.0) ++stats.very_slow_calls;
     if (elapsed > stats.slowest_call) {
         stats.slowest_call = elapsed;
         stats.slowest_call_description = g_current_call;
@@ -544,7 +575,7 @@ void end_call(const CallScope& scope, const char* result) {
     FUZZ_CHECK(g_call.null_arguments == 0, "logger called with a NULL instanceName, category or message", "");
     FUZZ_CHECK(g_call.wrong_environment == 0, "logger called with a foreign componentEnvironment", "");
     FUZZ_CHECK(g_call.wrong_name == 0, "logger called with a wrong instanceName", "");
-    FUZZ_CHECK(g_call.conversions == 0, "logged message contains an unescaped printf conversion", "");
+    FUZZ_CHECK(g_call.conversions == 0, "logged message contains an unescaped printf conversion", g_call.first_conversion);
 }
 
 // Runs one status-returning call and checks the invariants common to all of them.
@@ -632,6 +663,7 @@ unsigned invalid_vr(Random& r, unsigned max_valid) {
 struct Sequence {
     Random random;
     std::vector<std::unique_ptr<Instance>> live;
+    std::vector<SerializedState> serialized;  // serialized FMU states: portable between the instances
     double chaos = 0.5;
     int next_id = 0;
     explicit Sequence(unsigned long long seed) : random(seed) {}
@@ -790,8 +822,8 @@ void do_instantiate(Sequence& s, bool valid) {
 void free_instance(Sequence& s, size_t index) {
     Instance& inst = *s.live[index];
     // Free the FMU states first (with the FMU's own function, while the instance lives).
-    for (fmi2FMUstate& state : inst.states) {
-        fmi2FMUstate copy = state;
+    for (SavedState& saved : inst.states) {
+        fmi2FMUstate copy = saved.pointer;
         call(&inst, format("fmi2FreeFMUstate(%s, &state %p)", component_text(&inst).c_str(), copy),
              [&] { return api.freeFMUstate(inst.component, &copy); });
     }
@@ -1006,22 +1038,43 @@ void do_get_real(Sequence& s, Instance* inst) {
     }
 }
 
-template <class T>
-void do_set_get_discrete(Sequence& s, Instance* inst, bool set, bool integer) {
+// A value a master could plausibly give an Integer or Boolean parameter: a small choice (structural
+// variants), a scaled step budget, or a flag.
+long long mild_discrete(Random& r, const Variable& v, bool integer) {
+    if (!integer) return r.integer(0, 1);
+    if (v.start >= 0.0 && v.start <= 3.0) return r.integer(0, 3);
+    return std::max(1LL, static_cast<long long>(v.start * r.pick(std::vector<double>{1e-5, 1e-4, 1e-3, 1e-2, 1.0, 1.0})));
+}
+
+void do_set_get_discrete(Sequence& s, Instance* inst, bool set, bool integer, bool valid) {
     Random& r = s.random;
     const std::vector<const Variable*>& all = integer ? model.integer_all : model.boolean_all;
+    std::vector<const Variable*> parameters;
+    for (const Variable* v : all)
+        if (v->causality == "parameter") parameters.push_back(v);
     const unsigned max_vr = model.max_vr[integer ? 1 : 2];
-    size_t n = static_cast<size_t>(r.integer(0, 5));
+    if (valid && parameters.empty()) valid = false;
+    size_t n = static_cast<size_t>(valid ? r.integer(1, 3) : r.integer(0, 5));
     std::vector<fmi2ValueReference> vr;
-    std::vector<T> value(n + 1, static_cast<T>(-7));
+    std::vector<fmi2Integer> value(n + 1, -7);
     for (size_t i = 0; i < n; ++i) {
-        vr.push_back(!all.empty() && r.chance(0.75) ? r.pick(all)->vr : invalid_vr(r, max_vr));
+        if (valid) {
+            const Variable* v = r.pick(parameters);
+            vr.push_back(v->vr);
+            value[i] = static_cast<fmi2Integer>(mild_discrete(r, *v, integer));
+            continue;
+        }
+        const Variable* v = !all.empty() && r.chance(0.75) ? (r.chance(0.5) && !parameters.empty() ? r.pick(parameters) : r.pick(all)) : nullptr;
+        vr.push_back(v != nullptr ? v->vr : invalid_vr(r, max_vr));
         if (set) {
-            value[i] = integer ? static_cast<T>(r.pick(std::vector<long long>{0, 1, -1, 2, INT_MAX, INT_MIN, 100000, r.integer(-1000, 1000)}))
-                               : static_cast<T>(r.pick(std::vector<long long>{fmi2True, fmi2False, 2, -1, 255}));
+            value[i] = v != nullptr && r.chance(0.4)
+                           ? static_cast<fmi2Integer>(mild_discrete(r, *v, integer))
+                       : integer ? static_cast<fmi2Integer>(r.pick(std::vector<long long>{0, 1, -1, 2, 3, 4, INT_MAX, INT_MIN, 100000, r.integer(-1000, 1000)}))
+                                 : static_cast<fmi2Integer>(r.pick(std::vector<long long>{fmi2True, fmi2False, 2, -1, 255}));
         }
     }
-    const int mode = null_mode(r);
+    using T = fmi2Integer;  // fmi2Boolean is int as well
+    const int mode = valid ? 0 : null_mode(r);
     if (mode == 3 && r.chance(0.5)) n = 0;
     const fmi2ValueReference* vr_pointer = mode == 1 || mode == 3 ? nullptr : vr.data();
     T* value_pointer = mode == 2 || mode == 3 ? nullptr : value.data();
@@ -1086,27 +1139,56 @@ void do_set_debug_logging(Sequence& s, Instance* inst) {
     call(inst, d, [&] { return api.setDebugLogging(inst != nullptr ? inst->component : nullptr, on, n, pointer); });
 }
 
+// After a successful fmi2SetFMUstate the FMU is where the state was taken.
+void restored(Instance& inst, const Snapshot& snapshot) {
+    if (snapshot.known) {
+        inst.phase = snapshot.phase;
+        inst.time = snapshot.time;
+        inst.stop_time_defined = snapshot.stop_time_defined;
+        inst.stop_time = snapshot.stop_time;
+        return;
+    }
+    // Unknown (deserialized from altered bytes): ask the FMU where it is.
+    fmi2Real last = kNaN;
+    const fmi2Status status = call(&inst, format("[resync] fmi2GetRealStatus(%s, fmi2LastSuccessfulTime)", component_text(&inst).c_str()),
+                                   [&] { return api.getRealStatus(inst.component, fmi2LastSuccessfulTime, &last); });
+    if (status == fmi2OK) inst.time = last, inst.phase = Phase::step_complete;
+}
+
 void do_fmu_state(Sequence& s, Instance* inst, Function f) {
     Random& r = s.random;
     fmi2Component component = inst != nullptr ? inst->component : nullptr;
     const std::string c = component_text(inst);
     // Only states this instance handed out, or NULL: never a dangling pointer.
-    const bool have_state = inst != nullptr && !inst->states.empty() && r.chance(0.8);
+    const bool have_state = inst != nullptr && !inst->states.empty() && r.chance(0.85);
     const size_t state_index = have_state ? static_cast<size_t>(r.integer(0, static_cast<long long>(inst->states.size()) - 1)) : 0;
-    fmi2FMUstate state = have_state ? inst->states[state_index] : nullptr;
+    fmi2FMUstate state = have_state ? inst->states[state_index].pointer : nullptr;
     switch (f) {
         case F_GetFMUstate: {
-            fmi2FMUstate fresh = nullptr;
-            const bool null_pointer = r.chance(0.1);
-            const fmi2Status status = call(inst, format("fmi2GetFMUstate(%s, %s)", c.c_str(), null_pointer ? "NULL" : "&state"),
-                                           [&] { return api.getFMUstate(component, null_pointer ? nullptr : &fresh); });
-            if (inst != nullptr && status <= fmi2Warning && fresh != nullptr && !null_pointer) inst->states.push_back(fresh);
+            // The standard lets the master hand back one of its states to be overwritten.
+            const bool reuse = have_state && r.chance(0.3);
+            fmi2FMUstate fresh = reuse ? state : nullptr;
+            const bool null_pointer = r.chance(0.08);
+            const fmi2Status status =
+                call(inst, format("fmi2GetFMUstate(%s, %s)", c.c_str(), null_pointer ? "NULL" : reuse ? "&own state (reuse)" : "&NULL"),
+                     [&] { return api.getFMUstate(component, null_pointer ? nullptr : &fresh); });
+            if (inst == nullptr || null_pointer) break;
+            if (status <= fmi2Warning) {
+                FUZZ_CHECK(fresh != nullptr, "fmi2GetFMUstate succeeded without a state", "");
+                if (reuse) inst->states[state_index] = SavedState{fresh, snapshot_of(*inst)};
+                else if (fresh != nullptr) inst->states.push_back(SavedState{fresh, snapshot_of(*inst)});
+            } else if (reuse) {
+                FUZZ_CHECK(fresh == state, "a refused fmi2GetFMUstate changed the state pointer handed in", "");
+            }
             break;
         }
-        case F_SetFMUstate:
-            call(inst, format("fmi2SetFMUstate(%s, %s)", c.c_str(), have_state ? "own state" : "NULL"),
-                 [&] { return api.setFMUstate(component, state); });
+        case F_SetFMUstate: {
+            const fmi2Status status = call(inst, format("fmi2SetFMUstate(%s, %s)", c.c_str(), have_state ? "own state" : "NULL"),
+                                           [&] { return api.setFMUstate(component, state); });
+            if (inst != nullptr && have_state && status <= fmi2Warning) restored(*inst, inst->states[state_index].snapshot);
+            if (inst != nullptr && have_state && status == fmi2Error) inst->phase = Phase::error;
             break;
+        }
         case F_FreeFMUstate: {
             fmi2FMUstate copy = state;
             const bool null_pointer = r.chance(0.1);
@@ -1128,52 +1210,77 @@ void do_fmu_state(Sequence& s, Instance* inst, Function f) {
             break;
         }
         case F_SerializeFMUstate: {
-            size_t size = 0;
+            size_t needed = 0;
             if (have_state) {
                 const fmi2Status status = call(inst, format("fmi2SerializedFMUstateSize(%s, own state, &size)", c.c_str()),
-                                               [&] { return api.serializedFMUstateSize(component, state, &size); });
-                if (status > fmi2Warning) size = 16;
+                                               [&] { return api.serializedFMUstateSize(component, state, &needed); });
+                if (status > fmi2Warning) needed = 16;
             } else {
-                size = static_cast<size_t>(r.integer(0, 64));
+                needed = static_cast<size_t>(r.integer(0, 64));
             }
-            if (size > (1u << 24)) size = 1u << 24;  // a sane buffer; the FMU is told the true length
-            std::vector<fmi2Byte> buffer(size + 1, 0);
-            const bool null_buffer = r.chance(0.1);
+            if (needed > (1u << 24)) needed = 1u << 24;  // a sane buffer; the FMU is told its true length
+            size_t size = needed;
+            const double u = r.uniform(0.0, 1.0);
+            if (u < 0.1) size = needed > 0 ? needed - 1 : 0;
+            else if (u < 0.15) size = 0;
+            else if (u < 0.25) size = needed + static_cast<size_t>(r.integer(1, 100));
+            // 64 guard bytes after the size passed: the FMU must not write past it.
+            std::vector<fmi2Byte> buffer(size + 64, static_cast<fmi2Byte>(0xA5));
+            const bool null_buffer = r.chance(0.08);
             const fmi2Status status =
-                call(inst, format("fmi2SerializeFMUstate(%s, %s, %s, size=%zu)", c.c_str(), have_state ? "own state" : "NULL",
-                                  null_buffer ? "NULL" : "buffer", size),
+                call(inst, format("fmi2SerializeFMUstate(%s, %s, %s, size=%zu of %zu needed)", c.c_str(), have_state ? "own state" : "NULL",
+                                  null_buffer ? "NULL" : "buffer", size, needed),
                      [&] { return api.serializeFMUstate(component, state, null_buffer ? nullptr : buffer.data(), size); });
+            bool guard_intact = true;
+            for (size_t k = size; k < buffer.size(); ++k) guard_intact = guard_intact && buffer[k] == static_cast<fmi2Byte>(0xA5);
+            FUZZ_CHECK(guard_intact, "fmi2SerializeFMUstate wrote past the size it was given", format("size %zu", size));
             if (inst != nullptr && status <= fmi2Warning && have_state && !null_buffer) {
-                buffer.resize(size);
-                inst->serialized.push_back(buffer);
+                FUZZ_CHECK(size >= needed, "fmi2SerializeFMUstate accepted a buffer below fmi2SerializedFMUstateSize",
+                           format("%zu < %zu", size, needed));
+                buffer.resize(needed);
+                s.serialized.push_back(SerializedState{buffer, inst->states[state_index].snapshot});
             }
             break;
         }
         case F_DeSerializeFMUstate: {
             std::vector<fmi2Byte> bytes;
             std::string what;
-            if (inst != nullptr && !inst->serialized.empty() && r.chance(0.6)) {
-                bytes = r.pick(inst->serialized);
-                what = "own serialized state";
-                if (r.chance(0.3) && !bytes.empty()) {
-                    bytes[static_cast<size_t>(r.integer(0, static_cast<long long>(bytes.size()) - 1))] ^= 0x5a;
-                    what = "corrupted serialized state";
+            Snapshot snapshot;
+            snapshot.known = false;
+            if (!s.serialized.empty() && r.chance(0.7)) {
+                const SerializedState& source = r.pick(s.serialized);
+                bytes = source.bytes;
+                snapshot = source.snapshot;
+                what = "serialized state";
+                const double u = r.uniform(0.0, 1.0);
+                if (u < 0.1 && !bytes.empty()) {
+                    // Altered bytes: the standard does not promise detection, but the FMU must not crash.
+                    const size_t k = static_cast<size_t>(r.integer(0, static_cast<long long>(bytes.size()) - 1));
+                    bytes[k] = static_cast<fmi2Byte>(bytes[k] ^ (1 << r.integer(0, 7)));
+                    what = format("serialized state with bit flipped in byte %zu", k);
+                    snapshot.known = false;
+                } else if (u < 0.2 && !bytes.empty()) {
+                    bytes.pop_back();
+                    what = "truncated serialized state";
+                } else if (u < 0.25) {
+                    bytes.push_back(0);
+                    what = "serialized state with an extra byte";
                 }
-                if (r.chance(0.2) && !bytes.empty()) bytes.pop_back(), what = "truncated serialized state";
             } else {
                 bytes.resize(static_cast<size_t>(r.integer(0, 256)));
                 for (fmi2Byte& b : bytes) b = static_cast<fmi2Byte>(r.integer(0, 255));
                 what = "random bytes";
             }
-            const bool null_bytes = r.chance(0.1);
+            const bool null_bytes = r.chance(0.08);
             const size_t size = null_bytes ? static_cast<size_t>(r.integer(0, 1)) * 8 : bytes.size();
-            const bool null_state = r.chance(0.1);
+            const bool null_state = r.chance(0.08);
             fmi2FMUstate result = nullptr;
             const fmi2Status status = call(
                 inst, format("fmi2DeSerializeFMUstate(%s, %s, size=%zu, %s)", c.c_str(), null_bytes ? "NULL" : what.c_str(), size,
                              null_state ? "NULL" : "&state"),
                 [&] { return api.deSerializeFMUstate(component, null_bytes ? nullptr : bytes.data(), size, null_state ? nullptr : &result); });
-            if (inst != nullptr && status <= fmi2Warning && !null_state && result != nullptr) inst->states.push_back(result);
+            if (inst != nullptr && status <= fmi2Warning && !null_state && result != nullptr)
+                inst->states.push_back(SavedState{result, snapshot});
             break;
         }
         default: break;
@@ -1310,10 +1417,10 @@ void dispatch(Sequence& s, Function f, Instance* inst, bool valid) {
         case F_Reset:
         case F_CancelStep: do_lifecycle(inst, f); break;
         case F_GetReal: do_get_real(s, inst); break;
-        case F_GetInteger: do_set_get_discrete<fmi2Integer>(s, inst, false, true); break;
-        case F_GetBoolean: do_set_get_discrete<fmi2Boolean>(s, inst, false, false); break;
-        case F_SetInteger: do_set_get_discrete<fmi2Integer>(s, inst, true, true); break;
-        case F_SetBoolean: do_set_get_discrete<fmi2Boolean>(s, inst, true, false); break;
+        case F_GetInteger: do_set_get_discrete(s, inst, false, true, false); break;
+        case F_GetBoolean: do_set_get_discrete(s, inst, false, false, false); break;
+        case F_SetInteger: do_set_get_discrete(s, inst, true, true, valid); break;
+        case F_SetBoolean: do_set_get_discrete(s, inst, true, false, valid); break;
         case F_GetString: do_string(s, inst, false); break;
         case F_SetString: do_string(s, inst, true); break;
         case F_SetReal: do_set_real(s, inst, valid); break;
@@ -1339,12 +1446,19 @@ void dispatch(Sequence& s, Function f, Instance* inst, bool valid) {
 // The next call of a well-behaved master in the instance's phase.
 Function progress_function(Random& r, const Instance& inst) {
     switch (inst.phase) {
-        case Phase::instantiated:
-            return r.chance(0.25) ? F_SetupExperiment : r.chance(0.3) ? F_SetReal : F_EnterInitializationMode;
-        case Phase::initialization: return r.chance(0.35) ? F_SetReal : F_ExitInitializationMode;
+        case Phase::instantiated: {
+            const double u = r.uniform(0.0, 1.0);
+            return u < 0.2 ? F_SetupExperiment : u < 0.4 ? F_SetReal : u < 0.5 ? F_SetInteger : u < 0.55 ? F_SetBoolean
+                                                                                                 : F_EnterInitializationMode;
+        }
+        case Phase::initialization: {
+            const double u = r.uniform(0.0, 1.0);
+            return u < 0.25 ? F_SetReal : u < 0.35 ? F_SetInteger : u < 0.4 ? F_SetBoolean : F_ExitInitializationMode;
+        }
         case Phase::step_complete: {
             const double u = r.uniform(0.0, 1.0);
-            return u < 0.25 ? F_SetReal : u < 0.9 ? F_DoStep : u < 0.95 ? F_GetReal : F_Terminate;
+            return u < 0.2 ? F_SetReal : u < 0.8 ? F_DoStep : u < 0.84 ? F_GetReal : u < 0.89 ? F_GetFMUstate
+                   : u < 0.94 ? F_SetFMUstate : u < 0.96 ? F_SerializeFMUstate : u < 0.98 ? F_DeSerializeFMUstate : F_Terminate;
         }
         case Phase::step_failed:
         case Phase::terminated:
@@ -1485,10 +1599,10 @@ int main(int argc, char** argv) {
 
     std::printf("fuzz_fmi_calls: %.2f s; statuses OK/Warning/Discard/Error/Fatal = %lld/%lld/%lld/%lld/%lld; %lld instances, "
                 "%lld initializations, %lld successful steps, %lld discarded steps, %lld NULL-component calls, %lld log messages; "
-                "slowest call %.3f s (sequence %lld: %s)\n",
+                "%lld calls > 0.1 s, %lld > 1 s, slowest %.3f s (sequence %lld: %s)\n",
                 elapsed, stats.by_status[0], stats.by_status[1], stats.by_status[2], stats.by_status[3], stats.by_status[4],
                 stats.instances, stats.successful_initializations, stats.successful_steps, stats.discarded_steps,
-                stats.null_component_calls, g_total_messages, stats.slowest_call, stats.slowest_call_sequence,
+                stats.null_component_calls, g_total_messages, stats.slow_calls, stats.very_slow_calls, stats.slowest_call, stats.slowest_call_sequence,
                 stats.slowest_call_description.c_str());
     for (const auto& kind : stats.failure_kinds)
         std::fprintf(stderr, "fuzz_fmi_calls: %lld x %s\n", kind.second, kind.first.c_str());

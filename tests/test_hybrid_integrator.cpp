@@ -125,6 +125,7 @@ void check_method(IntegrationMethod method) {
         Chatter fast(1e-10);
         IntegratorSettings fine = settings;
         fine.max_step = 2e-11;  // so that every sign change is seen
+        fine.max_steps = 2000000;
         auto integrator_owner = HybridIntegrator::create(fast, fine, quiet, quiet);
         HybridIntegrator& integrator = *integrator_owner;
         double x[1] = {0.0};

@@ -53,6 +53,10 @@ GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value) 
     return core->instance.get_real(vr, *value);
 }
 
+GimbalStatus gimbal_core_set_input_derivative(GimbalCore* core, unsigned vr, int order, double value) {
+    return core->instance.set_input_derivative(vr, order, value);
+}
+
 GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value) {
     return core->instance.set_integer(vr, value);
 }

@@ -62,18 +62,18 @@ void GimbalHybridSystem::set_inputs(const StepInputs& inputs) {
 }
 
 bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
-    return evaluate_state_derivative(params_, inputs_, modes_, base_at(time), state, derivative);
+    return evaluate_state_derivative(params_, inputs_, modes_, base_at(time), time, state, derivative);
 }
 
 bool GimbalHybridSystem::jacobian(double time, const double* state, double* column_major) {
-    evaluate_jacobian(params_, inputs_, modes_, base_at(time), state, column_major);
+    evaluate_jacobian(params_, inputs_, modes_, base_at(time), time, state, column_major);
     return true;
 }
 
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     std::fill(values, values + kEventCount, 1.0);
     Dynamics d;
-    evaluate_dynamics(params_, inputs_, base_at(time), state, modes_, d);
+    evaluate_dynamics(params_, inputs_, base_at(time), time, state, modes_, d);
 
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params_.gear[axis];
@@ -103,6 +103,12 @@ void GimbalHybridSystem::event_functions(double time, const double* state, doubl
         } else {
             g[0] = d.steady_current[axis] - limited * limit;
         }
+        // A ramped voltage (input derivatives) reaching the clamp of (2.142-2.145).
+        if (inputs_.voltage_rate[axis] != 0.0) {
+            const double ramp = ramped_voltage(inputs_, axis, time);
+            g[2] = ramp - params_.motor[axis].voltage_limit;
+            g[3] = ramp + params_.motor[axis].voltage_limit;
+        }
     }
     for (int body = 0; body < 4; ++body) {
         const DryFrictionParameters& friction = params_.coordinate_friction[body];
@@ -126,7 +132,7 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
     const Modes previous = modes_;
     Dynamics d;
     const BaseKinematics base = base_at(time);
-    evaluate_dynamics(params_, inputs_, base, state, modes_, d);
+    evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
 
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params_.gear[axis];
@@ -162,6 +168,18 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
     for (int axis = 0; axis < 2; ++axis) {
         const double limit = params_.motor[axis].current_limit;
         const int slot = motor_slot(axis);
+        // The clamp first: the limiter's steady current depends on the voltage.
+        int clamped = 0;
+        if (inputs_.voltage_rate[axis] != 0.0) {
+            const double ramp = ramped_voltage(inputs_, axis, time);
+            const double voltage_limit = params_.motor[axis].voltage_limit;
+            if (side(ramp - voltage_limit, directions, slot + 2) >= 0) clamped = 1;
+            else if (side(ramp + voltage_limit, directions, slot + 3) <= 0) clamped = -1;
+        }
+        if (clamped != modes_.voltage_clamped[axis]) {
+            modes_.voltage_clamped[axis] = clamped;
+            evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
+        }
         const int current = previous.motor_limited[axis];
         const int current_slot = params_.layout.current_slot[axis];
         const double free_current = current_slot >= 0 ? state[current_slot] : d.steady_current[axis];
@@ -192,7 +210,7 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
         else if (!low_speed(previous.friction[body])) modes_.friction[body] = FrictionMode::hold;
         else modes_.friction[body] = previous.friction[body];
     }
-    evaluate_dynamics(params_, inputs_, base, state, modes_, d);
+    evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
     for (int body = 0; body < 4; ++body) {
         if (!low_speed(modes_.friction[body])) continue;
         const DryFrictionParameters& friction = params_.coordinate_friction[body];
@@ -212,6 +230,7 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
 
     int changes = 0;
     for (int axis = 0; axis < 2; ++axis) {
+        if (modes_.voltage_clamped[axis] != previous.voltage_clamped[axis]) ++changes;
         if (modes_.gear_contact[axis] != previous.gear_contact[axis]) ++counters_.backlash[axis], ++changes;
         if (modes_.motor_limited[axis] != previous.motor_limited[axis]) ++counters_.current_limit[axis], ++changes;
     }

@@ -12,6 +12,21 @@
 namespace gimbal {
 namespace {
 
+// Whether the voltages at the start of a step continue the running ramps: then nothing jumps. A
+// master's own arithmetic may differ from ours in the last bits, hence the tolerance.
+bool continues(const StepInputs& running, const StepInputs& next, double time) {
+    for (int axis = 0; axis < 2; ++axis) {
+        if (running.voltage_rate[axis] == 0.0 && next.voltage_rate[axis] == 0.0) {
+            if (running.voltage[axis] != next.voltage[axis]) return false;
+            continue;
+        }
+        const double expected = ramped_voltage(running, axis, time);
+        if (std::fabs(next.commanded_voltage[axis] - expected) > 1e-12 * std::max(1.0, std::fabs(expected)))
+            return false;
+    }
+    return true;
+}
+
 bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
     return a.attitude == b.attitude && a.attitude_rate == b.attitude_rate && a.attitude_accel == b.attitude_accel &&
            a.velocity_a == b.velocity_a && a.acceleration_a == b.acceleration_a;
@@ -20,7 +35,7 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 Vec3 vector_at(const double* values, unsigned first) { return Vec3(values[first], values[first + 1], values[first + 2]); }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 1;
+constexpr std::uint32_t kSnapshotVersion = 2;
 
 struct Snapshot {
     std::uint32_t magic;
@@ -35,6 +50,9 @@ struct Snapshot {
     EventCounters counters;
     IntegratorStatistics statistics;
     double voltage[2];
+    double commanded_voltage[2];
+    double voltage_rate[2];
+    double pending_voltage_rate[2];
     double base[15];  // attitude, rate, accel, v_a, a_a at the arc start
     double arc_start_time;
 };
@@ -55,6 +73,7 @@ void GimbalInstance::reset() {
     system_.reset();
     integrator_running_ = false;
     preview_current_ = false;
+    voltage_rate_[0] = voltage_rate_[1] = 0.0;
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
 }
@@ -75,6 +94,29 @@ GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
     }
     reals_[vr] = value;
     preview_current_ = false;
+    // A new voltage starts a new ramp: its derivative must be given again.
+    if (vr == vr_u_R1) voltage_rate_[0] = 0.0;
+    if (vr == vr_u_R2) voltage_rate_[1] = 0.0;
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::set_input_derivative(unsigned vr, int order, double value) {
+    const int axis = vr == vr_u_R1 ? 0 : (vr == vr_u_R2 ? 1 : -1);
+    if (axis < 0) {
+        const char* name = vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)";
+        return refuse(GIMBAL_ERROR, std::string("fmi2SetRealInputDerivatives: ") + name +
+                                        " takes no derivative: only u_R1 and u_R2 do (the base inputs carry their own "
+                                        "rates and accelerations)");
+    }
+    if (order != 1) {
+        return refuse(GIMBAL_ERROR, "fmi2SetRealInputDerivatives: order " + std::to_string(order) + " for " +
+                                        kRealVariables[vr].name + " refused: only first derivatives are used");
+    }
+    if (!std::isfinite(value)) {
+        return refuse(GIMBAL_ERROR, std::string("fmi2SetRealInputDerivatives: the derivative of ") +
+                                        kRealVariables[vr].name + " must be finite");
+    }
+    voltage_rate_[axis] = value;
     return GIMBAL_OK;
 }
 
@@ -130,8 +172,12 @@ GimbalStatus GimbalInstance::get_boolean(unsigned vr, bool& value) const {
 
 StepInputs GimbalInstance::read_step_inputs(double step_start) const {
     StepInputs inputs;
-    inputs.voltage[0] = clamp_voltage(params_.motor[0], reals_[vr_u_R1]);
-    inputs.voltage[1] = clamp_voltage(params_.motor[1], reals_[vr_u_R2]);
+    inputs.commanded_voltage[0] = reals_[vr_u_R1];
+    inputs.commanded_voltage[1] = reals_[vr_u_R2];
+    for (int axis = 0; axis < 2; ++axis) {
+        inputs.voltage[axis] = clamp_voltage(params_.motor[axis], inputs.commanded_voltage[axis]);
+        inputs.voltage_rate[axis] = voltage_rate_[axis];
+    }
     inputs.base.attitude = vector_at(reals_, vr_base_delta);
     inputs.base.attitude_rate = vector_at(reals_, vr_base_delta_dot);
     inputs.base.attitude_accel = vector_at(reals_, vr_base_delta_ddot);
@@ -300,13 +346,18 @@ void GimbalInstance::save(void* buffer) {
     snap.initialized = integrator_ != nullptr;
     snap.time = time_;
     std::copy(state_, state_ + kMaxStateSize, snap.state);
+    snap.pending_voltage_rate[0] = voltage_rate_[0];
+    snap.pending_voltage_rate[1] = voltage_rate_[1];
     if (snap.initialized) {
         snap.modes = system_->modes();
         snap.counters = system_->counters();
         snap.statistics = integrator_->statistics();
         const StepInputs& in = system_->inputs();
-        snap.voltage[0] = in.voltage[0];
-        snap.voltage[1] = in.voltage[1];
+        for (int axis = 0; axis < 2; ++axis) {
+            snap.voltage[axis] = in.voltage[axis];
+            snap.commanded_voltage[axis] = in.commanded_voltage[axis];
+            snap.voltage_rate[axis] = in.voltage_rate[axis];
+        }
         const Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel,
                                 &in.base.velocity_a, &in.base.acceleration_a};
         for (int p = 0; p < 5; ++p)
@@ -331,14 +382,19 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     system_.reset();
     time_ = snap.time;
     std::copy(snap.state, snap.state + kMaxStateSize, state_);
+    voltage_rate_[0] = snap.pending_voltage_rate[0];
+    voltage_rate_[1] = snap.pending_voltage_rate[1];
     if (!snap.initialized) return GIMBAL_OK;
 
     std::string error;
     if (!build_parameters(params_, error)) return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
     system_ = std::make_unique<GimbalHybridSystem>(params_);
     StepInputs in;
-    in.voltage[0] = snap.voltage[0];
-    in.voltage[1] = snap.voltage[1];
+    for (int axis = 0; axis < 2; ++axis) {
+        in.voltage[axis] = snap.voltage[axis];
+        in.commanded_voltage[axis] = snap.commanded_voltage[axis];
+        in.voltage_rate[axis] = snap.voltage_rate[axis];
+    }
     Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel, &in.base.velocity_a,
                       &in.base.acceleration_a};
     for (int p = 0; p < 5; ++p)
@@ -359,8 +415,7 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     const StepInputs& running = system_->inputs();
     // The right-hand side is continuous across the step boundary only if the held voltages are the same
     // and the base motion continues the running constant-acceleration arc; otherwise restart.
-    const bool continuous = integrator_running_ && inputs.voltage[0] == running.voltage[0] &&
-                            inputs.voltage[1] == running.voltage[1] &&
+    const bool continuous = integrator_running_ && continues(running, inputs, current_time) &&
                             same_base_motion(inputs.base, running.base.advanced(current_time - running.step_start_time));
     double step_start_state[kMaxStateSize];
     std::copy(state_, state_ + kMaxStateSize, step_start_state);
@@ -368,7 +423,13 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     const EventCounters step_start_counters = system_->counters();
 
     if (continuous) {
-        inputs = running;
+        // The right-hand side does not jump: keep the integrator's history, follow the new ramps.
+        if (inputs.voltage_rate[0] != running.voltage_rate[0] || inputs.voltage_rate[1] != running.voltage_rate[1] ||
+            inputs.commanded_voltage[0] != running.commanded_voltage[0] ||
+            inputs.commanded_voltage[1] != running.commanded_voltage[1]) {
+            inputs.base = running.base.advanced(current_time - running.step_start_time);
+            system_->set_inputs(inputs);
+        }
     } else {
         system_->set_inputs(inputs);
         // New inputs may cross a switching surface at once (e.g. the voltage reverses while limited).
@@ -389,6 +450,7 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
         return refuse(GIMBAL_DISCARD, s.str());
     }
     integrator_running_ = true;
+    voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
     double previous_reals[kRealVariableCount];
     int previous_integers[kIntegerVariableCount];
     std::copy(reals_, reals_ + kRealVariableCount, previous_reals);

@@ -73,7 +73,14 @@ Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Mo
     return modified.partialPivLu().solve(rhs);
 }
 
-FullState expand_state(const ModelParameters& params, const Modes& modes, const StepInputs& inputs,
+double applied_voltage(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, int axis,
+                       double time) {
+    if (inputs.voltage_rate[axis] == 0.0) return inputs.voltage[axis];
+    if (modes.voltage_clamped[axis] != 0) return modes.voltage_clamped[axis] * params.motor[axis].voltage_limit;
+    return ramped_voltage(inputs, axis, time);
+}
+
+FullState expand_state(const ModelParameters& params, const Modes& modes, const StepInputs& inputs, double time,
                        const double* state) {
     const StateLayout& layout = params.layout;
     FullState full;
@@ -96,7 +103,8 @@ FullState expand_state(const ModelParameters& params, const Modes& modes, const 
         } else if (layout.current_slot[axis] >= 0) {
             full.current[axis] = state[layout.current_slot[axis]];
         } else {
-            full.current[axis] = unlimited_steady_current(motor, inputs.voltage[axis], full.rate[rotor]);
+            full.current[axis] =
+                unlimited_steady_current(motor, applied_voltage(params, inputs, modes, axis, time), full.rate[rotor]);
         }
         full.backlash[axis] = layout.backlash_slot[axis] >= 0 ? state[layout.backlash_slot[axis]] : 0.0;
     }
@@ -104,9 +112,9 @@ FullState expand_state(const ModelParameters& params, const Modes& modes, const 
 }
 
 void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, const BaseKinematics& base,
-                       const double* state, const Modes& modes, Dynamics& out) {
+                       double time, const double* state, const Modes& modes, Dynamics& out) {
     const StateLayout& layout = params.layout;
-    out.full = expand_state(params, modes, inputs, state);
+    out.full = expand_state(params, modes, inputs, time, state);
     const Vec4& q = out.full.angle;
     const Vec4& qd = out.full.rate;
 
@@ -157,7 +165,8 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
         out.shaft_torque[axis] = shaft_torque;
         out.backlash_rate[axis] = backlash_rate;
 
-        const double voltage = inputs.voltage[axis];
+        const double voltage = applied_voltage(params, inputs, modes, axis, time);
+        out.voltage[axis] = voltage;
         out.steady_current[axis] = unlimited_steady_current(motor, voltage, qd[rotor]);
         out.current_rate[axis] = 0.0;
         if (layout.current_slot[axis] >= 0 && modes.motor_limited[axis] == 0)
@@ -205,12 +214,12 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
 }
 
 void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                       const BaseKinematics& base, const double* state, double* column_major) {
+                       const BaseKinematics& base, double time, const double* state, double* column_major) {
     using Mat4x12 = Eigen::Matrix<double, 4, 12>;
     const StateLayout& layout = params.layout;
     const int n = layout.size;
     Dynamics d;
-    evaluate_dynamics(params, inputs, base, state, modes, d);
+    evaluate_dynamics(params, inputs, base, time, state, modes, d);
 
     // Derivatives of the full generalized forces: columns q (0-3), qd (4-7), currents (8-9), theta_b (10-11).
     Mat4x12 force = Mat4x12::Zero();
@@ -319,10 +328,10 @@ void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, 
 }
 
 bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                               const BaseKinematics& base, const double* state, double* derivative) {
+                               const BaseKinematics& base, double time, const double* state, double* derivative) {
     const StateLayout& layout = params.layout;
     Dynamics d;
-    evaluate_dynamics(params, inputs, base, state, modes, d);
+    evaluate_dynamics(params, inputs, base, time, state, modes, d);
     for (int body = 0; body < 4; ++body) {
         if (!layout.independent(body)) continue;
         derivative[layout.angle_slot[body]] = d.full.rate[body];
@@ -364,7 +373,7 @@ ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& i
                                        : inputs.base.advanced(time - inputs.step_start_time);
     const BaseKinematics base = evaluate_base_kinematics(base_motion, params.multibody.gravity);
     Dynamics d;
-    evaluate_dynamics(params, inputs, base, state, modes, d);
+    evaluate_dynamics(params, inputs, base, time, state, modes, d);
 
     ModelOutputs out;
     out.full = d.full;

@@ -85,16 +85,30 @@ bool HybridIntegrator::restart(double time, const double* state) {
 
 bool HybridIntegrator::advance(double end_time, double* state) {
     double* y = N_VGetArrayPointer(y_);
+    // One budget of internal steps for the whole call: restarts after mode changes reset the
+    // backend's own count, and switches 10-100 ns apart would otherwise run on without bound.
+    const long steps_at_start = statistics().steps;
+    long events_here = 0;
     for (;;) {
         double reached = 0.0;
         const Outcome outcome = backend_advance(end_time, reached);
         if (outcome == Outcome::failure) return false;
         std::copy(y, y + size_, state);
         if (outcome == Outcome::reached_end) return true;
+        if (statistics().steps - steps_at_start > settings_.max_steps) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "more than solver.max_steps = " << settings_.max_steps << " internal steps (" << events_here
+              << " mode changes) before t = " << reached << ": the inputs or parameters drive switching faster than "
+              << "the model can follow";
+            error_sink_(s.str());
+            return false;
+        }
 
         backend_roots(root_directions_.data());
         const int changes = system_.update_modes(reached, state, root_directions_.data());
         totals_.events += changes;
+        events_here += changes;
         if (changes > 0 && settings_.events_logged()) {
             std::ostringstream s;
             s.precision(17);

@@ -15,14 +15,14 @@ STATES = ["alpha", "alpha_m", "beta", "beta_m", "alpha_dot", "alpha_m_dot", "bet
 
 
 class FMU:
-    def __init__(self, path: pathlib.Path | str):
+    def __init__(self, path: pathlib.Path | str, workdir: pathlib.Path | str | None = None):
         from fmpy import extract, read_model_description
 
         self.path = pathlib.Path(path)
         if not self.path.is_file():
             raise SceneError(f"{self.path}: no such FMU (build it: cmake --build build, or bash scripts/setup.sh)")
         self.md = read_model_description(str(self.path))
-        self.unzipdir = extract(str(self.path), unzipdir=tempfile.mkdtemp(prefix="gimbal_scene_"))
+        self.unzipdir = extract(str(self.path), unzipdir=tempfile.mkdtemp(prefix="gimbal_scene_", dir=workdir))
         self.variables = {v.name: v for v in self.md.modelVariables}
 
     def close(self) -> None:

@@ -29,10 +29,14 @@ MODE_OUTPUTS = ["gear1.contact", "gear2.contact", "motor1.limited", "motor2.limi
 
 
 def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None = None,
-        controller=None) -> RunResult:
+        controller=None, slave=None, log: list | None = None) -> RunResult:
     """Runs `scene` (to `stop_time` if given) and returns the recorded signals ('time' and one array
     per signal, sampled at every communication point (row k: outputs at t_k, the voltage applied
-    over [t_k, t_{k+1}], the controller output computed at t_k, the base inputs at t_k), with line-of-sight signals added."""
+    over [t_k, t_{k+1}], the controller output computed at t_k, the base inputs at t_k), with line-of-sight signals added.
+
+    `slave` (with the `log` list its logger appends to, from `fmu.instantiate(name, log)`): reuse this
+    instance instead of instantiating a fresh one; it is reset first (fmi2Reset: back to the start
+    values, state 'instantiated'), the log is cleared, and the instance is left alive for the next run."""
     check_against_fmu(scene, fmu)
     h = scene.step_size
     t_end = scene.stop_time if stop_time is None else stop_time
@@ -63,8 +67,14 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     u_applied = np.empty((n + 1, 2))
     refs = np.empty((n + 1, 2))
 
-    log: list = []
-    slave = fmu.instantiate(scene.name, log)
+    owned = slave is None
+    if owned:
+        log = []
+        slave = fmu.instantiate(scene.name, log)
+    else:
+        if log is not None:
+            log.clear()
+        slave.reset()
     bar = Progress(t_end, enabled=progress)
     wall0 = time.perf_counter()
     k = 0
@@ -99,10 +109,11 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     except SceneError:
         raise
     except Exception as exc:   # fmpy raises on fmi2Error / fmi2Discard
-        details = "; ".join(log[-5:]) or "no log message"
+        details = "; ".join((log or [])[-5:]) or "no log message"
         raise SceneError(f"{scene.name}: the FMU failed at t = {k * h:.6g} s ({exc}): {details}") from None
     finally:
-        slave.freeInstance()
+        if owned:
+            slave.freeInstance()
     wall = time.perf_counter() - wall0
 
     signals = {"time": times}

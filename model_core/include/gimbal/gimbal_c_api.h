@@ -40,6 +40,7 @@ void gimbal_core_reset(GimbalCore* core);
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value);
 GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value);
+GimbalStatus gimbal_core_set_input_derivative(GimbalCore* core, unsigned vr, int order, double value);
 GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value);
 GimbalStatus gimbal_core_get_integer(GimbalCore* core, unsigned vr, int* value);
 GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value);

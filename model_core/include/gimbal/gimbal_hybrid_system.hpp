@@ -19,7 +19,7 @@ class GimbalHybridSystem final : public HybridSystem {
 public:
     // Fixed slots, so that the integrator sees one event vector whatever the modes; slots a mode
     // does not use hold a constant 1.
-    static constexpr int kGearSlots = 2, kMotorSlots = 2, kFrictionSlots = 6;
+    static constexpr int kGearSlots = 2, kMotorSlots = 4, kFrictionSlots = 6;
     static constexpr int kEventCount = 2 * kGearSlots + 2 * kMotorSlots + 4 * kFrictionSlots;
 
     explicit GimbalHybridSystem(const ModelParameters& params) : params_(params) {}

@@ -32,6 +32,8 @@ public:
     GimbalStatus set_boolean(unsigned vr, bool value);
     GimbalStatus get_boolean(unsigned vr, bool& value) const;
     GimbalStatus initialize(double start_time);
+    // fmi2SetRealInputDerivatives: the voltages may ramp over the next step (order 1 only).
+    GimbalStatus set_input_derivative(unsigned vr, int order, double value);
 
     // Everything a rollback needs, as plain bytes (fmi2GetFMUstate / serialization). Saving ends the
     // current integration segment: the next step restarts the integrator, so that a rollback to this
@@ -64,7 +66,8 @@ private:
     std::unique_ptr<HybridIntegrator> integrator_;
     bool integrator_running_ = false;  // false: the next step must restart the integrator
     bool preview_current_ = false;
-    std::string last_integrator_error_;     // the calculated outputs reflect the current start values
+    std::string last_integrator_error_;
+    double voltage_rate_[2] = {0.0, 0.0};  // for the next step only     // the calculated outputs reflect the current start values
     double time_ = 0.0;
 };
 

@@ -92,13 +92,17 @@ inline bool low_speed(FrictionMode mode) {
 struct Modes {
     int gear_contact[2] = {0, 0};    // -1 at -eta, 0 in the gap (or no backlash), +1 at +eta
     int motor_limited[2] = {0, 0};   // -1 held at -i_L, 0 free, +1 held at +i_L
+    int voltage_clamped[2] = {0, 0}; // a ramped voltage held at -U_L / +U_L (0: follows the ramp)
     FrictionMode friction[4] = {FrictionMode::none, FrictionMode::none, FrictionMode::none, FrictionMode::none};
 };
 
-// Inputs held over one communication step.
+// Inputs over one communication step: voltages held (or, when the master gives their derivatives,
+// ramped), base motion at constant acceleration from the step start.
 struct StepInputs {
-    double voltage[2] = {0, 0};  // already clamped to +-U_L
-    BaseMotion base;             // at the step start
+    double voltage[2] = {0, 0};            // commanded at the step start, clamped to +-U_L
+    double commanded_voltage[2] = {0, 0};  // as set, unclamped
+    double voltage_rate[2] = {0, 0};       // fmi2SetRealInputDerivatives, order 1
+    BaseMotion base;                       // at the step start
     double step_start_time = 0.0;
 };
 
@@ -123,6 +127,7 @@ struct Dynamics {
     double steady_current[2];       // (u - k_emf w) / R
     Vec4 friction_torque;           // T_as per padded coordinate
     Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
+    double voltage[2];              // applied
     Mat4 reduced_mass;              // padded coordinates
     Mat4 reduction;                 // q_full = reduction * q_padded
 };
@@ -130,11 +135,19 @@ struct Dynamics {
 // Gears whose damping is 0 are pure dead zones: theta_b follows theta_d inside the gap.
 inline bool dead_zone_gear(const GearParameters& gear) { return gear.half_backlash > 0.0 && gear.damping == 0.0; }
 
-FullState expand_state(const ModelParameters& params, const Modes& modes, const StepInputs& inputs,
+// The voltage at the motor terminals' input at `time` (after the clamp of 2.142-2.145).
+double applied_voltage(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, int axis,
+                       double time);
+// The ramp a voltage follows before its clamp (constant without input derivatives).
+inline double ramped_voltage(const StepInputs& inputs, int axis, double time) {
+    return inputs.commanded_voltage[axis] + inputs.voltage_rate[axis] * (time - inputs.step_start_time);
+}
+
+FullState expand_state(const ModelParameters& params, const Modes& modes, const StepInputs& inputs, double time,
                        const double* state);
 
 void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, const BaseKinematics& base,
-                       const double* state, const Modes& modes, Dynamics& out);
+                       double time, const double* state, const Modes& modes, Dynamics& out);
 
 // Solves (2.106) with the columns of the low-speed coordinates replaced by unit vectors: T_outros.
 Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Modes& modes,
@@ -144,13 +157,13 @@ Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Mo
 // circuits, backlash, viscous and stick damping) and leaving out the slow configuration dependence of
 // J and f (gravity, gyroscopic terms): the iteration matrix of Newton's method needs no more.
 void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                       const BaseKinematics& base, const double* state, double* column_major);
+                       const BaseKinematics& base, double time, const double* state, double* column_major);
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
 
 // dx/dt within the current modes; false if it is not finite.
 bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                               const BaseKinematics& base, const double* state, double* derivative);
+                               const BaseKinematics& base, double time, const double* state, double* derivative);
 
 // Quantities derived from the state for outputs and diagnostics.
 struct ModelOutputs {

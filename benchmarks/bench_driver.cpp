@@ -1,0 +1,985 @@
+// gimbal_bench: native benchmark driver for the Gimbal2Axis FMU (issue 6).
+//
+// Loads the FMU's shared object with dlopen and runs a ship-stabilization master loop without
+// Python: a sea-state base motion (analytic sums of sinusoids, exact rates and accelerations), a
+// PD line-of-sight controller with payload-gyro rate feedback and the seed's one-step delay, and a
+// fixed communication step. Reports wall and CPU time, doStep calls, the real-time factor, the
+// FMU's solver counters, and the heap allocations made inside fmi2DoStep (malloc & co. are
+// interposed by this executable: the FMU resolves them dynamically, so the definitions below win).
+//
+// Mode --fmi-overhead: doStep of a model at rest (fixed base, g = 0, zero voltage) with a tiny step,
+// many calls: nanoseconds per doStep and the instance's heap memory.
+//
+// Run `gimbal_bench --help` for the options.
+#include <dlfcn.h>
+#include <execinfo.h>
+#include <malloc.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdarg>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fmi2Functions.h"
+
+// ------------------------------------------------------------------------------------------------
+// Heap allocation counting (interposition of the C allocator)
+// ------------------------------------------------------------------------------------------------
+extern "C" {
+void* __libc_malloc(size_t);
+void* __libc_calloc(size_t, size_t);
+void* __libc_realloc(void*, size_t);
+void __libc_free(void*);
+void* __libc_memalign(size_t, size_t);
+}
+
+namespace {
+
+struct AllocCounters {
+    uint64_t allocations = 0;  // malloc, calloc, realloc (to a new or grown block), memalign family
+    uint64_t frees = 0;
+    uint64_t bytes = 0;        // requested bytes
+    int64_t live = 0;          // usable bytes currently held (malloc_usable_size)
+};
+
+AllocCounters g_alloc;
+bool g_trace = false;      // capture call sites of allocations (only inside the measured doStep calls)
+bool g_in_trace = false;   // re-entrancy guard while backtrace() runs
+
+constexpr int kMaxFrames = 24;
+constexpr int kMaxSites = 16;
+struct Site {
+    void* frames[kMaxFrames];
+    int depth = 0;
+    uint64_t count = 0;
+    uint64_t bytes = 0;
+    double first_time = 0.0;  // communication point of the first occurrence
+};
+Site g_sites[kMaxSites];
+int g_site_count = 0;
+uint64_t g_sites_dropped = 0;
+uint64_t g_traced = 0;                 // allocations whose call site was recorded
+constexpr uint64_t kMaxTraced = 256;   // then only count: backtrace() would distort the timing
+double g_current_time = 0.0;
+
+void record_site(size_t n) {
+    if (g_in_trace) return;
+    if (g_traced >= kMaxTraced) {
+        g_sites_dropped++;
+        return;
+    }
+    g_traced++;
+    g_in_trace = true;
+    void* frames[kMaxFrames];
+    const int depth = backtrace(frames, kMaxFrames);
+    // frames[0] is record_site, frames[1] the interposed allocator: skip them.
+    const int skip = 2;
+    int found = -1;
+    for (int s = 0; s < g_site_count && found < 0; ++s) {
+        if (g_sites[s].depth != depth - skip) continue;
+        if (std::memcmp(g_sites[s].frames, frames + skip, sizeof(void*) * (depth - skip)) == 0) found = s;
+    }
+    if (found < 0 && g_site_count < kMaxSites) {
+        found = g_site_count++;
+        Site& site = g_sites[found];
+        site.depth = std::max(0, depth - skip);
+        std::memcpy(site.frames, frames + skip, sizeof(void*) * site.depth);
+        site.first_time = g_current_time;
+    }
+    if (found >= 0) {
+        g_sites[found].count++;
+        g_sites[found].bytes += n;
+    } else {
+        g_sites_dropped++;
+    }
+    g_in_trace = false;
+}
+
+inline void note_alloc(void* p, size_t n) {
+    if (p == nullptr) return;
+    g_alloc.allocations++;
+    g_alloc.bytes += n;
+    g_alloc.live += static_cast<int64_t>(malloc_usable_size(p));
+    if (g_trace) record_site(n);
+}
+
+inline void note_free(void* p) {
+    if (p == nullptr) return;
+    g_alloc.frees++;
+    g_alloc.live -= static_cast<int64_t>(malloc_usable_size(p));
+}
+
+}  // namespace
+
+extern "C" {
+void* malloc(size_t n) {
+    void* p = __libc_malloc(n);
+    note_alloc(p, n);
+    return p;
+}
+void* calloc(size_t count, size_t n) {
+    void* p = __libc_calloc(count, n);
+    note_alloc(p, count * n);
+    return p;
+}
+void* realloc(void* old, size_t n) {
+    if (old == nullptr) return malloc(n);
+    if (n == 0) {
+        free(old);
+        return nullptr;
+    }
+    const int64_t old_size = static_cast<int64_t>(malloc_usable_size(old));
+    void* p = __libc_realloc(old, n);
+    if (p != nullptr) {
+        g_alloc.live += static_cast<int64_t>(malloc_usable_size(p)) - old_size;
+        g_alloc.allocations++;  // a realloc counts as an allocation (it may move the block)
+        g_alloc.bytes += n;
+        if (g_trace) record_site(n);
+    }
+    return p;
+}
+void free(void* p) {
+    note_free(p);
+    __libc_free(p);
+}
+void* memalign(size_t alignment, size_t n) {
+    void* p = __libc_memalign(alignment, n);
+    note_alloc(p, n);
+    return p;
+}
+void* aligned_alloc(size_t alignment, size_t n) { return memalign(alignment, n); }
+int posix_memalign(void** out, size_t alignment, size_t n) {
+    void* p = memalign(alignment, n);
+    if (p == nullptr) return ENOMEM;
+    *out = p;
+    return 0;
+}
+void* valloc(size_t n) { return memalign(4096, n); }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Utilities
+// ------------------------------------------------------------------------------------------------
+namespace {
+
+[[noreturn]] void die(const std::string& message) {
+    std::fprintf(stderr, "gimbal_bench: %s\n", message.c_str());
+    std::exit(2);
+}
+
+double clock_seconds(clockid_t id) {
+    timespec ts;
+    clock_gettime(id, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// splitmix64: a portable, seeded generator (the same phases on every platform and compiler).
+struct Random {
+    uint64_t state;
+    explicit Random(uint64_t seed) : state(seed) {}
+    uint64_t next() {
+        uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        return z ^ (z >> 31);
+    }
+    double uniform() { return (next() >> 11) * 0x1.0p-53; }
+};
+
+// ------------------------------------------------------------------------------------------------
+// modelDescription.xml: GUID and name -> (type, value reference)
+// ------------------------------------------------------------------------------------------------
+struct VariableRef {
+    char type = '?';  // 'R', 'I', 'B', 'S'
+    fmi2ValueReference vr = 0;
+};
+
+struct ModelDescription {
+    std::string guid;
+    std::string model_identifier;
+    std::map<std::string, VariableRef> variables;
+
+    static std::string attribute(const std::string& text, size_t from, size_t to, const char* name) {
+        const std::string key = std::string(" ") + name + "=\"";
+        size_t p = text.find(key, from);
+        if (p == std::string::npos || p > to) {
+            const std::string key2 = std::string("\n") + name + "=\"";
+            p = text.find(key2, from);
+            if (p == std::string::npos || p > to) return "";
+        }
+        p = text.find('"', p) + 1;
+        const size_t q = text.find('"', p);
+        return text.substr(p, q - p);
+    }
+
+    void load(const std::string& path) {
+        std::ifstream in(path);
+        if (!in) die("cannot read " + path + " (give --model-description)");
+        std::stringstream buffer;
+        buffer << in.rdbuf();
+        const std::string text = buffer.str();
+        const size_t root = text.find("<fmiModelDescription");
+        if (root == std::string::npos) die(path + " is not an FMI model description");
+        guid = attribute(text, root, text.find('>', root), "guid");
+        const size_t cs = text.find("<CoSimulation");
+        if (cs != std::string::npos) model_identifier = attribute(text, cs, text.find('>', cs), "modelIdentifier");
+        size_t pos = 0;
+        while ((pos = text.find("<ScalarVariable", pos)) != std::string::npos) {
+            const size_t end_tag = text.find('>', pos);
+            const size_t close = text.find("</ScalarVariable>", pos);
+            const std::string name = attribute(text, pos, end_tag, "name");
+            const std::string vr = attribute(text, pos, end_tag, "valueReference");
+            VariableRef ref;
+            ref.vr = static_cast<fmi2ValueReference>(std::strtoul(vr.c_str(), nullptr, 10));
+            const std::string body = text.substr(end_tag, close - end_tag);
+            if (body.find("<Real") != std::string::npos) ref.type = 'R';
+            else if (body.find("<Integer") != std::string::npos) ref.type = 'I';
+            else if (body.find("<Boolean") != std::string::npos) ref.type = 'B';
+            else if (body.find("<String") != std::string::npos) ref.type = 'S';
+            variables[name] = ref;
+            pos = close == std::string::npos ? end_tag : close;
+        }
+        if (guid.empty() || variables.empty()) die(path + ": no guid or no variables found");
+    }
+
+    bool has(const std::string& name) const { return variables.count(name) != 0; }
+    fmi2ValueReference vr(const std::string& name, char type) const {
+        const auto it = variables.find(name);
+        if (it == variables.end()) die("the FMU has no variable '" + name + "'");
+        if (it->second.type != type)
+            die("variable '" + name + "' is of type " + it->second.type + ", expected " + type);
+        return it->second.vr;
+    }
+};
+
+// ------------------------------------------------------------------------------------------------
+// The FMU's functions
+// ------------------------------------------------------------------------------------------------
+struct Fmi2 {
+    void* handle = nullptr;
+    fmi2InstantiateTYPE* instantiate;
+    fmi2FreeInstanceTYPE* free_instance;
+    fmi2SetupExperimentTYPE* setup_experiment;
+    fmi2EnterInitializationModeTYPE* enter_initialization_mode;
+    fmi2ExitInitializationModeTYPE* exit_initialization_mode;
+    fmi2TerminateTYPE* terminate;
+    fmi2SetRealTYPE* set_real;
+    fmi2GetRealTYPE* get_real;
+    fmi2SetIntegerTYPE* set_integer;
+    fmi2GetIntegerTYPE* get_integer;
+    fmi2SetBooleanTYPE* set_boolean;
+    fmi2DoStepTYPE* do_step;
+
+    template <typename T>
+    void bind(T*& function, const char* name) {
+        function = reinterpret_cast<T*>(dlsym(handle, name));
+        if (function == nullptr) die(std::string("the FMU does not export ") + name);
+    }
+
+    void load(const std::string& path) {
+        handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (handle == nullptr) die(std::string("dlopen failed: ") + dlerror());
+        bind(instantiate, "fmi2Instantiate");
+        bind(free_instance, "fmi2FreeInstance");
+        bind(setup_experiment, "fmi2SetupExperiment");
+        bind(enter_initialization_mode, "fmi2EnterInitializationMode");
+        bind(exit_initialization_mode, "fmi2ExitInitializationMode");
+        bind(terminate, "fmi2Terminate");
+        bind(set_real, "fmi2SetReal");
+        bind(get_real, "fmi2GetReal");
+        bind(set_integer, "fmi2SetInteger");
+        bind(get_integer, "fmi2GetInteger");
+        bind(set_boolean, "fmi2SetBoolean");
+        bind(do_step, "fmi2DoStep");
+    }
+};
+
+int g_log_count = 0;
+void fmu_logger(fmi2ComponentEnvironment, fmi2String instance, fmi2Status status, fmi2String category,
+                fmi2String message, ...) {
+    if (++g_log_count > 20) return;  // a flood of warnings would distort the timing
+    std::fprintf(stderr, "[%s] %s (status %d): %s\n", instance ? instance : "?", category ? category : "?",
+                 static_cast<int>(status), message ? message : "");
+}
+
+void check(fmi2Status status, const char* what) {
+    if (status > fmi2Warning) die(std::string(what) + " failed with status " + std::to_string(status));
+}
+
+// ------------------------------------------------------------------------------------------------
+// Sea-state base motion: per axis q(t) = sum_i A_i sin(w_i t + phi_i), rates and accelerations
+// exact. The terms advance by an exact rotation per communication step (6 flops per term instead of
+// a sin and a cos) and are recomputed from t every 1024 steps, so rounding does not accumulate.
+// ------------------------------------------------------------------------------------------------
+struct SeaState {
+    static constexpr int kTerms = 10;
+    static constexpr int kAxes = 4;  // pitch delta, yaw psi, roll gamma, heave z
+    struct Term {
+        double A, w, phi;
+        double s, c;    // sin, cos of w t + phi at the current time
+        double cs, sn;  // cos(w h), sin(w h)
+    };
+    Term terms[kAxes][kTerms];
+    double h = 1e-3;
+    long k = 0;
+
+    // Significant amplitudes (2 sigma) [rad, rad, rad, m] and a JONSWAP-like spectrum about the
+    // peak period: a moderate sea, the ship heading into it.
+    void setup(uint64_t seed, double step) {
+        h = step;
+        Random rng(seed);
+        const double significant[kAxes] = {3.0 * M_PI / 180.0, 1.5 * M_PI / 180.0, 8.0 * M_PI / 180.0, 1.0};
+        const double peak_period[kAxes] = {7.0, 12.0, 9.0, 8.0};
+        for (int a = 0; a < kAxes; ++a) {
+            const double wp = 2.0 * M_PI / peak_period[a];
+            const double lo = 0.5 * wp, hi = 3.0 * wp, dw = (hi - lo) / kTerms;
+            double total = 0.0;
+            for (int i = 0; i < kTerms; ++i) {
+                Term& term = terms[a][i];
+                term.w = lo + (i + rng.uniform()) * dw;
+                term.phi = 2.0 * M_PI * rng.uniform();
+                const double r = wp / term.w;
+                const double shape = std::pow(term.w, -5.0) * std::exp(-1.25 * r * r * r * r) *
+                                     std::pow(3.3, std::exp(-std::pow(term.w - wp, 2) / (2.0 * 0.08 * 0.08 * wp * wp)));
+                term.A = shape * dw;  // variance share, normalized below
+                total += term.A;
+            }
+            const double sigma = significant[a] / 2.0;
+            for (int i = 0; i < kTerms; ++i) terms[a][i].A = std::sqrt(2.0 * terms[a][i].A / total) * sigma;
+            for (int i = 0; i < kTerms; ++i) {
+                terms[a][i].cs = std::cos(terms[a][i].w * h);
+                terms[a][i].sn = std::sin(terms[a][i].w * h);
+            }
+        }
+        reset(0);
+    }
+
+    void reset(long step_index) {
+        k = step_index;
+        const double t = k * h;
+        for (auto& axis : terms)
+            for (Term& term : axis) {
+                term.s = std::sin(term.w * t + term.phi);
+                term.c = std::cos(term.w * t + term.phi);
+            }
+    }
+
+    void advance() {
+        if (((k + 1) & 1023) == 0) {
+            reset(k + 1);
+            return;
+        }
+        ++k;
+        for (auto& axis : terms)
+            for (Term& term : axis) {
+                const double s = term.s * term.cs + term.c * term.sn;
+                const double c = term.c * term.cs - term.s * term.sn;
+                term.s = s;
+                term.c = c;
+            }
+    }
+
+    // The 15 base inputs in the order delta, psi, gamma, *_dot, *_ddot, v_a[1..3], a_a[1..3].
+    void inputs(double out[15]) const {
+        double q[kAxes], qd[kAxes], qdd[kAxes];
+        for (int a = 0; a < kAxes; ++a) {
+            double x = 0.0, v = 0.0, acc = 0.0;
+            for (const Term& term : terms[a]) {
+                x += term.A * term.s;
+                v += term.A * term.w * term.c;
+                acc -= term.A * term.w * term.w * term.s;
+            }
+            q[a] = x;
+            qd[a] = v;
+            qdd[a] = acc;
+        }
+        for (int a = 0; a < 3; ++a) {
+            out[a] = q[a];
+            out[3 + a] = qd[a];
+            out[6 + a] = qdd[a];
+        }
+        out[9] = 0.0;
+        out[10] = 0.0;
+        out[11] = qd[3];  // heave velocity of point a
+        out[12] = 0.0;
+        out[13] = 0.0;
+        out[14] = qdd[3];
+    }
+};
+
+// ------------------------------------------------------------------------------------------------
+// Line of sight: inverse kinematics of a fixed inertial target (geometry.py's gimbal_angles_for).
+// LOS = y of body 2; in G: GT0 Rz(alpha) Rx(beta) e_y, GT0 = Rx(delta) Rz(psi) Ry(gamma).
+// ------------------------------------------------------------------------------------------------
+void gimbal_angles_for(const double target[3], double delta, double psi, double gamma, double alpha_near,
+                       double& alpha, double& beta) {
+    double x = target[0], y = target[1], z = target[2];
+    double c = std::cos(delta), s = std::sin(delta);
+    double y1 = c * y + s * z, z1 = -s * y + c * z;
+    y = y1;
+    z = z1;
+    c = std::cos(psi);
+    s = std::sin(psi);
+    double x1 = c * x + s * y;
+    y1 = -s * x + c * y;
+    x = x1;
+    y = y1;
+    c = std::cos(gamma);
+    s = std::sin(gamma);
+    x1 = c * x - s * z;
+    z1 = s * x + c * z;
+    x = x1;
+    z = z1;
+    beta = std::atan2(z, std::hypot(x, y));
+    alpha = std::atan2(-x, y);
+    alpha += 2.0 * M_PI * std::round((alpha_near - alpha) / (2.0 * M_PI));
+}
+
+// PD on each axis about the IK set points, with the payload gyro as the rate signal:
+// elevation rate = los.omega[1], azimuth rate = los.omega[3] / cos(beta) (secant correction).
+struct Controller {
+    double kp[2] = {300.0, 640.0};  // V/rad
+    double kd[2] = {6.0, 12.0};     // V.s/rad
+    double u_limit[2] = {24.0, 24.0};
+    double target[3];
+
+    void compute(double alpha, double beta, const double gyro[3], const double base[15], double u[2]) const {
+        double r_alpha, r_beta;
+        gimbal_angles_for(target, base[0], base[1], base[2], alpha, r_alpha, r_beta);
+        const double w_az = gyro[2] / std::max(std::cos(beta), 0.2);
+        const double w_el = gyro[0];
+        const double v1 = kp[0] * (r_alpha - alpha) - kd[0] * w_az;
+        const double v2 = kp[1] * (r_beta - beta) - kd[1] * w_el;
+        u[0] = std::min(std::max(v1, -u_limit[0]), u_limit[0]);
+        u[1] = std::min(std::max(v2, -u_limit[1]), u_limit[1]);
+    }
+};
+
+// ------------------------------------------------------------------------------------------------
+// Options
+// ------------------------------------------------------------------------------------------------
+struct Options {
+    std::string fmu;
+    std::string model_description;
+    double duration = 10.0;
+    double step = 1e-3;
+    double rtol = NAN;
+    double atol = NAN;
+    int method = -1;  // -1: the FMU's default (solver.method not set)
+    std::string fidelity = "full";
+    std::string trajectory;
+    bool json = false;
+    bool fmi_overhead = false;
+    long overhead_steps = 1000000;
+    double overhead_step = 1e-6;
+    uint64_t seed = 1;
+    bool trace_allocations = true;
+    bool time_dostep = false;
+    double target_azimuth_deg = 30.0;
+    double target_elevation_deg = 20.0;
+};
+
+void usage() {
+    std::puts(
+        "usage: gimbal_bench --fmu PATH/Gimbal2Axis.so [options]\n"
+        "  --fmu PATH               the FMU's shared object (binaries/linux64/Gimbal2Axis.so of an unpacked FMU)\n"
+        "  --model-description P    modelDescription.xml (default: ../../modelDescription.xml from the .so)\n"
+        "  --duration T             simulated time [s] (default 10)\n"
+        "  --step H                 communication step [s] (default 1e-3)\n"
+        "  --rtol R, --atol A       solver.rtol, solver.atol (default: the FMU's)\n"
+        "  --method M               Integer parameter solver.method: 0 CVODE BDF analytic Jacobian, 1 CVODE BDF\n"
+        "                           finite-difference Jacobian, 2 CVODE Adams, 3 ARKODE explicit RK (default: FMU's)\n"
+        "  --fidelity full|reduced  reduced: rigid gears (gear*.model = 0), quasi-static motors (motor*.model = 0)\n"
+        "  --trajectory FILE        write t, alpha, beta, los.omega[1..3] at every communication point\n"
+        "                           (FILE.csv: CSV with a header; otherwise raw little-endian float64, 6 per row)\n"
+        "  --seed N                 seed of the sea-state phases and frequencies (default 1)\n"
+        "  --json                   print one JSON line instead of the text report\n"
+        "  --fmi-overhead           doStep of a model at rest (fixed base, g = 0, 0 V): ns per doStep, memory\n"
+        "  --overhead-steps N       doStep calls in --fmi-overhead (default 1000000)\n"
+        "  --overhead-step H        step of --fmi-overhead [s] (default 1e-6)\n"
+        "  --no-trace               do not record the call sites of allocations inside doStep\n"
+        "  --time-dostep            also time each doStep (CLOCK_MONOTONIC, ~40 ns per step more)");
+}
+
+Options parse(int argc, char** argv) {
+    Options o;
+    auto value = [&](int& i) -> std::string {
+        if (i + 1 >= argc) die(std::string("option ") + argv[i] + " needs a value");
+        return argv[++i];
+    };
+    auto number = [&](int& i) -> double {
+        const std::string text = value(i);
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') die(std::string("option ") + argv[i - 1] + ": not a number: " + text);
+        return v;
+    };
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--fmu") o.fmu = value(i);
+        else if (a == "--model-description") o.model_description = value(i);
+        else if (a == "--duration") o.duration = number(i);
+        else if (a == "--step") o.step = number(i);
+        else if (a == "--rtol") o.rtol = number(i);
+        else if (a == "--atol") o.atol = number(i);
+        else if (a == "--method") o.method = static_cast<int>(number(i));
+        else if (a == "--fidelity") o.fidelity = value(i);
+        else if (a == "--trajectory") o.trajectory = value(i);
+        else if (a == "--seed") o.seed = static_cast<uint64_t>(number(i));
+        else if (a == "--json") o.json = true;
+        else if (a == "--fmi-overhead") o.fmi_overhead = true;
+        else if (a == "--overhead-steps") o.overhead_steps = static_cast<long>(number(i));
+        else if (a == "--overhead-step") o.overhead_step = number(i);
+        else if (a == "--no-trace") o.trace_allocations = false;
+        else if (a == "--time-dostep") o.time_dostep = true;
+        else if (a == "--help" || a == "-h") {
+            usage();
+            std::exit(0);
+        } else die("unknown option " + a + " (see --help)");
+    }
+    if (o.fmu.empty()) die("--fmu is required (see --help)");
+    if (o.fidelity != "full" && o.fidelity != "reduced") die("--fidelity must be 'full' or 'reduced'");
+    if (!(o.step > 0.0) || !(o.duration > 0.0)) die("--step and --duration must be > 0");
+    if (o.model_description.empty()) {
+        std::string dir = o.fmu.substr(0, o.fmu.find_last_of('/') == std::string::npos ? 0 : o.fmu.find_last_of('/'));
+        if (dir.empty()) dir = ".";
+        o.model_description = dir + "/../../modelDescription.xml";
+    }
+    return o;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Allocation call sites: resolve frames to object + offset, then to function names with addr2line.
+// ------------------------------------------------------------------------------------------------
+std::string resolve_frame(void* address) {
+    Dl_info info;
+    if (dladdr(address, &info) == 0 || info.dli_fname == nullptr) {
+        char text[64];
+        std::snprintf(text, sizeof text, "%p", address);
+        return text;
+    }
+    const uintptr_t offset = reinterpret_cast<uintptr_t>(address) - reinterpret_cast<uintptr_t>(info.dli_fbase);
+    // Return addresses point after the call: look up offset - 1.
+    char command[4096];
+    std::snprintf(command, sizeof command, "addr2line -f -C -e '%s' 0x%lx 2>/dev/null", info.dli_fname,
+                  static_cast<unsigned long>(offset - 1));
+    std::string function;
+    if (FILE* pipe = popen(command, "r")) {
+        char line[2048];
+        if (std::fgets(line, sizeof line, pipe)) function = line;
+        pclose(pipe);
+    }
+    while (!function.empty() && (function.back() == '\n' || function.back() == '\r')) function.pop_back();
+    if (function.empty() || function == "??") function = info.dli_sname ? info.dli_sname : "??";
+    const char* base = std::strrchr(info.dli_fname, '/');
+    char text[4096];
+    std::snprintf(text, sizeof text, "%s+0x%lx %s", base ? base + 1 : info.dli_fname,
+                  static_cast<unsigned long>(offset), function.c_str());
+    return text;
+}
+
+std::string json_escape(const std::string& s) {
+    std::string out;
+    for (char ch : s) {
+        if (ch == '"' || ch == '\\') {
+            out += '\\';
+            out += ch;
+        } else if (ch == '\n') {
+            out += "\\n";
+        } else if (static_cast<unsigned char>(ch) < 0x20) {
+            out += ' ';
+        } else {
+            out += ch;
+        }
+    }
+    return out;
+}
+
+struct Report {
+    std::string mode;
+    double simulated = 0, wall = 0, cpu = 0, dostep_wall = NAN, master_cpu = NAN;
+    long dostep_calls = 0;
+    long counters[4] = {-1, -1, -1, -1};  // rhs, jacobian, steps, events
+    uint64_t instance_allocations = 0;
+    int64_t instance_bytes = 0;
+    uint64_t first_step_allocations = 0;
+    uint64_t dostep_allocations = 0;
+    uint64_t dostep_alloc_bytes = 0;
+    long states = -1;
+    std::vector<std::string> sites;  // text per site
+    std::string failure;
+};
+
+const char* kCounterNames[4] = {"solver.rhs_evaluations", "solver.jacobian_evaluations", "solver.steps", "events.total"};
+const char* kCounterKeys[4] = {"rhs_evaluations", "jacobian_evaluations", "solver_steps", "events"};
+
+void collect_sites(Report& report) {
+    for (int s = 0; s < g_site_count; ++s) {
+        const Site& site = g_sites[s];
+        std::ostringstream text;
+        text << site.count << " allocations (" << site.bytes << " bytes), first at t = " << site.first_time << ":";
+        for (int f = 0; f < site.depth; ++f) {
+            const std::string frame = resolve_frame(site.frames[f]);
+            text << "\n      #" << f << " " << frame;
+            if (frame.find("fmi2DoStep") != std::string::npos) break;  // the rest is the driver
+        }
+        report.sites.push_back(text.str());
+    }
+    if (g_sites_dropped > 0)
+        report.sites.push_back(std::to_string(g_sites_dropped) + " further allocations not traced (the first " +
+                               std::to_string(kMaxTraced) + " were; counts per site above are among those)");
+}
+
+void print_report(const Options& o, const Report& r) {
+    const double rtf = r.cpu > 0 ? r.simulated / r.cpu : 0.0;
+    if (o.json) {
+        auto num = [](double v) {
+            char text[32];
+            if (std::isnan(v)) return std::string("null");
+            std::snprintf(text, sizeof text, "%.6g", v);
+            return std::string(text);
+        };
+        std::printf("{\"mode\": \"%s\", \"fidelity\": \"%s\", \"method\": %s, \"rtol\": %s, \"atol\": %s, "
+                    "\"step\": %.9g, \"duration\": %.9g, \"simulated\": %.9g, \"wall_s\": %.6g, \"cpu_s\": %.6g, "
+                    "\"dostep_wall_s\": %s, \"master_cpu_s\": %s, \"dostep_calls\": %ld, \"rtf\": %.6g, "
+                    "\"cpu_us_per_step\": %.6g, \"states\": %ld",
+                    r.mode.c_str(), o.fidelity.c_str(), o.method < 0 ? "null" : std::to_string(o.method).c_str(),
+                    num(o.rtol).c_str(), num(o.atol).c_str(),
+                    r.mode == "overhead" ? o.overhead_step : o.step, r.simulated, r.simulated, r.wall, r.cpu,
+                    num(r.dostep_wall).c_str(), num(r.master_cpu).c_str(), r.dostep_calls, rtf, r.dostep_calls ? 1e6 * r.cpu / r.dostep_calls : 0.0, r.states);
+        for (int c = 0; c < 4; ++c) std::printf(", \"%s\": %ld", kCounterKeys[c], r.counters[c]);
+        std::printf(", \"instance_allocations\": %llu, \"instance_bytes\": %lld, \"first_step_allocations\": %llu, "
+                    "\"dostep_allocations\": %llu, \"dostep_alloc_bytes\": %llu",
+                    (unsigned long long)r.instance_allocations, (long long)r.instance_bytes,
+                    (unsigned long long)r.first_step_allocations, (unsigned long long)r.dostep_allocations,
+                    (unsigned long long)r.dostep_alloc_bytes);
+        if (r.mode == "overhead")
+            std::printf(", \"ns_per_dostep\": %.6g, \"wall_ns_per_dostep\": %.6g", 1e9 * r.cpu / r.dostep_calls,
+                        1e9 * r.wall / r.dostep_calls);
+        std::printf(", \"allocation_sites\": [");
+        for (size_t s = 0; s < r.sites.size(); ++s)
+            std::printf("%s\"%s\"", s ? ", " : "", json_escape(r.sites[s]).c_str());
+        std::printf("], \"failure\": \"%s\"}\n", json_escape(r.failure).c_str());
+        return;
+    }
+    std::printf("gimbal_bench: %s, fidelity %s, method %s, rtol %s, atol %s\n", r.mode.c_str(), o.fidelity.c_str(),
+                o.method < 0 ? "FMU default" : std::to_string(o.method).c_str(),
+                std::isnan(o.rtol) ? "default" : std::to_string(o.rtol).c_str(),
+                std::isnan(o.atol) ? "default" : std::to_string(o.atol).c_str());
+    if (!r.failure.empty()) std::printf("  FAILED: %s\n", r.failure.c_str());
+    std::printf("  simulated          %.6g s in %ld doStep calls of %g s (%ld states)\n", r.simulated, r.dostep_calls,
+                r.mode == "overhead" ? o.overhead_step : o.step, r.states);
+    std::printf("  wall time          %.6g s", r.wall);
+    if (!std::isnan(r.dostep_wall)) std::printf(" (inside doStep %.6g s)", r.dostep_wall);
+    std::printf("\n  CPU time           %.6g s = %.4g us per doStep\n", r.cpu, 1e6 * r.cpu / std::max(1L, r.dostep_calls));
+    std::printf("  real-time factor   %.6g (simulated / CPU time)\n", rtf);
+    if (!std::isnan(r.master_cpu))
+        std::printf("  master's share     %.6g s CPU (same loop without doStep): FMU alone %.4g us per doStep, "
+                    "real-time factor %.6g\n",
+                    r.master_cpu, 1e6 * (r.cpu - r.master_cpu) / std::max(1L, r.dostep_calls),
+                    r.simulated / std::max(1e-12, r.cpu - r.master_cpu));
+    for (int c = 0; c < 4; ++c) std::printf("  %-27s %ld\n", kCounterNames[c], r.counters[c]);
+    std::printf("  instance memory    %lld bytes in %llu allocations (instantiate + initialization)\n",
+                (long long)r.instance_bytes, (unsigned long long)r.instance_allocations);
+    std::printf("  first doStep       %llu allocations\n", (unsigned long long)r.first_step_allocations);
+    std::printf("  later doSteps      %llu allocations, %llu bytes\n", (unsigned long long)r.dostep_allocations,
+                (unsigned long long)r.dostep_alloc_bytes);
+    for (const std::string& site : r.sites) std::printf("    %s\n", site.c_str());
+}
+
+struct Run {
+    Options o;
+    Fmi2 fmi;
+    ModelDescription md;
+    fmi2Component component = nullptr;
+    fmi2CallbackFunctions callbacks{fmu_logger, calloc, free, nullptr, nullptr};
+    Report report;
+
+    void set_real(const std::string& name, double v) {
+        const fmi2ValueReference vr = md.vr(name, 'R');
+        check(fmi.set_real(component, &vr, 1, &v), ("fmi2SetReal " + name).c_str());
+    }
+    void set_integer(const std::string& name, int v) {
+        const fmi2ValueReference vr = md.vr(name, 'I');
+        const fmi2Integer value = v;
+        check(fmi.set_integer(component, &vr, 1, &value), ("fmi2SetInteger " + name).c_str());
+    }
+    void set_boolean(const std::string& name, bool v) {
+        const fmi2ValueReference vr = md.vr(name, 'B');
+        const fmi2Boolean value = v ? fmi2True : fmi2False;
+        check(fmi.set_boolean(component, &vr, 1, &value), ("fmi2SetBoolean " + name).c_str());
+    }
+    double get_real(const std::string& name) {
+        const fmi2ValueReference vr = md.vr(name, 'R');
+        double v = 0;
+        check(fmi.get_real(component, &vr, 1, &v), ("fmi2GetReal " + name).c_str());
+        return v;
+    }
+
+    // Instantiate and set the structural parameters and tolerances (counted as instance memory).
+    void instantiate() {
+        const uint64_t a0 = g_alloc.allocations;
+        const int64_t live0 = g_alloc.live;
+        const std::string name = md.model_identifier.empty() ? "Gimbal2Axis" : md.model_identifier;
+        component = fmi.instantiate("bench", fmi2CoSimulation, md.guid.c_str(), "", &callbacks, fmi2False, fmi2False);
+        if (component == nullptr) die("fmi2Instantiate failed");
+        if (g_alloc.allocations == a0)
+            die("no heap allocation seen in fmi2Instantiate: the malloc interposition does not work");
+        if (o.method >= 0) {
+            if (!md.has("solver.method"))
+                die("--method " + std::to_string(o.method) +
+                    ": this FMU has no Integer parameter 'solver.method' (integrator choice not available yet)");
+            set_integer("solver.method", o.method);
+        }
+        if (o.fidelity == "reduced") {
+            for (const char* v : {"gear1.model", "gear2.model", "motor1.model", "motor2.model"}) {
+                if (!md.has(v)) die(std::string("--fidelity reduced: the FMU has no parameter '") + v + "'");
+                set_integer(v, 0);
+            }
+        }
+        if (!std::isnan(o.rtol)) set_real("solver.rtol", o.rtol);
+        if (!std::isnan(o.atol)) set_real("solver.atol", o.atol);
+        report.instance_allocations = g_alloc.allocations - a0;
+        report.instance_bytes = g_alloc.live - live0;
+        (void)name;
+    }
+
+    void finish_instance_memory(uint64_t a0, int64_t live0) {
+        report.instance_allocations = g_alloc.allocations - a0;
+        report.instance_bytes = g_alloc.live - live0;
+    }
+
+    void read_counters() {
+        for (int c = 0; c < 4; ++c) {
+            if (!md.has(kCounterNames[c])) continue;
+            const fmi2ValueReference vr = md.vr(kCounterNames[c], 'I');
+            fmi2Integer v = 0;
+            if (fmi.get_integer(component, &vr, 1, &v) <= fmi2Warning) report.counters[c] = v;
+        }
+        if (md.has("solver.states")) {
+            const fmi2ValueReference vr = md.vr("solver.states", 'I');
+            fmi2Integer v = 0;
+            if (fmi.get_integer(component, &vr, 1, &v) <= fmi2Warning) report.states = v;
+        }
+    }
+
+    // ------------------------------------------------------------------ ship stabilization
+    void ship_stabilization() {
+        report.mode = "ship_stabilization";
+        const long n = std::lround(o.duration / o.step);
+        const double h = o.step;
+        report.simulated = n * h;
+
+        SeaState sea;
+        sea.setup(o.seed, h);
+        Controller controller;
+        const double az = o.target_azimuth_deg * M_PI / 180.0, el = o.target_elevation_deg * M_PI / 180.0;
+        controller.target[0] = -std::sin(az) * std::cos(el);
+        controller.target[1] = std::cos(az) * std::cos(el);
+        controller.target[2] = std::sin(el);
+
+        const uint64_t a0 = g_alloc.allocations;
+        const int64_t live0 = g_alloc.live;
+        instantiate();
+        double base[15];
+        sea.inputs(base);
+        double alpha0, beta0;
+        gimbal_angles_for(controller.target, base[0], base[1], base[2], 0.0, alpha0, beta0);
+        // Stop time with half a step of slack: the accumulated time may pass n * h by rounding.
+        check(fmi.setup_experiment(component, fmi2False, 0.0, 0.0, fmi2True, (n + 0.5) * h), "fmi2SetupExperiment");
+        check(fmi.enter_initialization_mode(component), "fmi2EnterInitializationMode");
+        controller.u_limit[0] = get_real("motor1.U_L");
+        controller.u_limit[1] = get_real("motor2.U_L");
+        const double N1 = get_real("gear1.N"), N2 = get_real("gear2.N");
+        // Start on target with relaxed gears (rotor angle = N times the load's), at rest on the base.
+        set_real("alpha", alpha0);
+        set_real("alpha_m", N1 * alpha0);
+        set_real("beta", beta0);
+        set_real("beta_m", N2 * beta0);
+
+        static const char* kInputs[17] = {"u_R1", "u_R2", "base.delta", "base.psi", "base.gamma",
+                                          "base.delta_dot", "base.psi_dot", "base.gamma_dot", "base.delta_ddot",
+                                          "base.psi_ddot", "base.gamma_ddot", "base.v_a[1]", "base.v_a[2]",
+                                          "base.v_a[3]", "base.a_a[1]", "base.a_a[2]", "base.a_a[3]"};
+        static const char* kOutputs[5] = {"alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]"};
+        fmi2ValueReference in_vr[17], out_vr[5];
+        for (int i = 0; i < 17; ++i) in_vr[i] = md.vr(kInputs[i], 'R');
+        for (int i = 0; i < 5; ++i) out_vr[i] = md.vr(kOutputs[i], 'R');
+        double in[17] = {0.0};
+        std::memcpy(in + 2, base, sizeof base);
+        check(fmi.set_real(component, in_vr, 17, in), "fmi2SetReal inputs");
+        check(fmi.exit_initialization_mode(component), "fmi2ExitInitializationMode");
+        finish_instance_memory(a0, live0);
+
+        const bool record = !o.trajectory.empty();
+        std::vector<double> trajectory;
+        if (record) trajectory.reserve(static_cast<size_t>(n + 1) * 6);
+        double y[5];
+        double u_next[2] = {0.0, 0.0};  // computed at t_k, applied over [t_{k+1}, t_{k+2}]
+        backtrace(reinterpret_cast<void**>(y), 1);  // loads libgcc's unwinder now, not inside a measured step
+
+        const double wall0 = clock_seconds(CLOCK_MONOTONIC), cpu0 = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
+        double in_step = 0.0;
+        long k = 0;
+        // The communication points are accumulated (t += h), as the FMU accumulates its own time:
+        // the FMU refuses a currentCommunicationPoint more than 1e-12 relative from its time, and
+        // k * h drifts that far from the running sum after ~1e5 steps of 1 ms.
+        double t = 0.0;
+        for (; k < n; ++k, t += h) {
+            check(fmi.get_real(component, out_vr, 5, y), "fmi2GetReal outputs");
+            if (record) trajectory.insert(trajectory.end(), {t, y[0], y[1], y[2], y[3], y[4]});
+            sea.inputs(base);
+            double u[2];
+            controller.compute(y[0], y[1], y + 2, base, u);
+            in[0] = u_next[0];
+            in[1] = u_next[1];
+            std::memcpy(in + 2, base, sizeof base);
+            u_next[0] = u[0];
+            u_next[1] = u[1];
+            check(fmi.set_real(component, in_vr, 17, in), "fmi2SetReal inputs");
+
+            const uint64_t before = g_alloc.allocations, bytes_before = g_alloc.bytes;
+            g_current_time = t;
+            g_trace = k > 0 && o.trace_allocations;
+            fmi2Status status;
+            if (o.time_dostep) {
+                const double s0 = clock_seconds(CLOCK_MONOTONIC);
+                status = fmi.do_step(component, t, h, fmi2True);
+                in_step += clock_seconds(CLOCK_MONOTONIC) - s0;
+            } else {
+                status = fmi.do_step(component, t, h, fmi2True);
+            }
+            g_trace = false;
+            if (k == 0) {
+                report.first_step_allocations = g_alloc.allocations - before;
+            } else {
+                report.dostep_allocations += g_alloc.allocations - before;
+                report.dostep_alloc_bytes += g_alloc.bytes - bytes_before;
+            }
+            if (status > fmi2Warning) {
+                report.failure = "fmi2DoStep returned status " + std::to_string(status) + " at t = " + std::to_string(t);
+                break;
+            }
+            sea.advance();
+        }
+        report.cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
+        report.wall = clock_seconds(CLOCK_MONOTONIC) - wall0;
+        if (o.time_dostep) report.dostep_wall = in_step;
+        report.dostep_calls = k + (report.failure.empty() ? 0 : 1);
+        report.simulated = k * h;
+        if (report.failure.empty() && fmi.get_real(component, out_vr, 5, y) <= fmi2Warning && record)
+            trajectory.insert(trajectory.end(), {t, y[0], y[1], y[2], y[3], y[4]});
+        read_counters();
+        if (report.failure.empty()) {
+            // The master's own share: the same loop (outputs, sea state, controller, inputs) without
+            // doStep, on the final state. The FMU's share is cpu - master_cpu.
+            sea.reset(0);
+            u_next[0] = u_next[1] = 0.0;
+            const double m0 = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
+            for (long j = 0; j < k; ++j) {
+                check(fmi.get_real(component, out_vr, 5, y), "fmi2GetReal outputs");
+                if (record) trajectory[static_cast<size_t>(j) * 6] = j * h;  // same memory traffic
+                sea.inputs(base);
+                double u[2];
+                controller.compute(y[0], y[1], y + 2, base, u);
+                in[0] = u_next[0];
+                in[1] = u_next[1];
+                std::memcpy(in + 2, base, sizeof base);
+                u_next[0] = u[0];
+                u_next[1] = u[1];
+                check(fmi.set_real(component, in_vr, 17, in), "fmi2SetReal inputs");
+                sea.advance();
+            }
+            report.master_cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - m0;
+        }
+        collect_sites(report);
+        if (record) write_trajectory(trajectory);
+        fmi.terminate(component);
+        fmi.free_instance(component);
+    }
+
+    void write_trajectory(const std::vector<double>& data) {
+        const std::string& path = o.trajectory;
+        const bool csv = path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0;
+        FILE* f = std::fopen(path.c_str(), csv ? "w" : "wb");
+        if (f == nullptr) die("cannot write " + path);
+        if (csv) {
+            std::fprintf(f, "time,alpha,beta,los.omega[1],los.omega[2],los.omega[3]\n");
+            for (size_t i = 0; i + 6 <= data.size(); i += 6)
+                std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", data[i], data[i + 1], data[i + 2], data[i + 3],
+                             data[i + 4], data[i + 5]);
+        } else {
+            std::fwrite(data.data(), sizeof(double), data.size(), f);
+        }
+        std::fclose(f);
+    }
+
+    // ------------------------------------------------------------------ FMI overhead
+    void fmi_overhead() {
+        report.mode = "overhead";
+        const double h = o.overhead_step;
+        const long n = o.overhead_steps;
+        const uint64_t a0 = g_alloc.allocations;
+        const int64_t live0 = g_alloc.live;
+        instantiate();
+        set_boolean("base.fixed", true);
+        set_real("g", 0.0);  // at rest: no gravity torque, zero state, zero inputs
+        check(fmi.setup_experiment(component, fmi2False, 0.0, 0.0, fmi2False, 0.0), "fmi2SetupExperiment");
+        check(fmi.enter_initialization_mode(component), "fmi2EnterInitializationMode");
+        check(fmi.exit_initialization_mode(component), "fmi2ExitInitializationMode");
+        finish_instance_memory(a0, live0);
+        void* frames[2];
+        backtrace(frames, 1);
+
+        const uint64_t before_first = g_alloc.allocations;
+        check(fmi.do_step(component, 0.0, h, fmi2True), "fmi2DoStep");
+        report.first_step_allocations = g_alloc.allocations - before_first;
+
+        const uint64_t before = g_alloc.allocations, bytes_before = g_alloc.bytes;
+        g_trace = o.trace_allocations;
+        const double wall0 = clock_seconds(CLOCK_MONOTONIC), cpu0 = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
+        double t = h;
+        long k = 1;
+        for (; k < n; ++k) {
+            if (fmi.do_step(component, t, h, fmi2True) > fmi2Warning) {
+                report.failure = "fmi2DoStep failed at t = " + std::to_string(t);
+                break;
+            }
+            t += h;
+        }
+        report.cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
+        report.wall = clock_seconds(CLOCK_MONOTONIC) - wall0;
+        g_trace = false;
+        report.dostep_allocations = g_alloc.allocations - before;
+        report.dostep_alloc_bytes = g_alloc.bytes - bytes_before;
+        report.dostep_calls = k - 1;  // timed calls (the first is not)
+        report.simulated = report.dostep_calls * h;
+        read_counters();
+        collect_sites(report);
+        fmi.terminate(component);
+        fmi.free_instance(component);
+    }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Run run;
+    run.o = parse(argc, argv);
+    run.md.load(run.o.model_description);
+    run.fmi.load(run.o.fmu);
+    if (run.o.fmi_overhead) run.fmi_overhead();
+    else run.ship_stabilization();
+    print_report(run.o, run.report);
+    return run.report.failure.empty() ? 0 : 1;
+}

@@ -1,0 +1,168 @@
+"""What runs on a worker: one case of a sweep on a worker-local FMU instance.
+
+Each worker (a Dask worker, or the calling thread for a serial sweep) extracts the FMU once and
+instantiates it once; every further case reuses that instance through fmi2Reset (scene_lib.master.run
+with `slave=`). The cache is an attribute of the Dask worker (`get_worker()`), else thread-local, and is
+keyed by the FMU's SHA-256: a rebuilt FMU is loaded afresh. The FMU's logger messages of a case
+are collected and returned with a failure.
+"""
+from __future__ import annotations
+
+import atexit
+import hashlib
+import math
+import os
+import pathlib
+import tempfile
+import threading
+import time
+
+import numpy as np
+
+_LOCAL = threading.local()
+
+
+class _Loaded:
+    """An extracted FMU, one instance of it and the list its logger appends to."""
+
+    def __init__(self, fmu_path: pathlib.Path, workdir: pathlib.Path):
+        from scene_lib.fmu import FMU
+
+        self.fmu = FMU(fmu_path, workdir=workdir)
+        self.log: list = []
+        self.slave = None
+        self.cases = 0
+        atexit.register(self.close)
+
+    def instance(self):
+        if self.slave is None:
+            self.slave = self.fmu.instantiate("sweep", self.log)
+        return self.slave
+
+    def discard_instance(self):
+        if self.slave is not None:
+            try:
+                self.slave.freeInstance()
+            except Exception:
+                pass
+            self.slave = None
+
+    def close(self):
+        self.discard_instance()
+        self.fmu.close()
+
+
+def _cache() -> dict:
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+    except (ImportError, ValueError):
+        worker = None
+    if worker is not None:
+        if not hasattr(worker, "_gimbal_sweep_cache"):
+            worker._gimbal_sweep_cache = {}
+        return worker._gimbal_sweep_cache
+    if not hasattr(_LOCAL, "cache"):
+        _LOCAL.cache = {}
+    return _LOCAL.cache
+
+
+def _workdir() -> pathlib.Path:
+    try:
+        from distributed import get_worker
+
+        return pathlib.Path(get_worker().local_directory)
+    except (ImportError, ValueError):
+        return pathlib.Path(tempfile.gettempdir())
+
+
+def loaded_fmu(fmu_bytes: bytes, digest: str) -> _Loaded:
+    """The worker's FMU with this digest: written to the worker's directory and extracted once."""
+    cache = _cache()
+    entry = cache.get(digest)
+    if entry is None:
+        for old in list(cache.values()):   # an older build: free it
+            old.close()
+        cache.clear()
+        workdir = pathlib.Path(tempfile.mkdtemp(prefix="gimbal_sweep_", dir=_workdir()))
+        path = workdir / f"Gimbal2Axis-{digest[:12]}.fmu"
+        path.write_bytes(fmu_bytes)
+        entry = cache[digest] = _Loaded(path, workdir)
+    return entry
+
+
+def fmu_digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def metrics(result, from_s: float | None) -> dict:
+    """Summary metrics of a run: RMS, peak and final line-of-sight error [mrad] over [from_s, end]
+    (nan without a [target]), peak |current| per motor and overall [A], events, requirements met."""
+    s = result.signals
+    if from_s is None:
+        start = result.window_start()
+        from_s = start if start < result.stop_time else 0.0
+    if result.has_target:
+        los = result.los_metrics(from_s=from_s)
+        rms, peak, final = los["rms"] * 1e3, los["max"] * 1e3, los["final"] * 1e3
+    else:
+        rms = peak = final = math.nan
+    i1, i2 = float(np.max(np.abs(s["i_R1"]))), float(np.max(np.abs(s["i_R2"])))
+    failures = result.requirement_failures()
+    judged = bool(result.scene.requirements) and result.has_target and result.window_start() < result.stop_time
+    return {"los_rms_mrad": rms, "los_peak_mrad": peak, "los_final_mrad": final, "los_from_s": float(from_s),
+            "i_peak_R1_A": i1, "i_peak_R2_A": i2, "i_peak_A": max(i1, i2),
+            "events": int(s["events.total"][-1]) if "events.total" in s else -1,
+            "requirements_met": (not failures) if judged else None}
+
+
+def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> dict:
+    """Runs one case (the scene with its values already put in) on this worker's FMU instance and
+    returns its row: metrics and status 'ok', or status 'failed' with the error and the FMU's log.
+    Never raises for a failing case: failures are results too."""
+    from scene_lib.errors import SceneError
+    from scene_lib.master import run
+
+    row = {"case_id": case_id, "status": "failed", "message": "", "fmu_log": "", "wall_time_s": math.nan,
+           "worker": _worker_name()}
+    wall0 = time.perf_counter()
+    loaded = None
+    try:
+        loaded = loaded_fmu(fmu_bytes, digest)
+        try:
+            result = run(scene, loaded.fmu, slave=loaded.instance(), log=loaded.log)
+        except SceneError:
+            raise
+        except Exception:   # the reused instance would not reset: retry once on a fresh one
+            loaded.discard_instance()
+            result = run(scene, loaded.fmu, slave=loaded.instance(), log=loaded.log)
+        row.update(metrics(result, from_s))
+        row["status"] = "ok"
+        row["wall_time_s"] = time.perf_counter() - wall0   # the whole case: set-up, run, metrics
+        if loaded.log:   # warnings of a run that went through
+            row["fmu_log"] = "\n".join(loaded.log)
+    except SceneError as exc:
+        row["message"] = str(exc)
+        row["wall_time_s"] = time.perf_counter() - wall0
+        if loaded is not None:
+            row["fmu_log"] = "\n".join(loaded.log)
+    except Exception as exc:   # anything else: report it, and do not trust the instance any more
+        row["message"] = f"{type(exc).__name__}: {exc}"
+        row["wall_time_s"] = time.perf_counter() - wall0
+        if loaded is not None:
+            row["fmu_log"] = "\n".join(loaded.log)
+            loaded.discard_instance()
+    if loaded is not None:
+        loaded.cases += 1
+        row["instance_use"] = loaded.cases   # the n-th case of this worker's FMU (extracted once)
+    return row
+
+
+def _worker_name() -> str:
+    try:
+        from distributed import get_worker
+
+        return get_worker().address
+    except (ImportError, ValueError):
+        return f"serial-{os.getpid()}"
