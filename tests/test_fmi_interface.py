@@ -140,15 +140,16 @@ def test_instances_in_threads_match_one_at_a_time(gimbal_fmu):
 
 def test_integrator_failure_discards_and_rolls_back(gimbal_fmu):
     log = []
-    slave = started(gimbal_fmu, log=log, start=dict(START, **{"solver.max_steps": 50}))
+    slave = started(gimbal_fmu, log=log, start=dict(START, **{"solver.max_steps": 200}))
     try:
         gimbal_fmu.set_values(slave, {"u_R1": 10.0})
-        slave.doStep(0.0, 1e-4)  # 50 internal steps are enough for this...
+        slave.doStep(0.0, 1e-4)  # 200 internal steps are enough for this...
         before = gimbal_fmu.get_values(slave, OUTPUTS)
         with pytest.raises(FMICallException) as failure:
             slave.doStep(1e-4, 0.1)  # ...but not for this
         assert failure.value.status == DISCARD
-        assert any(status == DISCARD and "rolled back to t = 0.0001" in text and "CV_TOO_MUCH_WORK" in text
+        assert any(status == DISCARD and "rolled back to t = 0.0001" in text and
+                   ("CV_TOO_MUCH_WORK" in text or "more than solver.max_steps = 200" in text)
                    for status, _, text in log), log[-3:]
         assert slave.getRealStatus(fmi2LastSuccessfulTime) == 1e-4
         assert slave.getStatus(fmi2DoStepStatus) == DISCARD

@@ -61,6 +61,19 @@ void GimbalHybridSystem::set_inputs(const StepInputs& inputs) {
                      (b.attitude_rate.isZero(0.0) && b.attitude_accel.isZero(0.0) && b.acceleration_a.isZero(0.0));
 }
 
+bool GimbalHybridSystem::at_rest(double time, const double* state) {
+    if (!base_constant_ || inputs_.voltage_rate[0] != 0.0 || inputs_.voltage_rate[1] != 0.0) return false;
+    for (int body = 0; body < 4; ++body)  // the cheap test first: anything moving is not at rest
+        if (params_.layout.independent(body) && state[params_.layout.rate_slot[body]] != 0.0) return false;
+    double rate[kMaxStateSize];
+    if (!derivative(time, state, rate)) return false;
+    for (int k = 0; k < params_.layout.size; ++k) {
+        // Energy accumulators only integrate flows: they stay put when the flows are 0.
+        if (rate[k] != 0.0) return false;
+    }
+    return true;
+}
+
 bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
     return evaluate_state_derivative(params_, inputs_, modes_, base_at(time), time, state, derivative);
 }
@@ -160,6 +173,10 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
             const bool at_minus = !in_gap ? current == -1 : (side(backlash + eta, directions, slot + 1) <= 0);
             const int pull = side(d.free_backlash_rate[axis], directions, in_gap ? -1 : slot);
             contact = select_contact(at_plus, at_minus, pull, current);
+            // A located crossing of a stop from inside the gap is a contact: theta_b was moving outward,
+            // whatever sign X has on the root state (with k_s/c_s ~ 1e10 rounding flips it).
+            if (in_gap && directions != nullptr && directions[slot] > 0) contact = 1;
+            if (in_gap && directions != nullptr && directions[slot + 1] < 0) contact = -1;
             backlash = contact != 0 ? contact * eta : std::clamp(backlash, -eta, eta);
         }
         modes_.gear_contact[axis] = contact;

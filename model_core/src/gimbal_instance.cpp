@@ -73,6 +73,7 @@ void GimbalInstance::reset() {
     system_.reset();
     integrator_running_ = false;
     preview_current_ = false;
+    at_rest_ = false;
     voltage_rate_[0] = voltage_rate_[1] = 0.0;
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
@@ -363,7 +364,11 @@ void GimbalInstance::save(void* buffer) {
         for (int p = 0; p < 5; ++p)
             for (int k = 0; k < 3; ++k) snap.base[3 * p + k] = (*parts[p])[k];
         snap.arc_start_time = in.step_start_time;
-        integrator_running_ = false;  // replayable from here: see the header
+        // Replayable from here (see the header): the next step starts a fresh integrator, exactly as a
+        // restored copy will (a one-step method would otherwise carry its step size over).
+        const IntegratorStatistics totals = integrator_->statistics();
+        create_integrator();
+        integrator_->set_statistics(totals);
     }
     std::memcpy(buffer, &snap, sizeof snap);
 }
@@ -422,6 +427,11 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     const Modes step_start_modes = system_->modes();
     const EventCounters step_start_counters = system_->counters();
 
+    if (continuous && at_rest_ && inputs.voltage_rate[0] == 0.0 && inputs.voltage_rate[1] == 0.0) {
+        time_ = current_time + step_size;  // outputs cannot change either
+        return GIMBAL_OK;
+    }
+    at_rest_ = false;
     if (continuous) {
         // The right-hand side does not jump: keep the integrator's history, follow the new ramps.
         if (inputs.voltage_rate[0] != running.voltage_rate[0] || inputs.voltage_rate[1] != running.voltage_rate[1] ||
@@ -451,6 +461,7 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     }
     integrator_running_ = true;
     voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
+    at_rest_ = system_->at_rest(current_time + step_size, state_);
     double previous_reals[kRealVariableCount];
     int previous_integers[kIntegerVariableCount];
     std::copy(reals_, reals_ + kRealVariableCount, previous_reals);

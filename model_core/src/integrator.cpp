@@ -106,7 +106,12 @@ bool HybridIntegrator::advance(double end_time, double* state) {
         }
 
         backend_roots(root_directions_.data());
+        double before[64];
+        const bool tracked = size_ <= 64;
+        if (tracked) std::copy(state, state + size_, before);
         const int changes = system_.update_modes(reached, state, root_directions_.data());
+        // A projection without a mode change (e.g. theta_b clamped back onto a stop) must not be lost.
+        const bool projected = tracked && !std::equal(state, state + size_, before);
         totals_.events += changes;
         events_here += changes;
         if (changes > 0 && settings_.events_logged()) {
@@ -131,8 +136,8 @@ bool HybridIntegrator::advance(double end_time, double* state) {
             }
         }
         // New modes change the right-hand side: restart there, from the (possibly projected) state. A
-        // root that changed no mode (a grazing touch) needs no restart: the integrator carries on.
-        if (changes > 0 && !restart(reached, state)) return false;
+        // root that changed nothing (a grazing touch) needs no restart: the integrator carries on.
+        if ((changes > 0 || projected) && !restart(reached, state)) return false;
         if (reached >= end_time) return true;
     }
 }

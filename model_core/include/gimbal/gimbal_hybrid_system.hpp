@@ -33,6 +33,9 @@ public:
     int update_modes(double time, double* state, const int* directions) override;
 
     void set_inputs(const StepInputs& inputs);
+    // At an exact equilibrium under constant inputs the solution stays put (it is unique): a step
+    // needs no integration. True if the base does not move and every state derivative is exactly 0.
+    bool at_rest(double time, const double* state);
     const StepInputs& inputs() const { return inputs_; }
     const Modes& modes() const { return modes_; }
     const EventCounters& counters() const { return counters_; }

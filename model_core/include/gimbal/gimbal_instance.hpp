@@ -66,6 +66,7 @@ private:
     std::unique_ptr<HybridIntegrator> integrator_;
     bool integrator_running_ = false;  // false: the next step must restart the integrator
     bool preview_current_ = false;
+    bool at_rest_ = false;             // exact equilibrium under the running inputs: steps need no integration
     std::string last_integrator_error_;
     double voltage_rate_[2] = {0.0, 0.0};  // for the next step only     // the calculated outputs reflect the current start values
     double time_ = 0.0;
