@@ -53,6 +53,16 @@ def write(tmp_path, text, name):
 
 
 @pytest.fixture(scope="module")
+def fmu_path(fmu_path, tmp_path_factory):
+    """A copy of the FMU: the serial and the Dask runs use the same bytes even if the build replaces it."""
+    import shutil
+
+    copy = tmp_path_factory.mktemp("fmu") / "Gimbal2Axis.fmu"
+    shutil.copyfile(fmu_path, copy)
+    return copy
+
+
+@pytest.fixture(scope="module")
 def client():
     """A local cluster of 2 worker processes (the product's default), 1 thread each."""
     from sweep_lib import make_client

@@ -7,7 +7,7 @@ import pathlib
 
 FIRST = ["case_id", "case", "sweep", "scene", "scene_hash", "stop_time"]
 LAST = ["seed", "sampling_seed", "status", "los_rms_mrad", "los_peak_mrad", "los_final_mrad", "los_from_s",
-        "i_peak_R1_A", "i_peak_R2_A", "i_peak_A", "events", "requirements_met", "wall_time_s", "message", "fmu_log",
+        "i_peak_R1_A", "i_peak_R2_A", "i_peak_A", "events", "requirements_met", "wall_time_s", "cpu_time_s", "message", "fmu_log",
         "worker", "instance_use", "fmu_sha256"]
 METRICS = ["los_rms_mrad", "los_peak_mrad", "i_peak_A", "events", "wall_time_s"]
 
@@ -103,12 +103,17 @@ def plot_summary(rows: list[dict], parameters: list[str], path: pathlib.Path, ti
               "events": "events", "wall_time_s": "wall time [s]"}
     for j, p in enumerate(numeric):
         x_all = np.array([float(r[p]) for r in rows if r.get(p) is not None])
-        log_x = x_all.size and np.all(x_all > 0) and x_all.max() / x_all.min() >= 50
+        floats = any(isinstance(r.get(p), float) for r in rows)
+        log_x = floats and x_all.size and np.all(x_all > 0) and x_all.max() / x_all.min() >= 10
         for i, m in enumerate(metrics):
             ax = axes[i, j]
             x = np.array([float(r[p]) for r in ok if r.get(p) is not None and r.get(m) is not None])
             y = np.array([float(r[m]) for r in ok if r.get(p) is not None and r.get(m) is not None])
             ax.plot(x, y, ".", ms=3 if len(x) > 200 else 5, alpha=0.5 if len(x) > 200 else 0.9, color="tab:blue")
+            levels = np.unique(x)
+            if 1 < len(levels) <= 12 and len(x) > len(levels):   # a grid parameter: median per value
+                med = [np.nanmedian(y[x == v]) for v in levels]
+                ax.plot(levels, med, "-o", color="k", ms=3, lw=1, label="median")
             positive = y[np.isfinite(y) & (y > 0)]
             if m.startswith("los") and positive.size and positive.max() / positive.min() >= 50:
                 ax.set_yscale("log")

@@ -126,7 +126,7 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
 
     row = {"case_id": case_id, "status": "failed", "message": "", "fmu_log": "", "wall_time_s": math.nan,
            "worker": _worker_name()}
-    wall0 = time.perf_counter()
+    wall0, cpu0 = time.perf_counter(), time.thread_time()
     loaded = None
     try:
         loaded = loaded_fmu(fmu_bytes, digest)
@@ -153,6 +153,7 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
         if loaded is not None:
             row["fmu_log"] = "\n".join(loaded.log)
             loaded.discard_instance()
+    row["cpu_time_s"] = time.thread_time() - cpu0   # less than wall_time_s when the CPU is shared
     if loaded is not None:
         loaded.cases += 1
         row["instance_use"] = loaded.cases   # the n-th case of this worker's FMU (extracted once)
