@@ -175,10 +175,15 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
         force[rotor] += electromagnetic_torque(motor, out.full.current[axis]) - shaft_torque / gear.ratio;
     }
 
-    Mat4 reduced_mass = reduction.transpose() * mass_matrix * reduction;
-    for (int body = 0; body < 4; ++body)
-        if (!layout.independent(body)) reduced_mass(body, body) = 1.0;  // padding: a trivial equation
-    const Vec4 applied = reduction.transpose() * (force + bias);
+    const bool reduced = params.fidelity.gear[0] == GearModel::rigid || params.fidelity.gear[1] == GearModel::rigid;
+    Mat4 reduced_mass = mass_matrix;
+    Vec4 applied = force + bias;
+    if (reduced) {
+        reduced_mass = reduction.transpose() * mass_matrix * reduction;
+        for (int body = 0; body < 4; ++body)
+            if (!layout.independent(body)) reduced_mass(body, body) = 1.0;  // padding: a trivial equation
+        applied = reduction.transpose() * applied;
+    }
 
     bool any_low_speed = false;
     for (int k = 0; k < 4; ++k) any_low_speed = any_low_speed || low_speed(modes.friction[k]);
@@ -198,7 +203,7 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
         out.friction_torque[k] = torque;
     }
     out.acceleration = reduced_mass.llt().solve(applied + out.friction_torque);
-    out.full_acceleration = reduction * out.acceleration;
+    out.full_acceleration = reduced ? Vec4(reduction * out.acceleration) : out.acceleration;
     out.reduced_mass = reduced_mass;
     out.reduction = reduction;
 

@@ -5,22 +5,16 @@
 namespace gimbal {
 namespace {
 
-using Mat34 = Eigen::Matrix<double, 3, 4>;
-
-Mat3 skew(const Vec3& v) {
-    Mat3 s;
-    s << 0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0;
-    return s;
-}
-
-// Motion of one body at the current state with qdd = 0, in the body's own frame.
+// Motion of one body at the current state with qdd = 0, in the body's own frame. Its angular velocity
+// depends on at most two joint rates (its own, and the azimuth rate for the elevation bodies): the
+// partial angular velocities are kept as those columns only.
 struct BodyMotion {
-    Mat3 frame_T_0;                 // maps frame 0 coordinates to the body frame
-    Vec3 angular_velocity;          // inertial
-    Vec3 angular_accel_bias;        // inertial angular acceleration when qdd = 0
-    Mat34 partial_angular_velocity; // d(angular_velocity)/d(qd)
-    Vec3 accel_b;                   // inertial acceleration of point b
-    Vec3 gravity;
+    Mat3 frame_T_0;          // maps frame 0 coordinates to the body frame
+    Vec3 angular_velocity;   // inertial
+    Vec3 angular_accel_bias; // inertial angular acceleration when qdd = 0
+    int column_count;
+    int column[2];           // which generalized coordinates
+    Vec3 axis[2];            // d(angular_velocity)/d(qd_column)
 };
 
 struct GimbalMotion {
@@ -29,7 +23,6 @@ struct GimbalMotion {
 
 void compute_motion(const BaseKinematics& base, const Vec4& q, const Vec4& qd, GimbalMotion& motion) {
     const Vec3 ex = Vec3::UnitX(), ez = Vec3::UnitZ();
-
     // Carrier-fixed bodies (azimuth housing and its rotor) turn about z of frame 0.
     for (int k : {kAzimuthBody, kAzimuthRotor}) {
         BodyMotion& m = motion.body[k];
@@ -37,8 +30,9 @@ void compute_motion(const BaseKinematics& base, const Vec4& q, const Vec4& qd, G
         const Vec3 base_rate = m.frame_T_0 * base.angular_velocity;
         m.angular_velocity = base_rate + ez * qd[k];
         m.angular_accel_bias = m.frame_T_0 * base.angular_accel + base_rate.cross(ez * qd[k]);
-        m.partial_angular_velocity.setZero();
-        m.partial_angular_velocity.col(k) = ez;
+        m.column_count = 1;
+        m.column[0] = k;
+        m.axis[0] = ez;
     }
     // Elevation bodies turn about x of the azimuth housing (frame 1).
     const BodyMotion& housing = motion.body[kAzimuthBody];
@@ -49,8 +43,11 @@ void compute_motion(const BaseKinematics& base, const Vec4& q, const Vec4& qd, G
         const Vec3 housing_rate = frame_T_1 * housing.angular_velocity;
         m.angular_velocity = housing_rate + ex * qd[k];
         m.angular_accel_bias = frame_T_1 * housing.angular_accel_bias + housing_rate.cross(ex * qd[k]);
-        m.partial_angular_velocity = frame_T_1 * housing.partial_angular_velocity;
-        m.partial_angular_velocity.col(k) = ex;
+        m.column_count = 2;
+        m.column[0] = kAzimuthBody;
+        m.axis[0] = frame_T_1 * ez;
+        m.column[1] = k;
+        m.axis[1] = ex;
     }
 }
 
@@ -63,6 +60,8 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
     // Point b is fixed on the carrier: rigid-body acceleration transfer from point a.
     const Vec3 accel_b0 = base.accel_a + base.angular_accel.cross(model.d_ab) +
                           base.angular_velocity.cross(base.angular_velocity.cross(model.d_ab));
+    // Gravity and the carrier's acceleration act alike on every body: combine them once, in frame 0.
+    const Vec3 apparent_gravity0 = base.gravity - accel_b0;
 
     mass_matrix.setZero();
     bias.setZero();
@@ -71,17 +70,23 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
         const BodyMotion& m = motion.body[k];
         const Vec3& w = m.angular_velocity;
         const Vec3& d = body.centre_of_mass;
-        // Partial velocities of the centre of mass: (dw/dqd_j) x d.
-        const Mat34 partial_velocity = -skew(d) * m.partial_angular_velocity;
-        const Vec3 com_accel_bias = m.frame_T_0 * accel_b0 + m.angular_accel_bias.cross(d) + w.cross(w.cross(d));
-        const Vec3 gravity = m.frame_T_0 * base.gravity;
-        const Vec3 inertia_times_w = body.inertia * w;
-
-        mass_matrix.noalias() += body.mass * partial_velocity.transpose() * partial_velocity +
-                                 m.partial_angular_velocity.transpose() * body.inertia * m.partial_angular_velocity;
-        bias.noalias() += body.mass * partial_velocity.transpose() * (gravity - com_accel_bias) -
-                          m.partial_angular_velocity.transpose() *
-                              (body.inertia * m.angular_accel_bias + w.cross(inertia_times_w));
+        // Newton-Euler residual of the body with qdd = 0, projected below on its partial velocities.
+        const Vec3 force = body.mass * (m.frame_T_0 * apparent_gravity0 - m.angular_accel_bias.cross(d) -
+                                        w.cross(w.cross(d)));
+        const Vec3 torque = -(body.inertia * m.angular_accel_bias + w.cross(body.inertia * w));
+        Vec3 partial_velocity[2], inertia_axis[2];
+        for (int i = 0; i < m.column_count; ++i) {
+            partial_velocity[i] = m.axis[i].cross(d);  // of the centre of mass
+            inertia_axis[i] = body.inertia * m.axis[i];
+        }
+        for (int i = 0; i < m.column_count; ++i) {
+            const int row = m.column[i];
+            bias[row] += partial_velocity[i].dot(force) + m.axis[i].dot(torque);
+            for (int j = 0; j < m.column_count; ++j) {
+                mass_matrix(row, m.column[j]) +=
+                    body.mass * partial_velocity[i].dot(partial_velocity[j]) + m.axis[i].dot(inertia_axis[j]);
+            }
+        }
     }
 }
 
