@@ -20,7 +20,10 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   ctest --test-dir "$asan_dir" --output-on-failure
   # Left out here: the tests whose time goes to Python (the independent reference solution) or to
   # Dask worker processes (sweeps); they run in the release pass below.
-  LD_PRELOAD="$(gcc -print-file-name=libasan.so)" GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
+  # libstdc++ is preloaded too: ASan's exception interceptor must find it at start-up, and Python
+  # only loads it later (with matplotlib's C++ extensions, which throw).
+  LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
+    GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
     "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider \
     --deselect tests/test_reference_solution.py --ignore tests/test_sweep.py
   unset ASAN_OPTIONS UBSAN_OPTIONS
