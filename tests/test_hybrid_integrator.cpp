@@ -166,7 +166,8 @@ void check_method(IntegrationMethod method) {
 int main() {
     // The same hybrid layer over every backend.
     for (IntegrationMethod method : {IntegrationMethod::bdf_difference_jacobian, IntegrationMethod::adams,
-                                     IntegrationMethod::explicit_runge_kutta}) {
+                                     IntegrationMethod::explicit_runge_kutta, IntegrationMethod::automatic,
+                                     IntegrationMethod::dormand_prince, IntegrationMethod::rosenbrock}) {
         const int before = check::failures;
         check_method(method);
         if (check::failures != before) std::fprintf(stderr, "  (method %d)\n", static_cast<int>(method));

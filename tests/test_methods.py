@@ -22,7 +22,7 @@ def reference(gimbal_fmu):
                     scene, OUTPUTS)
 
 
-@pytest.mark.parametrize("method", [0, 1, 2, 3])
+@pytest.mark.parametrize("method", [0, 1, 2, 3, 4, 5, 6])
 def test_method_agrees_with_the_reference(gimbal_fmu, reference, method):
     r = simulate(gimbal_fmu, 0.25, 1e-3, {"solver.method": method, "solver.rtol": 1e-9, "solver.atol": 1e-11},
                  scene, OUTPUTS)

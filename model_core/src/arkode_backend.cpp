@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "gimbal/integrator.hpp"
+#include "sundials_integrator.hpp"
 
 namespace gimbal {
 namespace {
@@ -19,11 +19,11 @@ std::string flag_name(int flag) {
     return result;
 }
 
-class ArkodeBackend final : public HybridIntegrator {
+class ArkodeBackend final : public SundialsIntegrator {
 public:
     ArkodeBackend(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
                   MessageSink event_sink)
-        : HybridIntegrator(system, settings, std::move(error_sink), std::move(event_sink)) {
+        : SundialsIntegrator(system, settings, std::move(error_sink), std::move(event_sink)) {
         create_vector();
     }
 

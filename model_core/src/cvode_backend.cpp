@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "gimbal/integrator.hpp"
+#include "sundials_integrator.hpp"
 
 namespace gimbal {
 namespace {
@@ -20,11 +20,11 @@ std::string flag_name(int flag) {
     return result;
 }
 
-class CvodeBackend final : public HybridIntegrator {
+class CvodeBackend final : public SundialsIntegrator {
 public:
     CvodeBackend(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
                  MessageSink event_sink)
-        : HybridIntegrator(system, settings, std::move(error_sink), std::move(event_sink)) {
+        : SundialsIntegrator(system, settings, std::move(error_sink), std::move(event_sink)) {
         if (!create_vector()) return;
         jacobian_ = SUNDenseMatrix(size_, size_, context_);
         if (jacobian_ != nullptr) linear_solver_ = SUNLinSol_Dense(y_, jacobian_, context_);

@@ -1,6 +1,7 @@
 #include "gimbal/gimbal_hybrid_system.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 namespace gimbal {
 namespace {
@@ -56,6 +57,7 @@ const BaseKinematics& GimbalHybridSystem::base_at(double time) {
 void GimbalHybridSystem::set_inputs(const StepInputs& inputs) {
     inputs_ = inputs;
     base_cached_ = false;
+    cache_valid_ = false;
     const BaseMotion& b = inputs.base;
     base_constant_ = params_.fidelity.fixed_base ||
                      (b.attitude_rate.isZero(0.0) && b.attitude_accel.isZero(0.0) && b.acceleration_a.isZero(0.0));
@@ -74,8 +76,29 @@ bool GimbalHybridSystem::at_rest(double time, const double* state) {
     return true;
 }
 
+bool GimbalHybridSystem::time_dependent() const {
+    return !base_constant_ || (inputs_.voltage_rate[0] != 0.0 && modes_.voltage_clamped[0] == 0) ||
+           (inputs_.voltage_rate[1] != 0.0 && modes_.voltage_clamped[1] == 0);
+}
+
+const Dynamics& GimbalHybridSystem::dynamics_at(double time, const double* state) {
+    const int n = params_.layout.size;
+    if (!cache_valid_ || time != cache_time_ || !std::equal(state, state + n, cache_state_)) {
+        evaluate_dynamics(params_, inputs_, base_at(time), time, state, modes_, cache_);
+        cache_time_ = time;
+        std::copy(state, state + n, cache_state_);
+        cache_valid_ = true;
+    }
+    return cache_;
+}
+
 bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
-    return evaluate_state_derivative(params_, inputs_, modes_, base_at(time), time, state, derivative);
+    const int n = params_.layout.size;
+    evaluate_dynamics(params_, inputs_, base_at(time), time, state, modes_, cache_);
+    cache_time_ = time;
+    std::copy(state, state + n, cache_state_);
+    cache_valid_ = true;
+    return state_derivative(params_, cache_, derivative);
 }
 
 bool GimbalHybridSystem::jacobian(double time, const double* state, double* column_major) {
@@ -85,8 +108,7 @@ bool GimbalHybridSystem::jacobian(double time, const double* state, double* colu
 
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     std::fill(values, values + kEventCount, 1.0);
-    Dynamics d;
-    evaluate_dynamics(params_, inputs_, base_at(time), time, state, modes_, d);
+    const Dynamics& d = dynamics_at(time, state);
 
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params_.gear[axis];
@@ -143,6 +165,8 @@ void GimbalHybridSystem::event_functions(double time, const double* state, doubl
 
 int GimbalHybridSystem::update_modes(double time, double* state, const int* directions) {
     const Modes previous = modes_;
+    previous_modes_ = previous;
+    cache_valid_ = false;  // new modes, and perhaps a projected state
     Dynamics d;
     const BaseKinematics base = base_at(time);
     evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
@@ -256,6 +280,52 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
     counters_.total += changes;
     if (changes > 0) counters_.last_event_time = time;
     return changes;
+}
+
+namespace {
+
+const char* contact_name(int side) { return side > 0 ? "+eta stop" : (side < 0 ? "-eta stop" : "gap"); }
+const char* limit_name(int side) { return side > 0 ? "held at +i_L" : (side < 0 ? "held at -i_L" : "free"); }
+const char* clamp_name(int side) { return side > 0 ? "at +U_L" : (side < 0 ? "at -U_L" : "following the ramp"); }
+const char* friction_name(FrictionMode mode) {
+    switch (mode) {
+        case FrictionMode::none: return "none";
+        case FrictionMode::slip_positive: return "slipping +";
+        case FrictionMode::slip_negative: return "slipping -";
+        case FrictionMode::hold: return "stuck";
+        case FrictionMode::at_max_positive: return "breaking away (+T_max)";
+        case FrictionMode::at_max_negative: return "breaking away (-T_max)";
+    }
+    return "?";
+}
+const char* const kBodyNames[4] = {"body1", "rotor1", "body2", "rotor2"};
+
+}  // namespace
+
+std::string GimbalHybridSystem::describe_last_changes() const {
+    std::ostringstream s;
+    const char* separator = "";
+    auto change = [&](const std::string& element, const char* from, const char* to) {
+        s << separator << element << ": " << from << " -> " << to;
+        separator = "; ";
+    };
+    for (int axis = 0; axis < 2; ++axis) {
+        const std::string number = std::to_string(axis + 1);
+        if (previous_modes_.gear_contact[axis] != modes_.gear_contact[axis])
+            change("gear" + number + " backlash", contact_name(previous_modes_.gear_contact[axis]),
+                   contact_name(modes_.gear_contact[axis]));
+        if (previous_modes_.voltage_clamped[axis] != modes_.voltage_clamped[axis])
+            change("motor" + number + " voltage clamp", clamp_name(previous_modes_.voltage_clamped[axis]),
+                   clamp_name(modes_.voltage_clamped[axis]));
+        if (previous_modes_.motor_limited[axis] != modes_.motor_limited[axis])
+            change("motor" + number + " current limiter", limit_name(previous_modes_.motor_limited[axis]),
+                   limit_name(modes_.motor_limited[axis]));
+    }
+    for (int body = 0; body < 4; ++body)
+        if (previous_modes_.friction[body] != modes_.friction[body])
+            change(std::string(kBodyNames[body]) + " dry friction", friction_name(previous_modes_.friction[body]),
+                   friction_name(modes_.friction[body]));
+    return s.str();
 }
 
 }  // namespace gimbal

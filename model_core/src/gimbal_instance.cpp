@@ -35,7 +35,7 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 Vec3 vector_at(const double* values, unsigned first) { return Vec3(values[first], values[first + 1], values[first + 2]); }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 2;
+constexpr std::uint32_t kSnapshotVersion = 3;
 
 struct Snapshot {
     std::uint32_t magic;
@@ -54,7 +54,11 @@ struct Snapshot {
     double voltage_rate[2];
     double pending_voltage_rate[2];
     double base[15];  // attitude, rate, accel, v_a, a_a at the arc start
-    double arc_start_time;
+    double arc_start_time;  // model time
+    double epoch;
+    bool integrator_running;
+    bool at_rest;
+    IntegratorMemory integrator_memory;
 };
 static_assert(std::is_trivially_copyable<Snapshot>::value, "snapshots are copied as bytes");
 
@@ -77,6 +81,7 @@ void GimbalInstance::reset() {
     voltage_rate_[0] = voltage_rate_[1] = 0.0;
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
+    epoch_ = 0.0;
 }
 
 GimbalStatus GimbalInstance::refuse(GimbalStatus status, const std::string& message) const {
@@ -190,7 +195,9 @@ StepInputs GimbalInstance::read_step_inputs(double step_start) const {
 
 void GimbalInstance::publish_outputs() {
     const Modes& modes = system_->modes();
-    const ModelOutputs out = evaluate_outputs(params_, system_->inputs(), modes, time_, state_);
+    const double now = model_time(time_);
+    const Dynamics& dynamics = system_->dynamics_at(now, state_);
+    const ModelOutputs out = outputs_from(params_, system_->inputs(), system_->base_kinematics_at_time(now), now, dynamics);
     for (int k = 0; k < 4; ++k) {
         reals_[vr_alpha + k] = out.full.angle[k];
         reals_[vr_alpha_dot + k] = out.full.rate[k];
@@ -222,7 +229,7 @@ void GimbalInstance::publish_outputs() {
         integers_[vi_body1_stick_slip + body] = friction_mode_indicator(modes.friction[body], out.full.rate[body]);
     const EventCounters& events = system_->counters();
     const IntegratorStatistics stats = integrator_->statistics();
-    reals_[vr_events_last_time] = events.last_event_time;
+    reals_[vr_events_last_time] = epoch_ + events.last_event_time;
     integers_[vi_events_total] = static_cast<int>(events.total);
     integers_[vi_events_backlash1] = static_cast<int>(events.backlash[0]);
     integers_[vi_events_backlash2] = static_cast<int>(events.backlash[1]);
@@ -234,6 +241,7 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_solver_steps] = static_cast<int>(std::min<long>(stats.steps, 2147483647L));
     integers_[vi_solver_rhs_evaluations] = static_cast<int>(std::min<long>(stats.rhs_evaluations, 2147483647L));
     integers_[vi_solver_jacobian_evaluations] = static_cast<int>(std::min<long>(stats.jacobian_evaluations, 2147483647L));
+    integers_[vi_solver_method_switches] = static_cast<int>(std::min<long>(stats.method_switches, 2147483647L));
 }
 
 void GimbalInstance::load_start_state() {
@@ -302,9 +310,10 @@ GimbalStatus GimbalInstance::preview_outputs(const char* function, const char* n
                                         " cannot be computed from the current values: " + error);
     }
     load_start_state();
+    epoch_ = time_;
     system_ = std::make_unique<GimbalHybridSystem>(params_);
-    system_->set_inputs(read_step_inputs(time_));
-    system_->update_modes(time_, state_, nullptr);
+    system_->set_inputs(read_step_inputs(0.0));
+    system_->update_modes(0.0, state_, nullptr);
     create_integrator();
     publish_outputs();
     // The preview must not count as initialization: forget the integrator again.
@@ -323,11 +332,12 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     if (base_status != GIMBAL_OK) return base_status;
     load_start_state();
     time_ = start_time;
+    epoch_ = start_time;
     system_ = std::make_unique<GimbalHybridSystem>(params_);
-    system_->set_inputs(read_step_inputs(time_));
-    system_->update_modes(time_, state_, nullptr);
+    system_->set_inputs(read_step_inputs(0.0));
+    system_->update_modes(0.0, state_, nullptr);
     EventCounters none;
-    none.last_event_time = time_;
+    none.last_event_time = 0.0;
     system_->restore(system_->modes(), none);  // the initial choice of modes is not an event
     create_integrator();
     publish_outputs();
@@ -364,11 +374,21 @@ void GimbalInstance::save(void* buffer) {
         for (int p = 0; p < 5; ++p)
             for (int k = 0; k < 3; ++k) snap.base[3 * p + k] = (*parts[p])[k];
         snap.arc_start_time = in.step_start_time;
-        // Replayable from here (see the header): the next step starts a fresh integrator, exactly as a
-        // restored copy will (a one-step method would otherwise carry its step size over).
-        const IntegratorStatistics totals = integrator_->statistics();
-        create_integrator();
-        integrator_->set_statistics(totals);
+        snap.epoch = epoch_;
+        snap.at_rest = at_rest_;
+        if (integrator_->resumable()) {
+            // The one-step methods carry only their step-size controller: the snapshot holds it, and a
+            // restored copy continues exactly as this instance does.
+            snap.integrator_running = integrator_running_;
+            snap.integrator_memory = integrator_->memory();
+        } else {
+            // A multistep method's history does not fit in a snapshot: end the integration segment here,
+            // so that this instance and a restored copy both restart the integrator at the next step.
+            const IntegratorStatistics totals = integrator_->statistics();
+            create_integrator();
+            integrator_->set_statistics(totals);
+            snap.integrator_running = false;
+        }
     }
     std::memcpy(buffer, &snap, sizeof snap);
 }
@@ -405,9 +425,18 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     for (int p = 0; p < 5; ++p)
         for (int k = 0; k < 3; ++k) (*parts[p])[k] = snap.base[3 * p + k];
     in.step_start_time = snap.arc_start_time;
+    epoch_ = snap.epoch;
     system_->set_inputs(in);
     system_->restore(snap.modes, snap.counters);
     create_integrator();
+    if (snap.integrator_running && integrator_->resumable()) {
+        if (!integrator_->resume(model_time(time_), state_, snap.integrator_memory)) {
+            return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: the integrator cannot continue from the saved state (" +
+                                            last_integrator_error_ + ")");
+        }
+        integrator_running_ = true;
+        at_rest_ = snap.at_rest;
+    }
     integrator_->set_statistics(snap.statistics);
     return GIMBAL_OK;
 }
@@ -416,12 +445,14 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     if (!integrator_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance is not initialized");
     const GimbalStatus base_status = check_fixed_base("fmi2DoStep");
     if (base_status != GIMBAL_OK) return base_status;
-    StepInputs inputs = read_step_inputs(current_time);
+    const double step_start = model_time(current_time);
+    const double step_end = model_time(current_time + step_size);
+    StepInputs inputs = read_step_inputs(step_start);
     const StepInputs& running = system_->inputs();
     // The right-hand side is continuous across the step boundary only if the held voltages are the same
     // and the base motion continues the running constant-acceleration arc; otherwise restart.
-    const bool continuous = integrator_running_ && continues(running, inputs, current_time) &&
-                            same_base_motion(inputs.base, running.base.advanced(current_time - running.step_start_time));
+    const bool continuous = integrator_running_ && continues(running, inputs, step_start) &&
+                            same_base_motion(inputs.base, running.base.advanced(step_start - running.step_start_time));
     double step_start_state[kMaxStateSize];
     std::copy(state_, state_ + kMaxStateSize, step_start_state);
     const Modes step_start_modes = system_->modes();
@@ -437,19 +468,23 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
         if (inputs.voltage_rate[0] != running.voltage_rate[0] || inputs.voltage_rate[1] != running.voltage_rate[1] ||
             inputs.commanded_voltage[0] != running.commanded_voltage[0] ||
             inputs.commanded_voltage[1] != running.commanded_voltage[1]) {
-            inputs.base = running.base.advanced(current_time - running.step_start_time);
+            inputs.base = running.base.advanced(step_start - running.step_start_time);
             system_->set_inputs(inputs);
+            if (!integrator_->inputs_changed(step_start, state_)) {
+                return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not take the new inputs (" +
+                                                last_integrator_error_ + ")");
+            }
         }
     } else {
         system_->set_inputs(inputs);
         // New inputs may cross a switching surface at once (e.g. the voltage reverses while limited).
-        system_->update_modes(current_time, state_, nullptr);
-        if (!integrator_->restart(current_time, state_)) {
+        system_->update_modes(step_start, state_, nullptr);
+        if (!integrator_->restart(step_start, state_)) {
             return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not be restarted");
         }
     }
     last_integrator_error_.clear();
-    if (!integrator_->advance(current_time + step_size, state_)) {
+    if (!integrator_->advance(step_end, state_)) {
         std::copy(step_start_state, step_start_state + kMaxStateSize, state_);
         system_->restore(step_start_modes, step_start_counters);
         integrator_running_ = false;
@@ -461,7 +496,7 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     }
     integrator_running_ = true;
     voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
-    at_rest_ = system_->at_rest(current_time + step_size, state_);
+    at_rest_ = system_->at_rest(step_end, state_);
     double previous_reals[kRealVariableCount];
     int previous_integers[kIntegerVariableCount];
     std::copy(reals_, reals_ + kRealVariableCount, previous_reals);

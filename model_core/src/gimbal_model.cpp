@@ -334,9 +334,13 @@ void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, 
 
 bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
                                const BaseKinematics& base, double time, const double* state, double* derivative) {
-    const StateLayout& layout = params.layout;
     Dynamics d;
     evaluate_dynamics(params, inputs, base, time, state, modes, d);
+    return state_derivative(params, d, derivative);
+}
+
+bool state_derivative(const ModelParameters& params, const Dynamics& d, double* derivative) {
+    const StateLayout& layout = params.layout;
     for (int body = 0; body < 4; ++body) {
         if (!layout.independent(body)) continue;
         derivative[layout.angle_slot[body]] = d.full.rate[body];
@@ -379,7 +383,14 @@ ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& i
     const BaseKinematics base = evaluate_base_kinematics(base_motion, params.multibody.gravity);
     Dynamics d;
     evaluate_dynamics(params, inputs, base, time, state, modes, d);
+    return outputs_from(params, inputs, base, time, d);
+}
 
+ModelOutputs outputs_from(const ModelParameters& params, const StepInputs& inputs, const BaseKinematics& base,
+                          double time, const Dynamics& d) {
+    const Vec3 velocity_a = params.fidelity.fixed_base
+                                ? Vec3::Zero()
+                                : Vec3(inputs.base.velocity_a + inputs.base.acceleration_a * (time - inputs.step_start_time));
     ModelOutputs out;
     out.full = d.full;
     for (int axis = 0; axis < 2; ++axis) {
@@ -393,7 +404,7 @@ ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& i
             out.magnetic_energy += 0.5 * params.motor[axis].inductance * d.full.current[axis] * d.full.current[axis];
     }
     out.payload_angular_velocity = payload_angular_velocity(base, d.full.angle, d.full.rate);
-    const MultibodyEnergy energy = compute_energy(params.multibody, base, base_motion.velocity_a, d.full.angle, d.full.rate);
+    const MultibodyEnergy energy = compute_energy(params.multibody, base, velocity_a, d.full.angle, d.full.rate);
     out.kinetic_energy = energy.kinetic;
     out.potential_energy = energy.potential;
     return out;

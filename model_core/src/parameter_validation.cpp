@@ -1,5 +1,7 @@
 #include "gimbal/parameter_validation.hpp"
 
+#include "gimbal/integrator.hpp"
+
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
@@ -133,10 +135,12 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         return false;
     }
     params.max_steps = integers[vi_solver_max_steps];
-    if (integers[vi_solver_method] < 0 || integers[vi_solver_method] > 3) {
+    if (integers[vi_solver_method] < 0 || integers[vi_solver_method] >= kIntegrationMethodCount) {
         error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
-                " is invalid: it must be 0 (BDF, analytic Jacobian), 1 (BDF, difference quotients), 2 (Adams) or 3 "
-                "(explicit Runge-Kutta)";
+                " is invalid: it must be 4 (automatic: Dormand-Prince 5(4), RODAS4 while stiff; the default), "
+                "5 (Dormand-Prince 5(4) only), 6 (RODAS4 only), or a SUNDIALS reference method: 0 (CVODE BDF, "
+                "analytic Jacobian), 1 (CVODE BDF, difference quotients), 2 (CVODE Adams) or 3 (ARKODE explicit "
+                "Runge-Kutta)";
         return false;
     }
     params.method = integers[vi_solver_method];

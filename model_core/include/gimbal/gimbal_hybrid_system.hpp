@@ -32,7 +32,14 @@ public:
     void event_functions(double time, const double* state, double* values) override;
     int update_modes(double time, double* state, const int* directions) override;
 
+    bool time_dependent() const override;
+    std::string describe_last_changes() const override;
+
     void set_inputs(const StepInputs& inputs);
+    // The dynamics at (time, state) under the current modes: those of the last right-hand side when it
+    // was evaluated there (the usual case at the end of a step), else evaluated now.
+    const Dynamics& dynamics_at(double time, const double* state);
+    const BaseKinematics& base_kinematics_at_time(double time) { return base_at(time); }
     // At an exact equilibrium under constant inputs the solution stays put (it is unique): a step
     // needs no integration. True if the base does not move and every state derivative is exactly 0.
     bool at_rest(double time, const double* state);
@@ -40,7 +47,10 @@ public:
     const Modes& modes() const { return modes_; }
     const EventCounters& counters() const { return counters_; }
     // For rolling a failed step back.
-    void restore(const Modes& modes, const EventCounters& counters) { modes_ = modes, counters_ = counters; }
+    void restore(const Modes& modes, const EventCounters& counters) {
+        modes_ = modes, counters_ = counters;
+        cache_valid_ = false;
+    }
 
 private:
     const BaseKinematics& base_at(double time);
@@ -52,7 +62,14 @@ private:
     bool base_cached_ = false;
     bool base_constant_ = false;
     Modes modes_;
+    Modes previous_modes_;  // before the last update_modes, for the event log
     EventCounters counters_;
+    // The last evaluated dynamics and where: the event functions and outputs at the end of a step reuse
+    // the right-hand side's work instead of evaluating the dynamics again.
+    Dynamics cache_;
+    double cache_time_ = 0.0;
+    double cache_state_[kMaxStateSize];
+    bool cache_valid_ = false;
 };
 
 // Friction mode as the FMU reports it: 0 stuck, +-1 breaking away, +-2 slipping (sign = motion).

@@ -68,8 +68,12 @@ private:
     bool preview_current_ = false;
     bool at_rest_ = false;             // exact equilibrium under the running inputs: steps need no integration
     std::string last_integrator_error_;
-    double voltage_rate_[2] = {0.0, 0.0};  // for the next step only     // the calculated outputs reflect the current start values
+    double voltage_rate_[2] = {0.0, 0.0};  // for the next step only
     double time_ = 0.0;
+    // The model runs on time since initialization: results do not depend on where the master's clock
+    // starts, and event times keep their resolution at large start times.
+    double epoch_ = 0.0;
+    double model_time(double time) const { return time - epoch_; }
 };
 
 }  // namespace gimbal

@@ -161,7 +161,10 @@ void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, 
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
 
-// dx/dt within the current modes; false if it is not finite.
+// dx/dt within the current modes, from the dynamics evaluated at (t, x); false if it is not finite.
+bool state_derivative(const ModelParameters& params, const Dynamics& dynamics, double* derivative);
+
+// The same from scratch.
 bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
                                const BaseKinematics& base, double time, const double* state, double* derivative);
 
@@ -178,5 +181,8 @@ struct ModelOutputs {
 
 ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
                               double time, const double* state);
+// The same from the dynamics already evaluated at (time, state) with `base` = the kinematics there.
+ModelOutputs outputs_from(const ModelParameters& params, const StepInputs& inputs, const BaseKinematics& base,
+                          double time, const Dynamics& dynamics);
 
 }  // namespace gimbal

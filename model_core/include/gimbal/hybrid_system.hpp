@@ -3,6 +3,8 @@
 // update at an event. Independent of the integrator behind it.
 #pragma once
 
+#include <string>
+
 namespace gimbal {
 
 class HybridSystem {
@@ -26,6 +28,10 @@ public:
     // May project the state onto the new modes' constraints (e.g. theta_b = eta at contact).
     // Returns the number of mode changes.
     virtual int update_modes(double time, double* state, const int* directions) = 0;
+    // Whether the right-hand side depends on time explicitly (a Rosenbrock method then needs df/dt).
+    virtual bool time_dependent() const { return true; }
+    // What the last update_modes switched, named, for the event log ("gear1 backlash: gap -> +eta").
+    virtual std::string describe_last_changes() const { return std::string(); }
 };
 
 }  // namespace gimbal

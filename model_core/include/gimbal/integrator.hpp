@@ -1,53 +1,73 @@
-// Integrators under a hybrid system: root finding locates each mode change, the system switches its
-// modes, and the integrator restarts from the switching point. The event loop, the chattering guard
-// and the statistics are shared; SUNDIALS CVODE (BDF or Adams) and ARKODE (explicit Runge-Kutta)
-// are the backends.
+// Integrators under a hybrid system: each locates the mode changes of the system's event functions,
+// lets the system switch its modes there, and carries on from the switching point.
+//
+// Two families share this interface:
+// - the project's own one-step methods (one_step_integrator.hpp): Dormand-Prince 5(4) and the
+//   Rosenbrock method RODAS4, alone or switched automatically by stiffness. They keep their step size
+//   across communication points and restart after an input jump at the cost of one right-hand side;
+// - SUNDIALS CVODE (BDF, Adams) and ARKODE (explicit Runge-Kutta), kept as reference methods.
 #pragma once
 
 #include <functional>
 #include <memory>
 #include <string>
-#include <vector>
-
-#include <sundials/sundials_context.h>
-#include <sundials/sundials_linearsolver.h>
-#include <sundials/sundials_matrix.h>
-#include <sundials/sundials_nvector.h>
 
 #include "gimbal/hybrid_system.hpp"
 
 namespace gimbal {
 
 struct IntegratorStatistics {
-    long steps = 0;
+    long steps = 0;             // accepted steps
     long rhs_evaluations = 0;
     long jacobian_evaluations = 0;
-    long events = 0;       // located mode changes
-    long zeno_holds = 0;   // times the chattering guard engaged
+    long events = 0;            // located mode changes
+    long zeno_holds = 0;        // times the chattering guard engaged
+    long method_switches = 0;   // automatic method: explicit <-> Rosenbrock
+    long rejected_steps = 0;
 };
 
 enum class IntegrationMethod : int {
-    bdf_analytic_jacobian = 0,  // CVODE BDF, Newton with the system's Jacobian
+    bdf_analytic_jacobian = 0,    // CVODE BDF, Newton with the system's Jacobian
     bdf_difference_jacobian = 1,  // CVODE BDF, Newton with a difference-quotient Jacobian
-    adams = 2,                  // CVODE Adams-Moulton, Newton with a difference-quotient Jacobian
-    explicit_runge_kutta = 3,   // ARKODE ERKStep, Dormand-Prince 5(4), adaptive
+    adams = 2,                    // CVODE Adams-Moulton, Newton with a difference-quotient Jacobian
+    explicit_runge_kutta = 3,     // ARKODE ERKStep, Dormand-Prince 5(4), adaptive
+    automatic = 4,                // own: Dormand-Prince 5(4), RODAS4 while the problem is stiff (default)
+    dormand_prince = 5,           // own: Dormand-Prince 5(4) only
+    rosenbrock = 6,               // own: RODAS4 only
 };
+constexpr int kIntegrationMethodCount = 7;
+
+inline bool is_sundials_method(IntegrationMethod method) { return static_cast<int>(method) <= 3; }
 
 struct IntegratorSettings {
-    IntegrationMethod method = IntegrationMethod::bdf_analytic_jacobian;
+    IntegrationMethod method = IntegrationMethod::automatic;
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;
     long max_steps = 100000;  // internal steps per call of advance
-    double max_step = 0.0;  // 0: unlimited. Root finding sees only sign changes between steps.
-    // Chattering guard: this many located roots in a row, each within `zeno_window` of the previous
-    // one (relative to max(1, |t|)), freeze the event functions for `zeno_dwell` (same scale); modes
-    // are then re-selected where the functions come back. Switches further apart than the window
-    // (1 ns at t ~ 1 s, i.e. chatter above 1 GHz) are never affected.
+    double max_step = 0.0;    // 0: unlimited. Events are seen as sign changes between steps.
+    // Chattering guard: this many located roots in a row, each within `zeno_window` seconds of the
+    // previous one, freeze the event functions for `zeno_dwell` seconds; modes are then re-selected
+    // from the functions' signs. Switches further apart than the window (chatter below 1 GHz) are
+    // never affected. Absolute durations: results must not depend on where time starts.
     int zeno_event_limit = 50;
     double zeno_window = 1e-9;
     double zeno_dwell = 1e-6;
     // Whether anyone listens to event messages: they are only formatted (and allocated) if so.
     std::function<bool()> events_logged = [] { return true; };
+};
+
+// Everything a one-step integrator carries from one communication step to the next besides the state:
+// saved with an FMU state, so that a restored copy continues bit for bit.
+struct IntegratorMemory {
+    double step_size = 0.0;       // the controller's next proposal (0: not yet chosen)
+    double previous_error = 1e-4; // for the PI controller
+    int stiff = 0;                // 1 while the Rosenbrock method runs
+    int stiff_votes = 0;          // consecutive explicit steps at the stability boundary
+    int nonstiff_votes = 0;       // consecutive steps that voted the other way
+    int last_step_rejected = 0;
+    double last_event_time = -1e300;
+    int rapid_events = 0;
+    double dwell_until = -1e300;
 };
 
 class HybridIntegrator {
@@ -56,54 +76,42 @@ public:
 
     static std::unique_ptr<HybridIntegrator> create(HybridSystem& system, const IntegratorSettings& settings,
                                                     MessageSink error_sink, MessageSink event_sink);
-    virtual ~HybridIntegrator();
+    virtual ~HybridIntegrator() = default;
     HybridIntegrator(const HybridIntegrator&) = delete;
     HybridIntegrator& operator=(const HybridIntegrator&) = delete;
 
-    // Starts afresh at (time, state): after any discontinuity of the right-hand side.
-    bool restart(double time, const double* state);
+    // Starts again at (time, state) after a discontinuity of the right-hand side (new inputs, new
+    // modes). A one-step method keeps its step size; a multistep method starts over.
+    virtual bool restart(double time, const double* state) = 0;
+
+    // The inputs changed at (time, state) without a jump of the right-hand side (a voltage ramp that
+    // continues from where the last one ended): a one-step method refreshes its first stage, whose
+    // value would otherwise be stale; a multistep method keeps its history.
+    virtual bool inputs_changed(double time, const double* state) {
+        (void)time, (void)state;
+        return true;
+    }
 
     // Integrates to exactly end_time, switching modes at every located event. False on failure, with
     // the reason sent to the error sink; the state is then unspecified and the caller must roll back.
-    bool advance(double end_time, double* state);
+    virtual bool advance(double end_time, double* state) = 0;
 
-    IntegratorStatistics statistics() const;
+    virtual IntegratorStatistics statistics() const = 0;
     // For restoring a saved instance: counts continue from these.
-    void set_statistics(const IntegratorStatistics& totals) { totals_ = totals; }
+    virtual void set_statistics(const IntegratorStatistics& totals) = 0;
+
+    // Whether memory() holds all this integrator needs to continue bit for bit after a restore; a
+    // multistep method's history does not fit, so a snapshot ends its integration segment instead.
+    virtual bool resumable() const { return false; }
+    virtual IntegratorMemory memory() const { return {}; }
+    // With the state the integrator was at when memory() was taken.
+    virtual bool resume(double time, const double* state, const IntegratorMemory& memory) {
+        (void)memory;
+        return restart(time, state);
+    }
 
 protected:
-    enum class Outcome { reached_end, root, failure };
-
-    HybridIntegrator(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
-                     MessageSink event_sink);
-    bool create_vector();
-
-    // Backend: (re)initialize at (time, y_), integrate towards end_time stopping there exactly, report
-    // root directions, and count work since the last (re)initialization.
-    virtual bool backend_restart(double time) = 0;
-    virtual Outcome backend_advance(double end_time, double& reached) = 0;
-    virtual void backend_roots(int* directions) = 0;
-    virtual IntegratorStatistics backend_counters() const = 0;
-
-    // Callbacks with SUNDIALS signatures, shared by the backends (user data = this).
-    static int right_hand_side(sunrealtype time, N_Vector y, N_Vector ydot, void* user_data);
-    static int event_functions(sunrealtype time, N_Vector y, sunrealtype* values, void* user_data);
-    static void forward_error(int code, const char* module, const char* function, char* message, void* user_data);
-
-    HybridSystem& system_;
-    IntegratorSettings settings_;
-    MessageSink error_sink_, event_sink_;
-    int size_;
-    SUNContext context_ = nullptr;
-    N_Vector y_ = nullptr;
-    bool initialized_ = false;
-    std::vector<int> root_directions_;
-
-private:
-    IntegratorStatistics totals_;  // of finished backend runs (their counters reset at each restart)
-    double last_event_time_ = -1e300;
-    int rapid_events_ = 0;
-    double dwell_until_ = -1e300;
+    HybridIntegrator() = default;
 };
 
 }  // namespace gimbal

@@ -1,0 +1,535 @@
+#include "one_step_integrator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "tableaus.hpp"
+
+namespace gimbal {
+namespace {
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+// Step size control (E. Hairer's DOPRI5 and RODAS defaults).
+constexpr double kSafety = 0.9;
+constexpr double kPiBeta = 0.04;                   // DOPRI5's stabilized (PI) controller
+constexpr double kMaxGrowth = 10.0, kMaxShrink = 0.2;  // per step, after an accepted / a rejected step
+// Automatic method: explicit steps in a row at the stability boundary before the Rosenbrock method
+// takes over, and Rosenbrock steps in a row at which the explicit method would be stable before it
+// hands back. A few of each: a wrong vote costs one or two steps, a missed switch many.
+constexpr int kVotesForStiff = 3, kVotesForNonstiff = 3;
+// The explicit method counts as stable at |h lambda| below this (its boundary is ~3.3), with margin.
+constexpr double kExplicitStableBound = 2.5;
+
+}  // namespace
+
+OneStepIntegrator::OneStepIntegrator(HybridSystem& system, const IntegratorSettings& settings,
+                                     MessageSink error_sink, MessageSink event_sink)
+    : system_(system),
+      settings_(settings),
+      error_sink_(std::move(error_sink)),
+      event_sink_(std::move(event_sink)),
+      size_(system.state_size()),
+      event_count_(system.event_count()),
+      g_(event_count_, 0.0),
+      g_new_(event_count_, 0.0),
+      g_low_(event_count_, 0.0),
+      g_high_(event_count_, 0.0),
+      g_mid_(event_count_, 0.0),
+      directions_(event_count_, 0) {
+    const int n = std::min(size_, kMaxStates);
+    for (Vector* v : {&y_, &f_, &y_new_, &f_new_, &stage_state_, &error_, &time_derivative_, &perturbed_})
+        v->setZero(n);
+    for (Vector& v : stage_) v.setZero(n);
+    for (Vector& v : dense_) v.setZero(n);
+    jacobian_.setZero(n, n);
+    iteration_matrix_.setZero(n, n);
+    lu_.compute(Matrix::Identity(n, n));  // sizes its storage once
+    if (settings_.method == IntegrationMethod::rosenbrock) memory_.stiff = 1;
+}
+
+bool OneStepIntegrator::rhs(double time, const Vector& y, Vector& dy) {
+    ++totals_.rhs_evaluations;
+    return system_.derivative(time, y.data(), dy.data());
+}
+
+bool OneStepIntegrator::event_values(double time, const Vector& y, std::vector<double>& values) {
+    if (event_count_ > 0) system_.event_functions(time, y.data(), values.data());
+    return true;
+}
+
+bool OneStepIntegrator::refresh_at_current_point() {
+    jacobian_current_ = false;
+    if (!rhs(t_, y_, f_)) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "the right-hand side is not finite at t = " << t_;
+        error_sink_(s.str());
+        return false;
+    }
+    event_values(t_, y_, g_);
+    // A function exactly at zero here (a state projected onto a switching surface) has no sign to
+    // change: take the sign it has just after, or a return to zero within the next step goes unseen.
+    bool on_surface = false;
+    for (int k = 0; k < event_count_; ++k) on_surface = on_surface || g_[k] == 0.0;
+    if (on_surface) {
+        const double delta = 1e-6 * (memory_.step_size > 0.0 ? memory_.step_size : 1e-6);
+        for (int i = 0; i < size_; ++i) stage_state_[i] = y_[i] + delta * f_[i];
+        event_values(t_ + delta, stage_state_, g_mid_);
+        for (int k = 0; k < event_count_; ++k)
+            if (g_[k] == 0.0) g_[k] = g_mid_[k];
+    }
+    return true;
+}
+
+bool OneStepIntegrator::restart(double time, const double* state) {
+    if (size_ > kMaxStates) {
+        error_sink_("the one-step integrators hold at most " + std::to_string(kMaxStates) + " states");
+        return false;
+    }
+    t_ = time;
+    for (int k = 0; k < size_; ++k) y_[k] = state[k];
+    initialized_ = refresh_at_current_point();
+    return initialized_;
+}
+
+bool OneStepIntegrator::resume(double time, const double* state, const IntegratorMemory& memory) {
+    memory_ = memory;
+    if (settings_.method == IntegrationMethod::rosenbrock) memory_.stiff = 1;
+    if (settings_.method == IntegrationMethod::dormand_prince) memory_.stiff = 0;
+    return restart(time, state);
+}
+
+double OneStepIntegrator::error_norm(const Vector& error, const Vector& y_old, const Vector& y_new) const {
+    double sum = 0.0;
+    for (int k = 0; k < size_; ++k) {
+        const double scale = settings_.absolute_tolerance +
+                             settings_.relative_tolerance * std::max(std::fabs(y_old[k]), std::fabs(y_new[k]));
+        const double ratio = error[k] / scale;
+        sum += ratio * ratio;
+    }
+    return std::sqrt(sum / size_);
+}
+
+// E. Hairer's starting step (HINIT of DOPRI5): from the sizes of y, f and an estimate of f'.
+double OneStepIntegrator::initial_step(double end_time) {
+    double limit = end_time - t_;
+    if (settings_.max_step > 0.0) limit = std::min(limit, settings_.max_step);
+    double norm_y = 0.0, norm_f = 0.0;
+    for (int k = 0; k < size_; ++k) {
+        const double scale = settings_.absolute_tolerance + settings_.relative_tolerance * std::fabs(y_[k]);
+        norm_y += (y_[k] / scale) * (y_[k] / scale);
+        norm_f += (f_[k] / scale) * (f_[k] / scale);
+    }
+    norm_y = std::sqrt(norm_y / size_), norm_f = std::sqrt(norm_f / size_);
+    double h = (norm_f <= 1e-5 || norm_y <= 1e-5) ? 1e-6 : 0.01 * norm_y / norm_f;
+    h = std::min(h, limit);
+    for (int k = 0; k < size_; ++k) stage_state_[k] = y_[k] + h * f_[k];
+    if (!rhs(t_ + h, stage_state_, stage_[1])) return std::min(1e-6, limit);
+    double second = 0.0;
+    for (int k = 0; k < size_; ++k) {
+        const double scale = settings_.absolute_tolerance + settings_.relative_tolerance * std::fabs(y_[k]);
+        const double d = (stage_[1][k] - f_[k]) / scale;
+        second += d * d;
+    }
+    second = std::sqrt(second / size_) / h;
+    const double larger = std::max(second, norm_f);
+    const double h1 = larger <= 1e-15 ? std::max(1e-6, h * 1e-3) : std::pow(0.01 / larger, 0.2);
+    return std::min({100.0 * h, h1, limit});
+}
+
+OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, double t_new) {
+    using namespace tableau::dopri5;
+    const int n = size_;
+    Vector* k = stage_;
+    k[0] = f_;
+    auto stage = [&](int index, double c, auto&& combine) {
+        for (int i = 0; i < n; ++i) stage_state_[i] = y_[i] + h * combine(i);
+        return rhs(c, stage_state_, k[index]);
+    };
+    bool ok = stage(1, t_ + c2 * h, [&](int i) { return a21 * k[0][i]; }) &&
+              stage(2, t_ + c3 * h, [&](int i) { return a31 * k[0][i] + a32 * k[1][i]; }) &&
+              stage(3, t_ + c4 * h, [&](int i) { return a41 * k[0][i] + a42 * k[1][i] + a43 * k[2][i]; }) &&
+              stage(4, t_ + c5 * h,
+                    [&](int i) { return a51 * k[0][i] + a52 * k[1][i] + a53 * k[2][i] + a54 * k[3][i]; }) &&
+              stage(5, t_new, [&](int i) {
+                  return a61 * k[0][i] + a62 * k[1][i] + a63 * k[2][i] + a64 * k[3][i] + a65 * k[4][i];
+              });
+    // stage_state_ now holds the argument of the sixth stage, which the stiffness test needs.
+    if (ok) {
+        for (int i = 0; i < n; ++i)
+            y_new_[i] = y_[i] + h * (b1 * k[0][i] + b3 * k[2][i] + b4 * k[3][i] + b5 * k[4][i] + b6 * k[5][i]);
+        ok = rhs(t_new, y_new_, f_new_);
+    }
+    if (!ok) {  // a non-finite right-hand side: try a much smaller step
+        memory_.step_size = 0.25 * h;
+        return StepResult::rejected;
+    }
+    for (int i = 0; i < n; ++i)
+        error_[i] = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] + e6 * k[5][i] + e7 * f_new_[i]);
+    const double err = error_norm(error_, y_, y_new_);
+    const double exponent = 0.2 - kPiBeta * 0.75;
+    const double raw = std::pow(err, exponent);
+    if (!(err <= 1.0)) {
+        memory_.step_size = h / std::min(1.0 / kMaxShrink, raw / kSafety);
+        memory_.last_step_rejected = 1;
+        return StepResult::rejected;
+    }
+    double factor = raw / std::pow(memory_.previous_error, kPiBeta) / kSafety;
+    factor = std::clamp(factor, 1.0 / kMaxGrowth, 1.0 / kMaxShrink);
+    double next = h / factor;
+    if (memory_.last_step_rejected) next = std::min(next, h);
+    memory_.previous_error = std::max(err, 1e-4);
+    memory_.last_step_rejected = 0;
+
+    // Hairer's stiffness test: h |lambda| estimated from the last two stages, both at t_new.
+    double numerator = 0.0, denominator = 0.0;
+    for (int i = 0; i < n; ++i) {
+        numerator += (f_new_[i] - k[5][i]) * (f_new_[i] - k[5][i]);
+        denominator += (y_new_[i] - stage_state_[i]) * (y_new_[i] - stage_state_[i]);
+    }
+    stiffness_estimate_ = denominator > 0.0 ? h * std::sqrt(numerator / denominator) : 0.0;
+
+    dense_rosenbrock_ = false;
+    dense_t0_ = t_, dense_h_ = h;
+    for (int i = 0; i < n; ++i) {
+        const double difference = y_new_[i] - y_[i];
+        const double slope_start = h * k[0][i] - difference;
+        dense_[0][i] = y_[i];
+        dense_[1][i] = difference;
+        dense_[2][i] = slope_start;
+        dense_[3][i] = difference - h * f_new_[i] - slope_start;
+        dense_[4][i] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] + d6 * k[5][i] + d7 * f_new_[i]);
+    }
+    proposal_ = next;
+    return StepResult::accepted;
+}
+
+bool OneStepIntegrator::jacobian_at(double time, const Vector& y) {
+    ++totals_.jacobian_evaluations;
+    const int n = size_;
+    if (system_.has_jacobian() && system_.jacobian(time, y.data(), jacobian_.data())) return jacobian_.allFinite();
+    // Forward differences, one right-hand side per column (f_ holds f(time, y)).
+    perturbed_ = y;
+    for (int j = 0; j < n; ++j) {
+        const double delta = std::sqrt(kEpsilon) * std::max(1e-5, std::fabs(y[j]));
+        perturbed_[j] = y[j] + delta;
+        if (!rhs(time, perturbed_, stage_state_)) return false;
+        jacobian_.col(j) = (stage_state_ - f_) / delta;
+        perturbed_[j] = y[j];
+    }
+    return jacobian_.allFinite();
+}
+
+OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, double t_new) {
+    using namespace tableau::rodas4;
+    iteration_matrix_ = -jacobian_;
+    iteration_matrix_.diagonal().array() += 1.0 / (h * gamma);
+    lu_.compute(iteration_matrix_);
+    const double hd1 = h * d1, hd2 = h * d2, hd3 = h * d3, hd4 = h * d4;
+    const double hc21 = c21 / h, hc31 = c31 / h, hc32 = c32 / h, hc41 = c41 / h, hc42 = c42 / h, hc43 = c43 / h;
+    const double hc51 = c51 / h, hc52 = c52 / h, hc53 = c53 / h, hc54 = c54 / h;
+    const double hc61 = c61 / h, hc62 = c62 / h, hc63 = c63 / h, hc64 = c64 / h, hc65 = c65 / h;
+    Vector* k = stage_;
+    Vector& dy = f_new_;  // stage derivative (f_new_ is written last)
+    auto reject = [&] {
+        memory_.step_size = 0.25 * h;
+        memory_.last_step_rejected = 1;
+        return StepResult::rejected;
+    };
+    k[0] = lu_.solve(f_ + hd1 * time_derivative_);
+
+    stage_state_ = y_ + a21 * k[0];
+    if (!rhs(t_ + c2 * h, stage_state_, dy)) return reject();
+    k[1] = lu_.solve(dy + hd2 * time_derivative_ + hc21 * k[0]);
+
+    stage_state_ = y_ + a31 * k[0] + a32 * k[1];
+    if (!rhs(t_ + c3 * h, stage_state_, dy)) return reject();
+    k[2] = lu_.solve(dy + hd3 * time_derivative_ + hc31 * k[0] + hc32 * k[1]);
+
+    stage_state_ = y_ + a41 * k[0] + a42 * k[1] + a43 * k[2];
+    if (!rhs(t_ + c4 * h, stage_state_, dy)) return reject();
+    k[3] = lu_.solve(dy + hd4 * time_derivative_ + hc41 * k[0] + hc42 * k[1] + hc43 * k[2]);
+
+    stage_state_ = y_ + a51 * k[0] + a52 * k[1] + a53 * k[2] + a54 * k[3];
+    if (!rhs(t_new, stage_state_, dy)) return reject();
+    k[4] = lu_.solve(dy + hc51 * k[0] + hc52 * k[1] + hc53 * k[2] + hc54 * k[3]);
+
+    // Stiffly accurate: the embedded solution is the fifth stage's argument plus k5.
+    stage_state_ += k[4];
+    if (!rhs(t_new, stage_state_, dy)) return reject();
+    k[5] = lu_.solve(dy + hc61 * k[0] + hc62 * k[1] + hc63 * k[2] + hc64 * k[3] + hc65 * k[4]);
+    y_new_ = stage_state_ + k[5];
+    if (!y_new_.allFinite()) return reject();
+
+    const double err = error_norm(k[5], y_, y_new_);
+    const double raw = std::pow(err, 0.25) / kSafety;
+    if (!(err <= 1.0)) {
+        memory_.step_size = h / std::min(1.0 / kMaxShrink, raw);
+        memory_.last_step_rejected = 1;
+        return StepResult::rejected;
+    }
+    double next = h / std::clamp(raw, 1.0 / 6.0, 1.0 / kMaxShrink);
+    if (memory_.last_step_rejected) next = std::min(next, h);
+    memory_.last_step_rejected = 0;
+    memory_.previous_error = std::max(err, 1e-4);
+
+    dense_rosenbrock_ = true;
+    dense_t0_ = t_, dense_h_ = h;
+    dense_[0] = y_;
+    dense_[1] = y_new_;
+    dense_[2] = d21 * k[0] + d22 * k[1] + d23 * k[2] + d24 * k[3] + d25 * k[4];
+    dense_[3] = d31 * k[0] + d32 * k[1] + d33 * k[2] + d34 * k[3] + d35 * k[4];
+    // The next step's first stage needs f(t_new, y_new) anyway: it also feeds the event check.
+    if (!rhs(t_new, y_new_, f_new_)) return reject();
+    proposal_ = next;
+    return StepResult::accepted;
+}
+
+void OneStepIntegrator::dense_output(double time, double* state) const {
+    const double s = dense_h_ > 0.0 ? (time - dense_t0_) / dense_h_ : 1.0;
+    const double r = 1.0 - s;
+    for (int i = 0; i < size_; ++i) {
+        if (dense_rosenbrock_) {
+            state[i] = r * dense_[0][i] + s * (dense_[1][i] + r * (dense_[2][i] + s * dense_[3][i]));
+        } else {
+            state[i] = dense_[0][i] + s * (dense_[1][i] + r * (dense_[2][i] + s * (dense_[3][i] + r * dense_[4][i])));
+        }
+    }
+}
+
+// Magnitude of the Jacobian's dominant eigenvalue by power iteration: (|J^m v| / |v|)^(1/m). A
+// complex pair or a multiple eigenvalue does not converge to a single ratio, but the m-th root of the
+// growth is within a factor (states)^(1/m) of it, enough for a choice between two methods.
+double OneStepIntegrator::spectral_radius_estimate() const {
+    constexpr int kIterations = 8;
+    Vector v = Vector::Ones(size_) / std::sqrt(static_cast<double>(size_));
+    double log_growth = 0.0;
+    for (int iteration = 0; iteration < kIterations; ++iteration) {
+        Vector w = jacobian_ * v;
+        const double norm = w.norm();
+        if (!(norm > 0.0) || !std::isfinite(norm)) return norm > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+        log_growth += std::log(norm);
+        v = w / norm;
+    }
+    return std::exp(log_growth / kIterations);
+}
+
+void OneStepIntegrator::vote_on_stiffness_explicit(double h) {
+    (void)h;
+    if (settings_.method != IntegrationMethod::automatic) return;
+    if (stiffness_estimate_ > tableau::dopri5::stiffness_threshold) {
+        memory_.nonstiff_votes = 0;
+        if (++memory_.stiff_votes >= kVotesForStiff) {
+            memory_.stiff = 1;
+            memory_.stiff_votes = 0;
+            memory_.previous_error = 1e-4;
+            ++totals_.method_switches;
+        }
+    } else if (++memory_.nonstiff_votes >= 6) {
+        memory_.stiff_votes = 0;
+    }
+}
+
+void OneStepIntegrator::vote_on_stiffness_rosenbrock(double h) {
+    if (settings_.method != IntegrationMethod::automatic) return;
+    // Would the explicit method be stable at the step size the Rosenbrock method takes for accuracy?
+    // (It is at least as accurate there: order 5 against 4.)
+    if (spectral_radius_estimate() * h <= kExplicitStableBound) {
+        if (++memory_.nonstiff_votes >= kVotesForNonstiff) {
+            memory_.stiff = 0;
+            memory_.nonstiff_votes = 0;
+            memory_.stiff_votes = 0;
+            memory_.previous_error = 1e-4;
+            ++totals_.method_switches;
+        }
+    } else {
+        memory_.nonstiff_votes = 0;
+    }
+}
+
+bool OneStepIntegrator::any_crossing(const std::vector<double>& before, const std::vector<double>& after) const {
+    for (int k = 0; k < event_count_; ++k)
+        if (crossed(before[k], after[k])) return true;
+    return false;
+}
+
+void OneStepIntegrator::log_events(double time, int changes) {
+    if (changes <= 0 || !settings_.events_logged()) return;
+    std::ostringstream s;
+    s.precision(17);
+    s << "t = " << time << ": " << changes << " mode change(s)";
+    const std::string what = system_.describe_last_changes();
+    if (!what.empty()) s << ": " << what;
+    event_sink_(s.str());
+}
+
+bool OneStepIntegrator::handle_events(bool& event_found) {
+    event_found = false;
+    if (event_count_ == 0 || t_new_ <= memory_.dwell_until) return true;
+    event_values(t_new_, y_new_, g_new_);
+    if (t_ < memory_.dwell_until) {
+        // The chattering guard held the modes until inside this step: re-select them here.
+        return true;
+    }
+    if (!any_crossing(g_, g_new_)) return true;
+    event_found = true;
+
+    // Illinois iteration on the first root in (t_, t_new_], with every function watched at once.
+    double low = t_, high = t_new_;
+    g_low_ = g_, g_high_ = g_new_;
+    const double tolerance = 100.0 * kEpsilon * (std::fabs(t_) + (t_new_ - t_));
+    double weight = 1.0;
+    int previous_side = 0;
+    for (int iteration = 0; iteration < 100 && high - low > tolerance; ++iteration) {
+        double estimate = high;
+        for (int k = 0; k < event_count_; ++k) {
+            if (!crossed(g_low_[k], g_high_[k])) continue;
+            const double denominator = g_high_[k] - weight * g_low_[k];
+            const double candidate = denominator != 0.0 ? high - (high - low) * g_high_[k] / denominator : high;
+            estimate = std::min(estimate, candidate);
+        }
+        const double margin = 0.5 * tolerance;
+        double middle = std::clamp(estimate, low + margin, high - margin);
+        if (iteration % 8 == 7) middle = 0.5 * (low + high);  // a bisection now and then bounds the count
+        dense_output(middle, stage_state_.data());
+        event_values(middle, stage_state_, g_mid_);
+        int side;
+        if (any_crossing(g_low_, g_mid_)) {
+            high = middle, g_high_ = g_mid_, side = 1;
+        } else {
+            low = middle, g_low_ = g_mid_, side = 2;
+        }
+        if (side == previous_side) weight = side == 2 ? 2.0 * weight : 0.5 * weight;
+        else weight = 1.0;
+        previous_side = side;
+    }
+
+    // Switch at the right end of the bracket: every function that crossed has its new sign there.
+    const double root = high;
+    if (root != t_new_) dense_output(root, y_new_.data());
+    event_values(root, y_new_, g_high_);
+    for (int k = 0; k < event_count_; ++k)
+        directions_[k] = crossed(g_[k], g_high_[k]) ? (g_high_[k] > g_[k] ? 1 : -1) : 0;
+    t_ = root;
+    y_ = y_new_;
+    const int changes = system_.update_modes(root, y_.data(), directions_.data());
+    totals_.events += changes;
+    log_events(root, changes);
+
+    memory_.rapid_events = root - memory_.last_event_time <= settings_.zeno_window ? memory_.rapid_events + 1 : 0;
+    memory_.last_event_time = root;
+    if (memory_.rapid_events >= settings_.zeno_event_limit) {
+        memory_.dwell_until = root + settings_.zeno_dwell;
+        memory_.rapid_events = 0;
+        ++totals_.zeno_holds;
+        if (settings_.events_logged()) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "t = " << root << ": " << settings_.zeno_event_limit
+              << " events without progress in time (chattering); modes held until t = " << memory_.dwell_until;
+            event_sink_(s.str());
+        }
+    }
+    // New modes (or a projection onto a stop) change the right-hand side: one evaluation restarts.
+    return refresh_at_current_point();
+}
+
+bool OneStepIntegrator::reselect_after_dwell() {
+    memory_.dwell_until = -1e300;
+    const int changes = system_.update_modes(t_, y_.data(), nullptr);
+    totals_.events += changes;
+    log_events(t_, changes);
+    return refresh_at_current_point();
+}
+
+bool OneStepIntegrator::advance(double end_time, double* state) {
+    if (!initialized_) {
+        error_sink_("the integrator was not started");
+        return false;
+    }
+    long attempts = 0;
+    long events_here = 0;
+    while (t_ < end_time) {
+        if (memory_.dwell_until > -1e300 && t_ >= memory_.dwell_until && !reselect_after_dwell()) return false;
+        if (++attempts > settings_.max_steps) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "more than solver.max_steps = " << settings_.max_steps << " internal steps (" << events_here
+              << " mode changes) before t = " << t_ << ": the inputs or parameters drive switching faster than "
+              << "the model can follow";
+            error_sink_(s.str());
+            return false;
+        }
+        if (memory_.step_size <= 0.0) memory_.step_size = initial_step(end_time);
+        double h = memory_.step_size;
+        if (settings_.max_step > 0.0) h = std::min(h, settings_.max_step);
+        const double remaining = end_time - t_;
+        bool last = false;
+        if (h >= remaining * (1.0 - 1e-12)) {
+            h = remaining, last = true;
+        } else if (h > 0.5 * remaining) {
+            h = 0.5 * remaining;  // two equal steps rather than a long one and a short one
+        }
+        if (h <= 16.0 * kEpsilon * std::max(1.0, std::fabs(t_))) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "the step size fell to " << h << " at t = " << t_ << " (a right-hand side that is not finite, or "
+              << "an accuracy the tolerances cannot reach)";
+            error_sink_(s.str());
+            return false;
+        }
+        t_new_ = last ? end_time : t_ + h;
+        h = t_new_ - t_;
+
+        StepResult result;
+        if (memory_.stiff && !jacobian_current_) {
+            if (!jacobian_at(t_, y_)) {
+                error_sink_("the Jacobian is not finite");
+                return false;
+            }
+            if (system_.time_dependent()) {
+                const double delta = std::sqrt(kEpsilon) * std::max(1.0, std::fabs(t_));
+                if (!rhs(t_ + delta, y_, time_derivative_)) {
+                    error_sink_("the right-hand side is not finite just after t");
+                    return false;
+                }
+                time_derivative_ = (time_derivative_ - f_) / delta;
+            } else {
+                time_derivative_.setZero(size_);
+            }
+            jacobian_current_ = true;  // until the point or the modes change (a rejected step keeps it)
+        }
+        if (memory_.stiff) {
+            result = rosenbrock_step(h, t_new_);
+        } else {
+            result = dormand_prince_step(h, t_new_);
+        }
+        if (result == StepResult::rejected) {
+            ++totals_.rejected_steps;
+            continue;
+        }
+        ++totals_.steps;
+        jacobian_current_ = false;
+        // A step cut short to land on end_time says nothing against the longer step before it.
+        memory_.step_size = last ? std::max(proposal_, std::min(memory_.step_size, proposal_ * kMaxGrowth)) : proposal_;
+        bool event_found = false;
+        const long events_before = totals_.events;
+        if (!handle_events(event_found)) return false;
+        events_here += totals_.events - events_before;
+        if (event_found) continue;
+        t_ = t_new_;
+        std::swap(y_, y_new_);
+        std::swap(f_, f_new_);
+        std::swap(g_, g_new_);
+        if (event_count_ > 0 && t_ >= memory_.dwell_until && memory_.dwell_until > -1e300 && !reselect_after_dwell())
+            return false;
+        if (memory_.stiff) vote_on_stiffness_rosenbrock(h);
+        else vote_on_stiffness_explicit(h);
+    }
+    for (int k = 0; k < size_; ++k) state[k] = y_[k];
+    return true;
+}
+
+}  // namespace gimbal

@@ -1,0 +1,97 @@
+// The project's own one-step integrators under the hybrid layer: Dormand-Prince 5(4) (explicit, FSAL,
+// dense output of order 4) and RODAS4 (L-stable Rosenbrock, dense output of order 3), alone or
+// switched by stiffness. At 4-17 states generic drivers cost more than the physics
+// (docs/benchmarks.md), hence these: fixed-capacity storage, no allocation after construction.
+//
+// Events are found as sign changes of the event functions between accepted steps and located on the
+// dense output with the Illinois method; the system switches its modes at the root and the
+// integration goes on from there with the same step size. An input jump costs one right-hand side.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "gimbal/integrator.hpp"
+
+namespace gimbal {
+
+class OneStepIntegrator final : public HybridIntegrator {
+public:
+    static constexpr int kMaxStates = 24;
+    using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxStates, 1>;
+    using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStates, kMaxStates>;
+
+    OneStepIntegrator(HybridSystem& system, const IntegratorSettings& settings, MessageSink error_sink,
+                      MessageSink event_sink);
+
+    bool restart(double time, const double* state) override;
+    bool inputs_changed(double time, const double* state) override { return restart(time, state); }
+    bool advance(double end_time, double* state) override;
+    IntegratorStatistics statistics() const override { return totals_; }
+    void set_statistics(const IntegratorStatistics& totals) override { totals_ = totals; }
+    bool resumable() const override { return true; }
+    IntegratorMemory memory() const override { return memory_; }
+    bool resume(double time, const double* state, const IntegratorMemory& memory) override;
+
+    // The continuous extension of the last accepted step, at `time` within it (for tests).
+    void dense_output(double time, double* state) const;
+    bool stiff() const { return memory_.stiff != 0; }
+
+private:
+    enum class StepResult { accepted, rejected, failed };
+
+    bool rhs(double time, const Vector& y, Vector& dy);
+    bool event_values(double time, const Vector& y, std::vector<double>& values);
+    double initial_step(double end_time);
+    double error_norm(const Vector& error, const Vector& y_old, const Vector& y_new) const;
+    // One attempt from (t_, y_, f_) to t_new; fills y_new_, f_new_ (explicit: the FSAL stage) and the
+    // dense output, and sets the controller's next proposal in memory_.
+    StepResult dormand_prince_step(double h, double t_new);
+    StepResult rosenbrock_step(double h, double t_new);
+    bool jacobian_at(double time, const Vector& y);
+    double spectral_radius_estimate() const;
+    void vote_on_stiffness_explicit(double h);
+    void vote_on_stiffness_rosenbrock(double h);
+    // Looks for sign changes between g_ (at t_) and g_new_ (at t_new_); if any, locates the first root on
+    // the dense output, switches modes there and restarts. False on failure.
+    bool handle_events(bool& event_found);
+    bool crossed(double before, double after) const { return before != 0.0 && (after == 0.0 || (before > 0.0) != (after > 0.0)); }
+    bool any_crossing(const std::vector<double>& before, const std::vector<double>& after) const;
+    bool reselect_after_dwell();
+    bool refresh_at_current_point();
+    void log_events(double time, int changes);
+
+    HybridSystem& system_;
+    IntegratorSettings settings_;
+    MessageSink error_sink_, event_sink_;
+    int size_;
+    int event_count_;
+    bool initialized_ = false;
+
+    double t_ = 0.0;
+    Vector y_, f_;              // state and its derivative under the current modes
+    std::vector<double> g_;     // event functions at (t_, y_)
+    IntegratorMemory memory_;
+    IntegratorStatistics totals_;
+
+    // Work space of one step.
+    double t_new_ = 0.0;
+    Vector y_new_, f_new_, stage_[7], stage_state_, error_;
+    std::vector<double> g_new_, g_low_, g_high_, g_mid_;
+    std::vector<int> directions_;
+    // Continuous extension of the last accepted step over [dense_t0_, dense_t0_ + dense_h_].
+    bool dense_rosenbrock_ = false;
+    double dense_t0_ = 0.0, dense_h_ = 0.0;
+    Vector dense_[5];
+    // Rosenbrock: Jacobian, df/dt and the factorized iteration matrix.
+    Matrix jacobian_, iteration_matrix_;
+    Eigen::PartialPivLU<Matrix> lu_;
+    Vector time_derivative_, perturbed_;
+    double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
+    bool jacobian_current_ = false;    // jacobian_ and time_derivative_ belong to (t_, y_) and the modes
+    double proposal_ = 0.0;            // the controller's next step size after the last accepted step
+};
+
+}  // namespace gimbal

@@ -1,0 +1,180 @@
+// Orders of the project's own one-step methods on time-dependent problems with known solutions, their
+// continuous extensions, L-stability, and the automatic switch between them.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "check.hpp"
+#include "one_step_integrator.hpp"
+
+using namespace gimbal;
+
+namespace {
+
+// y' = -lambda(t) (y - sin t) + cos t, y(0) = 1: y = sin t + exp(-Lambda(t)), Lambda' = lambda. With a
+// constant lambda the problem is linear and time-dependent: a Rosenbrock method that mishandles df/dt
+// drops to first order on it.
+class ForcedRelaxation final : public HybridSystem {
+public:
+    // lambda(t) = base + bump * exp(-((t - centre) / width)^2)
+    ForcedRelaxation(double base, double bump = 0.0, double centre = 1.5, double width = 0.2)
+        : base_(base), bump_(bump), centre_(centre), width_(width) {}
+    int state_size() const override { return 1; }
+    int event_count() const override { return 0; }
+    double lambda(double t) const { return base_ + bump_ * std::exp(-std::pow((t - centre_) / width_, 2)); }
+    double exact(double t) const {
+        const double integral =
+            base_ * t + bump_ * width_ * std::sqrt(M_PI) / 2.0 * (std::erf((t - centre_) / width_) + std::erf(centre_ / width_));
+        return std::sin(t) + std::exp(-integral);
+    }
+    bool derivative(double t, const double* y, double* dy) override {
+        dy[0] = -lambda(t) * (y[0] - std::sin(t)) + std::cos(t);
+        return true;
+    }
+    bool has_jacobian() const override { return true; }
+    bool jacobian(double t, const double*, double* j) override {
+        j[0] = -lambda(t);
+        return true;
+    }
+    void event_functions(double, const double*, double*) override {}
+    int update_modes(double, double*, const int*) override { return 0; }
+
+private:
+    double base_, bump_, centre_, width_;
+};
+
+// A two-state oscillator with forcing, non-stiff: x'' = -x + cos(2t), x(0) = 1, x'(0) = 0:
+// x = (4/3) cos t - (1/3) cos 2t. Its Jacobian has a complex pair.
+class ForcedOscillator final : public HybridSystem {
+public:
+    int state_size() const override { return 2; }
+    int event_count() const override { return 0; }
+    static double exact(double t) { return 4.0 / 3.0 * std::cos(t) - std::cos(2.0 * t) / 3.0; }
+    bool derivative(double t, const double* y, double* dy) override {
+        dy[0] = y[1];
+        dy[1] = -y[0] + std::cos(2.0 * t);
+        return true;
+    }
+    void event_functions(double, const double*, double*) override {}
+    int update_modes(double, double*, const int*) override { return 0; }
+};
+
+IntegratorSettings fixed_steps(IntegrationMethod method) {
+    IntegratorSettings settings;
+    settings.method = method;
+    settings.relative_tolerance = 1e3;  // every step accepted: the step size is the one imposed
+    settings.absolute_tolerance = 1e3;
+    return settings;
+}
+
+auto quiet = [](const std::string&) {};
+
+// Global error at t = 1 and the worst error of the continuous extension at the step midpoints, with
+// `steps` equal steps.
+struct Errors {
+    double end = 0.0, dense = 0.0;
+};
+
+template <class System, class Exact>
+Errors run_fixed(System& system, IntegrationMethod method, int steps, double y0[], Exact exact) {
+    OneStepIntegrator integrator(system, fixed_steps(method), quiet, quiet);
+    const double h = 1.0 / steps;
+    IntegratorMemory memory;
+    memory.step_size = h;
+    double y[2] = {y0[0], y0[1]};
+    CHECK(integrator.resume(0.0, y, memory));
+    Errors errors;
+    for (int k = 1; k <= steps; ++k) {
+        const double end = k == steps ? 1.0 : k * h;
+        CHECK(integrator.advance(end, y));
+        double middle[2];
+        const double t_middle = end - 0.5 * h;
+        integrator.dense_output(t_middle, middle);
+        errors.dense = std::max(errors.dense, std::fabs(middle[0] - exact(t_middle)));
+    }
+    CHECK(integrator.statistics().steps == steps);
+    errors.end = std::fabs(y[0] - exact(1.0));
+    return errors;
+}
+
+void check_order(const char* name, IntegrationMethod method, double order, double dense_order) {
+    ForcedRelaxation relaxation(2.0);
+    ForcedOscillator oscillator;
+    for (int problem = 0; problem < 2; ++problem) {
+        double y0[2] = {1.0, 0.0};
+        Errors coarse, fine;
+        if (problem == 0) {
+            coarse = run_fixed(relaxation, method, 20, y0, [&](double t) { return relaxation.exact(t); });
+            fine = run_fixed(relaxation, method, 40, y0, [&](double t) { return relaxation.exact(t); });
+        } else {
+            coarse = run_fixed(oscillator, method, 20, y0, ForcedOscillator::exact);
+            fine = run_fixed(oscillator, method, 40, y0, ForcedOscillator::exact);
+        }
+        const double observed = std::log2(coarse.end / fine.end);
+        const double observed_dense = std::log2(coarse.dense / fine.dense);
+        std::printf("%s, problem %d: global error %.3g -> %.3g (order %.2f), dense %.3g -> %.3g (order %.2f)\n", name,
+                    problem, coarse.end, fine.end, observed, coarse.dense, fine.dense, observed_dense);
+        CHECK(std::fabs(observed - order) < 0.3);
+        CHECK(observed_dense > dense_order - 0.3);
+    }
+}
+
+}  // namespace
+
+int main() {
+    check_order("Dormand-Prince 5(4)", IntegrationMethod::dormand_prince, 5.0, 4.0);
+    check_order("RODAS4", IntegrationMethod::rosenbrock, 4.0, 3.0);
+
+    {
+        // L-stability: lambda = 1e6 with steps of 0.01 (h lambda = 1e4). RODAS4 damps the transient and
+        // follows sin t; the explicit method would need 3e5 steps to stay stable.
+        ForcedRelaxation stiff(1e6);
+        OneStepIntegrator integrator(stiff, fixed_steps(IntegrationMethod::rosenbrock), quiet, quiet);
+        IntegratorMemory memory;
+        memory.step_size = 0.01;
+        double y[1] = {1.0};
+        CHECK(integrator.resume(0.0, y, memory));
+        for (int k = 1; k <= 100; ++k) CHECK(integrator.advance(0.01 * k, y));
+        CHECK_NEAR(y[0], stiff.exact(1.0), 1e-8);
+    }
+    {
+        // Turns stiff and back: lambda rises from 1 to 1e5 around t = 1.5 and falls again. The automatic
+        // method switches to RODAS4 and back, within tolerance all along.
+        ForcedRelaxation episode(1.0, 1e5, 1.5, 0.2);
+        IntegratorSettings settings;
+        settings.method = IntegrationMethod::automatic;
+        settings.relative_tolerance = 1e-8;
+        settings.absolute_tolerance = 1e-10;
+        OneStepIntegrator integrator(episode, settings, quiet, quiet);
+        double y[1] = {1.0};
+        CHECK(integrator.restart(0.0, y));
+        double worst = 0.0;
+        bool was_stiff = false;
+        for (int k = 1; k <= 3000; ++k) {
+            const double t = 1e-3 * k;
+            CHECK(integrator.advance(t, y));
+            worst = std::max(worst, std::fabs(y[0] - episode.exact(t)));
+            if (t > 1.4 && t < 1.6) was_stiff = was_stiff || integrator.stiff();
+        }
+        const IntegratorStatistics stats = integrator.statistics();
+        std::printf("stiff episode: %ld steps, %ld rejected, %ld method switches, worst error %.3g, stiff at the end %d\n",
+                    stats.steps, stats.rejected_steps, stats.method_switches, worst, integrator.stiff() ? 1 : 0);
+        CHECK(was_stiff);
+        CHECK(!integrator.stiff());
+        CHECK(stats.method_switches >= 2);
+        CHECK(worst < 1e-6);
+        // The explicit method alone pays for stability over the episode.
+        OneStepIntegrator explicit_only(episode, [&] {
+            IntegratorSettings s = settings;
+            s.method = IntegrationMethod::dormand_prince;
+            return s;
+        }(), quiet, quiet);
+        double z[1] = {1.0};
+        CHECK(explicit_only.restart(0.0, z));
+        for (int k = 1; k <= 3000; ++k) CHECK(explicit_only.advance(1e-3 * k, z));
+        std::printf("explicit only: %ld steps, %ld right-hand sides; automatic: %ld right-hand sides\n",
+                    explicit_only.statistics().steps, explicit_only.statistics().rhs_evaluations, stats.rhs_evaluations);
+        CHECK(explicit_only.statistics().rhs_evaluations > 2 * stats.rhs_evaluations);
+    }
+    return check_report("one_step_methods");
+}
