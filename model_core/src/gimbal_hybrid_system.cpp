@@ -13,6 +13,16 @@ constexpr int friction_slot(int body) {
            GimbalHybridSystem::kFrictionSlots * body;
 }
 
+bool same_modes(const Modes& a, const Modes& b) {
+    for (int axis = 0; axis < 2; ++axis)
+        if (a.gear_contact[axis] != b.gear_contact[axis] || a.motor_limited[axis] != b.motor_limited[axis] ||
+            a.voltage_clamped[axis] != b.voltage_clamped[axis])
+            return false;
+    for (int body = 0; body < 4; ++body)
+        if (a.friction[body] != b.friction[body]) return false;
+    return true;
+}
+
 int sign(double value) { return value > 0.0 ? 1 : (value < 0.0 ? -1 : 0); }
 
 // Sign of an event function at a mode decision. Right after a located crossing the function may sit
@@ -166,10 +176,12 @@ void GimbalHybridSystem::event_functions(double time, const double* state, doubl
 int GimbalHybridSystem::update_modes(double time, double* state, const int* directions) {
     const Modes previous = modes_;
     previous_modes_ = previous;
+    const int n = params_.layout.size;
+    double state_before[kMaxStateSize];
+    std::copy(state, state + n, state_before);
+    Dynamics d = dynamics_at(time, state);
     cache_valid_ = false;  // new modes, and perhaps a projected state
-    Dynamics d;
     const BaseKinematics base = base_at(time);
-    evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
 
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params_.gear[axis];
@@ -229,7 +241,23 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
         int push = 0;
         if (at_plus) push = side(d.steady_current[axis] - limit, directions, current == 1 ? slot : -1);
         if (at_minus && !at_plus) push = side(d.steady_current[axis] + limit, directions, current == -1 ? slot : -1);
-        const int limited = select_contact(at_plus, at_minus, push, current);
+        int limited = select_contact(at_plus, at_minus, push, current);
+        if (current_slot < 0) {
+            // A quasi-static motor's current is the steady current itself, which jumps with the voltage:
+            // decide from where it lies now, on either side, not only whether the old limit still holds.
+            const double steady = d.steady_current[axis];
+            int crossing_plus = 0, crossing_minus = 0;
+            if (directions != nullptr) {
+                if (current == 0) crossing_plus = directions[slot], crossing_minus = directions[slot + 1];
+                if (current == 1) crossing_plus = directions[slot];
+                if (current == -1) crossing_minus = directions[slot];
+            }
+            const int above = crossing_plus != 0 ? crossing_plus : sign(steady - limit);
+            const int below = crossing_minus != 0 ? crossing_minus : sign(steady + limit);
+            if (above > 0 || (above == 0 && current == 1)) limited = 1;
+            else if (below < 0 || (below == 0 && current == -1)) limited = -1;
+            else limited = 0;
+        }
         modes_.motor_limited[axis] = limited;
         if (current_slot >= 0)
             state[current_slot] = limited != 0 ? limited * limit : std::clamp(state[current_slot], -limit, limit);
@@ -251,7 +279,11 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
         else if (!low_speed(previous.friction[body])) modes_.friction[body] = FrictionMode::hold;
         else modes_.friction[body] = previous.friction[body];
     }
-    evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
+    // The other torques of the low-speed bodies depend on the modes and the state chosen so far.
+    bool any_low_speed = false;
+    for (int body = 0; body < 4; ++body) any_low_speed = any_low_speed || low_speed(modes_.friction[body]);
+    if (any_low_speed && (!same_modes(modes_, previous) || !std::equal(state, state + n, state_before)))
+        evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
     for (int body = 0; body < 4; ++body) {
         if (!low_speed(modes_.friction[body])) continue;
         const DryFrictionParameters& friction = params_.coordinate_friction[body];

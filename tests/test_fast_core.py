@@ -1,0 +1,139 @@
+"""The default integration core (solver.method = 4): what it must keep while it runs fast.
+
+Snapshots do not disturb the trajectory, results do not depend on where time starts, a quasi-static
+motor's limiter is decided again at every input change, the method switches to RODAS4 when the model
+turns stiff and back when it stops being so, and the first stage is refreshed after every input jump.
+"""
+import numpy as np
+import pytest
+
+from fmu_driver import simulate
+
+RECORDED = ["alpha", "beta", "alpha_dot", "beta_dot", "i_R1", "i_R2", "theta_b1", "theta_b2", "T_E1",
+            "los.omega[1]", "los.omega[2]", "los.omega[3]", "events.total", "solver.steps",
+            "solver.rhs_evaluations", "solver.jacobian_evaluations", "solver.method_switches"]
+
+
+def ship_inputs(t, y):
+    """A moving base, a PD loop with a jump at every step: events, restarts and both methods."""
+    return {"u_R1": 60.0 * (0.2 - y["alpha"]) - 1.5 * y["alpha_dot"],
+            "u_R2": 80.0 * (-0.1 - y["beta"]) - 2.0 * y["beta_dot"],
+            "base.gamma": 0.08 * np.sin(1.3 * t), "base.gamma_dot": 0.104 * np.cos(1.3 * t),
+            "base.gamma_ddot": -0.1352 * np.sin(1.3 * t),
+            "base.delta": 0.03 * np.sin(0.7 * t), "base.delta_dot": 0.021 * np.cos(0.7 * t),
+            "base.delta_ddot": -0.0147 * np.sin(0.7 * t)}
+
+
+def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapshot=None):
+    """Like fmu_driver.simulate, with a start time and an optional FMU-state action at every step:
+    'get' (take and free a state), 'get-set' (take it, set it back, free it)."""
+    slave = fmu.instantiate()
+    try:
+        slave.setupExperiment(startTime=start_time)
+        fmu.set_values(slave, start_values)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        n = int(round(stop_time / step))
+        record = np.empty((n + 1, len(RECORDED)))
+        record[0] = fmu.get_values(slave, RECORDED)
+        latest = dict(zip(RECORDED, record[0]))
+        for k in range(n):
+            t = k * step
+            fmu.set_values(slave, inputs(t, latest))
+            if snapshot is not None:
+                state = slave.getFMUstate()
+                if snapshot == "get-set":
+                    slave.setFMUstate(state)
+                slave.freeFMUstate(state)
+            slave.doStep(currentCommunicationPoint=start_time + t, communicationStepSize=step)
+            record[k + 1] = fmu.get_values(slave, RECORDED)
+            latest = dict(zip(RECORDED, record[k + 1]))
+        slave.terminate()
+    finally:
+        slave.freeInstance()
+    return {name: record[:, j] for j, name in enumerate(RECORDED)}
+
+
+@pytest.mark.parametrize("method", [4, 5, 6])
+@pytest.mark.parametrize("action", ["get", "get-set"])
+def test_snapshots_at_every_step_leave_the_trajectory_bit_identical(gimbal_fmu, method, action):
+    start = {"solver.method": method}
+    never = run_loop(gimbal_fmu, 0.3, 1e-3, start, ship_inputs)
+    always = run_loop(gimbal_fmu, 0.3, 1e-3, start, ship_inputs, snapshot=action)
+    assert never["events.total"][-1] > 5
+    for name in RECORDED:
+        assert np.array_equal(never[name], always[name]), name
+
+
+def square_wave(t, y):
+    return {"u_R1": 12.0 if int(t / 0.05) % 2 == 0 else -12.0, "u_R2": -12.0 if int(t / 0.03) % 2 == 0 else 12.0}
+
+
+def test_results_do_not_depend_on_the_start_time(gimbal_fmu):
+    """Free swing under a +-12 V square wave: events 10-50 ms apart at any start time. The model runs on
+    time since initialization, so the same steps give the same trajectory bit for bit. The step is a
+    power of two, so that start + k h is exact at 1.7e9 (whose spacing of doubles is 2.4e-7 s): a step
+    of 1e-3 would itself be rounded there, and the comparison would measure the master's clock instead."""
+    start = {"beta": 0.5, "base.fixed": True}
+    step = 2.0 ** -10
+    runs = [run_loop(gimbal_fmu, 600 * step, step, start, square_wave, start_time=t0) for t0 in (0.0, 1e7, 1.7e9)]
+    assert runs[0]["events.total"][-1] > 20
+    for other in runs[1:]:
+        for name in RECORDED:
+            assert np.array_equal(other[name], runs[0][name]), name
+
+
+def test_quasi_static_limiter_holds_the_current_and_matches_the_inductive_limit(gimbal_fmu):
+    """+-24 V reversals with i_L = 2 A: the quasi-static current never exceeds the limit, and the motion
+    is the L -> 0 limit of the inductive motor (first-order convergence in L)."""
+    def reversals(t, y):
+        return {"u_R1": 24.0 if int(t / 0.1) % 2 == 0 else -24.0}
+
+    common = {"motor1.i_L": 2.0, "base.fixed": True, "dry_friction": False, "gear1.model": 0}
+    outputs = ["alpha", "i_R1", "motor1.limited"]
+    quasi = simulate(gimbal_fmu, 0.6, 1e-3, {**common, "motor1.model": 0}, reversals, outputs)
+    assert np.max(np.abs(quasi["i_R1"])) <= 2.0 * (1 + 1e-12)
+    # Held at the limit whenever the free current lies beyond it (here: right after every reversal).
+    assert np.all(quasi["motor1.limited"][1:] != 0)
+    errors = []
+    for inductance in (1e-4, 1e-5):
+        inductive = simulate(gimbal_fmu, 0.6, 1e-3, {**common, "motor1.L": inductance, "solver.rtol": 1e-8,
+                                                    "solver.atol": 1e-10}, reversals, outputs)
+        errors.append(np.max(np.abs(inductive["alpha"] - quasi["alpha"])))
+    assert errors[1] < errors[0] / 5, errors  # converging as L -> 0
+    assert errors[1] < 1e-3, errors
+
+
+def test_a_run_that_turns_stiff_and_back_switches_methods_and_stays_accurate(gimbal_fmu):
+    """Little shaft damping makes the free-play state stiff (eigenvalue -k_s/c_s) whenever the gear is
+    in its gap; meshed, the model is not stiff. The default switches to RODAS4 and back, and agrees
+    with CVODE BDF at a tight tolerance."""
+    start = {"gear2.c_s": 0.5, "gear2.eta": 2e-3, "base.fixed": True, "dry_friction": False}
+
+    def slews(t, y):
+        return {"u_R2": 4.0 * np.sin(2 * np.pi * 2 * t) - 0.5 * y["beta_dot"]}
+
+    outputs = ["beta", "beta_dot", "theta_b2", "gear2.contact", "solver.method_switches",
+               "solver.jacobian_evaluations", "events.backlash2"]
+    fast = simulate(gimbal_fmu, 1.0, 1e-3, start, slews, outputs)
+    reference = simulate(gimbal_fmu, 1.0, 1e-3, {**start, "solver.method": 0, "solver.rtol": 1e-11,
+                                                  "solver.atol": 1e-13}, slews, outputs)
+    assert reference["events.backlash2"][-1] >= 4  # the gear leaves its stops and comes back
+    assert fast["solver.method_switches"][-1] >= 2, fast["solver.method_switches"][-1]
+    assert fast["solver.jacobian_evaluations"][-1] > 0
+    assert np.max(np.abs(fast["beta"] - reference["beta"])) < 1e-6
+    assert np.max(np.abs(fast["theta_b2"] - reference["theta_b2"])) < 1e-6
+
+
+def test_input_jumps_refresh_the_first_stage(gimbal_fmu):
+    """Voltages that jump at every step: Dormand-Prince alone (FSAL) against a tight reference. A first
+    stage left over from the previous step's voltage would err by about h * L^-1 * jump in the current."""
+    def jumps(t, y):
+        return {"u_R1": 10.0 * (-1) ** int(t / 1e-3), "u_R2": -6.0 * (-1) ** int(t / 2e-3)}
+
+    outputs = ["i_R1", "i_R2", "alpha", "beta"]
+    fast = simulate(gimbal_fmu, 0.05, 1e-3, {"solver.method": 5}, jumps, outputs)
+    reference = simulate(gimbal_fmu, 0.05, 1e-3, {"solver.method": 0, "solver.rtol": 1e-11,
+                                                  "solver.atol": 1e-13}, jumps, outputs)
+    for name in ("i_R1", "i_R2"):
+        assert np.max(np.abs(fast[name] - reference[name])) < 1e-5, name
