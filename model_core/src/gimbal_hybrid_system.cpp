@@ -112,7 +112,8 @@ bool GimbalHybridSystem::derivative(double time, const double* state, double* de
 }
 
 bool GimbalHybridSystem::jacobian(double time, const double* state, double* column_major) {
-    evaluate_jacobian(params_, inputs_, modes_, base_at(time), time, state, column_major);
+    const Dynamics& dynamics = dynamics_at(time, state);
+    evaluate_jacobian(params_, modes_, base_at(time), dynamics, column_major);
     return true;
 }
 

@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 
 #include <cmath>
+#include <limits>
 
 namespace gimbal {
 
@@ -218,13 +219,11 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     }
 }
 
-void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                       const BaseKinematics& base, double time, const double* state, double* column_major) {
+void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const BaseKinematics& base,
+                       const Dynamics& d, double* column_major) {
     using Mat4x12 = Eigen::Matrix<double, 4, 12>;
     const StateLayout& layout = params.layout;
     const int n = layout.size;
-    Dynamics d;
-    evaluate_dynamics(params, inputs, base, time, state, modes, d);
 
     // Derivatives of the full generalized forces: columns q (0-3), qd (4-7), currents (8-9), theta_b (10-11).
     Mat4x12 force = Mat4x12::Zero();
@@ -259,12 +258,46 @@ void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, 
             }
         }
     }
+    // The rigid-body terms, which vary slowly with the configuration and the rates (gravity, carrier
+    // motion, gyroscopic and centripetal forces, the mass matrix's dependence on the angles), by forward
+    // differences of J(q) and f(q, qd): a Rosenbrock method keeps its order only with the whole Jacobian.
+    Mat4 inertia_derivative[4];  // dJ/dq_j, full coordinates
+    {
+        const Vec4& q = d.full.angle;
+        const Vec4& qd = d.full.rate;
+        Mat4 mass_matrix, perturbed_mass;
+        Vec4 bias, perturbed_bias;
+        compute_mass_matrix_and_bias(params.multibody, base, q, qd, mass_matrix, bias);
+        const double root_epsilon = std::sqrt(std::numeric_limits<double>::epsilon());
+        for (int j = 0; j < 4; ++j) {
+            Vec4 shifted = q;
+            const double step = root_epsilon * std::max(1.0, std::fabs(q[j]));
+            shifted[j] += step;
+            compute_mass_matrix_and_bias(params.multibody, base, shifted, qd, perturbed_mass, perturbed_bias);
+            inertia_derivative[j] = (perturbed_mass - mass_matrix) / step;
+            force.col(j) += (perturbed_bias - bias) / step;
+            shifted = qd;
+            const double rate_step = root_epsilon * std::max(1.0, std::fabs(qd[j]));
+            shifted[j] += rate_step;
+            compute_mass_matrix_and_bias(params.multibody, base, q, shifted, perturbed_mass, perturbed_bias);
+            force.col(4 + j) += (perturbed_bias - bias) / rate_step;
+        }
+    }
+
     // To padded coordinates: q_full = T q_padded, forces projected with T^T.
     const Mat4& T = d.reduction;
     Mat4x12 applied;
     applied.block<4, 4>(0, 0) = T.transpose() * force.block<4, 4>(0, 0) * T;
     applied.block<4, 4>(0, 4) = T.transpose() * force.block<4, 4>(0, 4) * T;
     applied.block<4, 4>(0, 8) = T.transpose() * force.block<4, 4>(0, 8);
+    // d(T^T J T)/dq_padded,k = sum_j T(j, k) T^T dJ/dq_j T.
+    Mat4 padded_inertia_derivative[4];
+    for (int k = 0; k < 4; ++k) {
+        Mat4 full = Mat4::Zero();
+        for (int j = 0; j < 4; ++j)
+            if (T(j, k) != 0.0) full += T(j, k) * inertia_derivative[j];
+        padded_inertia_derivative[k] = T.transpose() * full * T;
+    }
 
     // A held coordinate's friction cancels the other torques (2.101), which depend on the state too.
     Mat4x12 friction = Mat4x12::Zero();
@@ -274,14 +307,24 @@ void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, 
         Mat4 modified = d.reduced_mass;
         for (int k = 0; k < 4; ++k)
             if (low_speed(modes.friction[k])) modified.col(k) = Vec4::Unit(k);
-        const Mat4x12 other = modified.partialPivLu().solve(applied);
+        // T_outros = M^-1 applied, with M the mass matrix whose low-speed columns are unit vectors.
+        Mat4x12 other_rhs = applied;
+        for (int k = 0; k < 4; ++k) {
+            Mat4 modified_derivative = padded_inertia_derivative[k];
+            for (int c = 0; c < 4; ++c)
+                if (low_speed(modes.friction[c])) modified_derivative.col(c).setZero();
+            other_rhs.col(k) -= modified_derivative * d.other_torque;
+        }
+        const Mat4x12 other = modified.partialPivLu().solve(other_rhs);
         for (int k = 0; k < 4; ++k) {
             if (modes.friction[k] != FrictionMode::hold) continue;
             friction.row(k) = -other.row(k);
             friction(k, 4 + k) -= params.coordinate_friction[k].numerical_damping();
         }
     }
-    const Mat4x12 acceleration = d.reduced_mass.llt().solve(applied + friction);
+    Mat4x12 acceleration_rhs = applied + friction;
+    for (int k = 0; k < 4; ++k) acceleration_rhs.col(k) -= padded_inertia_derivative[k] * d.acceleration;
+    const Mat4x12 acceleration = d.reduced_mass.llt().solve(acceleration_rhs);
 
     // Column of the padded-derivative matrices that a state slot stands for.
     int column_of_slot[kMaxStateSize];

@@ -153,11 +153,13 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
 Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Modes& modes,
                    const DryFrictionParameters (&friction)[4]);
 
-// d(dx/dt)/dx, column-major, exact for everything that makes the system stiff (gears, motor
-// circuits, backlash, viscous and stick damping) and leaving out the slow configuration dependence of
-// J and f (gravity, gyroscopic terms): the iteration matrix of Newton's method needs no more.
-void evaluate_jacobian(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,
-                       const BaseKinematics& base, double time, const double* state, double* column_major);
+// d(dx/dt)/dx at the point where `dynamics` was evaluated, column-major. Analytic for the drive train,
+// the backlash, the motor circuits and the friction modes (everything that makes the system stiff);
+// the slowly varying rigid-body terms (gravity, carrier motion, gyroscopic forces, the configuration
+// dependence of J) by forward differences of J and f. The rows of the energy accumulators are left at 0:
+// they integrate flows and feed nothing back.
+void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const BaseKinematics& base,
+                       const Dynamics& dynamics, double* column_major);
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time);
 
