@@ -487,6 +487,7 @@ struct Options {
     bool time_dostep = false;
     double target_azimuth_deg = 30.0;
     double target_elevation_deg = 20.0;
+    std::vector<std::pair<std::string, double>> real_parameters;  // --set NAME=VALUE
 };
 
 void usage() {
@@ -497,9 +498,11 @@ void usage() {
         "  --duration T             simulated time [s] (default 10)\n"
         "  --step H                 communication step [s] (default 1e-3)\n"
         "  --rtol R, --atol A       solver.rtol, solver.atol (default: the FMU's)\n"
-        "  --method M               Integer parameter solver.method: 0 CVODE BDF analytic Jacobian, 1 CVODE BDF\n"
-        "                           finite-difference Jacobian, 2 CVODE Adams, 3 ARKODE explicit RK (default: FMU's)\n"
+        "  --method M               Integer parameter solver.method: 4 automatic (the FMU's default), 5 Dormand-\n"
+        "                           Prince, 6 RODAS4; SUNDIALS: 0 CVODE BDF analytic Jacobian, 1 CVODE BDF finite-\n"
+        "                           difference Jacobian, 2 CVODE Adams, 3 ARKODE explicit RK (default: FMU's)\n"
         "  --fidelity full|reduced  reduced: rigid gears (gear*.model = 0), quasi-static motors (motor*.model = 0)\n"
+        "  --set NAME=VALUE         a Real parameter, e.g. --set motor1.L=1e-7 (repeatable): the stiff variants\n"
         "  --trajectory FILE        write t, alpha, beta, los.omega[1..3] at every communication point\n"
         "                           (FILE.csv: CSV with a header; otherwise raw little-endian float64, 6 per row)\n"
         "  --seed N                 seed of the sea-state phases and frequencies (default 1)\n"
@@ -534,6 +537,16 @@ Options parse(int argc, char** argv) {
         else if (a == "--atol") o.atol = number(i);
         else if (a == "--method") o.method = static_cast<int>(number(i));
         else if (a == "--fidelity") o.fidelity = value(i);
+        else if (a == "--set") {
+            const std::string assignment = value(i);
+            const auto equals = assignment.find('=');
+            if (equals == std::string::npos || equals == 0) die("--set expects NAME=VALUE, got " + assignment);
+            const std::string text = assignment.substr(equals + 1);
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (end == text.c_str() || *end != '\0') die("--set " + assignment + ": not a number");
+            o.real_parameters.emplace_back(assignment.substr(0, equals), v);
+        }
         else if (a == "--trajectory") o.trajectory = value(i);
         else if (a == "--seed") o.seed = static_cast<uint64_t>(number(i));
         else if (a == "--json") o.json = true;
@@ -609,7 +622,7 @@ struct Report {
     std::string mode;
     double simulated = 0, wall = 0, cpu = 0, dostep_wall = NAN, master_cpu = NAN;
     long dostep_calls = 0;
-    long counters[4] = {-1, -1, -1, -1};  // rhs, jacobian, steps, events
+    long counters[5] = {-1, -1, -1, -1, -1};  // rhs, jacobian, steps, events, method switches
     uint64_t instance_allocations = 0;
     int64_t instance_bytes = 0;
     uint64_t first_step_allocations = 0;
@@ -620,8 +633,9 @@ struct Report {
     std::string failure;
 };
 
-const char* kCounterNames[4] = {"solver.rhs_evaluations", "solver.jacobian_evaluations", "solver.steps", "events.total"};
-const char* kCounterKeys[4] = {"rhs_evaluations", "jacobian_evaluations", "solver_steps", "events"};
+const char* kCounterNames[5] = {"solver.rhs_evaluations", "solver.jacobian_evaluations", "solver.steps", "events.total",
+                                "solver.method_switches"};
+const char* kCounterKeys[5] = {"rhs_evaluations", "jacobian_evaluations", "solver_steps", "events", "method_switches"};
 
 void collect_sites(Report& report) {
     for (int s = 0; s < g_site_count; ++s) {
@@ -657,7 +671,7 @@ void print_report(const Options& o, const Report& r) {
                     num(o.rtol).c_str(), num(o.atol).c_str(),
                     r.mode == "overhead" ? o.overhead_step : o.step, r.simulated, r.simulated, r.wall, r.cpu,
                     num(r.dostep_wall).c_str(), num(r.master_cpu).c_str(), r.dostep_calls, rtf, r.dostep_calls ? 1e6 * r.cpu / r.dostep_calls : 0.0, r.states);
-        for (int c = 0; c < 4; ++c) std::printf(", \"%s\": %ld", kCounterKeys[c], r.counters[c]);
+        for (int c = 0; c < 5; ++c) std::printf(", \"%s\": %ld", kCounterKeys[c], r.counters[c]);
         std::printf(", \"instance_allocations\": %llu, \"instance_bytes\": %lld, \"first_step_allocations\": %llu, "
                     "\"dostep_allocations\": %llu, \"dostep_alloc_bytes\": %llu",
                     (unsigned long long)r.instance_allocations, (long long)r.instance_bytes,
@@ -688,7 +702,7 @@ void print_report(const Options& o, const Report& r) {
                     "real-time factor %.6g\n",
                     r.master_cpu, 1e6 * (r.cpu - r.master_cpu) / std::max(1L, r.dostep_calls),
                     r.simulated / std::max(1e-12, r.cpu - r.master_cpu));
-    for (int c = 0; c < 4; ++c) std::printf("  %-27s %ld\n", kCounterNames[c], r.counters[c]);
+    for (int c = 0; c < 5; ++c) std::printf("  %-27s %ld\n", kCounterNames[c], r.counters[c]);
     std::printf("  instance memory    %lld bytes in %llu allocations (instantiate + initialization)\n",
                 (long long)r.instance_bytes, (unsigned long long)r.instance_allocations);
     std::printf("  first doStep       %llu allocations\n", (unsigned long long)r.first_step_allocations);
@@ -749,6 +763,10 @@ struct Run {
         }
         if (!std::isnan(o.rtol)) set_real("solver.rtol", o.rtol);
         if (!std::isnan(o.atol)) set_real("solver.atol", o.atol);
+        for (const auto& [name, v] : o.real_parameters) {
+            if (!md.has(name)) die("--set: the FMU has no variable '" + name + "'");
+            set_real(name, v);
+        }
         report.instance_allocations = g_alloc.allocations - a0;
         report.instance_bytes = g_alloc.live - live0;
         (void)name;
@@ -760,7 +778,7 @@ struct Run {
     }
 
     void read_counters() {
-        for (int c = 0; c < 4; ++c) {
+        for (int c = 0; c < 5; ++c) {
             if (!md.has(kCounterNames[c])) continue;
             const fmi2ValueReference vr = md.vr(kCounterNames[c], 'I');
             fmi2Integer v = 0;

@@ -164,11 +164,20 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
     }
     if (!ok) {  // a non-finite right-hand side: try a much smaller step
         memory_.step_size = 0.25 * h;
+        stiffness_estimate_ = 0.0;
         return StepResult::rejected;
     }
     for (int i = 0; i < n; ++i)
         error_[i] = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] + e6 * k[5][i] + e7 * f_new_[i]);
     const double err = error_norm(error_, y_, y_new_);
+    // Hairer's stiffness test: h |lambda| estimated from the last two stages, both at t_new. Taken on
+    // rejected steps too: a step rejected for instability is the clearest sign of stiffness.
+    double numerator = 0.0, denominator = 0.0;
+    for (int i = 0; i < n; ++i) {
+        numerator += (f_new_[i] - k[5][i]) * (f_new_[i] - k[5][i]);
+        denominator += (y_new_[i] - stage_state_[i]) * (y_new_[i] - stage_state_[i]);
+    }
+    stiffness_estimate_ = denominator > 0.0 ? h * std::sqrt(numerator / denominator) : 0.0;
     const double exponent = 0.2 - kPiBeta * 0.75;
     const double raw = std::pow(err, exponent);
     if (!(err <= 1.0)) {
@@ -182,14 +191,6 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
     if (memory_.last_step_rejected) next = std::min(next, h);
     memory_.previous_error = std::max(err, 1e-4);
     memory_.last_step_rejected = 0;
-
-    // Hairer's stiffness test: h |lambda| estimated from the last two stages, both at t_new.
-    double numerator = 0.0, denominator = 0.0;
-    for (int i = 0; i < n; ++i) {
-        numerator += (f_new_[i] - k[5][i]) * (f_new_[i] - k[5][i]);
-        denominator += (y_new_[i] - stage_state_[i]) * (y_new_[i] - stage_state_[i]);
-    }
-    stiffness_estimate_ = denominator > 0.0 ? h * std::sqrt(numerator / denominator) : 0.0;
 
     dense_rosenbrock_ = false;
     dense_t0_ = t_, dense_h_ = h;
@@ -263,7 +264,12 @@ OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, doubl
     y_new_ = stage_state_ + k[5];
     if (!y_new_.allFinite()) return reject();
 
-    const double err = error_norm(k[5], y_, y_new_);
+    // The embedded estimate k6, filtered through (I - h gamma J)^-1 as RADAU5 filters its own (Hairer &
+    // Wanner, section IV.8): components with |h lambda| >> 1 follow the slow ones within the step, and
+    // their raw estimate (the distance still to go in a boundary layer after an input jump) would force
+    // steps of the fast time scale although the solution does not need them.
+    error_ = lu_.solve(k[5]) / (h * gamma);
+    const double err = error_norm(error_, y_, y_new_);
     const double raw = std::pow(err, 0.25) / kSafety;
     if (!(err <= 1.0)) {
         memory_.step_size = h / std::min(1.0 / kMaxShrink, raw);
@@ -417,6 +423,7 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
     const int changes = system_.update_modes(root, y_.data(), directions_.data());
     totals_.events += changes;
     log_events(root, changes);
+    const bool stiffness_may_change = changes > 0;
 
     memory_.rapid_events = root - memory_.last_event_time <= settings_.zeno_window ? memory_.rapid_events + 1 : 0;
     memory_.last_event_time = root;
@@ -433,7 +440,22 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
         }
     }
     // New modes (or a projection onto a stop) change the right-hand side: one evaluation restarts.
-    return refresh_at_current_point();
+    if (!refresh_at_current_point()) return false;
+    if (stiffness_may_change) check_stiffness_after_switch();
+    return true;
+}
+
+// A mode change can make the model stiff at once (a motor's current released from its limit, a gear
+// entering its gap): rather than learn it from rejected explicit steps, look at the Jacobian.
+void OneStepIntegrator::check_stiffness_after_switch() {
+    if (settings_.method != IntegrationMethod::automatic || memory_.stiff || memory_.step_size <= 0.0) return;
+    if (!jacobian_at(t_, y_)) return;
+    if (spectral_radius_estimate() * memory_.step_size > tableau::dopri5::stiffness_threshold) {
+        memory_.stiff = 1;
+        memory_.stiff_votes = memory_.nonstiff_votes = 0;
+        memory_.previous_error = 1e-4;
+        ++totals_.method_switches;
+    }
 }
 
 bool OneStepIntegrator::reselect_after_dwell() {
@@ -508,6 +530,7 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
         }
         if (result == StepResult::rejected) {
             ++totals_.rejected_steps;
+            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit(h);
             continue;
         }
         ++totals_.steps;
@@ -525,7 +548,9 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
         std::swap(g_, g_new_);
         if (event_count_ > 0 && t_ >= memory_.dwell_until && memory_.dwell_until > -1e300 && !reselect_after_dwell())
             return false;
-        if (memory_.stiff) vote_on_stiffness_rosenbrock(h);
+        // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
+        // input jump it takes a few short steps, at which any method would be stable.
+        if (memory_.stiff) vote_on_stiffness_rosenbrock(std::max(h, memory_.step_size));
         else vote_on_stiffness_explicit(h);
     }
     for (int k = 0; k < size_; ++k) state[k] = y_[k];

@@ -54,6 +54,7 @@ private:
     double spectral_radius_estimate() const;
     void vote_on_stiffness_explicit(double h);
     void vote_on_stiffness_rosenbrock(double h);
+    void check_stiffness_after_switch();
     // Looks for sign changes between g_ (at t_) and g_new_ (at t_new_); if any, locates the first root on
     // the dense output, switches modes there and restarts. False on failure.
     bool handle_events(bool& event_found);
