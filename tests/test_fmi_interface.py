@@ -190,6 +190,10 @@ def test_debug_logging_categories_switch_event_messages(gimbal_fmu):
         run(gimbal_fmu, slave, 0.04, 40, record=False)
         events = [text for _, category, text in log if category == "logEvents"]
         assert events and "mode change" in events[0]
+        # Each message names the element that switched and how, e.g. "gear1 backlash: gap -> +eta stop".
+        elements = ("backlash: ", "current limiter: ", "voltage clamp: ", "dry friction: ")
+        assert all(any(element in text for element in elements) and " -> " in text for text in events
+                   if "chattering" not in text), events[:5]
         slave.setDebugLogging(False, ["logEvents"])
         count = len(log)
         run(gimbal_fmu, slave, 0.08, 40, record=False)

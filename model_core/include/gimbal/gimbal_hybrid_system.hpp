@@ -4,6 +4,9 @@
 
 #include "gimbal/gimbal_model.hpp"
 #include "gimbal/hybrid_system.hpp"
+#include "gimbal/switching_elements.hpp"
+
+#include <vector>
 
 namespace gimbal {
 
@@ -17,15 +20,13 @@ struct EventCounters {
 
 class GimbalHybridSystem final : public HybridSystem {
 public:
-    // Fixed slots, so that the integrator sees one event vector whatever the modes; slots a mode
-    // does not use hold a constant 1.
-    static constexpr int kGearSlots = 2, kMotorSlots = 4, kFrictionSlots = 6;
-    static constexpr int kEventCount = 2 * kGearSlots + 2 * kMotorSlots + 4 * kFrictionSlots;
-
-    explicit GimbalHybridSystem(const ModelParameters& params) : params_(params) {}
+    explicit GimbalHybridSystem(const ModelParameters& params);
+    // The element list points into the element vectors: not copyable.
+    GimbalHybridSystem(const GimbalHybridSystem&) = delete;
+    GimbalHybridSystem& operator=(const GimbalHybridSystem&) = delete;
 
     int state_size() const override { return params_.state_size(); }
-    int event_count() const override { return kEventCount; }
+    int event_count() const override { return event_count_; }
     bool derivative(double time, const double* state, double* derivative) override;
     bool has_jacobian() const override { return true; }
     bool jacobian(double time, const double* state, double* column_major) override;
@@ -56,6 +57,13 @@ private:
     const BaseKinematics& base_at(double time);
 
     const ModelParameters& params_;
+    // The switching elements present, in decision order, and all of them for guards and the log.
+    std::vector<BacklashElement> backlash_;
+    std::vector<VoltageClampElement> clamps_;
+    std::vector<CurrentLimiterElement> limiters_;
+    std::vector<DryFrictionElement> friction_;
+    std::vector<const SwitchingElement*> elements_;
+    int event_count_ = 0;
     StepInputs inputs_;
     BaseKinematics base_;
     double base_time_ = 0.0;
