@@ -14,6 +14,8 @@ constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 // Step size control (E. Hairer's DOPRI5 and RODAS defaults).
 constexpr double kSafety = 0.9;
 constexpr double kPiBeta = 0.04;                   // DOPRI5's stabilized (PI) controller
+// A step may be stretched by this fraction of itself to end on a communication point.
+constexpr double kStretch = 0.1;
 constexpr double kMaxGrowth = 10.0, kMaxShrink = 0.2;  // per step, after an accepted / a rejected step
 // Automatic method: explicit steps in a row at the stability boundary before the Rosenbrock method
 // takes over, and Rosenbrock steps in a row at which the explicit method would be stable before it
@@ -488,11 +490,15 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
         double h = memory_.step_size;
         if (settings_.max_step > 0.0) h = std::min(h, settings_.max_step);
         const double remaining = end_time - t_;
+        // Equal steps to the end of the communication step, each at most 10 % longer than proposed (the
+        // controller's safety factor absorbs that): a proposal just short of a divisor of the
+        // communication step would otherwise cost a whole extra step.
+        const double steps_left = std::max(1.0, std::ceil(remaining / h - kStretch));
         bool last = false;
-        if (h >= remaining * (1.0 - 1e-12)) {
+        if (steps_left <= 1.0) {
             h = remaining, last = true;
-        } else if (h > 0.5 * remaining) {
-            h = 0.5 * remaining;  // two equal steps rather than a long one and a short one
+        } else {
+            h = remaining / steps_left;
         }
         if (h <= 16.0 * kEpsilon * std::max(1.0, std::fabs(t_))) {
             std::ostringstream s;
