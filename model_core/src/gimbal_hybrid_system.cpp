@@ -107,12 +107,8 @@ const Dynamics& GimbalHybridSystem::dynamics_at(double time, const double* state
 }
 
 bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
-    const int n = params_.layout.size;
-    evaluate_dynamics(params_, inputs_, base_at(time), time, state, modes_, cache_);
-    cache_time_ = time;
-    std::copy(state, state + n, cache_state_);
-    cache_valid_ = true;
-    return state_derivative(params_, cache_, derivative);
+    // A restart asks again for the point where the mode decision just evaluated the dynamics.
+    return state_derivative(params_, dynamics_at(time, state), derivative);
 }
 
 bool GimbalHybridSystem::jacobian(double time, const double* state, double* column_major) {
@@ -164,6 +160,13 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
         if (modes_.friction[body] != previous.friction[body]) ++counters_.stick_slip, ++changes;
     counters_.total += changes;
     if (changes > 0) counters_.last_event_time = time;
+    // Unchanged modes and state: the dynamics just evaluated are those of this point.
+    if (changes == 0 && std::equal(state, state + n, state_before)) {
+        cache_ = d;
+        cache_time_ = time;
+        std::copy(state, state + n, cache_state_);
+        cache_valid_ = true;
+    }
     return changes;
 }
 
