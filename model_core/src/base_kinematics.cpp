@@ -39,10 +39,16 @@ BaseKinematics evaluate_base_kinematics(const BaseMotion& base, double gravity) 
                  roll_rate = base.attitude_rate[2];
     const double pitch_accel = base.attitude_accel[0], yaw_accel = base.attitude_accel[1],
                  roll_accel = base.attitude_accel[2];
+    const double cp = std::cos(pitch), sp = std::sin(pitch);
     const double cy = std::cos(yaw), sy = std::sin(yaw), cr = std::cos(roll), sr = std::sin(roll);
 
     BaseKinematics out;
-    out.G_T_0 = rotation_x(pitch) * rotation_z(yaw) * rotation_y(roll);
+    // rotation_x(pitch) * rotation_z(yaw) * rotation_y(roll) multiplied out: Rz Ry has rows
+    // (cy cr, -sy, cy sr), (sy cr, cy, sy sr), (-sr, 0, cr); Rx mixes the last two.
+    const double sy_cr = sy * cr, sy_sr = sy * sr;
+    out.G_T_0 << cy * cr, -sy, cy * sr,
+                 cp * sy_cr + sp * sr, cp * cy, cp * sy_sr - sp * cr,
+                 sp * sy_cr - cp * sr, sp * cy, sp * sy_sr + cp * cr;
     out.angular_velocity << pitch_rate * cy * cr - yaw_rate * sr,
                             -pitch_rate * sy + roll_rate,
                             pitch_rate * cy * sr + yaw_rate * cr;
@@ -51,9 +57,15 @@ BaseKinematics evaluate_base_kinematics(const BaseMotion& base, double gravity) 
                          -pitch_accel * sy - pitch_rate * yaw_rate * cy + roll_accel,
                          pitch_accel * cy * sr - pitch_rate * yaw_rate * sy * sr + pitch_rate * roll_rate * cy * cr
                              + yaw_accel * cr - yaw_rate * roll_rate * sr;
-    const Mat3 zero_T_G = out.G_T_0.transpose();
-    out.accel_a = zero_T_G * base.acceleration_a;
-    out.gravity = zero_T_G * Vec3(0.0, 0.0, -gravity);
+    // G_T_0^T a, written by component from the scalars: Eigen's product would reload the matrix just
+    // stored element by element as SSE packets, and the failed store forwarding costs more than it.
+    const Mat3& G = out.G_T_0;
+    const Vec3& a = base.acceleration_a;
+    out.accel_a = Vec3(G(0, 0) * a.x() + G(1, 0) * a.y() + G(2, 0) * a.z(),
+                       G(0, 1) * a.x() + G(1, 1) * a.y() + G(2, 1) * a.z(),
+                       G(0, 2) * a.x() + G(1, 2) * a.y() + G(2, 2) * a.z());
+    // G_T_0^T (0, 0, -g) is -g times the last row of G_T_0.
+    out.gravity = Vec3(-gravity * G(2, 0), -gravity * G(2, 1), -gravity * G(2, 2));
     return out;
 }
 

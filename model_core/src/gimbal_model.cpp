@@ -203,7 +203,9 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
         }
         out.friction_torque[k] = torque;
     }
-    out.acceleration = reduced_mass.llt().solve(applied + out.friction_torque);
+    // A rigid gear keeps J's arrow pattern: its rotor's row and column become the padding identity, and
+    // the load's gain only the reflected inertia N^2 J_rotor on the diagonal.
+    out.acceleration = solve_mass_matrix(reduced_mass, Vec4(applied + out.friction_torque));
     out.full_acceleration = reduced ? Vec4(reduction * out.acceleration) : out.acceleration;
     out.reduced_mass = reduced_mass;
     out.reduction = reduction;
@@ -324,7 +326,7 @@ void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const 
     }
     Mat4x12 acceleration_rhs = applied + friction;
     for (int k = 0; k < 4; ++k) acceleration_rhs.col(k) -= padded_inertia_derivative[k] * d.acceleration;
-    const Mat4x12 acceleration = d.reduced_mass.llt().solve(acceleration_rhs);
+    const Mat4x12 acceleration = solve_mass_matrix<12>(d.reduced_mass, acceleration_rhs);
 
     // Column of the padded-derivative matrices that a state slot stands for.
     int column_of_slot[kMaxStateSize];

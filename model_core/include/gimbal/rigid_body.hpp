@@ -34,8 +34,42 @@ struct MultibodyEnergy {
 };
 
 // J qdd = Xi + f, with J symmetric positive definite.
+//
+// J has the arrow pattern below, and the zeros are written: rotor R1 turns on the carrier, so its rate
+// couples to nothing; each elevation body couples only to its own rate and the azimuth rate.
+//       [ x 0 x x ]
+//   J = [ 0 x 0 0 ]
+//       [ x 0 x 0 ]
+//       [ x 0 0 x ]
 void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinematics& base,
                                   const Vec4& q, const Vec4& qd, Mat4& mass_matrix, Vec4& bias);
+
+// Solves J x = rhs for a J with the arrow pattern of compute_mass_matrix_and_bias (symmetric positive
+// definite; the entries off the pattern are not read). Eliminating the elevation coordinates first
+// creates no fill-in, so it costs four divisions where a dense LLT costs four square roots and a
+// triangular solve pair. A J changed so that it loses the pattern (e.g. a rotor slaved to its load
+// through a gear ratio, which couples alpha_m to alpha) must be solved some other way.
+template <int Columns>
+Eigen::Matrix<double, 4, Columns> solve_mass_matrix(const Mat4& mass_matrix,
+                                                    const Eigen::Matrix<double, 4, Columns>& rhs) {
+    const Mat4& J = mass_matrix;
+    const double inv_rotor = 1.0 / J(1, 1);
+    const double inv_elevation = 1.0 / J(2, 2);
+    const double inv_elevation_rotor = 1.0 / J(3, 3);
+    // Row 0 after substituting x2 and x3 from rows 2 and 3: the Schur complement of the azimuth pivot.
+    const double coupling2 = J(0, 2) * inv_elevation, coupling3 = J(0, 3) * inv_elevation_rotor;
+    const double inv_schur = 1.0 / (J(0, 0) - coupling2 * J(2, 0) - coupling3 * J(3, 0));
+    Eigen::Matrix<double, 4, Columns> x;
+    x.row(0) = (rhs.row(0) - coupling2 * rhs.row(2) - coupling3 * rhs.row(3)) * inv_schur;
+    x.row(1) = rhs.row(1) * inv_rotor;
+    x.row(2) = (rhs.row(2) - J(2, 0) * x.row(0)) * inv_elevation;
+    x.row(3) = (rhs.row(3) - J(3, 0) * x.row(0)) * inv_elevation_rotor;
+    return x;
+}
+
+inline Vec4 solve_mass_matrix(const Mat4& mass_matrix, const Vec4& rhs) {
+    return solve_mass_matrix<1>(mass_matrix, rhs);
+}
 
 // Inertial angular velocity of the elevation payload in its own frame (what a payload gyro reads).
 Vec3 payload_angular_velocity(const BaseKinematics& base, const Vec4& q, const Vec4& qd);
