@@ -33,14 +33,45 @@ BaseMotion BaseMotion::advanced(double elapsed) const {
     return later;
 }
 
+SinCos sin_cos(double angle) { return SinCos{std::sin(angle), std::cos(angle)}; }
+
+SinCos sin_cos_near(const SinCos& reference, double offset) {
+    // Small offsets (the carrier's turn within a communication step): the addition theorem with the
+    // Taylor series of the offset, which at |offset| <= 1e-3 is exact in double precision (the first
+    // neglected terms are below 1e-22), instead of a library sincos at every integrator stage.
+    if (!(std::fabs(offset) <= 1e-3)) return SinCos{};  // caller falls back
+    const double square = offset * offset;
+    const double sine = offset * (1.0 - square / 6.0 * (1.0 - square / 20.0));
+    const double cosine = 1.0 - square / 2.0 * (1.0 - square / 12.0 * (1.0 - square / 30.0));
+    return SinCos{reference.sin * cosine + reference.cos * sine, reference.cos * cosine - reference.sin * sine};
+}
+
+AttitudeTrig attitude_trig(const Vec3& attitude) {
+    return AttitudeTrig{sin_cos(attitude[0]), sin_cos(attitude[1]), sin_cos(attitude[2])};
+}
+
+AttitudeTrig attitude_trig_near(const AttitudeTrig& reference, const Vec3& reference_attitude, const Vec3& attitude) {
+    AttitudeTrig trig;
+    SinCos* out[3] = {&trig.pitch, &trig.yaw, &trig.roll};
+    const SinCos* ref[3] = {&reference.pitch, &reference.yaw, &reference.roll};
+    for (int k = 0; k < 3; ++k) {
+        const double offset = attitude[k] - reference_attitude[k];
+        *out[k] = std::fabs(offset) <= 1e-3 ? sin_cos_near(*ref[k], offset) : sin_cos(attitude[k]);
+    }
+    return trig;
+}
+
 BaseKinematics evaluate_base_kinematics(const BaseMotion& base, double gravity) {
-    const double pitch = base.attitude[0], yaw = base.attitude[1], roll = base.attitude[2];
+    return evaluate_base_kinematics(base, attitude_trig(base.attitude), gravity);
+}
+
+BaseKinematics evaluate_base_kinematics(const BaseMotion& base, const AttitudeTrig& trig, double gravity) {
     const double pitch_rate = base.attitude_rate[0], yaw_rate = base.attitude_rate[1],
                  roll_rate = base.attitude_rate[2];
     const double pitch_accel = base.attitude_accel[0], yaw_accel = base.attitude_accel[1],
                  roll_accel = base.attitude_accel[2];
-    const double cp = std::cos(pitch), sp = std::sin(pitch);
-    const double cy = std::cos(yaw), sy = std::sin(yaw), cr = std::cos(roll), sr = std::sin(roll);
+    const double cp = trig.pitch.cos, sp = trig.pitch.sin;
+    const double cy = trig.yaw.cos, sy = trig.yaw.sin, cr = trig.roll.cos, sr = trig.roll.sin;
 
     BaseKinematics out;
     // rotation_x(pitch) * rotation_z(yaw) * rotation_y(roll) multiplied out: Rz Ry has rows

@@ -61,7 +61,13 @@ const BaseKinematics& GimbalHybridSystem::base_at(double time) {
     // The integrator asks for the same instant several times (right-hand side, events, Jacobian), and
     // a fixed or non-rotating base never changes: evaluate its trigonometry once.
     if (!base_cached_ || (time != base_time_ && !base_constant_)) {
-        base_ = base_kinematics_at(params_, inputs_, time);
+        if (params_.fidelity.fixed_base) {
+            base_ = base_kinematics_at(params_, inputs_, time);
+        } else {
+            const BaseMotion motion = inputs_.base.advanced(time - inputs_.step_start_time);
+            const AttitudeTrig trig = attitude_trig_near(arc_start_trig_, inputs_.base.attitude, motion.attitude);
+            base_ = evaluate_base_kinematics(motion, trig, params_.multibody.gravity);
+        }
         base_time_ = time;
         base_cached_ = true;
     }
@@ -73,6 +79,7 @@ void GimbalHybridSystem::set_inputs(const StepInputs& inputs) {
     base_cached_ = false;
     cache_valid_ = false;
     const BaseMotion& b = inputs.base;
+    arc_start_trig_ = attitude_trig(b.attitude);
     base_constant_ = params_.fidelity.fixed_base ||
                      (b.attitude_rate.isZero(0.0) && b.attitude_accel.isZero(0.0) && b.acceleration_a.isZero(0.0));
 }

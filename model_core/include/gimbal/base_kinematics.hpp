@@ -37,4 +37,17 @@ struct BaseKinematics {
 // Derivative of (2.13) is taken analytically so that w0, its derivative and G_T_0 stay consistent.
 BaseKinematics evaluate_base_kinematics(const BaseMotion& base, double gravity);
 
+struct SinCos {
+    double sin = 0.0, cos = 1.0;
+};
+// The trigonometry of the attitude angles (delta, psi, gamma), which is all the kinematics need of them.
+struct AttitudeTrig {
+    SinCos pitch, yaw, roll;
+};
+AttitudeTrig attitude_trig(const Vec3& attitude);
+// The same for an attitude close to one whose trigonometry is known: offsets up to 1e-3 rad by the
+// addition theorem (exact to rounding), larger ones by the library.
+AttitudeTrig attitude_trig_near(const AttitudeTrig& reference, const Vec3& reference_attitude, const Vec3& attitude);
+BaseKinematics evaluate_base_kinematics(const BaseMotion& base, const AttitudeTrig& trig, double gravity);
+
 }  // namespace gimbal

@@ -69,6 +69,7 @@ private:
     double base_time_ = 0.0;
     bool base_cached_ = false;
     bool base_constant_ = false;
+    AttitudeTrig arc_start_trig_;  // of the attitude where the inputs' constant-acceleration arc starts
     Modes modes_;
     Modes previous_modes_;  // before the last update_modes, for the event log
     EventCounters counters_;
