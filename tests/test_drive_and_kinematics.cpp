@@ -91,5 +91,22 @@ int main() {
     CHECK((Vec3(skew(2, 1), skew(0, 2), skew(1, 0)) - k.angular_velocity).norm() < 1e-8);
     // Gravity points down in G whatever the attitude.
     CHECK((k.G_T_0 * k.gravity - Vec3(0, 0, -9.81)).norm() < 1e-12);
+    // The carrier's trigonometry at an integrator stage from that of the arc start: the same as the
+    // library's to rounding, for offsets on both sides of the 1e-3 rad switch to the library.
+    {
+        const Vec3 start(0.3, -1.2, 2.9);
+        const AttitudeTrig reference = attitude_trig(start);
+        for (double offset : {-1e-3, -3e-4, -1e-9, 0.0, 2e-7, 5e-4, 1e-3, 1.5e-3, 0.2}) {
+            const Vec3 attitude = start + Vec3(offset, -0.7 * offset, 0.3 * offset);
+            const AttitudeTrig near = attitude_trig_near(reference, start, attitude);
+            const AttitudeTrig exact = attitude_trig(attitude);
+            CHECK_NEAR(near.pitch.sin, exact.pitch.sin, 4e-16);
+            CHECK_NEAR(near.pitch.cos, exact.pitch.cos, 4e-16);
+            CHECK_NEAR(near.yaw.sin, exact.yaw.sin, 4e-16);
+            CHECK_NEAR(near.yaw.cos, exact.yaw.cos, 4e-16);
+            CHECK_NEAR(near.roll.sin, exact.roll.sin, 4e-16);
+            CHECK_NEAR(near.roll.cos, exact.roll.cos, 4e-16);
+        }
+    }
     return check_report("drive_and_kinematics");
 }
