@@ -47,7 +47,6 @@ OneStepIntegrator::OneStepIntegrator(HybridSystem& system, const IntegratorSetti
     for (Vector& v : dense_) v.setZero(n);
     jacobian_.setZero(n, n);
     iteration_matrix_.setZero(n, n);
-    lu_.compute(Matrix::Identity(n, n));  // sizes its storage once
     if (settings_.method == IntegrationMethod::rosenbrock) memory_.stiff = 1;
 }
 
@@ -229,40 +228,45 @@ OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, doubl
     using namespace tableau::rodas4;
     iteration_matrix_ = -jacobian_;
     iteration_matrix_.diagonal().array() += 1.0 / (h * gamma);
-    lu_.compute(iteration_matrix_);
-    const double hd1 = h * d1, hd2 = h * d2, hd3 = h * d3, hd4 = h * d4;
-    const double hc21 = c21 / h, hc31 = c31 / h, hc32 = c32 / h, hc41 = c41 / h, hc42 = c42 / h, hc43 = c43 / h;
-    const double hc51 = c51 / h, hc52 = c52 / h, hc53 = c53 / h, hc54 = c54 / h;
-    const double hc61 = c61 / h, hc62 = c62 / h, hc63 = c63 / h, hc64 = c64 / h, hc65 = c65 / h;
     Vector* k = stage_;
-    Vector& dy = f_new_;  // stage derivative (f_new_ is written last)
     auto reject = [&] {
         memory_.step_size = 0.25 * h;
         memory_.last_step_rejected = 1;
         return StepResult::rejected;
     };
-    k[0] = lu_.solve(f_ + hd1 * time_derivative_);
+    if (!lu_.factorize(iteration_matrix_.data(), size_)) return reject();
+    // Stage i solves (I/(h gamma) - J) k_i = rhs in place.
+    auto solve = [&](Vector& stage, const auto& rhs) {
+        stage = rhs;
+        lu_.solve(stage.data());
+    };
+    const double hd1 = h * d1, hd2 = h * d2, hd3 = h * d3, hd4 = h * d4;
+    const double hc21 = c21 / h, hc31 = c31 / h, hc32 = c32 / h, hc41 = c41 / h, hc42 = c42 / h, hc43 = c43 / h;
+    const double hc51 = c51 / h, hc52 = c52 / h, hc53 = c53 / h, hc54 = c54 / h;
+    const double hc61 = c61 / h, hc62 = c62 / h, hc63 = c63 / h, hc64 = c64 / h, hc65 = c65 / h;
+    Vector& dy = f_new_;  // stage derivative (f_new_ is written last)
+    solve(k[0], f_ + hd1 * time_derivative_);
 
     stage_state_ = y_ + a21 * k[0];
     if (!rhs(t_ + c2 * h, stage_state_, dy)) return reject();
-    k[1] = lu_.solve(dy + hd2 * time_derivative_ + hc21 * k[0]);
+    solve(k[1], dy + hd2 * time_derivative_ + hc21 * k[0]);
 
     stage_state_ = y_ + a31 * k[0] + a32 * k[1];
     if (!rhs(t_ + c3 * h, stage_state_, dy)) return reject();
-    k[2] = lu_.solve(dy + hd3 * time_derivative_ + hc31 * k[0] + hc32 * k[1]);
+    solve(k[2], dy + hd3 * time_derivative_ + hc31 * k[0] + hc32 * k[1]);
 
     stage_state_ = y_ + a41 * k[0] + a42 * k[1] + a43 * k[2];
     if (!rhs(t_ + c4 * h, stage_state_, dy)) return reject();
-    k[3] = lu_.solve(dy + hd4 * time_derivative_ + hc41 * k[0] + hc42 * k[1] + hc43 * k[2]);
+    solve(k[3], dy + hd4 * time_derivative_ + hc41 * k[0] + hc42 * k[1] + hc43 * k[2]);
 
     stage_state_ = y_ + a51 * k[0] + a52 * k[1] + a53 * k[2] + a54 * k[3];
     if (!rhs(t_new, stage_state_, dy)) return reject();
-    k[4] = lu_.solve(dy + hc51 * k[0] + hc52 * k[1] + hc53 * k[2] + hc54 * k[3]);
+    solve(k[4], dy + hc51 * k[0] + hc52 * k[1] + hc53 * k[2] + hc54 * k[3]);
 
     // Stiffly accurate: the embedded solution is the fifth stage's argument plus k5.
     stage_state_ += k[4];
     if (!rhs(t_new, stage_state_, dy)) return reject();
-    k[5] = lu_.solve(dy + hc61 * k[0] + hc62 * k[1] + hc63 * k[2] + hc64 * k[3] + hc65 * k[4]);
+    solve(k[5], dy + hc61 * k[0] + hc62 * k[1] + hc63 * k[2] + hc64 * k[3] + hc65 * k[4]);
     y_new_ = stage_state_ + k[5];
     if (!y_new_.allFinite()) return reject();
 
@@ -270,7 +274,7 @@ OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, doubl
     // Wanner, section IV.8): components with |h lambda| >> 1 follow the slow ones within the step, and
     // their raw estimate (the distance still to go in a boundary layer after an input jump) would force
     // steps of the fast time scale although the solution does not need them.
-    error_ = lu_.solve(k[5]) / (h * gamma);
+    solve(error_, k[5] / (h * gamma));
     const double err = error_norm(error_, y_, y_new_);
     const double raw = std::pow(err, 0.25) / kSafety;
     if (!(err <= 1.0)) {
@@ -312,16 +316,24 @@ void OneStepIntegrator::dense_output(double time, double* state) const {
 // growth is within a factor (states)^(1/m) of it, enough for a choice between two methods.
 double OneStepIntegrator::spectral_radius_estimate() const {
     constexpr int kIterations = 8;
-    Vector v = Vector::Ones(size_) / std::sqrt(static_cast<double>(size_));
-    double log_growth = 0.0;
+    const int n = size_;
+    double v[kMaxStates], w[kMaxStates];
+    for (int i = 0; i < n; ++i) v[i] = 1.0 / std::sqrt(static_cast<double>(n));
+    double growth = 1.0;  // |J^m v| / |v|: at most (1e38)^8 before it counts as infinite
     for (int iteration = 0; iteration < kIterations; ++iteration) {
-        Vector w = jacobian_ * v;
-        const double norm = w.norm();
+        double norm = 0.0;
+        for (int i = 0; i < n; ++i) w[i] = 0.0;
+        for (int j = 0; j < n; ++j) {
+            const double* column = jacobian_.data() + j * n;  // n x n, column-major
+            for (int i = 0; i < n; ++i) w[i] += column[i] * v[j];
+        }
+        for (int i = 0; i < n; ++i) norm += w[i] * w[i];
+        norm = std::sqrt(norm);
         if (!(norm > 0.0) || !std::isfinite(norm)) return norm > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
-        log_growth += std::log(norm);
-        v = w / norm;
+        growth *= norm;
+        for (int i = 0; i < n; ++i) v[i] = w[i] / norm;
     }
-    return std::exp(log_growth / kIterations);
+    return std::pow(growth, 1.0 / kIterations);
 }
 
 void OneStepIntegrator::vote_on_stiffness_explicit(double h) {

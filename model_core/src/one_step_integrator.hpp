@@ -11,9 +11,9 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "gimbal/integrator.hpp"
+#include "small_lu.hpp"
 
 namespace gimbal {
 
@@ -88,7 +88,7 @@ private:
     Vector dense_[5];
     // Rosenbrock: Jacobian, df/dt and the factorized iteration matrix.
     Matrix jacobian_, iteration_matrix_;
-    Eigen::PartialPivLU<Matrix> lu_;
+    SmallLU<kMaxStates> lu_;
     Vector time_derivative_, perturbed_;
     double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
     bool jacobian_current_ = false;    // jacobian_ and time_derivative_ belong to (t_, y_) and the modes
