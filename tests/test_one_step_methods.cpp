@@ -6,6 +6,10 @@
 
 #include "check.hpp"
 #include "one_step_integrator.hpp"
+#include "small_lu.hpp"
+
+#include <random>
+#include <Eigen/Dense>
 
 using namespace gimbal;
 
@@ -121,7 +125,32 @@ void check_order(const char* name, IntegrationMethod method, double order, doubl
 
 }  // namespace
 
+// The iteration matrix's LU against Eigen's, on random matrices that need pivoting, at every size the
+// model has.
+void check_small_lu() {
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (int n = 1; n <= 17; ++n) {
+        Eigen::MatrixXd a(n, n);
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) a(i, j) = unit(random);
+        if (n > 1) a(0, 0) = 0.0;  // the first pivot must come from another row
+        Eigen::VectorXd b(n);
+        for (int i = 0; i < n; ++i) b[i] = unit(random);
+        SmallLU<24> lu;
+        CHECK(lu.factorize(a.data(), n));
+        Eigen::VectorXd x = b;
+        lu.solve(x.data());
+        const Eigen::VectorXd expected = a.partialPivLu().solve(b);
+        CHECK((x - expected).norm() <= 1e-12 * (1.0 + expected.norm()));
+    }
+    Eigen::MatrixXd singular = Eigen::MatrixXd::Zero(3, 3);
+    SmallLU<24> lu;
+    CHECK(!lu.factorize(singular.data(), 3));
+}
+
 int main() {
+    check_small_lu();
     check_order("Dormand-Prince 5(4)", IntegrationMethod::dormand_prince, 5.0, 4.0);
     check_order("RODAS4", IntegrationMethod::rosenbrock, 4.0, 3.0);
 
