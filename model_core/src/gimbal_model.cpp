@@ -179,11 +179,23 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     const bool reduced = params.fidelity.gear[0] == GearModel::rigid || params.fidelity.gear[1] == GearModel::rigid;
     Mat4 reduced_mass = mass_matrix;
     Vec4 applied = force + bias;
-    if (reduced) {
-        reduced_mass = reduction.transpose() * mass_matrix * reduction;
-        for (int body = 0; body < 4; ++body)
-            if (!layout.independent(body)) reduced_mass(body, body) = 1.0;  // padding: a trivial equation
-        applied = reduction.transpose() * applied;
+    // T^T J T and T^T (force + bias) for each rigid axis, written out: T only adds N times the rotor's
+    // row and column to the load's, and the rotor's become the padding identity (a trivial equation).
+    for (int axis = 0; axis < 2 && reduced; ++axis) {
+        if (params.fidelity.gear[axis] != GearModel::rigid) continue;
+        const int rotor = rotor_index(axis), load = load_index(axis);
+        const double ratio = params.gear[axis].ratio;
+        const double rotor_inertia = reduced_mass(rotor, rotor), cross = reduced_mass(load, rotor);
+        for (int k = 0; k < 4; ++k) {
+            if (k == rotor || k == load) continue;
+            reduced_mass(load, k) += ratio * reduced_mass(rotor, k);
+            reduced_mass(k, load) = reduced_mass(load, k);
+        }
+        reduced_mass(load, load) += 2.0 * ratio * cross + ratio * ratio * rotor_inertia;
+        for (int k = 0; k < 4; ++k) reduced_mass(rotor, k) = reduced_mass(k, rotor) = 0.0;
+        reduced_mass(rotor, rotor) = 1.0;
+        applied[load] += ratio * applied[rotor];
+        applied[rotor] = 0.0;
     }
 
     bool any_low_speed = false;
@@ -206,7 +218,10 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     // A rigid gear keeps J's arrow pattern: its rotor's row and column become the padding identity, and
     // the load's gain only the reflected inertia N^2 J_rotor on the diagonal.
     out.acceleration = solve_mass_matrix(reduced_mass, Vec4(applied + out.friction_torque));
-    out.full_acceleration = reduced ? Vec4(reduction * out.acceleration) : out.acceleration;
+    out.full_acceleration = out.acceleration;
+    for (int axis = 0; axis < 2 && reduced; ++axis)
+        if (params.fidelity.gear[axis] == GearModel::rigid)
+            out.full_acceleration[rotor_index(axis)] = params.gear[axis].ratio * out.acceleration[load_index(axis)];
     out.reduced_mass = reduced_mass;
     out.reduction = reduction;
 
