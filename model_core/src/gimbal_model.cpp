@@ -288,11 +288,14 @@ void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const 
         const double root_epsilon = std::sqrt(std::numeric_limits<double>::epsilon());
         for (int j = 0; j < 4; ++j) {
             Vec4 shifted = q;
-            const double step = root_epsilon * std::max(1.0, std::fabs(q[j]));
-            shifted[j] += step;
-            compute_mass_matrix_and_bias(params.multibody, base, shifted, qd, perturbed_mass, perturbed_bias);
-            inertia_derivative[j] = (perturbed_mass - mass_matrix) / step;
-            force.col(j) += (perturbed_bias - bias) / step;
+            inertia_derivative[j].setZero();
+            if (depends_on_angle(params.multibody, j)) {
+                const double step = root_epsilon * std::max(1.0, std::fabs(q[j]));
+                shifted[j] += step;
+                compute_mass_matrix_and_bias(params.multibody, base, shifted, qd, perturbed_mass, perturbed_bias);
+                inertia_derivative[j] = (perturbed_mass - mass_matrix) / step;
+                force.col(j) += (perturbed_bias - bias) / step;
+            }
             shifted = qd;
             const double rate_step = root_epsilon * std::max(1.0, std::fabs(qd[j]));
             shifted[j] += rate_step;

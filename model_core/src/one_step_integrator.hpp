@@ -8,6 +8,7 @@
 // integration goes on from there with the same step size. An input jump costs one right-hand side.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -51,7 +52,9 @@ private:
     StepResult dormand_prince_step(double h, double t_new);
     StepResult rosenbrock_step(double h, double t_new);
     bool jacobian_at(double time, const Vector& y);
-    double spectral_radius_estimate() const;
+    // Stops early once the estimate exceeds `enough`.
+    double spectral_radius_estimate(double enough = std::numeric_limits<double>::infinity()) const;
+    bool explicit_stable_at(double h) const;
     void vote_on_stiffness_explicit(double h);
     void vote_on_stiffness_rosenbrock(double h);
     void check_stiffness_after_switch();

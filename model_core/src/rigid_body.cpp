@@ -215,6 +215,12 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
     }
 }
 
+bool depends_on_angle(const MultibodyModel& model, int body) {
+    if (body == kAzimuthRotor) return !axisymmetric_about_z(model.bodies[kAzimuthRotor]);
+    if (body == kElevationRotor) return !axisymmetric_about_x(model.bodies[kElevationRotor]);
+    return true;
+}
+
 Vec3 payload_angular_velocity(const BaseKinematics& base, const Vec4& q, const Vec4& qd) {
     Vec3 housing_rate = into_frame_turned_about_z(joint_rotation(q[kAzimuthBody]), base.angular_velocity);
     housing_rate.z() += qd[kAzimuthBody];

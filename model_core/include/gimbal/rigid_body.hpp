@@ -71,6 +71,10 @@ inline Vec4 solve_mass_matrix(const Mat4& mass_matrix, const Vec4& rhs) {
     return solve_mass_matrix<1>(mass_matrix, rhs);
 }
 
+// Whether J and f depend on the angle of `body` (q order): a rotor that is axisymmetric about its
+// joint axis, with its centre of mass on it, looks the same at every angle.
+bool depends_on_angle(const MultibodyModel& model, int body);
+
 // Inertial angular velocity of the elevation payload in its own frame (what a payload gyro reads).
 Vec3 payload_angular_velocity(const BaseKinematics& base, const Vec4& q, const Vec4& qd);
 
