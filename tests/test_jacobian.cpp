@@ -115,7 +115,9 @@ int main() {
                     // Products of inertia and centres of mass off the axes: every rigid-body term present.
                     values.reals[vr_body2_I_xy] = 0.002, values.reals[vr_body2_I_xz] = -0.003, values.reals[vr_body2_I_yz] = 0.001;
                     values.reals[vr_body2_d_bd_1] = 0.01, values.reals[vr_body2_d_bd_2] = 0.02, values.reals[vr_body2_d_bd_3] = -0.03;
-                    values.reals[vr_rotor1_I_xy] = 1e-6, values.reals[vr_rotor2_d_bf_2] = 0.001;
+                    // Rotors off their axis of symmetry on a moving base; axisymmetric ones (whose angle
+                    // the Jacobian then skips) on the fixed base.
+                    if (fixed_base == 0) values.reals[vr_rotor1_I_xy] = 1e-6, values.reals[vr_rotor2_d_bf_2] = 0.001;
                     ModelParameters params;
                     std::string error;
                     if (!build_model_parameters(values.reals, values.integers, values.flags, params, error)) {
