@@ -137,3 +137,29 @@ def test_input_jumps_refresh_the_first_stage(gimbal_fmu):
                                                   "solver.atol": 1e-13}, jumps, outputs)
     for name in ("i_R1", "i_R2"):
         assert np.max(np.abs(fast[name] - reference[name])) < 1e-5, name
+
+
+def test_a_ramp_starting_exactly_on_the_voltage_clamp_leaves_it(gimbal_fmu):
+    """u_R1 = U_L exactly, ramping down: the clamp's guard starts at zero, and the mode must be the one
+    the ramp leaves to (following the ramp), as it is for a start a hair below U_L."""
+    def current_after_ramp(start_voltage):
+        slave = gimbal_fmu.instantiate()
+        try:
+            slave.setupExperiment(startTime=0.0)
+            gimbal_fmu.set_values(slave, {"motor1.i_L": 1e3})
+            slave.enterInitializationMode()
+            slave.exitInitializationMode()
+            gimbal_fmu.set_values(slave, {"u_R1": 5.0})
+            for k in range(100):
+                slave.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
+            gimbal_fmu.set_values(slave, {"u_R1": start_voltage})
+            slave.setRealInputDerivatives([gimbal_fmu.vr["u_R1"]], [1], [-2000.0])
+            slave.doStep(currentCommunicationPoint=0.1, communicationStepSize=0.01)
+            current = gimbal_fmu.get_values(slave, ["i_R1"])[0]
+            slave.terminate()
+            return current
+        finally:
+            slave.freeInstance()
+
+    on_clamp, below = current_after_ramp(24.0), current_after_ramp(24.0 - 1e-12)
+    assert abs(on_clamp - below) < 1e-6 * max(1.0, abs(below)), (on_clamp, below)

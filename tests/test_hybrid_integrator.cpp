@@ -91,7 +91,7 @@ void check_method(IntegrationMethod method) {
     settings.method = method;
     settings.relative_tolerance = 1e-10;
     settings.absolute_tolerance = 1e-12;
-    auto quiet = [](const std::string&) {};
+    auto quiet = [](const std::string& m) { if (std::getenv("DEBUG_INTEGRATOR")) std::fprintf(stderr, "%s\n", m.c_str()); };
     {
         BouncingBall ball(0.5);
         auto integrator_owner = HybridIntegrator::create(ball, settings, quiet, quiet);

@@ -56,32 +56,76 @@ bool OneStepIntegrator::rhs(double time, const Vector& y, Vector& dy) {
 }
 
 bool OneStepIntegrator::event_values(double time, const Vector& y, std::vector<double>& values) {
-    if (event_count_ > 0) system_.event_functions(time, y.data(), values.data());
-    return true;
-}
-
-bool OneStepIntegrator::refresh_at_current_point() {
-    jacobian_current_ = false;
-    if (!rhs(t_, y_, f_)) {
+    if (event_count_ == 0) return true;
+    system_.event_functions(time, y.data(), values.data());
+    for (int k = 0; k < event_count_; ++k) {
+        if (std::isfinite(values[k])) continue;
         std::ostringstream s;
         s.precision(17);
-        s << "the right-hand side is not finite at t = " << t_;
+        s << "event function " << k << " is not finite at t = " << time;
         error_sink_(s.str());
         return false;
     }
-    event_values(t_, y_, g_);
-    // A function exactly at zero here (a state projected onto a switching surface) has no sign to
-    // change: take the sign it has just after, or a return to zero within the next step goes unseen.
-    bool on_surface = false;
-    for (int k = 0; k < event_count_; ++k) on_surface = on_surface || g_[k] == 0.0;
-    if (on_surface) {
+    return true;
+}
+
+bool OneStepIntegrator::refresh_at_current_point(const int* decided) {
+    jacobian_current_ = false;
+    // Scratch: the side each guard's mode was decided for: by the event that reported its crossing,
+    // or by the first round below from where the guard goes next.
+    std::vector<double>& decided_side = g_low_;
+    for (int k = 0; k < event_count_; ++k) decided_side[k] = decided != nullptr ? decided[k] : 0;
+    for (int round = 0;; ++round) {
+        if (!rhs(t_, y_, f_)) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "the right-hand side is not finite at t = " << t_;
+            error_sink_(s.str());
+            return false;
+        }
+        if (!event_values(t_, y_, g_)) return false;
+        // A guard exactly at zero here (a state projected onto a switching surface, a ramp starting on
+        // the clamp) has no sign to change: take the sign it has just after, or a return to zero within
+        // the next step goes unseen. The modes were chosen blind to that direction where the guard sat
+        // on zero: decide them again with it, once.
+        bool on_surface = false;
+        for (int k = 0; k < event_count_; ++k) on_surface = on_surface || g_[k] == 0.0;
+        if (!on_surface) return true;
         const double delta = 1e-6 * (memory_.step_size > 0.0 ? memory_.step_size : 1e-6);
         for (int i = 0; i < size_; ++i) stage_state_[i] = y_[i] + delta * f_[i];
-        event_values(t_ + delta, stage_state_, g_mid_);
-        for (int k = 0; k < event_count_; ++k)
-            if (g_[k] == 0.0) g_[k] = g_mid_[k];
+        if (!event_values(t_ + delta, stage_state_, g_mid_)) return false;
+        if (round == 0) {
+            bool departs = false;
+            for (int k = 0; k < event_count_; ++k) {
+                // A guard whose crossing the event just reported has been decided with its direction.
+                // (`decided` may be directions_ itself: read it before overwriting.)
+                directions_[k] = 0;
+                if (g_[k] != 0.0 || g_mid_[k] == 0.0) continue;
+                const int departure = g_mid_[k] > 0.0 ? 1 : -1;
+                // Decided for the side it now leaves to (a bounce's reset, a ramp leaving the clamp):
+                // nothing to do. Undecided, or decided for the other side: decide again with it.
+                if (decided_side[k] == departure) continue;
+                directions_[k] = departure;
+                decided_side[k] = departure;
+                departs = true;
+            }
+            if (departs) {
+                const int changes = system_.update_modes(t_, y_.data(), directions_.data());
+                totals_.events += changes;
+                log_events(t_, changes);
+                if (changes > 0) continue;  // new modes: evaluate again under them
+            }
+        }
+        // The baseline is the side the modes were decided for: if the modes push the guard back across
+        // (a sliding surface), the next step sees that crossing and the chattering guard deals with it,
+        // instead of the guard leaving on the wrong side unseen.
+        for (int k = 0; k < event_count_; ++k) {
+            if (g_[k] != 0.0) continue;
+            const double size = g_mid_[k] != 0.0 ? std::fabs(g_mid_[k]) : std::numeric_limits<double>::min();
+            g_[k] = decided_side[k] != 0.0 ? std::copysign(size, decided_side[k]) : g_mid_[k];
+        }
+        return true;
     }
-    return true;
 }
 
 bool OneStepIntegrator::restart(double time, const double* state) {
@@ -165,6 +209,7 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
     }
     if (!ok) {  // a non-finite right-hand side: try a much smaller step
         memory_.step_size = 0.25 * h;
+        memory_.last_step_rejected = 1;
         stiffness_estimate_ = 0.0;
         return StepResult::rejected;
     }
@@ -215,7 +260,7 @@ bool OneStepIntegrator::jacobian_at(double time, const Vector& y) {
     // Forward differences, one right-hand side per column (f_ holds f(time, y)).
     perturbed_ = y;
     for (int j = 0; j < n; ++j) {
-        const double delta = std::sqrt(kEpsilon) * std::max(1e-5, std::fabs(y[j]));
+        const double delta = std::sqrt(kEpsilon * std::max(1e-5, std::fabs(y[j])));  // as in Hairer's codes
         perturbed_[j] = y[j] + delta;
         if (!rhs(time, perturbed_, stage_state_)) return false;
         jacobian_.col(j) = (stage_state_ - f_) / delta;
@@ -321,7 +366,14 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
     constexpr int kIterations = 8;
     const int n = size_;
     double v[kMaxStates], w[kMaxStates];
-    for (int i = 0; i < n; ++i) v[i] = 1.0 / std::sqrt(static_cast<double>(n));
+    // An uneven start: a uniform vector lies in the null space of, e.g., a spring between two equal
+    // coordinates (J 1 = 0 there), and the estimate would read 0.
+    double start_norm = 0.0;
+    for (int i = 0; i < n; ++i) {
+        v[i] = 1.0 + std::fmod(0.6180339887 * (i + 1), 1.0);
+        start_norm += v[i] * v[i];
+    }
+    for (int i = 0; i < n; ++i) v[i] /= std::sqrt(start_norm);
     double growth = 1.0;  // |J^m v| / |v|: at most (1e38)^8 before it counts as infinite
     for (int iteration = 0; iteration < kIterations; ++iteration) {
         double norm = 0.0;
@@ -332,7 +384,17 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
         }
         for (int i = 0; i < n; ++i) norm += w[i] * w[i];
         norm = std::sqrt(norm);
-        if (!(norm > 0.0) || !std::isfinite(norm)) return norm > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+        if (!std::isfinite(norm)) return std::numeric_limits<double>::infinity();
+        if (!(norm > 0.0)) {
+            // Still in a null space: fall back on Gershgorin's bound, max_i sum_j |J_ij|.
+            double bound = 0.0;
+            for (int i = 0; i < n; ++i) {
+                double row = 0.0;
+                for (int j = 0; j < n; ++j) row += std::fabs(jacobian_.data()[i + j * n]);
+                bound = std::max(bound, row);
+            }
+            return bound;
+        }
         growth *= norm;
         for (int i = 0; i < n; ++i) v[i] = w[i] / norm;
         if (iteration >= 1) {
@@ -401,7 +463,7 @@ void OneStepIntegrator::log_events(double time, int changes) {
 bool OneStepIntegrator::handle_events(bool& event_found) {
     event_found = false;
     if (event_count_ == 0 || t_new_ <= memory_.dwell_until) return true;
-    event_values(t_new_, y_new_, g_new_);
+    if (!event_values(t_new_, y_new_, g_new_)) return false;
     if (t_ < memory_.dwell_until) {
         // The chattering guard held the modes until inside this step: re-select them here.
         return true;
@@ -427,7 +489,7 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
         double middle = std::clamp(estimate, low + margin, high - margin);
         if (iteration % 8 == 7) middle = 0.5 * (low + high);  // a bisection now and then bounds the count
         dense_output(middle, stage_state_.data());
-        event_values(middle, stage_state_, g_mid_);
+        if (!event_values(middle, stage_state_, g_mid_)) return false;
         int side;
         if (any_crossing(g_low_, g_mid_)) {
             high = middle, g_high_ = g_mid_, side = 1;
@@ -442,7 +504,7 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
     // Switch at the right end of the bracket: every function that crossed has its new sign there.
     const double root = high;
     if (root != t_new_) dense_output(root, y_new_.data());
-    event_values(root, y_new_, g_high_);
+    if (!event_values(root, y_new_, g_high_)) return false;
     for (int k = 0; k < event_count_; ++k)
         directions_[k] = crossed(g_[k], g_high_[k]) ? (g_high_[k] > g_[k] ? 1 : -1) : 0;
     t_ = root;
@@ -452,7 +514,10 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
     log_events(root, changes);
     const bool stiffness_may_change = changes > 0;
 
-    memory_.rapid_events = root - memory_.last_event_time <= settings_.zeno_window ? memory_.rapid_events + 1 : 0;
+    // Roots closer than a few location tolerances cannot be told apart: at large times (1e5 s and more)
+    // that spacing exceeds the window itself.
+    const double window = std::max(settings_.zeno_window, 4.0 * tolerance);
+    memory_.rapid_events = root - memory_.last_event_time <= window ? memory_.rapid_events + 1 : 0;
     memory_.last_event_time = root;
     if (memory_.rapid_events >= settings_.zeno_event_limit) {
         memory_.dwell_until = root + settings_.zeno_dwell;
@@ -467,7 +532,7 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
         }
     }
     // New modes (or a projection onto a stop) change the right-hand side: one evaluation restarts.
-    if (!refresh_at_current_point()) return false;
+    if (!refresh_at_current_point(directions_.data())) return false;
     if (stiffness_may_change) check_stiffness_after_switch();
     return true;
 }
@@ -482,7 +547,20 @@ void OneStepIntegrator::check_stiffness_after_switch() {
         memory_.stiff_votes = memory_.nonstiff_votes = 0;
         memory_.previous_error = 1e-4;
         ++totals_.method_switches;
+        // The Jacobian just taken is the one the first Rosenbrock step needs.
+        jacobian_current_ = time_derivative_at_current_point();
     }
+}
+
+bool OneStepIntegrator::time_derivative_at_current_point() {
+    if (!system_.time_dependent()) {
+        time_derivative_.setZero(size_);
+        return true;
+    }
+    const double delta = std::sqrt(kEpsilon) * std::max(1.0, std::fabs(t_));
+    if (!rhs(t_ + delta, y_, time_derivative_)) return false;
+    time_derivative_ = (time_derivative_ - f_) / delta;
+    return true;
 }
 
 bool OneStepIntegrator::reselect_after_dwell() {
@@ -498,6 +576,15 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
         error_sink_("the integrator was not started");
         return false;
     }
+    // A failed advance leaves the controller where it was (the caller rolls the state back): a step
+    // size shrunk to nothing on the way must not fail the next attempt from a healthy point.
+    const IntegratorMemory at_start = memory_;
+    if (advance_steps(end_time, state)) return true;
+    memory_ = at_start;
+    return false;
+}
+
+bool OneStepIntegrator::advance_steps(double end_time, double* state) {
     long attempts = 0;
     long events_here = 0;
     while (t_ < end_time) {
@@ -525,7 +612,16 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
         } else {
             h = remaining / steps_left;
         }
-        if (h <= 16.0 * kEpsilon * std::max(1.0, std::fabs(t_))) {
+        const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
+        if (remaining <= smallest) {
+            // A few ulp left (an event located just short of the end): no step can be that short;
+            // move there with the derivative, which is exact to rounding over such a span.
+            for (int i = 0; i < size_; ++i) y_[i] += remaining * f_[i];
+            t_ = end_time;
+            if (!refresh_at_current_point()) return false;
+            break;
+        }
+        if (h <= smallest) {
             std::ostringstream s;
             s.precision(17);
             s << "the step size fell to " << h << " at t = " << t_ << " (a right-hand side that is not finite, or "
@@ -534,6 +630,10 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
             return false;
         }
         t_new_ = last ? end_time : t_ + h;
+        // The chattering guard's hold ends at a step end, so that the modes are re-selected on time.
+        bool cut_short = last;
+        if (t_ < memory_.dwell_until && memory_.dwell_until < t_new_ && memory_.dwell_until - t_ > smallest)
+            t_new_ = memory_.dwell_until, last = false, cut_short = true;
         h = t_new_ - t_;
 
         StepResult result;
@@ -542,15 +642,9 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
                 error_sink_("the Jacobian is not finite");
                 return false;
             }
-            if (system_.time_dependent()) {
-                const double delta = std::sqrt(kEpsilon) * std::max(1.0, std::fabs(t_));
-                if (!rhs(t_ + delta, y_, time_derivative_)) {
-                    error_sink_("the right-hand side is not finite just after t");
-                    return false;
-                }
-                time_derivative_ = (time_derivative_ - f_) / delta;
-            } else {
-                time_derivative_.setZero(size_);
+            if (!time_derivative_at_current_point()) {
+                error_sink_("the right-hand side is not finite just after t");
+                return false;
             }
             jacobian_current_ = true;  // until the point or the modes change (a rejected step keeps it)
         }
@@ -566,8 +660,10 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
         }
         ++totals_.steps;
         jacobian_current_ = false;
-        // A step cut short to land on end_time says nothing against the longer step before it.
-        memory_.step_size = last ? std::max(proposal_, std::min(memory_.step_size, proposal_ * kMaxGrowth)) : proposal_;
+        // A step cut short to land on end_time or on the end of a hold says nothing against the longer
+        // step proposed before it.
+        memory_.step_size =
+            cut_short ? std::max(proposal_, std::min(memory_.step_size, proposal_ * kMaxGrowth)) : proposal_;
         bool event_found = false;
         const long events_before = totals_.events;
         if (!handle_events(event_found)) return false;

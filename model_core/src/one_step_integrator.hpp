@@ -43,6 +43,7 @@ public:
 private:
     enum class StepResult { accepted, rejected, failed };
 
+    bool advance_steps(double end_time, double* state);
     bool rhs(double time, const Vector& y, Vector& dy);
     bool event_values(double time, const Vector& y, std::vector<double>& values);
     double initial_step(double end_time);
@@ -58,13 +59,15 @@ private:
     void vote_on_stiffness_explicit(double h);
     void vote_on_stiffness_rosenbrock(double h);
     void check_stiffness_after_switch();
+    bool time_derivative_at_current_point();
     // Looks for sign changes between g_ (at t_) and g_new_ (at t_new_); if any, locates the first root on
     // the dense output, switches modes there and restarts. False on failure.
     bool handle_events(bool& event_found);
     bool crossed(double before, double after) const { return before != 0.0 && (after == 0.0 || (before > 0.0) != (after > 0.0)); }
     bool any_crossing(const std::vector<double>& before, const std::vector<double>& after) const;
     bool reselect_after_dwell();
-    bool refresh_at_current_point();
+    // f_ and g_ at (t_, y_); `decided`: guards whose crossing update_modes has just been told.
+    bool refresh_at_current_point(const int* decided = nullptr);
     void log_events(double time, int changes);
 
     HybridSystem& system_;
