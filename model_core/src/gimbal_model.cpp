@@ -1,6 +1,5 @@
 #include "gimbal/gimbal_model.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 #include <cmath>
