@@ -411,8 +411,8 @@ bool OneStepIntegrator::explicit_stable_at(double h) const {
     return spectral_radius_estimate(20.0 * kExplicitStableBound / h) * h <= kExplicitStableBound;
 }
 
-void OneStepIntegrator::vote_on_stiffness_explicit(double h) {
-    (void)h;
+void OneStepIntegrator::vote_on_stiffness_explicit() {
+    // stiffness_estimate_ is already h |lambda| of the step just taken.
     if (settings_.method != IntegrationMethod::automatic) return;
     if (stiffness_estimate_ > tableau::dopri5::stiffness_threshold) {
         memory_.nonstiff_votes = 0;
@@ -655,7 +655,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         }
         if (result == StepResult::rejected) {
             ++totals_.rejected_steps;
-            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit(h);
+            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit();
             continue;
         }
         ++totals_.steps;
@@ -678,7 +678,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
         // input jump it takes a few short steps, at which any method would be stable.
         if (memory_.stiff) vote_on_stiffness_rosenbrock(std::max(h, memory_.step_size));
-        else vote_on_stiffness_explicit(h);
+        else vote_on_stiffness_explicit();
     }
     for (int k = 0; k < size_; ++k) state[k] = y_[k];
     return true;

@@ -56,7 +56,7 @@ private:
     // Stops early once the estimate exceeds `enough`.
     double spectral_radius_estimate(double enough = std::numeric_limits<double>::infinity()) const;
     bool explicit_stable_at(double h) const;
-    void vote_on_stiffness_explicit(double h);
+    void vote_on_stiffness_explicit();
     void vote_on_stiffness_rosenbrock(double h);
     void check_stiffness_after_switch();
     bool time_derivative_at_current_point();
