@@ -1,5 +1,8 @@
 /* FMI 2.0 Co-Simulation wrapper: the state machine, argument checks and logging of the standard,
- * over the C interface of the dynamics core (model_core/include/gimbal/gimbal_c_api.h). */
+ * over the C interface of the dynamics core (model_core/include/gimbal/gimbal_c_api.h).
+ *
+ * Every exported fmi2* function is a thin shell (at the end of this file) that holds the host's
+ * floating-point environment around the implementation of the same name in lower case. */
 #include <math.h>
 #include <stdint.h>
 #include <stdarg.h>
@@ -8,7 +11,9 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "fmu_state.h"
 #include "gimbal/gimbal_c_api.h"
+#include "host_fp_environment.h"
 
 typedef enum {
     STATE_INSTANTIATED = 1 << 0,
@@ -19,9 +24,57 @@ typedef enum {
     STATE_ERROR = 1 << 5,
 } InstanceState;
 
+#define ANY_STATE (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED | STATE_ERROR)
 #define GET_STATES (STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED | STATE_ERROR)
 #define SET_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE)
-#define ANY_STATE (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED | STATE_ERROR)
+#define FMU_STATE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
+#define STATUS_STATES (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
+
+/* The states in which each function may be called (FMI 2.0, section 4.2.4), in one table. */
+typedef enum {
+    FN_SetDebugLogging, FN_SetupExperiment, FN_EnterInitializationMode, FN_ExitInitializationMode, FN_Terminate,
+    FN_Reset, FN_GetReal, FN_GetInteger, FN_GetBoolean, FN_GetString, FN_SetReal, FN_SetInteger, FN_SetBoolean,
+    FN_SetString, FN_GetFMUstate, FN_SetFMUstate, FN_FreeFMUstate, FN_SerializedFMUstateSize, FN_SerializeFMUstate,
+    FN_DeSerializeFMUstate, FN_GetDirectionalDerivative, FN_SetRealInputDerivatives, FN_GetRealOutputDerivatives,
+    FN_DoStep, FN_CancelStep, FN_GetStatus, FN_GetRealStatus, FN_GetIntegerStatus, FN_GetBooleanStatus,
+    FN_GetStringStatus, FUNCTION_COUNT
+} Function;
+
+static const struct {
+    const char* name;
+    int states;
+} kFunctions[FUNCTION_COUNT] = {
+    [FN_SetDebugLogging] = {"fmi2SetDebugLogging", ANY_STATE},
+    [FN_SetupExperiment] = {"fmi2SetupExperiment", STATE_INSTANTIATED},
+    [FN_EnterInitializationMode] = {"fmi2EnterInitializationMode", STATE_INSTANTIATED},
+    [FN_ExitInitializationMode] = {"fmi2ExitInitializationMode", STATE_INITIALIZATION},
+    [FN_Terminate] = {"fmi2Terminate", STATE_STEP_COMPLETE | STATE_STEP_FAILED},
+    [FN_Reset] = {"fmi2Reset", ANY_STATE},
+    [FN_GetReal] = {"fmi2GetReal", GET_STATES},
+    [FN_GetInteger] = {"fmi2GetInteger", GET_STATES},
+    [FN_GetBoolean] = {"fmi2GetBoolean", GET_STATES},
+    [FN_GetString] = {"fmi2GetString", GET_STATES},
+    [FN_SetReal] = {"fmi2SetReal", SET_STATES},
+    [FN_SetInteger] = {"fmi2SetInteger", SET_STATES},
+    [FN_SetBoolean] = {"fmi2SetBoolean", SET_STATES},
+    [FN_SetString] = {"fmi2SetString", SET_STATES},
+    [FN_GetFMUstate] = {"fmi2GetFMUstate", FMU_STATE_STATES},
+    [FN_SetFMUstate] = {"fmi2SetFMUstate", FMU_STATE_STATES},
+    [FN_FreeFMUstate] = {"fmi2FreeFMUstate", ANY_STATE},
+    [FN_SerializedFMUstateSize] = {"fmi2SerializedFMUstateSize", ANY_STATE},
+    [FN_SerializeFMUstate] = {"fmi2SerializeFMUstate", ANY_STATE},
+    [FN_DeSerializeFMUstate] = {"fmi2DeSerializeFMUstate", ANY_STATE},
+    [FN_GetDirectionalDerivative] = {"fmi2GetDirectionalDerivative", ANY_STATE},
+    [FN_SetRealInputDerivatives] = {"fmi2SetRealInputDerivatives", STATE_INITIALIZATION | STATE_STEP_COMPLETE},
+    [FN_GetRealOutputDerivatives] = {"fmi2GetRealOutputDerivatives", ANY_STATE},
+    [FN_DoStep] = {"fmi2DoStep", STATE_STEP_COMPLETE},
+    [FN_CancelStep] = {"fmi2CancelStep", 0}, /* doStep never runs asynchronously */
+    [FN_GetStatus] = {"fmi2GetStatus", STATUS_STATES},
+    [FN_GetRealStatus] = {"fmi2GetRealStatus", STATUS_STATES},
+    [FN_GetIntegerStatus] = {"fmi2GetIntegerStatus", STATUS_STATES},
+    [FN_GetBooleanStatus] = {"fmi2GetBooleanStatus", STATUS_STATES},
+    [FN_GetStringStatus] = {"fmi2GetStringStatus", STATUS_STATES},
+};
 
 /* Log categories of modelDescription.xml, in the order of its <LogCategories>. */
 static const char* const kLogCategories[] = {"logEvents", "logSolver", "logStatusWarning", "logStatusDiscard",
@@ -40,6 +93,7 @@ typedef struct {
     int stop_time_defined;
     double last_successful_time;
     fmi2Status last_step_status;
+    FmuStateRegistry states; /* the FMU states this instance handed out */
 } Instance;
 
 static int category_index(const char* category) {
@@ -105,10 +159,10 @@ static const char* state_name(InstanceState state) {
 }
 
 /* NULL-safe check that a call is allowed in the instance's current state. */
-static int allowed(Instance* instance, const char* function, int states) {
+static int allowed(Instance* instance, Function function) {
     if (instance == NULL) return 0;
-    if (instance->state & states) return 1;
-    log_message(instance, fmi2Error, "logStatusError", "%s is not allowed in state '%s'", function,
+    if (instance->state & kFunctions[function].states) return 1;
+    log_message(instance, fmi2Error, "logStatusError", "%s is not allowed in state '%s'", kFunctions[function].name,
                 state_name(instance->state));
     return 0;
 }
@@ -124,10 +178,10 @@ static int not_null(Instance* instance, const char* function, const void* pointe
 const char* fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char* fmi2GetVersion(void) { return fmi2Version; }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SetDebugLogging", ANY_STATE)) return fmi2Error;
+    if (!allowed(instance, FN_SetDebugLogging)) return fmi2Error;
     if (nCategories == 0) {
         for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
         return fmi2OK;
@@ -145,7 +199,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
     return fmi2OK;
 }
 
-fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
                               fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)fmuResourceLocation;
@@ -193,9 +247,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     return instance;
 }
 
-void fmi2FreeInstance(fmi2Component c) {
+static void impl_FreeInstance(fmi2Component c) {
     Instance* instance = (Instance*)c;
     if (instance == NULL) return;
+    fmu_states_release_all(&instance->states);
     gimbal_core_destroy(instance->core);
     free(instance->instance_name);
     free(instance);
@@ -203,34 +258,34 @@ void fmi2FreeInstance(fmi2Component c) {
 
 /* ---------------------------------------------------------------- initialization and termination */
 
-fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     Instance* instance = (Instance*)c;
-    (void)toleranceDefined; /* solver.rtol is the tolerance of this FMU; a master's is advisory */
-    (void)tolerance;
-    if (!allowed(instance, "fmi2SetupExperiment", STATE_INSTANTIATED)) return fmi2Error;
+    if (!allowed(instance, FN_SetupExperiment)) return fmi2Error;
     if (!isfinite(startTime) || (stopTimeDefined && (!isfinite(stopTime) || stopTime < startTime))) {
         log_message(instance, fmi2Error, "logStatusError",
                     "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
                     startTime, stopTime);
         return fmi2Error;
     }
+    const fmi2Status status = from_core(gimbal_core_set_master_tolerance(instance->core, toleranceDefined != fmi2False, tolerance));
+    if (status > fmi2Warning) return status;
     instance->time = startTime;
     instance->stop_time = stopTime;
     instance->stop_time_defined = stopTimeDefined ? 1 : 0;
     return fmi2OK;
 }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+static fmi2Status impl_EnterInitializationMode(fmi2Component c) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2EnterInitializationMode", STATE_INSTANTIATED)) return fmi2Error;
+    if (!allowed(instance, FN_EnterInitializationMode)) return fmi2Error;
     instance->state = STATE_INITIALIZATION;
     return fmi2OK;
 }
 
-fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2ExitInitializationMode", STATE_INITIALIZATION)) return fmi2Error;
+    if (!allowed(instance, FN_ExitInitializationMode)) return fmi2Error;
     const fmi2Status status = from_core(gimbal_core_initialize(instance->core, instance->time));
     if (status > fmi2Warning) {
         log_message(instance, fmi2Error, "logStatusError",
@@ -242,17 +297,21 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     return status;
 }
 
-fmi2Status fmi2Terminate(fmi2Component c) {
+static fmi2Status impl_Terminate(fmi2Component c) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2Terminate", STATE_STEP_COMPLETE | STATE_STEP_FAILED)) return fmi2Error;
+    if (!allowed(instance, FN_Terminate)) return fmi2Error;
     instance->state = STATE_TERMINATED;
     return fmi2OK;
 }
 
-fmi2Status fmi2Reset(fmi2Component c) {
+static fmi2Status impl_Reset(fmi2Component c) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2Reset", ANY_STATE)) return fmi2Error;
-    gimbal_core_reset(instance->core);
+    if (!allowed(instance, FN_Reset)) return fmi2Error;
+    const fmi2Status status = from_core(gimbal_core_reset(instance->core));
+    if (status > fmi2Warning) {
+        instance->state = STATE_ERROR;
+        return status;
+    }
     instance->time = 0.0;
     instance->stop_time_defined = 0;
     instance->last_successful_time = 0.0;
@@ -279,9 +338,10 @@ static int settable(Instance* instance, const GimbalVariableInfo* info) {
 static const char* const kTypeName[] = {"Real", "Integer", "Boolean"};
 
 /* Common checks of every fmi2Set*: state, pointers, value reference, and the variable's settability. */
-static int check_set(Instance* instance, const char* function, GimbalType type, const fmi2ValueReference vr[],
-                     size_t nvr, const void* value) {
-    if (!allowed(instance, function, SET_STATES)) return 0;
+static int check_set(Instance* instance, Function id, GimbalType type, const fmi2ValueReference vr[], size_t nvr,
+                     const void* value) {
+    if (!allowed(instance, id)) return 0;
+    const char* function = kFunctions[id].name;
     if (nvr == 0) return 1;
     if (!not_null(instance, function, vr, "vr") || !not_null(instance, function, value, "value")) return 0;
     for (size_t i = 0; i < nvr; ++i) {
@@ -300,16 +360,16 @@ static int check_set(Instance* instance, const char* function, GimbalType type, 
     return 1;
 }
 
-static int check_get(Instance* instance, const char* function, const fmi2ValueReference vr[], size_t nvr,
-                     const void* value) {
-    if (!allowed(instance, function, GET_STATES)) return 0;
+static int check_get(Instance* instance, Function id, const fmi2ValueReference vr[], size_t nvr, const void* value) {
+    if (!allowed(instance, id)) return 0;
+    const char* function = kFunctions[id].name;
     if (nvr == 0) return 1;
     return not_null(instance, function, vr, "vr") && not_null(instance, function, value, "value");
 }
 
-fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_set(instance, "fmi2SetReal", GIMBAL_REAL, vr, nvr, value)) return fmi2Error;
+    if (!check_set(instance, FN_SetReal, GIMBAL_REAL, vr, nvr, value)) return fmi2Error;
     /* All or nothing: a refused call must not leave some of its values applied. */
     for (size_t i = 0; i < nvr; ++i) {
         if (!isfinite(value[i])) {
@@ -327,9 +387,9 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     return fmi2OK;
 }
 
-fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+static fmi2Status impl_GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_get(instance, "fmi2GetReal", vr, nvr, value)) return fmi2Error;
+    if (!check_get(instance, FN_GetReal, vr, nvr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         const fmi2Status status = from_core(gimbal_core_get_real(instance->core, vr[i], &value[i]));
         if (status > fmi2Warning) return status;
@@ -337,9 +397,9 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     return fmi2OK;
 }
 
-fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+static fmi2Status impl_SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_set(instance, "fmi2SetInteger", GIMBAL_INTEGER, vr, nvr, value)) return fmi2Error;
+    if (!check_set(instance, FN_SetInteger, GIMBAL_INTEGER, vr, nvr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         const fmi2Status status = from_core(gimbal_core_set_integer(instance->core, vr[i], value[i]));
         if (status > fmi2Warning) return status;
@@ -347,9 +407,9 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     return fmi2OK;
 }
 
-fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+static fmi2Status impl_GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_get(instance, "fmi2GetInteger", vr, nvr, value)) return fmi2Error;
+    if (!check_get(instance, FN_GetInteger, vr, nvr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         int v = 0;
         const fmi2Status status = from_core(gimbal_core_get_integer(instance->core, vr[i], &v));
@@ -359,9 +419,9 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     return fmi2OK;
 }
 
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
+static fmi2Status impl_SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_set(instance, "fmi2SetBoolean", GIMBAL_BOOLEAN, vr, nvr, value)) return fmi2Error;
+    if (!check_set(instance, FN_SetBoolean, GIMBAL_BOOLEAN, vr, nvr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         const fmi2Status status = from_core(gimbal_core_set_boolean(instance->core, vr[i], value[i] != fmi2False));
         if (status > fmi2Warning) return status;
@@ -369,9 +429,9 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     return fmi2OK;
 }
 
-fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+static fmi2Status impl_GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_get(instance, "fmi2GetBoolean", vr, nvr, value)) return fmi2Error;
+    if (!check_get(instance, FN_GetBoolean, vr, nvr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         int v = 0;
         const fmi2Status status = from_core(gimbal_core_get_boolean(instance->core, vr[i], &v));
@@ -382,18 +442,18 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 /* The model has no String variables: any value reference is refused. */
-fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+static fmi2Status impl_GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
     Instance* instance = (Instance*)c;
-    if (!check_get(instance, "fmi2GetString", vr, nvr, value)) return fmi2Error;
+    if (!check_get(instance, FN_GetString, vr, nvr, value)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     log_message(instance, fmi2Error, "logStatusError", "fmi2GetString: value reference %u is not a String variable",
                 (unsigned)vr[0]);
     return fmi2Error;
 }
 
-fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+static fmi2Status impl_SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SetString", SET_STATES)) return fmi2Error;
+    if (!allowed(instance, FN_SetString)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     if (!not_null(instance, "fmi2SetString", vr, "vr") || !not_null(instance, "fmi2SetString", value, "value"))
         return fmi2Error;
@@ -404,138 +464,198 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 /* ---------------------------------------------------------------- capabilities not offered (yet) */
 
-static fmi2Status unsupported(fmi2Component c, const char* function, const char* flag) {
+static fmi2Status unsupported(fmi2Component c, Function function, const char* declaration) {
     Instance* instance = (Instance*)c;
     if (instance != NULL)
-        log_message(instance, fmi2Error, "logStatusError", "%s is not supported: modelDescription.xml declares %s=\"false\"",
-                    function, flag);
+        log_message(instance, fmi2Error, "logStatusError", "%s is not supported: modelDescription.xml declares %s",
+                    kFunctions[function].name, declaration);
     return fmi2Error;
 }
 
-/* An FMU state: the wrapper's own fields, then the core's snapshot bytes. Serialized as is. */
-typedef struct {
-    uint32_t magic;
-    uint32_t size; /* of the whole record */
-    char guid[64];
-    int state;
-    double time;
-    double stop_time;
-    int stop_time_defined;
-    double last_successful_time;
-    int last_step_status;
-} StateHeader;
-
-#define STATE_MAGIC 0x46535441u /* "FSTA" */
-#define STATE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
+/* ---------------------------------------------------------------- FMU states */
 
 static size_t state_record_size(void) { return sizeof(StateHeader) + gimbal_core_snapshot_size(); }
 
-static int valid_state_record(Instance* instance, const char* function, const void* record, size_t size) {
-    const StateHeader* header = (const StateHeader*)record;
-    if (size != state_record_size() || header->magic != STATE_MAGIC || header->size != state_record_size() ||
-        strncmp(header->guid, GIMBAL_GUID, sizeof header->guid) != 0) {
+/* A registered record of this instance, or NULL with the refusal logged. */
+static unsigned char* own_state(Instance* instance, Function function, const void* state) {
+    if (state == NULL) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: argument FMUstate is a null pointer", kFunctions[function].name);
+        return NULL;
+    }
+    if (fmu_states_find(&instance->states, state) < 0) {
         log_message(instance, fmi2Error, "logStatusError",
-                    "%s: the FMU state was not saved by this FMU (GUID %s, %u bytes expected)", function, GIMBAL_GUID,
-                    (unsigned)state_record_size());
+                    "%s: FMUstate %p is not an FMU state of instance '%s' (not handed out by its fmi2GetFMUstate or "
+                    "fmi2DeSerializeFMUstate, or already freed)",
+                    kFunctions[function].name, state, instance->instance_name);
+        return NULL;
+    }
+    return (unsigned char*)state;
+}
+
+static int is_single_state(int32_t state) {
+    return (state & FMU_STATE_STATES) != 0 && (state & (state - 1)) == 0;
+}
+
+/* The wrapper's fields of a record, range-checked, and the core's snapshot checked by the core; a
+ * record that could not have been saved by this FMU is refused with the reason. */
+static int valid_state_content(Instance* instance, Function function, const unsigned char* record) {
+    StateHeader header;
+    memcpy(&header, record, sizeof header);
+    const char* problem = NULL;
+    if (!is_single_state(header.state)) problem = "its instance state is not one an FMU state can be taken in";
+    else if (header.stop_time_defined != 0 && header.stop_time_defined != 1) problem = "its stop-time flag is not a boolean";
+    else if (header.last_step_status < fmi2OK || header.last_step_status > fmi2Pending) problem = "its last step status is not an fmi2Status";
+    else if (!isfinite(header.time) || !isfinite(header.stop_time) || !isfinite(header.last_successful_time))
+        problem = "its times are not finite";
+    else if (header.stop_time_defined && header.time > header.stop_time) problem = "its time lies beyond its stop time";
+    if (problem != NULL) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: the FMU state is refused: %s", kFunctions[function].name,
+                    problem);
+        return 0;
+    }
+    int initialized = 0;
+    if (from_core(gimbal_core_check_snapshot(instance->core, kFunctions[function].name, record + sizeof header,
+                                             &initialized)) > fmi2Warning)
+        return 0;
+    const int running = (header.state & (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)) != 0;
+    if (running != initialized) {
+        log_message(instance, fmi2Error, "logStatusError",
+                    "%s: the FMU state is refused: its instance state '%s' contradicts its %s model", kFunctions[function].name,
+                    state_name((InstanceState)header.state), initialized ? "initialized" : "uninitialized");
         return 0;
     }
     return 1;
 }
 
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
+static fmi2Status impl_GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2GetFMUstate", STATE_STATES)) return fmi2Error;
+    if (!allowed(instance, FN_GetFMUstate)) return fmi2Error;
     if (!not_null(instance, "fmi2GetFMUstate", FMUstate, "FMUstate")) return fmi2Error;
-    /* Reuse the host's previous state object when it hands one back, as the standard allows. */
-    unsigned char* record = (unsigned char*)*FMUstate;
-    if (record != NULL && !valid_state_record(instance, "fmi2GetFMUstate", record, state_record_size())) return fmi2Error;
-    if (record == NULL) record = (unsigned char*)calloc(1, state_record_size());
-    if (record == NULL) {
-        log_message(instance, fmi2Error, "logStatusError", "fmi2GetFMUstate: out of memory");
+    /* Overwrite the host's previous state when it hands back one of ours, as the standard allows.
+     * Anything else (FMI4j passes an uninitialised pointer) is not ours to touch: take a new record. */
+    unsigned char* record = fmu_states_find(&instance->states, *FMUstate) >= 0 ? (unsigned char*)*FMUstate : NULL;
+    const int fresh = record == NULL;
+    if (fresh) {
+        record = (unsigned char*)calloc(1, state_record_size());
+        if (record == NULL || !fmu_states_add(&instance->states, record)) {
+            free(record);
+            log_message(instance, fmi2Error, "logStatusError", "fmi2GetFMUstate: out of memory");
+            return fmi2Error;
+        }
+    }
+    StateHeader header;
+    memset(&header, 0, sizeof header);
+    header.magic = STATE_MAGIC;
+    header.format_version = STATE_FORMAT_VERSION;
+    header.size = state_record_size();
+    strncpy(header.guid, GIMBAL_GUID, sizeof header.guid - 1);
+    header.state = (int32_t)instance->state;
+    header.time = instance->time;
+    header.stop_time = instance->stop_time;
+    header.stop_time_defined = instance->stop_time_defined;
+    header.last_successful_time = instance->last_successful_time;
+    header.last_step_status = (int32_t)instance->last_step_status;
+    if (from_core(gimbal_core_save(instance->core, record + sizeof header)) > fmi2Warning) {
+        if (fresh) fmu_states_release(&instance->states, fmu_states_find(&instance->states, record));
         return fmi2Error;
     }
-    StateHeader* header = (StateHeader*)record;
-    memset(header, 0, sizeof *header);
-    header->magic = STATE_MAGIC;
-    header->size = (uint32_t)state_record_size();
-    strncpy(header->guid, GIMBAL_GUID, sizeof header->guid - 1);
-    header->state = (int)instance->state;
-    header->time = instance->time;
-    header->stop_time = instance->stop_time;
-    header->stop_time_defined = instance->stop_time_defined;
-    header->last_successful_time = instance->last_successful_time;
-    header->last_step_status = (int)instance->last_step_status;
-    gimbal_core_save(instance->core, record + sizeof(StateHeader));
+    memcpy(record, &header, sizeof header);
     *FMUstate = record;
     return fmi2OK;
 }
 
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
+static fmi2Status impl_SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SetFMUstate", STATE_STATES)) return fmi2Error;
-    if (!not_null(instance, "fmi2SetFMUstate", FMUstate, "FMUstate")) return fmi2Error;
-    if (!valid_state_record(instance, "fmi2SetFMUstate", FMUstate, state_record_size())) return fmi2Error;
-    const StateHeader* header = (const StateHeader*)FMUstate;
-    const fmi2Status status =
-        from_core(gimbal_core_restore(instance->core, (const unsigned char*)FMUstate + sizeof(StateHeader)));
-    if (status > fmi2Warning) {
-        instance->state = STATE_ERROR;
-        return status;
-    }
-    instance->state = (InstanceState)header->state;
-    instance->time = header->time;
-    instance->stop_time = header->stop_time;
-    instance->stop_time_defined = header->stop_time_defined;
-    instance->last_successful_time = header->last_successful_time;
-    instance->last_step_status = (fmi2Status)header->last_step_status;
+    if (!allowed(instance, FN_SetFMUstate)) return fmi2Error;
+    const unsigned char* record = own_state(instance, FN_SetFMUstate, FMUstate);
+    if (record == NULL || !valid_state_content(instance, FN_SetFMUstate, record)) return fmi2Error;
+    StateHeader header;
+    memcpy(&header, record, sizeof header);
+    /* A refused snapshot leaves the core as it was: so does the wrapper. */
+    const fmi2Status status = from_core(gimbal_core_restore(instance->core, record + sizeof header));
+    if (status > fmi2Warning) return status;
+    instance->state = (InstanceState)header.state;
+    instance->time = header.time;
+    instance->stop_time = header.stop_time;
+    instance->stop_time_defined = header.stop_time_defined;
+    instance->last_successful_time = header.last_successful_time;
+    instance->last_step_status = (fmi2Status)header.last_step_status;
     return fmi2OK;
 }
 
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
+static fmi2Status impl_FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2FreeFMUstate", ANY_STATE)) return fmi2Error;
+    if (!allowed(instance, FN_FreeFMUstate)) return fmi2Error;
     if (FMUstate == NULL) return fmi2OK;
-    free(*FMUstate);
+    /* The Reference-FMUs' fmusim passes the state itself instead of its address: recognised before
+     * anything behind the pointer is read. */
+    if (fmu_states_find(&instance->states, FMUstate) >= 0) {
+        log_message(instance, fmi2Error, "logStatusError",
+                    "fmi2FreeFMUstate: the argument is an FMU state, not the address of one (pass &state); nothing was "
+                    "freed");
+        return fmi2Error;
+    }
+    if (*FMUstate == NULL) return fmi2OK;
+    const long index = fmu_states_find(&instance->states, *FMUstate);
+    if (index < 0) {
+        log_message(instance, fmi2Error, "logStatusError",
+                    "fmi2FreeFMUstate: *FMUstate = %p is not an FMU state of instance '%s' (never handed out, or "
+                    "already freed); nothing was freed",
+                    *FMUstate, instance->instance_name);
+        return fmi2Error;
+    }
+    fmu_states_release(&instance->states, index);
     *FMUstate = NULL;
     return fmi2OK;
 }
 
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size) {
+static fmi2Status impl_SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SerializedFMUstateSize", ANY_STATE)) return fmi2Error;
-    if (!not_null(instance, "fmi2SerializedFMUstateSize", FMUstate, "FMUstate") ||
+    if (!allowed(instance, FN_SerializedFMUstateSize)) return fmi2Error;
+    if (own_state(instance, FN_SerializedFMUstateSize, FMUstate) == NULL ||
         !not_null(instance, "fmi2SerializedFMUstateSize", size, "size"))
         return fmi2Error;
     *size = state_record_size();
     return fmi2OK;
 }
 
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
+static fmi2Status impl_SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SerializeFMUstate", ANY_STATE)) return fmi2Error;
-    if (!not_null(instance, "fmi2SerializeFMUstate", FMUstate, "FMUstate") ||
-        !not_null(instance, "fmi2SerializeFMUstate", serializedState, "serializedState"))
+    if (!allowed(instance, FN_SerializeFMUstate)) return fmi2Error;
+    const unsigned char* record = own_state(instance, FN_SerializeFMUstate, FMUstate);
+    if (record == NULL || !not_null(instance, "fmi2SerializeFMUstate", serializedState, "serializedState"))
         return fmi2Error;
-    if (!valid_state_record(instance, "fmi2SerializeFMUstate", FMUstate, state_record_size())) return fmi2Error;
     if (size < state_record_size()) {
-        log_message(instance, fmi2Error, "logStatusError", "fmi2SerializeFMUstate: size %u is below the %u bytes needed",
-                    (unsigned)size, (unsigned)state_record_size());
+        log_message(instance, fmi2Error, "logStatusError", "fmi2SerializeFMUstate: size %zu is below the %zu bytes needed",
+                    size, state_record_size());
         return fmi2Error;
     }
-    memcpy(serializedState, FMUstate, state_record_size());
+    memcpy(serializedState, record, state_record_size());
+    const uint64_t checksum = fmu_state_checksum((const unsigned char*)serializedState, state_record_size());
+    memcpy(serializedState + offsetof(StateHeader, checksum), &checksum, sizeof checksum);
     return fmi2OK;
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
-                                   fmi2FMUstate* FMUstate) {
+static fmi2Status impl_DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                           fmi2FMUstate* FMUstate) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2DeSerializeFMUstate", ANY_STATE)) return fmi2Error;
+    if (!allowed(instance, FN_DeSerializeFMUstate)) return fmi2Error;
     if (!not_null(instance, "fmi2DeSerializeFMUstate", serializedState, "serializedState") ||
         !not_null(instance, "fmi2DeSerializeFMUstate", FMUstate, "FMUstate"))
         return fmi2Error;
-    if (!valid_state_record(instance, "fmi2DeSerializeFMUstate", serializedState, size)) return fmi2Error;
+    const char* problem = fmu_state_integrity_problem((const unsigned char*)serializedState, size, state_record_size(),
+                                                      GIMBAL_GUID);
+    if (problem != NULL) {
+        log_message(instance, fmi2Error, "logStatusError",
+                    "fmi2DeSerializeFMUstate: the %zu bytes are refused: %s (an FMU state of this FMU, GUID %s, has %zu "
+                    "bytes)",
+                    size, problem, GIMBAL_GUID, state_record_size());
+        return fmi2Error;
+    }
+    if (!valid_state_content(instance, FN_DeSerializeFMUstate, (const unsigned char*)serializedState)) return fmi2Error;
     void* record = malloc(size);
-    if (record == NULL) {
+    if (record == NULL || !fmu_states_add(&instance->states, record)) {
+        free(record);
         log_message(instance, fmi2Error, "logStatusError", "fmi2DeSerializeFMUstate: out of memory");
         return fmi2Error;
     }
@@ -544,7 +664,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
     return fmi2OK;
 }
 
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+static fmi2Status impl_GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[]) {
     (void)vUnknown_ref;
@@ -553,12 +673,12 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
     (void)nKnown;
     (void)dvKnown;
     (void)dvUnknown;
-    return unsupported(c, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative");
+    return unsupported(c, FN_GetDirectionalDerivative, "providesDirectionalDerivative=\"false\"");
 }
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+static fmi2Status impl_SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SetRealInputDerivatives", STATE_INITIALIZATION | STATE_STEP_COMPLETE)) return fmi2Error;
+    if (!allowed(instance, FN_SetRealInputDerivatives)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     if (!not_null(instance, "fmi2SetRealInputDerivatives", vr, "vr") ||
         !not_null(instance, "fmi2SetRealInputDerivatives", order, "order") ||
@@ -572,22 +692,22 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     return fmi2OK;
 }
 
-fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+static fmi2Status impl_GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr;
     (void)nvr;
     (void)order;
     (void)value;
-    return unsupported(c, "fmi2GetRealOutputDerivatives", "maxOutputDerivativeOrder");
+    return unsupported(c, FN_GetRealOutputDerivatives, "maxOutputDerivativeOrder=\"0\"");
 }
 
 /* ---------------------------------------------------------------- stepping */
 
-fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Instance* instance = (Instance*)c;
     (void)noSetFMUStatePriorToCurrentPoint;
-    if (!allowed(instance, "fmi2DoStep", STATE_STEP_COMPLETE)) return fmi2Error;
+    if (!allowed(instance, FN_DoStep)) return fmi2Error;
     if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize)) {
         log_message(instance, fmi2Error, "logStatusError", "fmi2DoStep: communicationStepSize = %g must be finite and > 0",
                     communicationStepSize);
@@ -622,15 +742,15 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
     return status;
 }
 
-fmi2Status fmi2CancelStep(fmi2Component c) {
+static fmi2Status impl_CancelStep(fmi2Component c) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2CancelStep", 0)) return fmi2Error; /* doStep never runs asynchronously */
+    if (!allowed(instance, FN_CancelStep)) return fmi2Error; /* doStep never runs asynchronously */
     return fmi2Error;
 }
 
-fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value) {
+static fmi2Status impl_GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2GetStatus", STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)) return fmi2Error;
+    if (!allowed(instance, FN_GetStatus)) return fmi2Error;
     if (!not_null(instance, "fmi2GetStatus", value, "value")) return fmi2Error;
     if (s != fmi2DoStepStatus) {
         log_message(instance, fmi2Error, "logStatusError", "fmi2GetStatus: status kind %d is not a fmi2Status", (int)s);
@@ -640,9 +760,9 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* va
     return fmi2OK;
 }
 
-fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value) {
+static fmi2Status impl_GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2GetRealStatus", STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED))
+    if (!allowed(instance, FN_GetRealStatus))
         return fmi2Error;
     if (!not_null(instance, "fmi2GetRealStatus", value, "value")) return fmi2Error;
     if (s != fmi2LastSuccessfulTime) {
@@ -653,17 +773,17 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* 
     return fmi2OK;
 }
 
-fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value) {
-    (void)value;
+static fmi2Status impl_GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value) {
     Instance* instance = (Instance*)c;
-    if (instance != NULL)
-        log_message(instance, fmi2Error, "logStatusError", "fmi2GetIntegerStatus: status kind %d has no Integer value", (int)s);
+    if (!allowed(instance, FN_GetIntegerStatus)) return fmi2Error;
+    if (!not_null(instance, "fmi2GetIntegerStatus", value, "value")) return fmi2Error;
+    log_message(instance, fmi2Error, "logStatusError", "fmi2GetIntegerStatus: status kind %d has no Integer value", (int)s);
     return fmi2Error;
 }
 
-fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value) {
+static fmi2Status impl_GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2GetBooleanStatus", STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED))
+    if (!allowed(instance, FN_GetBooleanStatus))
         return fmi2Error;
     if (!not_null(instance, "fmi2GetBooleanStatus", value, "value")) return fmi2Error;
     if (s != fmi2Terminated) {
@@ -674,9 +794,9 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
     return fmi2OK;
 }
 
-fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value) {
+static fmi2Status impl_GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2GetStringStatus", STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED))
+    if (!allowed(instance, FN_GetStringStatus))
         return fmi2Error;
     if (!not_null(instance, "fmi2GetStringStatus", value, "value")) return fmi2Error;
     if (s != fmi2PendingStatus) {
@@ -685,4 +805,151 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     }
     *value = ""; /* doStep is synchronous: never pending */
     return fmi2OK;
+}
+
+/* ---------------------------------------------------------------- the exported functions */
+
+/* Runs an implementation in the FMU's floating-point environment and gives the host its own back. */
+#define IN_FMU_FP_ENVIRONMENT(type, call)   \
+    HostFpEnvironment host_environment;     \
+    enter_fmu_fp(&host_environment);        \
+    const type result = call;               \
+    leave_fmu_fp(&host_environment);        \
+    return result
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetDebugLogging(c, loggingOn, nCategories, categories));
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Component,
+                          impl_Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation, functions, visible, loggingOn));
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    HostFpEnvironment host_environment;
+    enter_fmu_fp(&host_environment);
+    impl_FreeInstance(c);
+    leave_fmu_fp(&host_environment);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,
+                               fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status,
+                          impl_SetupExperiment(c, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime));
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_EnterInitializationMode(c));
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_ExitInitializationMode(c));
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_Terminate(c)); }
+
+fmi2Status fmi2Reset(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_Reset(c)); }
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetReal(c, vr, nvr, value));
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetInteger(c, vr, nvr, value));
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetBoolean(c, vr, nvr, value));
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetString(c, vr, nvr, value));
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetReal(c, vr, nvr, value));
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetInteger(c, vr, nvr, value));
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetBoolean(c, vr, nvr, value));
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetString(c, vr, nvr, value));
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetFMUstate(c, FMUstate));
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetFMUstate(c, FMUstate));
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_FreeFMUstate(c, FMUstate));
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SerializedFMUstateSize(c, FMUstate, size));
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SerializeFMUstate(c, FMUstate, serializedState, size));
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate* FMUstate) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_DeSerializeFMUstate(c, serializedState, size, FMUstate));
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
+                                        fmi2Real dvUnknown[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status,
+                          impl_GetDirectionalDerivative(c, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown));
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetRealInputDerivatives(c, vr, nvr, order, value));
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetRealOutputDerivatives(c, vr, nvr, order, value));
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status,
+                          impl_DoStep(c, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint));
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_CancelStep(c)); }
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetStatus(c, s, value));
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetRealStatus(c, s, value));
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetIntegerStatus(c, s, value));
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetBooleanStatus(c, s, value));
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetStringStatus(c, s, value));
 }

@@ -86,9 +86,10 @@ def test_foreign_serialized_state_is_refused(gimbal_fmu):
         blob[0] ^= 0xFF
         with pytest.raises(FMICallException):
             slave.deSerializeFMUstate(bytes(blob))
-        assert "not saved by this FMU" in log[-1][2]
+        assert "does not start like an FMU state of this FMU" in log[-1][2]
         with pytest.raises(FMICallException):
             slave.deSerializeFMUstate(bytes(blob[:100]))
+        assert "its size is not that of this FMU's states" in log[-1][2]
         run(gimbal_fmu, slave, 0.0, 3)  # still usable
     finally:
         slave.freeInstance()

@@ -1,15 +1,50 @@
-// extern "C" face of the core. No C++ exception may cross into the host: each entry point catches.
+// extern "C" face of the core. No C++ exception may cross into the host: every entry point runs its
+// body through guarded(), which turns any exception into a status and a logged message (as cppfmu's
+// entry points do).
 #include "gimbal/gimbal_c_api.h"
 
+#include <cstdio>
+#include <exception>
 #include <new>
 
 #include "gimbal/gimbal_instance.hpp"
 
 struct GimbalCore {
-    GimbalCore(gimbal::GimbalInstance::Logger logger, gimbal::GimbalInstance::LogFilter filter)
-        : instance(std::move(logger), std::move(filter)) {}
+    GimbalCore(GimbalLogFunction log_function, void* context, gimbal::GimbalInstance::Logger logger,
+               gimbal::GimbalInstance::LogFilter filter)
+        : log(log_function), log_context(context), instance(std::move(logger), std::move(filter)) {}
+
+    // Straight to the host's callback, through a stack buffer: usable when memory has run out.
+    void report(const char* function, const char* what) const noexcept {
+        if (log == nullptr) return;
+        char message[512];
+        std::snprintf(message, sizeof message, "%s: %s", function, what);
+        log(log_context, GIMBAL_ERROR, "logStatusError", message);
+    }
+
+    GimbalLogFunction log;
+    void* log_context;
     gimbal::GimbalInstance instance;
 };
+
+namespace {
+
+template <class Body>
+GimbalStatus guarded(GimbalCore* core, const char* function, Body&& body) noexcept {
+    if (core == nullptr) return GIMBAL_ERROR;
+    try {
+        return body();
+    } catch (const std::bad_alloc&) {
+        core->report(function, "out of memory; the instance is left as it was before the call");
+    } catch (const std::exception& error) {
+        core->report(function, error.what());
+    } catch (...) {
+        core->report(function, "internal error (an unknown C++ exception)");
+    }
+    return GIMBAL_ERROR;
+}
+
+}  // namespace
 
 extern "C" {
 
@@ -35,78 +70,93 @@ GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction e
         auto wants = [enabled, log_context](const char* category) {
             return enabled == nullptr || enabled(log_context, category) != 0;
         };
-        return new (std::nothrow) GimbalCore{logger, wants};
+        return new GimbalCore{log, log_context, logger, wants};
     } catch (...) {
+        if (log != nullptr) log(log_context, GIMBAL_ERROR, "logStatusError", "fmi2Instantiate: out of memory");
         return nullptr;
     }
 }
 
 void gimbal_core_destroy(GimbalCore* core) { delete core; }
 
-void gimbal_core_reset(GimbalCore* core) { core->instance.reset(); }
+GimbalStatus gimbal_core_reset(GimbalCore* core) {
+    return guarded(core, "fmi2Reset", [&] {
+        core->instance.reset();
+        return GIMBAL_OK;
+    });
+}
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value) {
-    return core->instance.set_real(vr, value);
+    return guarded(core, "fmi2SetReal", [&] { return core->instance.set_real(vr, value); });
 }
 
 GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value) {
-    return core->instance.get_real(vr, *value);
+    return guarded(core, "fmi2GetReal", [&] { return core->instance.get_real(vr, *value); });
 }
 
 GimbalStatus gimbal_core_set_input_derivative(GimbalCore* core, unsigned vr, int order, double value) {
-    return core->instance.set_input_derivative(vr, order, value);
+    return guarded(core, "fmi2SetRealInputDerivatives",
+                   [&] { return core->instance.set_input_derivative(vr, order, value); });
 }
 
 GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value) {
-    return core->instance.set_integer(vr, value);
+    return guarded(core, "fmi2SetInteger", [&] { return core->instance.set_integer(vr, value); });
 }
 
 GimbalStatus gimbal_core_get_integer(GimbalCore* core, unsigned vr, int* value) {
-    return core->instance.get_integer(vr, *value);
+    return guarded(core, "fmi2GetInteger", [&] { return core->instance.get_integer(vr, *value); });
 }
 
 GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value) {
-    return core->instance.set_boolean(vr, value != 0);
+    return guarded(core, "fmi2SetBoolean", [&] { return core->instance.set_boolean(vr, value != 0); });
 }
 
 GimbalStatus gimbal_core_get_boolean(GimbalCore* core, unsigned vr, int* value) {
-    bool flag = false;
-    const GimbalStatus status = core->instance.get_boolean(vr, flag);
-    *value = flag ? 1 : 0;
-    return status;
+    return guarded(core, "fmi2GetBoolean", [&] {
+        bool flag = false;
+        const GimbalStatus status = core->instance.get_boolean(vr, flag);
+        *value = flag ? 1 : 0;
+        return status;
+    });
+}
+
+GimbalStatus gimbal_core_set_master_tolerance(GimbalCore* core, int defined, double tolerance) {
+    return guarded(core, "fmi2SetupExperiment", [&] {
+        core->instance.set_master_tolerance(defined != 0, tolerance);
+        return GIMBAL_OK;
+    });
 }
 
 GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time) {
-    try {
-        return core->instance.initialize(start_time);
-    } catch (const std::bad_alloc&) {
-        return GIMBAL_ERROR;
-    }
+    return guarded(core, "fmi2ExitInitializationMode", [&] { return core->instance.initialize(start_time); });
 }
 
 GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double step_size) {
-    try {
-        return core->instance.do_step(current_time, step_size);
-    } catch (const std::bad_alloc&) {
-        return GIMBAL_ERROR;
-    }
+    return guarded(core, "fmi2DoStep", [&] { return core->instance.do_step(current_time, step_size); });
 }
 
-double gimbal_core_time(const GimbalCore* core) { return core->instance.time(); }
+double gimbal_core_time(const GimbalCore* core) { return core != nullptr ? core->instance.time() : 0.0; }
 
 size_t gimbal_core_snapshot_size(void) { return gimbal::GimbalInstance::snapshot_size(); }
 
 GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer) {
-    core->instance.save(buffer);
-    return GIMBAL_OK;
+    return guarded(core, "fmi2GetFMUstate", [&] {
+        core->instance.save(buffer);
+        return GIMBAL_OK;
+    });
+}
+
+GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, const void* buffer, int* initialized) {
+    return guarded(core, function, [&] {
+        bool flag = false;
+        const GimbalStatus status = core->instance.check_snapshot(function, buffer, flag);
+        *initialized = flag ? 1 : 0;
+        return status;
+    });
 }
 
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer) {
-    try {
-        return core->instance.restore(buffer);
-    } catch (const std::bad_alloc&) {
-        return GIMBAL_ERROR;
-    }
+    return guarded(core, "fmi2SetFMUstate", [&] { return core->instance.restore(buffer); });
 }
 
 }  // extern "C"

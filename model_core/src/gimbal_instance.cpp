@@ -35,15 +35,22 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 Vec3 vector_at(const double* values, unsigned first) { return Vec3(values[first], values[first + 1], values[first + 2]); }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 3;
+constexpr std::uint32_t kSnapshotVersion = 4;
 
+// Plain integers and doubles only, flags as bytes: any byte pattern decodes without undefined
+// behaviour, and check_snapshot() decides whether it is a state this model can be in.
 struct Snapshot {
     std::uint32_t magic;
     std::uint32_t version;
     double reals[kRealVariableCount];
-    int integers[kIntegerVariableCount];
-    bool booleans[kBooleanVariableCount];
-    bool initialized;
+    std::int32_t integers[kIntegerVariableCount];
+    std::uint8_t booleans[kBooleanVariableCount];
+    std::uint8_t initialized;
+    std::uint8_t integrator_running;
+    std::uint8_t at_rest;
+    std::uint8_t rtol_set;
+    std::uint8_t master_tolerance_defined;
+    double master_tolerance;
     double time;
     double state[kMaxStateSize];
     Modes modes;
@@ -56,11 +63,56 @@ struct Snapshot {
     double base[15];  // attitude, rate, accel, v_a, a_a at the arc start
     double arc_start_time;  // model time
     double epoch;
-    bool integrator_running;
-    bool at_rest;
     IntegratorMemory integrator_memory;
 };
 static_assert(std::is_trivially_copyable<Snapshot>::value, "snapshots are copied as bytes");
+static_assert(sizeof(int) == sizeof(std::int32_t), "Integer variables are stored as int");
+
+// Counters beyond this are not the product of any run (2^53 steps would take centuries).
+constexpr double kMaxCount = 9007199254740992.0;
+
+// Collects the first reason a snapshot is refused.
+struct SnapshotCheck {
+    std::string reason;
+    bool ok() const { return reason.empty(); }
+    void fail(const std::string& why) {
+        if (reason.empty()) reason = why;
+    }
+    void finite(const char* field, const double* values, std::size_t count) {
+        for (std::size_t k = 0; k < count && ok(); ++k)
+            if (!std::isfinite(values[k])) fail(std::string(field) + "[" + std::to_string(k) + "] is not finite");
+    }
+    void flag(const char* field, std::uint8_t value) {
+        if (value > 1) fail(std::string(field) + " = " + std::to_string(value) + " is not a boolean");
+    }
+    void count(const char* field, long value) {
+        if (value < 0 || static_cast<double>(value) > kMaxCount)
+            fail(std::string(field) + " = " + std::to_string(value) + " is not a count");
+    }
+    void within(const char* field, long value, long low, long high) {
+        if (value < low || value > high)
+            fail(std::string(field) + " = " + std::to_string(value) + " lies outside [" + std::to_string(low) + ", " +
+                 std::to_string(high) + "]");
+    }
+};
+
+// The hybrid system keeps a reference to the instance's parameters, so new ones go in place before
+// it is built; this puts the previous ones back unless the new run is committed.
+class ParameterSwap {
+public:
+    ParameterSwap(ModelParameters& current, const ModelParameters& next) : current_(current), previous_(current) {
+        current_ = next;
+    }
+    ~ParameterSwap() {
+        if (!committed_) current_ = previous_;
+    }
+    void commit() { committed_ = true; }
+
+private:
+    ModelParameters& current_;
+    ModelParameters previous_;
+    bool committed_ = false;
+};
 
 }  // namespace
 
@@ -82,6 +134,10 @@ void GimbalInstance::reset() {
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
     epoch_ = 0.0;
+    master_tolerance_defined_ = false;
+    master_tolerance_ = 0.0;
+    rtol_set_ = false;
+    steps_over_budget_ = 0;
 }
 
 GimbalStatus GimbalInstance::refuse(GimbalStatus status, const std::string& message) const {
@@ -100,6 +156,7 @@ GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
     }
     reals_[vr] = value;
     preview_current_ = false;
+    if (vr == vr_solver_rtol) rtol_set_ = true;
     // A new voltage starts a new ramp: its derivative must be given again.
     if (vr == vr_u_R1) voltage_rate_[0] = 0.0;
     if (vr == vr_u_R2) voltage_rate_[1] = 0.0;
@@ -285,36 +342,77 @@ bool GimbalInstance::build_parameters(ModelParameters& params, std::string& erro
            validate_start_state(reals_, params, error);
 }
 
-void GimbalInstance::create_integrator() {
+std::unique_ptr<HybridIntegrator> GimbalInstance::make_integrator(GimbalHybridSystem& system,
+                                                                  const ModelParameters& params) {
     IntegratorSettings settings;
-    settings.relative_tolerance = params_.relative_tolerance;
-    settings.absolute_tolerance = params_.absolute_tolerance;
-    settings.max_steps = params_.max_steps;
-    settings.method = static_cast<IntegrationMethod>(params_.method);
+    settings.relative_tolerance = params.relative_tolerance;
+    settings.absolute_tolerance = params.absolute_tolerance;
+    settings.max_steps = params.max_steps;
+    settings.method = static_cast<IntegrationMethod>(params.method);
     settings.events_logged = [this] { return log_filter_("logEvents"); };
-    integrator_ = HybridIntegrator::create(
-        *system_, settings,
+    return HybridIntegrator::create(
+        system, settings,
         [this](const std::string& message) {
             last_integrator_error_ = message;
             logger_(GIMBAL_WARNING, "logSolver", message);
         },
         [this](const std::string& message) { logger_(GIMBAL_OK, "logEvents", message); });
+}
+
+void GimbalInstance::create_integrator() {
+    integrator_ = make_integrator(*system_, params_);
     integrator_running_ = false;
+}
+
+void GimbalInstance::set_master_tolerance(bool defined, double tolerance) {
+    master_tolerance_defined_ = defined;
+    master_tolerance_ = defined ? tolerance : 0.0;
+}
+
+// The FMI standard gives the master's tolerance to the FMU's integrator; solver.rtol, when the user
+// set it, says more precisely what this FMU should do.
+void GimbalInstance::apply_master_tolerance() {
+    if (!master_tolerance_defined_) return;
+    std::ostringstream s;
+    s.precision(17);
+    if (rtol_set_) {
+        if (master_tolerance_ != reals_[vr_solver_rtol]) {
+            s << "fmi2SetupExperiment: tolerance = " << master_tolerance_ << " is not used: solver.rtol = "
+              << reals_[vr_solver_rtol] << " was set explicitly";
+            logger_(GIMBAL_OK, "logSolver", s.str());
+        }
+        return;
+    }
+    if (!(master_tolerance_ > 0.0 && master_tolerance_ < 1.0)) {
+        s << "fmi2SetupExperiment: tolerance = " << master_tolerance_ << " is ignored (a relative tolerance lies in "
+          << "(0, 1)); solver.rtol keeps " << reals_[vr_solver_rtol];
+        logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
+        return;
+    }
+    reals_[vr_solver_rtol] = master_tolerance_;
+    s << "solver.rtol = " << master_tolerance_ << ", the tolerance of fmi2SetupExperiment (set solver.rtol to override)";
+    logger_(GIMBAL_OK, "logSolver", s.str());
 }
 
 GimbalStatus GimbalInstance::preview_outputs(const char* function, const char* name) {
     if (preview_current_) return GIMBAL_OK;
     std::string error;
-    if (!build_parameters(params_, error)) {
+    ModelParameters params;
+    if (!build_parameters(params, error)) {
         return refuse(GIMBAL_ERROR, std::string(function) + ": " + name +
                                         " cannot be computed from the current values: " + error);
     }
+    // Built aside and committed only at the end: a failure (out of memory) leaves nothing half-made.
+    ParameterSwap swap(params_, params);
+    auto system = std::make_unique<GimbalHybridSystem>(params_);
+    auto integrator = make_integrator(*system, params_);
+    swap.commit();
     load_start_state();
     epoch_ = time_;
-    system_ = std::make_unique<GimbalHybridSystem>(params_);
-    system_->set_inputs(read_step_inputs(0.0));
-    system_->update_modes(0.0, state_, nullptr);
-    create_integrator();
+    system->set_inputs(read_step_inputs(0.0));
+    system->update_modes(0.0, state_, nullptr);
+    system_ = std::move(system);
+    integrator_ = std::move(integrator);
     publish_outputs();
     // The preview must not count as initialization: forget the integrator again.
     integrator_.reset();
@@ -324,22 +422,42 @@ GimbalStatus GimbalInstance::preview_outputs(const char* function, const char* n
 }
 
 GimbalStatus GimbalInstance::initialize(double start_time) {
+    const double rtol_before = reals_[vr_solver_rtol];
+    apply_master_tolerance();
     std::string error;
     ModelParameters params;
-    if (!build_parameters(params, error)) return refuse(GIMBAL_ERROR, error);
-    params_ = params;
+    if (!build_parameters(params, error)) {
+        reals_[vr_solver_rtol] = rtol_before;
+        return refuse(GIMBAL_ERROR, error);
+    }
+    std::unique_ptr<GimbalHybridSystem> system;
+    std::unique_ptr<HybridIntegrator> integrator;
+    ParameterSwap swap(params_, params);
+    try {
+        system = std::make_unique<GimbalHybridSystem>(params_);
+        integrator = make_integrator(*system, params_);
+    } catch (...) {
+        reals_[vr_solver_rtol] = rtol_before;
+        throw;
+    }
     const GimbalStatus base_status = check_fixed_base("fmi2ExitInitializationMode");
-    if (base_status != GIMBAL_OK) return base_status;
+    if (base_status != GIMBAL_OK) {
+        reals_[vr_solver_rtol] = rtol_before;
+        return base_status;
+    }
+    swap.commit();
     load_start_state();
     time_ = start_time;
     epoch_ = start_time;
-    system_ = std::make_unique<GimbalHybridSystem>(params_);
-    system_->set_inputs(read_step_inputs(0.0));
-    system_->update_modes(0.0, state_, nullptr);
+    system->set_inputs(read_step_inputs(0.0));
+    system->update_modes(0.0, state_, nullptr);
     EventCounters none;
     none.last_event_time = 0.0;
-    system_->restore(system_->modes(), none);  // the initial choice of modes is not an event
-    create_integrator();
+    system->restore(system->modes(), none);  // the initial choice of modes is not an event
+    system_ = std::move(system);
+    integrator_ = std::move(integrator);
+    integrator_running_ = false;
+    steps_over_budget_ = 0;
     publish_outputs();
     return GIMBAL_OK;
 }
@@ -353,12 +471,17 @@ void GimbalInstance::save(void* buffer) {
     snap.version = kSnapshotVersion;
     std::copy(reals_, reals_ + kRealVariableCount, snap.reals);
     std::copy(integers_, integers_ + kIntegerVariableCount, snap.integers);
-    std::copy(booleans_, booleans_ + kBooleanVariableCount, snap.booleans);
+    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) snap.booleans[vr] = booleans_[vr] ? 1 : 0;
     snap.initialized = integrator_ != nullptr;
+    snap.rtol_set = rtol_set_;
+    snap.master_tolerance_defined = master_tolerance_defined_;
+    snap.master_tolerance = master_tolerance_;
     snap.time = time_;
     std::copy(state_, state_ + kMaxStateSize, snap.state);
     snap.pending_voltage_rate[0] = voltage_rate_[0];
     snap.pending_voltage_rate[1] = voltage_rate_[1];
+    snap.epoch = epoch_;
+    snap.integrator_memory = IntegratorMemory{};
     if (snap.initialized) {
         snap.modes = system_->modes();
         snap.counters = system_->counters();
@@ -374,7 +497,6 @@ void GimbalInstance::save(void* buffer) {
         for (int p = 0; p < 5; ++p)
             for (int k = 0; k < 3; ++k) snap.base[3 * p + k] = (*parts[p])[k];
         snap.arc_start_time = in.step_start_time;
-        snap.epoch = epoch_;
         snap.at_rest = at_rest_;
         if (integrator_->resumable()) {
             // The one-step methods carry only their step-size controller: the snapshot holds it, and a
@@ -393,56 +515,236 @@ void GimbalInstance::save(void* buffer) {
     std::memcpy(buffer, &snap, sizeof snap);
 }
 
-GimbalStatus GimbalInstance::restore(const void* buffer) {
+GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* buffer, bool& initialized) const {
     Snapshot snap;
     std::memcpy(&snap, buffer, sizeof snap);
-    if (snap.magic != kSnapshotMagic || snap.version != kSnapshotVersion) {
-        return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: the state was not saved by this version of Gimbal2Axis");
+    SnapshotCheck check;
+    if (snap.magic != kSnapshotMagic || snap.version != kSnapshotVersion)
+        check.fail("it was not saved by this version of Gimbal2Axis (snapshot format " +
+                   std::to_string(kSnapshotVersion) + ")");
+    check.finite("Real variable", snap.reals, kRealVariableCount);
+    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) check.flag(kBooleanVariables[vr].name, snap.booleans[vr]);
+    check.flag("initialized", snap.initialized);
+    check.flag("integrator_running", snap.integrator_running);
+    check.flag("at_rest", snap.at_rest);
+    check.flag("rtol_set", snap.rtol_set);
+    check.flag("master_tolerance_defined", snap.master_tolerance_defined);
+    check.finite("master tolerance", &snap.master_tolerance, 1);
+    check.finite("time", &snap.time, 1);
+    check.finite("epoch", &snap.epoch, 1);
+    check.finite("state", snap.state, kMaxStateSize);
+    check.finite("pending voltage rate", snap.pending_voltage_rate, 2);
+    const IntegerVariable mode_outputs[] = {vi_gear1_contact, vi_gear2_contact, vi_motor1_limited, vi_motor2_limited};
+    for (IntegerVariable vi : mode_outputs) check.within(kIntegerVariables[vi].name, snap.integers[vi], -1, 1);
+    const IntegerVariable friction_outputs[] = {vi_body1_stick_slip, vi_rotor1_stick_slip, vi_body2_stick_slip,
+                                                vi_rotor2_stick_slip};
+    for (IntegerVariable vi : friction_outputs) check.within(kIntegerVariables[vi].name, snap.integers[vi], -2, 2);
+    for (unsigned vr = vi_events_total; vr <= vi_events_zeno_guard; ++vr)
+        check.count(kIntegerVariables[vr].name, snap.integers[vr]);
+    const IntegerVariable solver_outputs[] = {vi_solver_states, vi_solver_steps, vi_solver_rhs_evaluations,
+                                              vi_solver_jacobian_evaluations, vi_solver_method_switches};
+    for (IntegerVariable vi : solver_outputs) check.count(kIntegerVariables[vi].name, snap.integers[vi]);
+    if (check.ok() && snap.initialized) {
+        check.finite("voltage", snap.voltage, 2);
+        check.finite("commanded voltage", snap.commanded_voltage, 2);
+        check.finite("voltage rate", snap.voltage_rate, 2);
+        check.finite("base motion", snap.base, 15);
+        check.finite("arc start time", &snap.arc_start_time, 1);
+        if (!(snap.time >= snap.epoch)) check.fail("the time lies before the start of the run");
+        const Modes& modes = snap.modes;
+        for (int axis = 0; axis < 2; ++axis) {
+            check.within("gear contact mode", modes.gear_contact[axis], -1, 1);
+            check.within("current limiter mode", modes.motor_limited[axis], -1, 1);
+            check.within("voltage clamp mode", modes.voltage_clamped[axis], -1, 1);
+        }
+        for (int body = 0; body < 4; ++body)
+            check.within("friction mode", static_cast<long>(modes.friction[body]),
+                         static_cast<long>(FrictionMode::none), static_cast<long>(FrictionMode::at_max_negative));
+        const EventCounters& c = snap.counters;
+        const long counters[] = {c.total, c.backlash[0], c.backlash[1], c.current_limit[0], c.current_limit[1],
+                                 c.stick_slip};
+        for (long value : counters) check.count("event counter", value);
+        check.finite("last event time", &c.last_event_time, 1);
+        const IntegratorStatistics& st = snap.statistics;
+        const long statistics[] = {st.steps, st.rhs_evaluations, st.jacobian_evaluations, st.events, st.zeno_holds,
+                                   st.method_switches, st.rejected_steps};
+        for (long value : statistics) check.count("integrator statistic", value);
+        const IntegratorMemory& m = snap.integrator_memory;
+        const double memory_reals[] = {m.step_size, m.previous_error, m.last_event_time, m.dwell_until};
+        check.finite("integrator memory", memory_reals, 4);
+        if (!(m.step_size >= 0.0)) check.fail("the saved step size is negative");
+        if (!(m.previous_error > 0.0)) check.fail("the saved error estimate is not positive");
+        check.flag("stiff", static_cast<std::uint8_t>(m.stiff < 0 || m.stiff > 1 ? 2 : m.stiff));
+        check.flag("last_step_rejected",
+                   static_cast<std::uint8_t>(m.last_step_rejected < 0 || m.last_step_rejected > 1 ? 2 : m.last_step_rejected));
+        check.count("stiff votes", m.stiff_votes);
+        check.count("non-stiff votes", m.nonstiff_votes);
+        check.count("rapid events", m.rapid_events);
     }
-    std::copy(snap.reals, snap.reals + kRealVariableCount, reals_);
-    std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers_);
-    std::copy(snap.booleans, snap.booleans + kBooleanVariableCount, booleans_);
-    preview_current_ = false;
-    integrator_.reset();
-    system_.reset();
-    time_ = snap.time;
-    std::copy(snap.state, snap.state + kMaxStateSize, state_);
-    voltage_rate_[0] = snap.pending_voltage_rate[0];
-    voltage_rate_[1] = snap.pending_voltage_rate[1];
-    if (!snap.initialized) return GIMBAL_OK;
+    if (check.ok() && snap.initialized) {
+        // The parameters must be valid, and the modes possible for the elements they define.
+        double reals[kRealVariableCount];
+        int integers[kIntegerVariableCount];
+        bool booleans[kBooleanVariableCount];
+        std::copy(snap.reals, snap.reals + kRealVariableCount, reals);
+        std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers);
+        for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans[vr] = snap.booleans[vr] != 0;
+        ModelParameters params;
+        std::string error;
+        if (!build_model_parameters(reals, integers, booleans, params, error)) check.fail(error);
+        for (int axis = 0; axis < 2 && check.ok(); ++axis) {
+            if (params.fidelity.gear[axis] != GearModel::backlash && snap.modes.gear_contact[axis] != 0)
+                check.fail("gear " + std::to_string(axis + 1) + " has no backlash but a contact mode");
+        }
+        for (int body = 0; body < 4 && check.ok(); ++body) {
+            if (!params.fidelity.dry_friction && snap.modes.friction[body] != FrictionMode::none)
+                check.fail("a friction mode is set but dry friction is off");
+        }
+        for (int k = params.layout.size; k < kMaxStateSize && check.ok(); ++k)
+            if (snap.state[k] != 0.0) check.fail("the state has values beyond the model's " +
+                                                 std::to_string(params.layout.size) + " states");
+    }
+    if (!check.ok()) return refuse(GIMBAL_ERROR, std::string(function) + ": the FMU state is refused: " + check.reason);
+    initialized = snap.initialized != 0;
+    return GIMBAL_OK;
+}
 
-    std::string error;
-    if (!build_parameters(params_, error)) return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
-    system_ = std::make_unique<GimbalHybridSystem>(params_);
-    StepInputs in;
-    for (int axis = 0; axis < 2; ++axis) {
-        in.voltage[axis] = snap.voltage[axis];
-        in.commanded_voltage[axis] = snap.commanded_voltage[axis];
-        in.voltage_rate[axis] = snap.voltage_rate[axis];
-    }
-    Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel, &in.base.velocity_a,
-                      &in.base.acceleration_a};
-    for (int p = 0; p < 5; ++p)
-        for (int k = 0; k < 3; ++k) (*parts[p])[k] = snap.base[3 * p + k];
-    in.step_start_time = snap.arc_start_time;
-    epoch_ = snap.epoch;
-    system_->set_inputs(in);
-    system_->restore(snap.modes, snap.counters);
-    create_integrator();
-    if (snap.integrator_running && integrator_->resumable()) {
-        if (!integrator_->resume(model_time(time_), state_, snap.integrator_memory)) {
+GimbalStatus GimbalInstance::restore(const void* buffer) {
+    bool initialized = false;
+    const GimbalStatus checked = check_snapshot("fmi2SetFMUstate", buffer, initialized);
+    if (checked != GIMBAL_OK) return checked;
+    Snapshot snap;
+    std::memcpy(&snap, buffer, sizeof snap);
+
+    // Everything is built aside first: a refusal (or running out of memory) leaves the instance as it was.
+    ModelParameters params;
+    std::unique_ptr<GimbalHybridSystem> system;
+    std::unique_ptr<HybridIntegrator> integrator;
+    ParameterSwap swap(params_, params_);
+    if (initialized) {
+        double reals[kRealVariableCount];
+        int integers[kIntegerVariableCount];
+        bool booleans[kBooleanVariableCount];
+        std::copy(snap.reals, snap.reals + kRealVariableCount, reals);
+        std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers);
+        for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans[vr] = snap.booleans[vr] != 0;
+        std::string error;
+        if (!build_model_parameters(reals, integers, booleans, params, error) ||
+            !validate_start_state(reals, params, error))
+            return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
+        params_ = params;
+        system = std::make_unique<GimbalHybridSystem>(params_);
+        StepInputs in;
+        for (int axis = 0; axis < 2; ++axis) {
+            in.voltage[axis] = snap.voltage[axis];
+            in.commanded_voltage[axis] = snap.commanded_voltage[axis];
+            in.voltage_rate[axis] = snap.voltage_rate[axis];
+        }
+        Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel, &in.base.velocity_a,
+                          &in.base.acceleration_a};
+        for (int p = 0; p < 5; ++p)
+            for (int k = 0; k < 3; ++k) (*parts[p])[k] = snap.base[3 * p + k];
+        in.step_start_time = snap.arc_start_time;
+        system->set_inputs(in);
+        system->restore(snap.modes, snap.counters);
+        integrator = make_integrator(*system, params_);
+        if (snap.integrator_running && integrator->resumable() &&
+            !integrator->resume(snap.time - snap.epoch, snap.state, snap.integrator_memory)) {
             return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: the integrator cannot continue from the saved state (" +
                                             last_integrator_error_ + ")");
         }
-        integrator_running_ = true;
-        at_rest_ = snap.at_rest;
+        integrator->set_statistics(snap.statistics);
     }
-    integrator_->set_statistics(snap.statistics);
+
+    std::copy(snap.reals, snap.reals + kRealVariableCount, reals_);
+    std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers_);
+    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans_[vr] = snap.booleans[vr] != 0;
+    preview_current_ = false;
+    rtol_set_ = snap.rtol_set != 0;
+    master_tolerance_defined_ = snap.master_tolerance_defined != 0;
+    master_tolerance_ = snap.master_tolerance;
+    time_ = snap.time;
+    epoch_ = snap.epoch;
+    std::copy(snap.state, snap.state + kMaxStateSize, state_);
+    voltage_rate_[0] = snap.pending_voltage_rate[0];
+    voltage_rate_[1] = snap.pending_voltage_rate[1];
+    integrator_running_ = initialized && snap.integrator_running && integrator->resumable();
+    at_rest_ = integrator_running_ && snap.at_rest;
+    swap.commit();
+    system_ = std::move(system);
+    integrator_ = std::move(integrator);
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     if (!integrator_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance is not initialized");
+    StepStart start;
+    std::copy(state_, state_ + kMaxStateSize, start.state);
+    start.modes = system_->modes();
+    start.counters = system_->counters();
+    start.work = integrator_->statistics();
+    std::copy(reals_, reals_ + kRealVariableCount, start.reals);
+    std::copy(integers_, integers_ + kIntegerVariableCount, start.integers);
+    start.time = time_;
+    GimbalStatus status;
+    try {
+        status = integrate_step(current_time, step_size, start);
+    } catch (...) {
+        // A C++ exception (out of memory while formatting a message, say) must not leave a half-taken step.
+        roll_back(start);
+        throw;
+    }
+    if (status != GIMBAL_OK) return status;
+    return report_step_work(step_size, start.work, start.counters);
+}
+
+void GimbalInstance::roll_back(const StepStart& start) {
+    std::copy(start.state, start.state + kMaxStateSize, state_);
+    system_->restore(start.modes, start.counters);
+    std::copy(start.reals, start.reals + kRealVariableCount, reals_);
+    std::copy(start.integers, start.integers + kIntegerVariableCount, integers_);
+    time_ = start.time;
+    integrator_running_ = false;
+    at_rest_ = false;
+}
+
+// A step that costs far more than the model usually needs is reported once in a while (the first
+// time, then at the 2nd, 4th, 8th, ... such step) with what most likely makes it expensive.
+GimbalStatus GimbalInstance::report_step_work(double step_size, const IntegratorStatistics& before,
+                                              const EventCounters& events_before) {
+    const IntegratorStatistics after = integrator_->statistics();
+    const long rhs = after.rhs_evaluations - before.rhs_evaluations;
+    if (rhs <= kStepWorkBudget) return GIMBAL_OK;
+    ++steps_over_budget_;
+    if ((steps_over_budget_ & (steps_over_budget_ - 1)) != 0) return GIMBAL_WARNING;
+    const long steps = after.steps - before.steps, rejected = after.rejected_steps - before.rejected_steps;
+    const long events = system_->counters().total - events_before.total;
+    const auto method = static_cast<IntegrationMethod>(params_.method);
+    std::ostringstream s;
+    s.precision(6);
+    s << "fmi2DoStep: the step to t = " << time_ << " (h = " << step_size << ") took " << rhs
+      << " right-hand-side evaluations (budget " << kStepWorkBudget << "), " << steps << " steps, " << rejected
+      << " rejected, " << events << " mode changes";
+    if (events > steps / 4) {
+        s << ". Likely cause: the switching elements change mode " << events
+          << " times in one step (backlash impacts of a stiff gear, stick-slip or limiter chatter)";
+    } else if (method == IntegrationMethod::dormand_prince || method == IntegrationMethod::explicit_runge_kutta) {
+        s << ". Likely cause: the problem is stiff (a stiff gear k_s, a small motor inductance L) and solver.method = "
+          << params_.method << " is explicit: its steps are held by stability, not accuracy; solver.method = 4 or 6 "
+          << "handles stiffness";
+    } else if (rejected > steps / 2) {
+        s << ". Likely cause: most steps are rejected (discontinuities the integrator has to resolve)";
+    } else {
+        s << ". Likely cause: solver.rtol = " << params_.relative_tolerance << " and solver.atol = "
+          << params_.absolute_tolerance << " ask for more accuracy than the step affords";
+    }
+    if (steps_over_budget_ > 1) s << " [" << steps_over_budget_ << " steps over budget so far]";
+    logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
+    return GIMBAL_WARNING;
+}
+
+GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, const StepStart& start) {
+
     const GimbalStatus base_status = check_fixed_base("fmi2DoStep");
     if (base_status != GIMBAL_OK) return base_status;
     const double step_start = model_time(current_time);
@@ -453,11 +755,6 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     // and the base motion continues the running constant-acceleration arc; otherwise restart.
     const bool continuous = integrator_running_ && continues(running, inputs, step_start) &&
                             same_base_motion(inputs.base, running.base.advanced(step_start - running.step_start_time));
-    double step_start_state[kMaxStateSize];
-    std::copy(state_, state_ + kMaxStateSize, step_start_state);
-    const Modes step_start_modes = system_->modes();
-    const EventCounters step_start_counters = system_->counters();
-
     if (continuous && at_rest_ && inputs.voltage_rate[0] == 0.0 && inputs.voltage_rate[1] == 0.0) {
         time_ = current_time + step_size;  // outputs cannot change either
         return GIMBAL_OK;
@@ -485,9 +782,7 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     }
     last_integrator_error_.clear();
     if (!integrator_->advance(step_end, state_)) {
-        std::copy(step_start_state, step_start_state + kMaxStateSize, state_);
-        system_->restore(step_start_modes, step_start_counters);
-        integrator_running_ = false;
+        roll_back(start);
         std::ostringstream s;
         s.precision(17);
         s << "fmi2DoStep: integration from t = " << current_time << " over h = " << step_size << " failed ("
@@ -497,10 +792,6 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     integrator_running_ = true;
     voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
     at_rest_ = system_->at_rest(step_end, state_);
-    double previous_reals[kRealVariableCount];
-    int previous_integers[kIntegerVariableCount];
-    std::copy(reals_, reals_ + kRealVariableCount, previous_reals);
-    std::copy(integers_, integers_ + kIntegerVariableCount, previous_integers);
     time_ = current_time + step_size;
     publish_outputs();
     // Finite states can still give non-finite outputs from absurd inputs (a base velocity of 1e300
@@ -512,12 +803,7 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
         s << "fmi2DoStep: " << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
           << ": an input or parameter lies beyond what the model can represent; state rolled back to t = "
           << current_time;
-        std::copy(step_start_state, step_start_state + kMaxStateSize, state_);
-        system_->restore(step_start_modes, step_start_counters);
-        std::copy(previous_reals, previous_reals + kRealVariableCount, reals_);
-        std::copy(previous_integers, previous_integers + kIntegerVariableCount, integers_);
-        integrator_running_ = false;
-        time_ = current_time;
+        roll_back(start);
         return refuse(GIMBAL_ERROR, s.str());
     }
     return GIMBAL_OK;

@@ -1,5 +1,7 @@
 /* C interface of the dynamics core, used by the FMI wrapper in fmu_src/.
- * The core knows variables, physics and integration; the wrapper knows the FMI state machine. */
+ * The core knows variables, physics and integration; the wrapper knows the FMI state machine.
+ * No function lets a C++ exception out: each returns GIMBAL_ERROR (with a logged reason) instead.
+ * Every GimbalCore* argument must come from gimbal_core_create; NULL is refused. */
 #ifndef GIMBAL_C_API_H
 #define GIMBAL_C_API_H
 
@@ -36,7 +38,7 @@ int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info)
 GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction enabled, void* log_context);
 void gimbal_core_destroy(GimbalCore* core);
 /* Back to the state right after creation: start values, no integrator. */
-void gimbal_core_reset(GimbalCore* core);
+GimbalStatus gimbal_core_reset(GimbalCore* core);
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value);
 GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value);
@@ -46,6 +48,8 @@ GimbalStatus gimbal_core_get_integer(GimbalCore* core, unsigned vr, int* value);
 GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value);
 GimbalStatus gimbal_core_get_boolean(GimbalCore* core, unsigned vr, int* value);
 
+/* fmi2SetupExperiment's tolerance (defined = 0: none). Used as solver.rtol unless solver.rtol is set. */
+GimbalStatus gimbal_core_set_master_tolerance(GimbalCore* core, int defined, double tolerance);
 /* Validates parameters and start values, and sets up the integrator at start_time. */
 GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time);
 /* Integrates from current_time to current_time + step_size with the inputs held. On failure the
@@ -57,6 +61,10 @@ double gimbal_core_time(const GimbalCore* core);
 size_t gimbal_core_snapshot_size(void);
 /* Saving ends the current integration segment, so that restoring it later replays bit for bit. */
 GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer);
+/* Range-checks every field of a snapshot from an untrusted source; logs the reason of a refusal under
+ * the name of the calling FMI function. *initialized tells whether it holds an initialized instance. */
+GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, const void* buffer, int* initialized);
+/* Checks the snapshot as above; a refused one leaves the instance as it was. */
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
 
 #ifdef __cplusplus

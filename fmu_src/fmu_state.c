@@ -1,0 +1,77 @@
+#include "fmu_state.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+_Static_assert(sizeof(StateHeader) == 128, "the state header has no padding");
+
+static uint64_t mix(uint64_t h) {
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdULL;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ULL;
+    h ^= h >> 33;
+    return h;
+}
+
+uint64_t fmu_state_checksum(const unsigned char* record, size_t size) {
+    const size_t first = offsetof(StateHeader, checksum) + sizeof(uint64_t);
+    uint64_t h = mix((uint64_t)size);
+    size_t i = first;
+    for (; i + 8 <= size; i += 8) {
+        uint64_t word;
+        memcpy(&word, record + i, 8);
+        h = mix(h ^ word);
+    }
+    if (i < size) {
+        uint64_t word = 0;
+        memcpy(&word, record + i, size - i);
+        h = mix(h ^ word);
+    }
+    return h;
+}
+
+const char* fmu_state_integrity_problem(const unsigned char* bytes, size_t size, size_t expected_size,
+                                        const char* guid) {
+    if (size != expected_size) return "its size is not that of this FMU's states";
+    StateHeader header;
+    memcpy(&header, bytes, sizeof header);
+    if (header.magic != STATE_MAGIC) return "it does not start like an FMU state of this FMU";
+    if (header.format_version != STATE_FORMAT_VERSION) return "it was saved by another version of this FMU";
+    if (header.size != expected_size) return "its recorded size does not match";
+    if (memchr(header.guid, '\0', sizeof header.guid) == NULL || strcmp(header.guid, guid) != 0)
+        return "it was saved by an FMU with another GUID";
+    if (header.checksum != fmu_state_checksum(bytes, size)) return "its checksum does not match: the bytes were altered";
+    return NULL;
+}
+
+long fmu_states_find(const FmuStateRegistry* registry, const void* record) {
+    if (record == NULL) return -1;
+    for (size_t k = 0; k < registry->count; ++k)
+        if (registry->records[k] == record) return (long)k;
+    return -1;
+}
+
+int fmu_states_add(FmuStateRegistry* registry, void* record) {
+    if (registry->count == registry->capacity) {
+        const size_t capacity = registry->capacity == 0 ? 8 : 2 * registry->capacity;
+        void** grown = (void**)realloc(registry->records, capacity * sizeof *grown);
+        if (grown == NULL) return 0;
+        registry->records = grown;
+        registry->capacity = capacity;
+    }
+    registry->records[registry->count++] = record;
+    return 1;
+}
+
+void fmu_states_release(FmuStateRegistry* registry, long index) {
+    free(registry->records[index]);
+    registry->records[index] = registry->records[--registry->count];
+}
+
+void fmu_states_release_all(FmuStateRegistry* registry) {
+    for (size_t k = 0; k < registry->count; ++k) free(registry->records[k]);
+    free(registry->records);
+    registry->records = NULL;
+    registry->count = registry->capacity = 0;
+}

@@ -1,0 +1,54 @@
+/* FMU states of one instance: the record a state is kept in, its integrity check, and the registry
+ * of the records this instance handed out. Host pointers are looked up here, never dereferenced:
+ * an importer that passes garbage (an uninitialised fmi2FMUstate, a state where its address is
+ * expected) gets a refusal instead of a crash. */
+#ifndef GIMBAL_FMU_STATE_H
+#define GIMBAL_FMU_STATE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* The wrapper's own fields, followed by the core's snapshot bytes; serialized as is. Fixed-width
+ * fields only, without padding, so that any byte pattern can be read and checked. */
+typedef struct {
+    uint32_t magic;
+    uint32_t format_version;
+    uint64_t size;     /* of the whole record */
+    uint64_t checksum; /* of every byte after this field; filled in by serialization */
+    char guid[64];
+    int32_t state;
+    int32_t stop_time_defined;
+    int32_t last_step_status;
+    int32_t reserved;
+    double time;
+    double stop_time;
+    double last_successful_time;
+} StateHeader;
+
+#define STATE_MAGIC 0x46535441u /* "FSTA" */
+#define STATE_FORMAT_VERSION 2u
+
+/* Checksum of a serialized record: every 8-byte word goes through a bijective mix (MurmurHash3's
+ * finalizer), so any change confined to one word - every single-bit flip - changes the result. */
+uint64_t fmu_state_checksum(const unsigned char* record, size_t size);
+
+/* NULL when the bytes are a record of this FMU (size, magic, format, GUID and checksum), otherwise
+ * what is wrong with them. */
+const char* fmu_state_integrity_problem(const unsigned char* bytes, size_t size, size_t expected_size,
+                                        const char* guid);
+
+typedef struct {
+    void** records;
+    size_t count;
+    size_t capacity;
+} FmuStateRegistry;
+
+/* Index of a record this instance handed out, or -1. */
+long fmu_states_find(const FmuStateRegistry* registry, const void* record);
+/* 0 when out of memory (the record is then not registered). */
+int fmu_states_add(FmuStateRegistry* registry, void* record);
+/* Frees the record and forgets it. */
+void fmu_states_release(FmuStateRegistry* registry, long index);
+void fmu_states_release_all(FmuStateRegistry* registry);
+
+#endif
