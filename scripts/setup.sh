@@ -10,6 +10,9 @@ dpkg -s libsundials-dev >/dev/null 2>&1 || need_apt+=(libsundials-dev)
 dpkg -s libeigen3-dev >/dev/null 2>&1 || need_apt+=(libeigen3-dev)
 dpkg -s libtbb12 >/dev/null 2>&1 || need_apt+=(libtbb12)
 command -v ninja >/dev/null 2>&1 || need_apt+=(ninja-build)
+# FMI4j, one of the masters of the test suite, is a Java library built with Maven.
+command -v javac >/dev/null 2>&1 || need_apt+=(default-jdk-headless)
+command -v mvn >/dev/null 2>&1 || need_apt+=(maven)
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "[setup] installing Debian packages: ${need_apt[*]}"
   sudo_cmd=""
