@@ -4,7 +4,8 @@
 //
 // only_sequence replays one sequence and prints its trace with every logged message; the environment
 // variable FUZZ_SKIP="a,b,..." leaves sequences out, to look past a known crash or hang; FUZZ_TIMEOUT sets
-// the watchdog of each sequence in seconds (default 10).
+// the watchdog of each sequence in seconds (default 10); FUZZ_FP_TRAPS=1 enables trapping floating-point
+// exceptions (invalid, divide-by-zero, overflow) in this host around every FMU call, as some hosts do.
 //
 // Loads the shared object with dlopen and drives random call sequences through every fmi2* function,
 // with valid and invalid arguments: value references, values (NaN, +-inf, 1e300, -0.0, huge voltages,
@@ -31,6 +32,7 @@
 // so a failing sequence can be replayed alone, with its full trace and log, by passing only_sequence.
 #include <dlfcn.h>
 #include <fcntl.h>
+#include <fenv.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -578,6 +580,9 @@ void end_call(const CallScope& scope, const char* result) {
     FUZZ_CHECK(g_call.conversions == 0, "logged message contains an unescaped printf conversion", g_call.first_conversion);
 }
 
+bool g_fp_traps = false;
+constexpr int kHostTraps = FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW;
+
 // Runs one status-returning call and checks the invariants common to all of them.
 template <class F>
 fmi2Status call(Instance* instance, const std::string& description, F&& function) {
@@ -585,7 +590,20 @@ fmi2Status call(Instance* instance, const std::string& description, F&& function
     begin_call(instance, description);
     scope.captured_before = capture_size();
     scope.start = std::chrono::steady_clock::now();
+    // FUZZ_FP_TRAPS: the host runs with FP exceptions trapping (SIGFPE) during every FMU call; the FMU
+    // must compute in its own environment and give this one back unchanged.
+    if (g_fp_traps) {
+        feclearexcept(FE_ALL_EXCEPT);
+        feenableexcept(kHostTraps);
+    }
     const fmi2Status status = function();
+    if (g_fp_traps) {
+        const int enabled = fegetexcept();
+        const int rounding = fegetround();
+        fedisableexcept(FE_ALL_EXCEPT);
+        FUZZ_CHECK(enabled == kHostTraps, "the call changed the host's enabled FP exceptions", format("%#x", enabled));
+        FUZZ_CHECK(rounding == FE_TONEAREST, "the call changed the host's rounding mode", format("%d", rounding));
+    }
     const long long raw = static_cast<long long>(status);
     end_call(scope, status_name(raw));
 
@@ -1546,6 +1564,7 @@ int main(int argc, char** argv) {
     // Seconds per sequence (FUZZ_TIMEOUT overrides): a sequence normally takes milliseconds.
     const unsigned timeout = std::getenv("FUZZ_TIMEOUT") ? static_cast<unsigned>(std::atoi(std::getenv("FUZZ_TIMEOUT"))) : 10u;
     g_verbose = only >= 0;
+    g_fp_traps = std::getenv("FUZZ_FP_TRAPS") != nullptr && std::string(std::getenv("FUZZ_FP_TRAPS")) == "1";
 
     if (!read_model(argv[2], model)) {
         std::fprintf(stderr, "fuzz_fmi_calls: cannot read the GUID and variables from %s\n", argv[2]);
