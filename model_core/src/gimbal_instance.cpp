@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "gimbal/parameter_validation.hpp"
+#include "gimbal/variable_groups.hpp"
 
 namespace gimbal {
 namespace {
@@ -31,8 +32,6 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
     return a.attitude == b.attitude && a.attitude_rate == b.attitude_rate && a.attitude_accel == b.attitude_accel &&
            a.velocity_a == b.velocity_a && a.acceleration_a == b.acceleration_a;
 }
-
-Vec3 vector_at(const double* values, unsigned first) { return Vec3(values[first], values[first + 1], values[first + 2]); }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
 constexpr std::uint32_t kSnapshotVersion = 4;
@@ -241,11 +240,11 @@ StepInputs GimbalInstance::read_step_inputs(double step_start) const {
         inputs.voltage[axis] = clamp_voltage(params_.motor[axis], inputs.commanded_voltage[axis]);
         inputs.voltage_rate[axis] = voltage_rate_[axis];
     }
-    inputs.base.attitude = vector_at(reals_, vr_base_delta);
-    inputs.base.attitude_rate = vector_at(reals_, vr_base_delta_dot);
-    inputs.base.attitude_accel = vector_at(reals_, vr_base_delta_ddot);
-    inputs.base.velocity_a = vector_at(reals_, vr_base_v_a_1);
-    inputs.base.acceleration_a = vector_at(reals_, vr_base_a_a_1);
+    inputs.base.attitude = read_vector(reals_, kBaseMotion.attitude);
+    inputs.base.attitude_rate = read_vector(reals_, kBaseMotion.attitude_rate);
+    inputs.base.attitude_accel = read_vector(reals_, kBaseMotion.attitude_accel);
+    inputs.base.velocity_a = read_vector(reals_, kBaseMotion.velocity_a);
+    inputs.base.acceleration_a = read_vector(reals_, kBaseMotion.acceleration_a);
     inputs.step_start_time = step_start;
     return inputs;
 }
@@ -256,8 +255,8 @@ void GimbalInstance::publish_outputs() {
     const Dynamics& dynamics = system_->dynamics_at(now, state_);
     const ModelOutputs out = outputs_from(params_, system_->inputs(), system_->base_kinematics_at_time(now), now, dynamics);
     for (int k = 0; k < 4; ++k) {
-        reals_[vr_alpha + k] = out.full.angle[k];
-        reals_[vr_alpha_dot + k] = out.full.rate[k];
+        reals_[kBodyAngle[k]] = out.full.angle[k];
+        reals_[kBodyRate[k]] = out.full.rate[k];
     }
     reals_[vr_i_R1] = out.full.current[0];
     reals_[vr_i_R2] = out.full.current[1];
@@ -265,7 +264,7 @@ void GimbalInstance::publish_outputs() {
     reals_[vr_theta_b2] = out.full.backlash[1];
     reals_[vr_T_E1] = out.shaft_torque[0];
     reals_[vr_T_E2] = out.shaft_torque[1];
-    for (int k = 0; k < 3; ++k) reals_[vr_los_omega_1 + k] = out.payload_angular_velocity[k];
+    for (int k = 0; k < 3; ++k) reals_[kPayloadAngularVelocity[k]] = out.payload_angular_velocity[k];
     reals_[vr_energy_kinetic] = out.kinetic_energy;
     reals_[vr_energy_potential] = out.potential_energy;
     reals_[vr_energy_spring] = out.spring_energy;
@@ -283,7 +282,7 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_motor1_limited] = modes.motor_limited[0];
     integers_[vi_motor2_limited] = modes.motor_limited[1];
     for (int body = 0; body < 4; ++body)
-        integers_[vi_body1_stick_slip + body] = friction_mode_indicator(modes.friction[body], out.full.rate[body]);
+        integers_[kBodyStickSlip[body]] = friction_mode_indicator(modes.friction[body], out.full.rate[body]);
     const EventCounters& events = system_->counters();
     const IntegratorStatistics stats = integrator_->statistics();
     reals_[vr_events_last_time] = epoch_ + events.last_event_time;
@@ -306,8 +305,8 @@ void GimbalInstance::load_start_state() {
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     for (int body = 0; body < 4; ++body) {
         if (!layout.independent(body)) continue;
-        state_[layout.angle_slot[body]] = reals_[vr_alpha + body];
-        state_[layout.rate_slot[body]] = reals_[vr_alpha_dot + body];
+        state_[layout.angle_slot[body]] = reals_[kBodyAngle[body]];
+        state_[layout.rate_slot[body]] = reals_[kBodyRate[body]];
     }
     const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
     for (int axis = 0; axis < 2; ++axis) {
@@ -315,18 +314,18 @@ void GimbalInstance::load_start_state() {
         if (layout.backlash_slot[axis] >= 0) state_[layout.backlash_slot[axis]] = reals_[backlash[axis]];
         const int rotor = rotor_index(axis), load = load_index(axis);
         const double ratio = params_.gear[axis].ratio;
-        if (!layout.independent(rotor) && (reals_[vr_alpha + rotor] != ratio * reals_[vr_alpha + load] ||
-                                           reals_[vr_alpha_dot + rotor] != ratio * reals_[vr_alpha_dot + load])) {
+        if (!layout.independent(rotor) && (reals_[kBodyAngle[rotor]] != ratio * reals_[kBodyAngle[load]] ||
+                                           reals_[kBodyRate[rotor]] != ratio * reals_[kBodyRate[load]])) {
             logger_(GIMBAL_WARNING, "logStatusWarning",
                     std::string("rigid gear ") + std::to_string(axis + 1) + ": the start values of " +
-                        kRealVariables[vr_alpha + rotor].name + " and its rate are replaced by N times the load's");
+                        kRealVariables[kBodyAngle[rotor]].name + " and its rate are replaced by N times the load's");
         }
     }
 }
 
 GimbalStatus GimbalInstance::check_fixed_base(const char* function) const {
     if (!params_.fidelity.fixed_base) return GIMBAL_OK;
-    for (unsigned vr = vr_base_delta; vr <= vr_base_a_a_3; ++vr) {
+    for (RealVariable vr : kBaseInputs) {
         if (reals_[vr] != 0.0) {
             std::ostringstream s;
             s << function << ": " << kRealVariables[vr].name << " = " << reals_[vr]
@@ -539,8 +538,7 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
     const IntegerVariable friction_outputs[] = {vi_body1_stick_slip, vi_rotor1_stick_slip, vi_body2_stick_slip,
                                                 vi_rotor2_stick_slip};
     for (IntegerVariable vi : friction_outputs) check.within(kIntegerVariables[vi].name, snap.integers[vi], -2, 2);
-    for (unsigned vr = vi_events_total; vr <= vi_events_zeno_guard; ++vr)
-        check.count(kIntegerVariables[vr].name, snap.integers[vr]);
+    for (IntegerVariable vi : kEventCounters) check.count(kIntegerVariables[vi].name, snap.integers[vi]);
     const IntegerVariable solver_outputs[] = {vi_solver_states, vi_solver_steps, vi_solver_rhs_evaluations,
                                               vi_solver_jacobian_evaluations, vi_solver_method_switches};
     for (IntegerVariable vi : solver_outputs) check.count(kIntegerVariables[vi].name, snap.integers[vi]);
@@ -683,8 +681,6 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     start.modes = system_->modes();
     start.counters = system_->counters();
     start.work = integrator_->statistics();
-    std::copy(reals_, reals_ + kRealVariableCount, start.reals);
-    std::copy(integers_, integers_ + kIntegerVariableCount, start.integers);
     start.time = time_;
     GimbalStatus status;
     try {
@@ -701,8 +697,10 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
 void GimbalInstance::roll_back(const StepStart& start) {
     std::copy(start.state, start.state + kMaxStateSize, state_);
     system_->restore(start.modes, start.counters);
-    std::copy(start.reals, start.reals + kRealVariableCount, reals_);
-    std::copy(start.integers, start.integers + kIntegerVariableCount, integers_);
+    if (start.outputs_saved) {
+        std::copy(start.reals, start.reals + kRealVariableCount, reals_);
+        std::copy(start.integers, start.integers + kIntegerVariableCount, integers_);
+    }
     time_ = start.time;
     integrator_running_ = false;
     at_rest_ = false;
@@ -743,7 +741,7 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
     return GIMBAL_WARNING;
 }
 
-GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, const StepStart& start) {
+GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, StepStart& start) {
 
     const GimbalStatus base_status = check_fixed_base("fmi2DoStep");
     if (base_status != GIMBAL_OK) return base_status;
@@ -792,6 +790,10 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
     integrator_running_ = true;
     voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
     at_rest_ = system_->at_rest(step_end, state_);
+    // Only now is there anything to undo in the published values (a step at rest publishes nothing).
+    std::copy(reals_, reals_ + kRealVariableCount, start.reals);
+    std::copy(integers_, integers_ + kIntegerVariableCount, start.integers);
+    start.outputs_saved = true;
     time_ = current_time + step_size;
     publish_outputs();
     // Finite states can still give non-finite outputs from absurd inputs (a base velocity of 1e300

@@ -65,11 +65,12 @@ private:
         Modes modes;
         EventCounters counters;
         IntegratorStatistics work;
-        double reals[kRealVariableCount];
+        double reals[kRealVariableCount];  // the published values, once the step is about to change them
         int integers[kIntegerVariableCount];
+        bool outputs_saved = false;
         double time;
     };
-    GimbalStatus integrate_step(double current_time, double step_size, const StepStart& start);
+    GimbalStatus integrate_step(double current_time, double step_size, StepStart& start);
     void roll_back(const StepStart& start);
     GimbalStatus report_step_work(double step_size, const IntegratorStatistics& before, const EventCounters& events_before);
     void apply_master_tolerance();
