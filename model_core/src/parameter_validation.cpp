@@ -1,6 +1,7 @@
 #include "gimbal/parameter_validation.hpp"
 
 #include "gimbal/integrator.hpp"
+#include "gimbal/variable_groups.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -31,26 +32,11 @@ struct Checker {
     bool positive(RealVariable vr) { return require(vr, values[vr] > 0.0, "it must be > 0"); }
 };
 
-Vec3 vector_at(const double (&values)[kRealVariableCount], RealVariable first) {
-    return Vec3(values[first], values[first + 1], values[first + 2]);
-}
-
-struct BodyVariables {
-    RealVariable mass, inertia_xx, centre_of_mass, viscous, slip_torque;  // slip_torque: T_din, T_max, w_min, mu
-    const char* prefix;
-};
-
-// Each body's inertia block is laid out I_xx, I_yy, I_zz, I_xy, I_xz, I_yz in the variable table.
-const BodyVariables kBodyVariables[4] = {
-    {vr_body1_m, vr_body1_I_xx, vr_body1_d_bc_1, vr_body1_c_visc, vr_body1_T_din, "body1"},
-    {vr_rotor1_m, vr_rotor1_I_xx, vr_rotor1_d_be_1, vr_rotor1_c_visc, vr_rotor1_T_din, "rotor1"},
-    {vr_body2_m, vr_body2_I_xx, vr_body2_d_bd_1, vr_body2_c_visc, vr_body2_T_din, "body2"},
-    {vr_rotor2_m, vr_rotor2_I_xx, vr_rotor2_d_bf_1, vr_rotor2_c_visc, vr_rotor2_T_din, "rotor2"},
-};
-
-bool build_inertia(Checker& check, const BodyVariables& body, Mat3& inertia) {
-    const double* i = &check.values[body.inertia_xx];
-    inertia << i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2];
+bool build_inertia(Checker& check, const BodyParameterVariables& body, Mat3& inertia) {
+    const InertiaVariables& i = body.inertia;
+    const double xx = check.get(i.xx), yy = check.get(i.yy), zz = check.get(i.zz), xy = check.get(i.xy),
+                 xz = check.get(i.xz), yz = check.get(i.yz);
+    inertia << xx, xy, xz, xy, yy, yz, xz, yz, zz;
     const Eigen::SelfAdjointEigenSolver<Mat3> solver(inertia, Eigen::EigenvaluesOnly);
     const Vec3 principal = solver.eigenvalues();  // ascending
     std::ostringstream s;
@@ -81,17 +67,16 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     }
 
     for (int k = 0; k < 4; ++k) {
-        const BodyVariables& vars = kBodyVariables[k];
+        const BodyParameterVariables& vars = kBodyParameters[k];
         RigidBody& body = params.multibody.bodies[k];
-        if (!check.non_negative(vars.mass) || !check.non_negative(vars.viscous)) return false;
+        if (!check.non_negative(vars.mass) || !check.non_negative(vars.viscous_friction)) return false;
         if (!build_inertia(check, vars, body.inertia)) return false;
         body.mass = values[vars.mass];
-        body.centre_of_mass = vector_at(values, vars.centre_of_mass);
-        params.viscous_friction[k] = values[vars.viscous];
+        body.centre_of_mass = read_vector(values, vars.centre_of_mass);
+        params.viscous_friction[k] = values[vars.viscous_friction];
 
-        const RealVariable slip = vars.slip_torque;
-        const auto breakaway = static_cast<RealVariable>(slip + 1), stick_speed = static_cast<RealVariable>(slip + 2),
-                   damping = static_cast<RealVariable>(slip + 3);
+        const RealVariable slip = vars.dry_friction.slip_torque, breakaway = vars.dry_friction.breakaway_torque,
+                           stick_speed = vars.dry_friction.stick_speed, damping = vars.dry_friction.damping_factor;
         if (!check.non_negative(slip) || !check.non_negative(breakaway) || !check.non_negative(damping) ||
             !check.require(slip, values[slip] <= values[breakaway], "T_din must not exceed T_max") ||
             (values[breakaway] > 0.0 && !check.require(stick_speed, values[stick_speed] > 0.0,
@@ -100,7 +85,7 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         params.dry_friction[k] = DryFrictionParameters{values[slip], values[breakaway], values[stick_speed], values[damping]};
     }
     params.energy_accounting = flags[vb_energy_accounting];
-    params.multibody.d_ab = vector_at(values, vr_base_d_ab_1);
+    params.multibody.d_ab = read_vector(values, kBasePointB);
     if (!check.non_negative(vr_g)) return false;
     params.multibody.gravity = values[vr_g];
 
@@ -172,9 +157,8 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
 
 bool validate_start_state(const double (&values)[kRealVariableCount], const ModelParameters& params, std::string& error) {
     Checker check{values, error};
-    for (unsigned vr = vr_alpha; vr <= vr_theta_b2; ++vr)
-        if (!check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "a start value must be finite"))
-            return false;
+    for (RealVariable vr : kStartState)
+        if (!check.require(vr, std::isfinite(values[vr]), "a start value must be finite")) return false;
     const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
     for (int j = 0; j < 2; ++j) {
         // States a reduced fidelity removed are derived, and their start values are not used.
