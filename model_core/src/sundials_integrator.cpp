@@ -2,11 +2,47 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 #include <nvector/nvector_serial.h>
+#include <sundials/sundials_config.h>
+#include <sundials/sundials_logger.h>
+#include <sunmatrix/sunmatrix_dense.h>
 
 namespace gimbal {
+namespace {
+
+// The content of the backends' vectors and Jacobian: SUNDIALS' own, then the integrator whose spares
+// the clones come from. SUNDIALS reaches the content only through NV_CONTENT_S / SM_CONTENT_D, which
+// see the first member, and frees it with free(), as it was allocated.
+struct VectorContent {
+    _N_VectorContent_Serial sundials;
+    SundialsIntegrator* owner;
+};
+
+struct MatrixContent {
+    _SUNMatrixContent_Dense sundials;
+    SundialsIntegrator* owner;
+};
+
+// Replaces the content SUNDIALS made for a new vector or matrix by its Content; false (the content
+// untouched) when memory runs out.
+template <class Content>
+bool attach_owner(void*& content, SundialsIntegrator* owner) {
+    auto* extended = static_cast<Content*>(std::malloc(sizeof(Content)));
+    if (extended == nullptr) return false;
+    extended->sundials = *static_cast<decltype(extended->sundials)*>(content);
+    extended->owner = owner;
+    std::free(content);
+    content = extended;
+    return true;
+}
+
+SundialsIntegrator* owner_of(N_Vector vector) { return static_cast<VectorContent*>(vector->content)->owner; }
+SundialsIntegrator* owner_of(SUNMatrix matrix) { return static_cast<MatrixContent*>(matrix->content)->owner; }
+
+}  // namespace
 
 SundialsIntegrator::SundialsIntegrator(HybridSystem& system, const IntegratorSettings& settings,
                                        MessageSink error_sink, MessageSink event_sink)
@@ -18,8 +54,58 @@ SundialsIntegrator::SundialsIntegrator(HybridSystem& system, const IntegratorSet
       root_directions_(system.event_count(), 0) {}
 
 SundialsIntegrator::~SundialsIntegrator() {
+    for (int k = 0; k < spare_vector_count_; ++k) N_VDestroy(spare_vectors_[k]);
+    for (int k = 0; k < spare_empty_vector_count_; ++k) N_VDestroy_Serial(spare_empty_vectors_[k]);
+    if (spare_matrix_ != nullptr) SUNMatDestroy(spare_matrix_);
     if (y_ != nullptr) N_VDestroy(y_);
     if (context_ != nullptr) SUNContext_Free(&context_);
+}
+
+N_Vector SundialsIntegrator::make_vector() {
+    N_Vector vector = N_VNew_Serial(size_, context_);
+    if (vector == nullptr) return nullptr;
+    if (!attach_owner<VectorContent>(vector->content, this)) {
+        N_VDestroy(vector);
+        return nullptr;
+    }
+    vector->ops->nvclone = clone_vector;
+    vector->ops->nvcloneempty = clone_vector_empty;
+    return vector;
+}
+
+// A vector without data (SUNDIALS points it at arrays of its own), kept for reuse when destroyed.
+N_Vector SundialsIntegrator::make_empty_vector() {
+    N_Vector vector = N_VCloneEmpty_Serial(y_);
+    if (vector == nullptr) return nullptr;
+    if (!attach_owner<VectorContent>(vector->content, this)) {
+        N_VDestroy(vector);
+        return nullptr;
+    }
+    vector->ops->nvdestroy = release_empty_vector;
+    return vector;
+}
+
+N_Vector SundialsIntegrator::clone_vector(N_Vector original) {
+    SundialsIntegrator* owner = owner_of(original);
+    if (owner->spare_vector_count_ > 0) return owner->spare_vectors_[--owner->spare_vector_count_];
+    // More clones than the backend reserved: still right, but no longer safe from out-of-memory.
+    return owner->make_vector();
+}
+
+N_Vector SundialsIntegrator::clone_vector_empty(N_Vector original) {
+    SundialsIntegrator* owner = owner_of(original);
+    if (owner->spare_empty_vector_count_ > 0) return owner->spare_empty_vectors_[--owner->spare_empty_vector_count_];
+    // More at once than reserved: still right, but no longer safe from out-of-memory.
+    return owner->make_empty_vector();
+}
+
+void SundialsIntegrator::release_empty_vector(N_Vector vector) {
+    SundialsIntegrator* owner = owner_of(vector);
+    NV_DATA_S(vector) = nullptr;
+    if (owner->spare_empty_vector_count_ < kSpareEmptyVectors)
+        owner->spare_empty_vectors_[owner->spare_empty_vector_count_++] = vector;
+    else
+        N_VDestroy_Serial(vector);
 }
 
 bool SundialsIntegrator::create_vector() {
@@ -28,31 +114,77 @@ bool SundialsIntegrator::create_vector() {
         context_ = nullptr;
         return false;
     }
-    y_ = N_VNew_Serial(size_, context_);
+    y_ = make_vector();
     return y_ != nullptr;
+}
+
+bool SundialsIntegrator::reserve_spare_vectors(int count) {
+    while (spare_vector_count_ < std::min(count, kMaxSpareVectors)) {
+        N_Vector spare = make_vector();
+        if (spare == nullptr) return false;
+        spare_vectors_[spare_vector_count_++] = spare;
+    }
+    while (spare_empty_vector_count_ < kSpareEmptyVectors) {
+        N_Vector spare = make_empty_vector();
+        if (spare == nullptr) return false;
+        spare_empty_vectors_[spare_empty_vector_count_++] = spare;
+    }
+    return true;
+}
+
+bool SundialsIntegrator::reserve_spare_matrix() {
+    if (spare_matrix_ == nullptr) spare_matrix_ = SUNDenseMatrix(size_, size_, context_);
+    return spare_matrix_ != nullptr;
+}
+
+SUNMatrix SundialsIntegrator::create_matrix() {
+    SUNMatrix matrix = SUNDenseMatrix(size_, size_, context_);
+    if (matrix == nullptr) return nullptr;
+    if (!attach_owner<MatrixContent>(matrix->content, this)) {
+        SUNMatDestroy(matrix);
+        return nullptr;
+    }
+    matrix->ops->clone = clone_matrix;
+    return matrix;
+}
+
+SUNMatrix SundialsIntegrator::clone_matrix(SUNMatrix original) {
+    SundialsIntegrator* owner = owner_of(original);
+    SUNMatrix clone = owner->spare_matrix_;
+    owner->spare_matrix_ = nullptr;
+    // A second clone: still right, but no longer safe from out-of-memory.
+    return clone != nullptr ? clone : SUNMatClone_Dense(original);
 }
 
 void SundialsIntegrator::forward_error(int code, const char* module, const char* function, char* message,
                                      void* user_data) {
     auto* self = static_cast<SundialsIntegrator*>(user_data);
     if (code >= 0) return;  // warnings are not failures; the caller reports what matters
-    self->error_sink_(std::string(module) + "::" + function + ": " + message);
+    // Out of memory here loses this detail only: the caller still reports the failure.
+    without_exceptions(0, [&] {
+        self->error_sink_(std::string(module) + "::" + function + ": " + message);
+        return 0;
+    });
 }
 
 int SundialsIntegrator::right_hand_side(sunrealtype time, N_Vector y, N_Vector ydot, void* user_data) {
     auto* self = static_cast<SundialsIntegrator*>(user_data);
     // Recoverable failure: the integrator retries with a smaller step.
-    return self->system_.derivative(time, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)) ? 0 : 1;
+    return without_exceptions(-1, [&] {
+        return self->system_.derivative(time, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)) ? 0 : 1;
+    });
 }
 
 int SundialsIntegrator::event_functions(sunrealtype time, N_Vector y, sunrealtype* values, void* user_data) {
     auto* self = static_cast<SundialsIntegrator*>(user_data);
-    if (time < self->dwell_until_) {
-        std::fill(values, values + self->root_directions_.size(), 1.0);
+    return without_exceptions(-1, [&] {
+        if (time < self->dwell_until_) {
+            std::fill(values, values + self->root_directions_.size(), 1.0);
+            return 0;
+        }
+        self->system_.event_functions(time, N_VGetArrayPointer(y), values);
         return 0;
-    }
-    self->system_.event_functions(time, N_VGetArrayPointer(y), values);
-    return 0;
+    });
 }
 
 bool SundialsIntegrator::restart(double time, const double* state) {
@@ -141,3 +273,54 @@ IntegratorStatistics SundialsIntegrator::statistics() const {
 }
 
 }  // namespace gimbal
+
+// ---------------------------------------------------------------------------- SUNDIALS' logger
+// SUNContext_Create makes a SUNLogger, and SUNDIALS 6's (sundials_logger.c) is not safe when memory
+// runs out: it writes through an unchecked malloc (SUNHashMap_New), and when the next one fails it
+// keeps a freed pointer that SUNContext_Free frees again. Both crash the host. These definitions
+// stand in for that file, so the static link never takes it from libsundials_generic: a logger of one
+// checked allocation that writes nothing. Nothing is lost: the FMU must never print, and SUNDIALS'
+// own logger writes to stdout/stderr (errors reach the FMU's log through forward_error instead).
+#if SUNDIALS_VERSION_MAJOR != 6
+#error "the SUNLogger stand-in below follows the SUNDIALS 6 API"
+#endif
+
+struct SUNLogger_ {
+    int output_rank;
+};
+
+extern "C" {
+
+int SUNLogger_Create(void*, int output_rank, SUNLogger* logger) {
+    if (logger == nullptr) return -1;
+    *logger = static_cast<SUNLogger>(std::malloc(sizeof(SUNLogger_)));
+    if (*logger == nullptr) return -1;
+    (*logger)->output_rank = output_rank;
+    return 0;
+}
+
+int SUNLogger_CreateFromEnv(void* comm, SUNLogger* logger) { return SUNLogger_Create(comm, 0, logger); }
+
+int SUNLogger_SetErrorFilename(SUNLogger logger, const char*) { return logger != nullptr ? 0 : -1; }
+int SUNLogger_SetWarningFilename(SUNLogger logger, const char*) { return logger != nullptr ? 0 : -1; }
+int SUNLogger_SetDebugFilename(SUNLogger logger, const char*) { return logger != nullptr ? 0 : -1; }
+int SUNLogger_SetInfoFilename(SUNLogger logger, const char*) { return logger != nullptr ? 0 : -1; }
+int SUNLogger_QueueMsg(SUNLogger logger, SUNLogLevel, const char*, const char*, const char*, ...) {
+    return logger != nullptr ? 0 : -1;
+}
+int SUNLogger_Flush(SUNLogger logger, SUNLogLevel) { return logger != nullptr ? 0 : -1; }
+
+int SUNLogger_GetOutputRank(SUNLogger logger, int* output_rank) {
+    if (logger == nullptr || output_rank == nullptr) return -1;
+    *output_rank = logger->output_rank;
+    return 0;
+}
+
+int SUNLogger_Destroy(SUNLogger* logger) {
+    if (logger == nullptr) return 0;
+    std::free(*logger);
+    *logger = nullptr;
+    return 0;
+}
+
+}  // extern "C"

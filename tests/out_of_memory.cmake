@@ -1,0 +1,23 @@
+# Out-of-memory test (issue 12): tests/oom_shim.c, preloaded, fails the n-th allocation of a full FMU
+# lifecycle, for every n; tests/test_out_of_memory.cpp drives the FMU's shared object through it.
+#
+# Not with GIMBAL_SANITIZE: AddressSanitizer replaces malloc itself, and its runtime must come first
+# in the process, so the shim could neither be preloaded alongside it nor see the FMU's allocations.
+if(GIMBAL_SANITIZE)
+  return()
+endif()
+
+add_library(oom_shim SHARED oom_shim.c)
+target_compile_options(oom_shim PRIVATE -Wall -Wextra)
+set_target_properties(oom_shim PROPERTIES C_VISIBILITY_PRESET hidden)
+
+add_executable(test_out_of_memory test_out_of_memory.cpp)
+target_include_directories(test_out_of_memory PRIVATE ${FMI2_INCLUDE_DIR})
+target_compile_options(test_out_of_memory PRIVATE -Wall -Wextra)
+target_link_libraries(test_out_of_memory PRIVATE ${CMAKE_DL_LIBS})
+add_dependencies(test_out_of_memory fmu oom_shim)
+
+add_test(NAME out_of_memory
+         COMMAND test_out_of_memory ${PROJECT_BINARY_DIR}/fmu_staging/binaries/linux64/${MODEL_IDENTIFIER}.so
+                 ${PROJECT_BINARY_DIR}/fmu_staging/modelDescription.xml)
+set_tests_properties(out_of_memory PROPERTIES TIMEOUT 300 ENVIRONMENT "LD_PRELOAD=$<TARGET_FILE:oom_shim>")
