@@ -5,6 +5,8 @@
 #include <dlfcn.h>
 
 #include <cstdarg>
+#include <cstdlib>
+#include <type_traits>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -25,9 +27,11 @@ struct Api {
     fmi2ExitInitializationModeTYPE* exitInitializationMode;
     fmi2TerminateTYPE* terminate;
     fmi2ResetTYPE* reset;
+    fmi2SetDebugLoggingTYPE* setDebugLogging;
     fmi2SetRealTYPE* setReal;
     fmi2GetRealTYPE* getReal;
     fmi2SetIntegerTYPE* setInteger;
+    fmi2GetIntegerTYPE* getInteger;
     fmi2DoStepTYPE* doStep;
     fmi2GetFMUstateTYPE* getFMUstate;
     fmi2SetFMUstateTYPE* setFMUstate;
@@ -37,11 +41,17 @@ struct Api {
     fmi2DeSerializeFMUstateTYPE* deSerializeFMUstate;
 
     bool load(const char* path) {
-        handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-        if (handle == nullptr) {
+        void* opened = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+        if (opened == nullptr) {
             std::fprintf(stderr, "dlopen(%s) failed: %s\n", path, dlerror());
             return false;
         }
+        return bind(opened);
+    }
+
+    // The functions of an object the caller opened.
+    bool bind(void* opened) {
+        handle = opened;
         bool ok = true;
         auto find = [&](auto& pointer, const char* name) {
             pointer = reinterpret_cast<std::remove_reference_t<decltype(pointer)>>(dlsym(handle, name));
@@ -57,9 +67,11 @@ struct Api {
         find(exitInitializationMode, "fmi2ExitInitializationMode");
         find(terminate, "fmi2Terminate");
         find(reset, "fmi2Reset");
+        find(setDebugLogging, "fmi2SetDebugLogging");
         find(setReal, "fmi2SetReal");
         find(getReal, "fmi2GetReal");
         find(setInteger, "fmi2SetInteger");
+        find(getInteger, "fmi2GetInteger");
         find(doStep, "fmi2DoStep");
         find(getFMUstate, "fmi2GetFMUstate");
         find(setFMUstate, "fmi2SetFMUstate");

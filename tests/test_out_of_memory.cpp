@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "fmi2FunctionTypes.h"
+#include "fmu_loader.hpp"
 
 namespace {
 
@@ -67,60 +68,7 @@ bool load_shim() {
     return shim.arm != nullptr && shim.disarm != nullptr && shim.count != nullptr && shim.failures != nullptr;
 }
 
-struct Api {
-    fmi2InstantiateTYPE* instantiate;
-    fmi2FreeInstanceTYPE* freeInstance;
-    fmi2SetDebugLoggingTYPE* setDebugLogging;
-    fmi2SetupExperimentTYPE* setupExperiment;
-    fmi2EnterInitializationModeTYPE* enterInitializationMode;
-    fmi2ExitInitializationModeTYPE* exitInitializationMode;
-    fmi2TerminateTYPE* terminate;
-    fmi2ResetTYPE* reset;
-    fmi2GetRealTYPE* getReal;
-    fmi2GetIntegerTYPE* getInteger;
-    fmi2SetRealTYPE* setReal;
-    fmi2SetIntegerTYPE* setInteger;
-    fmi2DoStepTYPE* doStep;
-    fmi2GetFMUstateTYPE* getFMUstate;
-    fmi2SetFMUstateTYPE* setFMUstate;
-    fmi2FreeFMUstateTYPE* freeFMUstate;
-    fmi2SerializedFMUstateSizeTYPE* serializedFMUstateSize;
-    fmi2SerializeFMUstateTYPE* serializeFMUstate;
-    fmi2DeSerializeFMUstateTYPE* deSerializeFMUstate;
-};
-
-Api api;
-
-bool load_api(void* handle) {
-    bool ok = true;
-    auto find = [&](auto& pointer, const char* name) {
-        pointer = reinterpret_cast<std::remove_reference_t<decltype(pointer)>>(dlsym(handle, name));
-        if (pointer == nullptr) {
-            std::fprintf(stderr, "test_out_of_memory: %s is not exported\n", name);
-            ok = false;
-        }
-    };
-    find(api.instantiate, "fmi2Instantiate");
-    find(api.freeInstance, "fmi2FreeInstance");
-    find(api.setDebugLogging, "fmi2SetDebugLogging");
-    find(api.setupExperiment, "fmi2SetupExperiment");
-    find(api.enterInitializationMode, "fmi2EnterInitializationMode");
-    find(api.exitInitializationMode, "fmi2ExitInitializationMode");
-    find(api.terminate, "fmi2Terminate");
-    find(api.reset, "fmi2Reset");
-    find(api.getReal, "fmi2GetReal");
-    find(api.getInteger, "fmi2GetInteger");
-    find(api.setReal, "fmi2SetReal");
-    find(api.setInteger, "fmi2SetInteger");
-    find(api.doStep, "fmi2DoStep");
-    find(api.getFMUstate, "fmi2GetFMUstate");
-    find(api.setFMUstate, "fmi2SetFMUstate");
-    find(api.freeFMUstate, "fmi2FreeFMUstate");
-    find(api.serializedFMUstateSize, "fmi2SerializedFMUstateSize");
-    find(api.serializeFMUstate, "fmi2SerializeFMUstate");
-    find(api.deSerializeFMUstate, "fmi2DeSerializeFMUstate");
-    return ok;
-}
+fmu_loader::Api api;
 
 // ------------------------------------------------------------------------- the model description
 
@@ -647,7 +595,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "test_out_of_memory: dlopen(%s) failed: %s\n", argv[1], dlerror());
         return 2;
     }
-    if (!load_api(handle)) return 2;
+    if (!api.bind(handle)) return 2;
     if (only_n >= 0) return run_single(methods[0], only_n, only_persistent);
 
     const char* jobs_text = std::getenv("OOM_JOBS");

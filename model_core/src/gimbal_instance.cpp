@@ -95,6 +95,18 @@ struct SnapshotCheck {
     }
 };
 
+// The model a snapshot's values define, validated as at initialization.
+bool snapshot_parameters(const Snapshot& snap, ModelParameters& params, std::string& error) {
+    double reals[kRealVariableCount];
+    int integers[kIntegerVariableCount];
+    bool booleans[kBooleanVariableCount];
+    std::copy(snap.reals, snap.reals + kRealVariableCount, reals);
+    std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers);
+    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans[vr] = snap.booleans[vr] != 0;
+    return build_model_parameters(reals, integers, booleans, params, error) &&
+           validate_start_state(reals, params, error);
+}
+
 // The hybrid system keeps a reference to the instance's parameters, so new ones go in place before
 // it is built; this puts the previous ones back unless the new run is committed.
 class ParameterSwap {
@@ -581,15 +593,9 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
     }
     if (check.ok() && snap.initialized) {
         // The parameters must be valid, and the modes possible for the elements they define.
-        double reals[kRealVariableCount];
-        int integers[kIntegerVariableCount];
-        bool booleans[kBooleanVariableCount];
-        std::copy(snap.reals, snap.reals + kRealVariableCount, reals);
-        std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers);
-        for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans[vr] = snap.booleans[vr] != 0;
         ModelParameters params;
         std::string error;
-        if (!build_model_parameters(reals, integers, booleans, params, error)) check.fail(error);
+        if (!snapshot_parameters(snap, params, error)) check.fail(error);
         for (int axis = 0; axis < 2 && check.ok(); ++axis) {
             if (params.fidelity.gear[axis] != GearModel::backlash && snap.modes.gear_contact[axis] != 0)
                 check.fail("gear " + std::to_string(axis + 1) + " has no backlash but a contact mode");
@@ -620,16 +626,8 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     std::unique_ptr<HybridIntegrator> integrator;
     ParameterSwap swap(params_, params_);
     if (initialized) {
-        double reals[kRealVariableCount];
-        int integers[kIntegerVariableCount];
-        bool booleans[kBooleanVariableCount];
-        std::copy(snap.reals, snap.reals + kRealVariableCount, reals);
-        std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers);
-        for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans[vr] = snap.booleans[vr] != 0;
         std::string error;
-        if (!build_model_parameters(reals, integers, booleans, params, error) ||
-            !validate_start_state(reals, params, error))
-            return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
+        if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
         params_ = params;
         system = std::make_unique<GimbalHybridSystem>(params_);
         StepInputs in;
