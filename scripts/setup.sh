@@ -13,6 +13,9 @@ command -v ninja >/dev/null 2>&1 || need_apt+=(ninja-build)
 # FMI4j, one of the masters of the test suite, is a Java library built with Maven.
 command -v javac >/dev/null 2>&1 || need_apt+=(default-jdk-headless)
 command -v mvn >/dev/null 2>&1 || need_apt+=(maven)
+# fmi-sim, another master of the test suite, is built by cargo; its FMI bindings are generated with
+# bindgen, which loads libclang.
+dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "[setup] installing Debian packages: ${need_apt[*]}"
   sudo_cmd=""
