@@ -1,4 +1,5 @@
-"""Digital controllers of the master: none (constant voltages), PID per axis, state feedback.
+"""Digital controllers of the master: none (constant voltages), PID per axis, state feedback, and
+the user's own (type "python": a class of the user's, see UserController).
 
 A controller is called once per communication step with the measured signals at t_k and returns
 the voltages (u_R1, u_R2) computed from them; the master applies them later (one-sample delay,
@@ -13,7 +14,12 @@ the line of sight (secant correction). On a fixed base these equal beta_dot and 
 """
 from __future__ import annotations
 
+import importlib
+import importlib.util
+import inspect
 import math
+import pathlib
+import sys
 
 from . import geometry
 from .errors import SceneError, check_keys, number
@@ -36,6 +42,9 @@ class Controller:
         self.voltage = tuple(voltage)
         self.u_limit = tuple(u_limit)
         self.reference = (math.nan, math.nan)   # last set points, for the record
+
+    def start(self, step_size: float, scene_name: str) -> None:
+        """Called by the master before every run (the built-in controllers need nothing)."""
 
     def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude, base_rates) -> tuple:
         return self.voltage
@@ -170,12 +179,119 @@ class StateFeedback(Controller, _ReferenceMixin):
         return tuple(u)
 
 
-CONTROLLER_KEYS = {"type", "delay_steps", "reference", "voltage_V", "K", "ki", "rate_source"} | set(AXES)
+class Measurements:
+    """What the controller sees at t_k, after the sensor models: the encoder angles alpha, beta
+    [rad]; gyro = (w1, w2, w3), the payload's inertial angular velocity in frame 2 [rad/s] (w1 about
+    the elevation axis, w3 the cross-elevation rate; gyro_axis_rates turns them into the rates that
+    move the line of sight); the carrier attitude (delta, psi, gamma) [rad] and its rates [rad/s]."""
+    __slots__ = ("alpha", "beta", "gyro", "base_attitude", "base_rates")
+
+    def __init__(self, alpha, beta, gyro, base_attitude, base_rates):
+        self.alpha, self.beta = alpha, beta
+        self.gyro, self.base_attitude, self.base_rates = gyro, base_attitude, base_rates
 
 
-def make_controller(spec: dict | None, target, u_limit) -> Controller:
+class ControllerContext:
+    """What a user controller's reset() is told about the run: the communication step h [s], the
+    motors' voltage limits (U_L1, U_L2) [V], the target direction in G (or None), the delay of the
+    voltages in steps, and the scene's name."""
+    __slots__ = ("step_size", "u_limit", "target", "delay_steps", "scene_name")
+
+    def __init__(self, step_size, u_limit, target, delay_steps, scene_name):
+        self.step_size, self.u_limit, self.target = step_size, tuple(u_limit), target
+        self.delay_steps, self.scene_name = delay_steps, scene_name
+
+
+class UserController(Controller):
+    """A controller written by the user, named in a scene:
+
+        [controller]
+        type = "python"
+        module = "my_controller.py"     # a file (relative to the scene file) or an importable module
+        class = "MyController"
+        options = { kp = 40.0 }         # keyword arguments of the class
+
+    The class needs two methods:
+        reset(self, context)            # before every run (a ControllerContext)
+        step(self, t, measurements)     # at every communication point t_k -> (u_R1, u_R2) [V]
+    and may set `self.reference = (alpha_ref, beta_ref)` for the record. The master applies the
+    voltages with the scene's delay and saturates them at +-U_L like a DAC; a voltage that is not a
+    finite number stops the run with a message naming the class."""
+    kind = "python"
+
+    def __init__(self, spec: dict, target, u_limit, base_dir: pathlib.Path | None):
+        super().__init__(u_limit=u_limit)
+        self.target = target
+        cls = _load_class(spec, base_dir)
+        options = spec.get("options", {})
+        if not isinstance(options, dict):
+            raise SceneError("[controller] options must be a table of keyword arguments")
+        self.label = f"{cls.__module__}.{cls.__qualname__}"
+        try:
+            self.user = cls(**options)
+        except TypeError as exc:
+            raise SceneError(f"[controller] {self.label}({', '.join(options)}): {exc}") from None
+        for method in ("reset", "step"):
+            if not callable(getattr(self.user, method, None)):
+                raise SceneError(f"[controller] {self.label} has no method {method}(); a controller class needs "
+                                 "reset(context) and step(t, measurements)")
+        self.delay_steps = int(spec.get("delay_steps", 1))
+
+    def start(self, step_size: float, scene_name: str) -> None:
+        self.user.reset(ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name))
+
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates):
+        u = self.user.step(t, Measurements(alpha, beta, gyro, base_attitude, base_rates))
+        try:
+            u1, u2 = float(u[0]), float(u[1])
+        except (TypeError, ValueError, IndexError):
+            raise SceneError(f"{self.label}.step(t = {t:.6g}) returned {u!r}; it must return (u_R1, u_R2) in V") from None
+        if not (math.isfinite(u1) and math.isfinite(u2)):
+            raise SceneError(f"{self.label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite")
+        self.reference = getattr(self.user, "reference", (math.nan, math.nan))
+        return self.clamp(u1, 0), self.clamp(u2, 1)
+
+
+def _load_class(spec: dict, base_dir: pathlib.Path | None):
+    module_name, class_name = spec.get("module"), spec.get("class")
+    if not isinstance(module_name, str) or not isinstance(class_name, str):
+        raise SceneError("[controller] type = 'python' needs module = '<file.py or module>' and class = '<name>'")
+    candidates = [pathlib.Path(module_name)]
+    if base_dir is not None and not candidates[0].is_absolute():
+        candidates.insert(0, base_dir / module_name)
+    path = next((c for c in candidates if c.suffix == ".py" and c.is_file()), None)
+    try:
+        if path is not None:
+            unique = f"gimbal_user_controller_{abs(hash(str(path.resolve())))}"
+            module = sys.modules.get(unique)
+            if module is None:
+                loader_spec = importlib.util.spec_from_file_location(unique, path)
+                module = importlib.util.module_from_spec(loader_spec)
+                loader_spec.loader.exec_module(module)
+                sys.modules[unique] = module
+        elif module_name.endswith(".py"):
+            raise SceneError(f"[controller] module file '{module_name}' not found (looked in "
+                             f"{', '.join(str(c) for c in candidates)})")
+        else:
+            module = importlib.import_module(module_name)
+    except SceneError:
+        raise
+    except Exception as exc:  # the user's module failed to import: say where
+        raise SceneError(f"[controller] importing '{module_name}' failed: {type(exc).__name__}: {exc}") from None
+    cls = getattr(module, class_name, None)
+    if not inspect.isclass(cls):
+        raise SceneError(f"[controller] '{module_name}' has no class '{class_name}'")
+    return cls
+
+
+CONTROLLER_KEYS = {"type", "delay_steps", "reference", "voltage_V", "K", "ki", "rate_source", "module", "class",
+                   "options"} | set(AXES)
+
+
+def make_controller(spec: dict | None, target, u_limit, base_dir: pathlib.Path | None = None) -> Controller:
     """Builds the controller of a scene's [controller] table; `target` a unit vector in G or None,
-    `u_limit` the motors' voltage limits (the controller output saturates there, like a DAC)."""
+    `u_limit` the motors' voltage limits (the controller output saturates there, like a DAC),
+    `base_dir` where a user controller's module file is looked for first (the scene's folder)."""
     spec = dict(spec or {"type": "none"})
     check_keys("controller", spec, CONTROLLER_KEYS)
     kind = spec.get("type", "none")
@@ -193,4 +309,7 @@ def make_controller(spec: dict | None, target, u_limit) -> Controller:
         for axis in AXES:
             check_keys(f"controller.{axis}", spec.get(axis, {}), {"reference"})
         return StateFeedback(spec, target, u_limit)
-    raise SceneError(f"[controller] type must be 'none', 'pid' or 'state_feedback', got {kind!r}")
+    if kind == "python":
+        check_keys("controller", spec, {"type", "delay_steps", "module", "class", "options"})
+        return UserController(spec, target, u_limit, base_dir)
+    raise SceneError(f"[controller] type must be 'none', 'pid', 'state_feedback' or 'python', got {kind!r}")

@@ -23,6 +23,27 @@ from .progress import Progress
 from .results import RunResult
 from .scene import Scene, check_against_fmu, parameter_value, start_values
 
+class FMUCallFailed(Exception):
+    def __init__(self, function: str):
+        super().__init__(f"{function} returned fmi2Discard or fmi2Error")
+
+
+class RawCalls:
+    """The four functions of the loop, called through ctypes with plain addresses: fmpy's wrappers
+    convert and check every argument, which costs more than the FMU's own step."""
+
+    def __init__(self, slave):
+        import ctypes
+
+        status, pointer, size = ctypes.c_int, ctypes.c_void_p, ctypes.c_size_t
+        array_call = ctypes.CFUNCTYPE(status, pointer, pointer, size, pointer)
+        self.get_real = array_call(("fmi2GetReal", slave.dll))
+        self.get_integer = array_call(("fmi2GetInteger", slave.dll))
+        self.set_real = array_call(("fmi2SetReal", slave.dll))
+        self.do_step = ctypes.CFUNCTYPE(status, pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int)(
+            ("fmi2DoStep", slave.dll))
+
+
 REAL_OUTPUTS = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
 MODE_OUTPUTS = ["gear1.contact", "gear2.contact", "motor1.limited", "motor2.limited", "body1.stick_slip",
                 "rotor1.stick_slip", "body2.stick_slip", "rotor2.stick_slip", "events.total"]
@@ -61,11 +82,15 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     i_gyro = [real_names.index(f"los.omega[{j}]") for j in (1, 2, 3)]
     input_vrs = [fmu.vr("u_R1"), fmu.vr("u_R2")] + ([] if motion.fixed else [fmu.vr(b) for b in BASE_INPUTS])
 
-    rec_real = np.empty((n + 1, len(real_names)))
-    rec_mode = np.empty((n + 1, len(mode_names)))
-    u_cmd = np.empty((n + 1, 2))
-    u_applied = np.empty((n + 1, 2))
-    refs = np.empty((n + 1, 2))
+    # Everything the loop touches is preallocated: the FMU reads its inputs from row k of `inputs`
+    # (base columns filled for the whole run up front) and writes its outputs into row k of the
+    # records, through raw pointers; Python only runs the sensors and the controller.
+    rec_real = np.zeros((n + 1, len(real_names)))
+    rec_mode = np.zeros((n + 1, len(mode_names)), dtype=np.int32)
+    inputs = np.zeros((n + 1, len(input_vrs)))
+    if not motion.fixed:
+        inputs[:, 2:] = base
+    u_cmd, refs = [], []  # lists: appending costs less than writing a numpy row
 
     owned = slave is None
     if owned:
@@ -85,30 +110,44 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
         slave.enterInitializationMode()
         slave.setReal(input_vrs, [0.0, 0.0] + ([] if motion.fixed else base_rows[0]))
         slave.exitInitializationMode()
-        get_real, set_real, do_step = slave.getReal, slave.setReal, slave.doStep
-        get_int = slave.getInteger if mode_vrs else (lambda vrs: [])
+        calls = RawCalls(slave)
+        vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (real_vrs, mode_vrs, input_vrs)]
+        (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
+            [a.ctypes.data for a in vr_arrays], [len(a) for a in vr_arrays]
+        real_row, real_stride = rec_real.ctypes.data, rec_real.strides[0]
+        mode_row, mode_stride = rec_mode.ctypes.data, rec_mode.strides[0]
+        input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
+        component = slave.component
+        get_real, get_integer, set_real, do_step = calls.get_real, calls.get_integer, calls.set_real, calls.do_step
+        measure = sensors.measure
+        controller.start(h, scene.name)
         zero = (0.0, 0.0)
         for k in range(n + 1):
-            y = get_real(real_vrs)
-            rec_real[k] = y
-            rec_mode[k] = get_int(mode_vrs)
+            t = k * h
+            if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
+                raise FMUCallFailed("fmi2GetReal")
+            if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
+                raise FMUCallFailed("fmi2GetInteger")
+            y = rec_real[k].tolist()
             row = base_rows[k]
-            u = controller(k * h, h, *sensors.measure(y[i_alpha], y[i_beta], [y[i] for i in i_gyro], row[:3], row[3:6]))
-            u_cmd[k] = u
-            refs[k] = controller.reference
+            u = controller(t, h, *measure(y[i_alpha], y[i_beta], [y[i] for i in i_gyro], row[:3], row[3:6]))
+            u_cmd.append(u)
+            refs.append(controller.reference)
             applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
-            u_applied[k] = applied
             if k == n:
                 break
-            set_real(input_vrs, [applied[0], applied[1]] + ([] if motion.fixed else row))
-            do_step(currentCommunicationPoint=k * h, communicationStepSize=h)
-            if k % 64 == 0:
+            inputs[k, 0], inputs[k, 1] = applied
+            if set_real(component, input_refs, input_count, input_row + k * input_stride) > 1:
+                raise FMUCallFailed("fmi2SetReal")
+            if do_step(component, t, h, 1) > 1:
+                raise FMUCallFailed("fmi2DoStep")
+            if k % 256 == 0:
                 bar.update((k + 1) * h)
         bar.close()
         slave.terminate()
     except SceneError:
         raise
-    except Exception as exc:   # fmpy raises on fmi2Error / fmi2Discard
+    except Exception as exc:   # a refused FMI call, or fmpy raising on fmi2Error / fmi2Discard
         details = "; ".join((log or [])[-5:]) or "no log message"
         raise SceneError(f"{scene.name}: the FMU failed at t = {k * h:.6g} s ({exc}): {details}") from None
     finally:
@@ -116,9 +155,13 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
             slave.freeInstance()
     wall = time.perf_counter() - wall0
 
+    u_cmd, refs = np.array(u_cmd, dtype=float).reshape(-1, 2), np.array(refs, dtype=float).reshape(-1, 2)
+    # Applied over [t_k, t_k+1]: the command of `delay` steps before (0 V until the first is due).
+    u_applied = np.zeros_like(u_cmd)
+    u_applied[delay:] = u_cmd[:len(u_cmd) - delay]
     signals = {"time": times}
     signals.update({name: rec_real[:, j] for j, name in enumerate(real_names)})
-    signals.update({name: rec_mode[:, j] for j, name in enumerate(mode_names)})
+    signals.update({name: rec_mode[:, j].astype(float) for j, name in enumerate(mode_names)})
     signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0],
                     "u_R2_cmd": u_cmd[:, 1], "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
     signals.update({name: base[:, j] for j, name in enumerate(BASE_INPUTS)})

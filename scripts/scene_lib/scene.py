@@ -80,7 +80,7 @@ class Scene:
         return make_base_motion(self.base_motion_spec, self.path.parent)
 
     def controller(self, u_limit=(math.inf, math.inf)):
-        return make_controller(self.controller_spec, self.target, u_limit)
+        return make_controller(self.controller_spec, self.target, u_limit, base_dir=self.path.parent)
 
     def sensors(self):
         return Sensors(self.sensors_spec)
