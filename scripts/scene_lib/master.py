@@ -101,7 +101,7 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
             log.clear()
         slave.reset()
     bar = Progress(t_end, enabled=progress)
-    wall0 = time.perf_counter()
+    wall0, cpu0 = time.perf_counter(), time.process_time()
     k = 0
     try:
         slave.setupExperiment(startTime=0.0, stopTime=t_end)
@@ -153,7 +153,7 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     finally:
         if owned:
             slave.freeInstance()
-    wall = time.perf_counter() - wall0
+    wall, loop_cpu = time.perf_counter() - wall0, time.process_time() - cpu0
 
     u_cmd, refs = np.array(u_cmd, dtype=float).reshape(-1, 2), np.array(refs, dtype=float).reshape(-1, 2)
     # Applied over [t_k, t_k+1]: the command of `delay` steps before (0 V until the first is due).
@@ -166,4 +166,6 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
                     "u_R2_cmd": u_cmd[:, 1], "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
     signals.update({name: base[:, j] for j, name in enumerate(BASE_INPUTS)})
     signals["heave"] = motion.position(times)[:, 2]
-    return RunResult(scene, signals, wall, t_end)
+    result = RunResult(scene, signals, wall, t_end)
+    result.loop_cpu_time = loop_cpu  # set-up, initialization and the loop; not the base motion's evaluation
+    return result
