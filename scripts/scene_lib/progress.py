@@ -1,40 +1,26 @@
-"""A progress bar on stderr for long runs: silent for the first second, then redrawn at most
-five times a second."""
+"""Progress of a long scene run on stderr, through tqdm: silent for the first second (short runs
+stay quiet), then redrawn at most five times a second with the simulated time, the real-time factor
+and the time left."""
 from __future__ import annotations
 
 import sys
-import time
+
+from tqdm import tqdm
 
 
 class Progress:
+    """`update(t)` with the simulated time reached; `close()` at the end."""
+
     def __init__(self, total_time: float, enabled: bool = True, stream=sys.stderr, quiet_for: float = 1.0):
-        self.total, self.enabled, self.stream = total_time, enabled, stream
-        self.start = time.perf_counter()
-        self.quiet_for = quiet_for
-        self.last = 0.0
-        self.shown = False
+        self.bar = tqdm(total=total_time, disable=not enabled, file=stream, delay=quiet_for, mininterval=0.2,
+                        unit="s", unit_scale=False, bar_format="{l_bar}{bar:30}| t = {n:.3f} of {total:g} s "
+                        "[{elapsed}<{remaining}, {rate_fmt}]", dynamic_ncols=False, leave=True)
 
     def update(self, t: float) -> None:
-        if not self.enabled:
-            return
-        now = time.perf_counter() - self.start
-        if now < self.quiet_for or now - self.last < 0.2:
-            return
-        self.last = now
-        done = min(t / self.total, 1.0)
-        eta = now * (1.0 - done) / done if done > 0 else 0.0
-        bar = "#" * int(30 * done)
-        self.stream.write(f"\r[{bar:<30}] {100 * done:5.1f} %  t = {t:8.3f} s  "
-                          f"{t / now:6.1f}x real time  ~{eta:5.1f} s left ")
-        self.stream.flush()
-        self.shown = True
+        # The rate tqdm shows is simulated seconds per wall second: the real-time factor.
+        self.bar.update(t - self.bar.n)
 
     def close(self) -> None:
-        if self.shown:
-            self.update_final()
-
-    def update_final(self) -> None:
-        now = time.perf_counter() - self.start
-        self.stream.write(f"\r[{'#' * 30}] 100.0 %  t = {self.total:8.3f} s  {self.total / now:6.1f}x real time"
-                          + " " * 16 + "\n")
-        self.stream.flush()
+        if self.bar.n < self.bar.total:
+            self.bar.update(self.bar.total - self.bar.n)
+        self.bar.close()
