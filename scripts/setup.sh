@@ -29,7 +29,7 @@ if [ ! -x "$venv/bin/python" ]; then
   echo "[setup] creating the Python virtual environment in .venv"
   python3 -m venv "$venv"
 fi
-if ! "$venv/bin/python" -c "import fmpy, numpy, scipy, sympy, matplotlib, pytest, libcosimpy, ecospy, dask.distributed, pyarrow" >/dev/null 2>&1 ||
+if ! "$venv/bin/python" -c "import fmpy, numpy, scipy, sympy, matplotlib, pytest, libcosimpy, ecospy, dask.distributed, pyarrow, tqdm, nbclient, ipykernel" >/dev/null 2>&1 ||
    [ "$repo/requirements.txt" -nt "$venv/.requirements-installed" ]; then
   echo "[setup] installing Python packages (requirements.txt)"
   "$venv/bin/pip" install -q --disable-pip-version-check -r "$repo/requirements.txt"
