@@ -1,4 +1,4 @@
-"""Hard cases for the numerical stability of the FMU (issue 7).
+"""Hard cases for the numerical stability of the FMU.
 
 Every test asserts physical or hybrid invariants that a broken integrator would violate, not only that
 the run finished. Run on its own with `pytest tests/test_hard_cases.py`; each test also records its

@@ -11,7 +11,7 @@ __all__ = ["SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run
 
 
 def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_time: float | None = None):
-    """Runs one scene file and writes <out>/<name>.csv and .png; returns (result, csv, png)."""
+    """Runs one scene file and writes <out>/<scene file's name>.csv and .png; returns (result, csv, png)."""
     import pathlib
 
     from .plotting import plot

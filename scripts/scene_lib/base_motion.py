@@ -3,8 +3,8 @@
 Every generator returns, for an array of times, the 15 base inputs of the FMU in the order of
 INPUTS: attitude (pitch delta, yaw psi, roll gamma), their rates and accelerations, the velocity
 v_a and acceleration a_a of point a in G. Analytic motions give exact derivatives, so the values
-the master sets at each step start are kinematically consistent (the FMU extrapolates inside the
-step with constant acceleration, INTERFACE.md). Translations: surge = x_G, sway = y_G, heave = z_G.
+the master sets at each step start are kinematically consistent (the FMU extrapolates them inside
+the step with constant acceleration). Translations: surge = x_G, sway = y_G, heave = z_G.
 """
 from __future__ import annotations
 
@@ -125,32 +125,90 @@ def sea_state_components(significant_amplitude: float, peak_period: float, gamma
     return amplitude, omega, phase
 
 
+def read_csv_columns(path: pathlib.Path) -> tuple[list[str], list[np.ndarray]]:
+    """The columns of a recorded motion: a header row of names, then rows of numbers, all separated
+    by commas ('#' starts a comment). Anything else is refused with the file, line and column."""
+    where = f"base_motion: recorded motion {path}"
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise SceneError(f"{where}: cannot read it: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{where}: not a text file (byte {exc.start} is not UTF-8)") from None
+    lines = [(number, line.split("#", 1)[0].strip()) for number, line in enumerate(text.splitlines(), start=1)]
+    lines = [(number, line) for number, line in lines if line]
+    if not lines:
+        raise SceneError(f"{where}: the file is empty (expected a header such as 'time,gamma' and rows of numbers)")
+    header_line, header = lines[0]
+    if ";" in header and "," not in header:
+        raise SceneError(f"{where}: line {header_line} is separated by semicolons ({header!r}); the file must be "
+                         "comma-separated with '.' as the decimal point (save it as CSV with ',' separators)")
+    names = [name.strip().strip('"').strip() for name in header.split(",")]
+    for index, name in enumerate(names, start=1):
+        if not name:
+            raise SceneError(f"{where}: line {header_line} (the header): column {index} has no name")
+        if names.index(name) != index - 1:
+            raise SceneError(f"{where}: line {header_line} (the header): column '{name}' appears twice")
+    if "time" not in names:
+        raise SceneError(f"{where}: no 'time' column in the header (line {header_line}: {', '.join(names)})")
+    rows = []
+    for row, (number, line) in enumerate(lines[1:], start=1):
+        cells = line.split(",")
+        if len(cells) != len(names):
+            hint = " (semicolons: the file must be comma-separated)" if ";" in line else ""
+            raise SceneError(f"{where}: line {number} (data row {row}) has {len(cells)} cells, the header "
+                             f"{len(names)}{hint}")
+        values = []
+        for name, cell in zip(names, cells):
+            cell = cell.strip()
+            try:
+                value = float(cell)
+            except ValueError:
+                what = "is empty" if not cell else f"is not a number: {cell!r}"
+                raise SceneError(f"{where}: line {number} (data row {row}), column '{name}' {what}") from None
+            if not math.isfinite(value):
+                raise SceneError(f"{where}: line {number} (data row {row}), column '{name}' is {cell!r}, "
+                                 "not a finite number")
+            values.append(value)
+        rows.append(values)
+    if len(rows) < 4:
+        raise SceneError(f"{where}: {len(rows)} data rows; a cubic spline needs at least 4")
+    table = np.array(rows)
+    t = table[:, names.index("time")]
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if len(bad):
+        i = int(bad[0]) + 1
+        raise SceneError(f"{where}: 'time' must increase strictly, but line {lines[i + 1][0]} has {t[i]:g} after "
+                         f"{t[i - 1]:g}")
+    return names, [table[:, j] for j in range(len(names))]
+
+
 class Recorded(BaseMotion):
-    """A recorded motion (CSV with a header). Column `time` [s] and any of: delta, psi, gamma [rad]
-    (or pitch_deg, yaw_deg, roll_deg), their `_dot` and `_ddot` [rad/s, rad/s2], x, y, z [m] of point a
-    in G. Missing derivatives come from a C2 cubic spline through the samples, so attitude, rates and
-    accelerations stay consistent; absent quantities are 0."""
+    """A recorded motion: a comma-separated file with a header row of names (`#` starts a comment).
+    Column `time` [s] and any of: delta, psi, gamma [rad] (or pitch_deg, yaw_deg, roll_deg), their
+    `_dot` and `_ddot` [rad/s, rad/s2], x, y, z [m] of point a in G. Missing derivatives come from a
+    C2 cubic spline through the samples, so attitude, rates and accelerations stay consistent;
+    absent quantities are 0."""
     kind = "recorded"
 
     def __init__(self, path: pathlib.Path):
         from scipy.interpolate import CubicSpline
 
-        try:
-            data = np.genfromtxt(path, delimiter=",", names=True, comments="#")
-        except OSError as exc:
-            raise SceneError(f"base_motion: cannot read recorded motion {path}: {exc}") from None
-        names = data.dtype.names or ()
-        if "time" not in names:
-            raise SceneError(f"base_motion: {path} has no 'time' column (columns: {', '.join(names)})")
+        names, columns = read_csv_columns(path)
+        data = dict(zip(names, columns))
         t = data["time"]
-        if len(t) < 4 or np.any(np.diff(t) <= 0):
-            raise SceneError(f"base_motion: {path}: 'time' must be strictly increasing with at least 4 samples")
         self.t_end = float(t[-1])
         self.t_start = float(t[0])
         allowed = {"time"}
         self.splines = {}
         for i, (rad, deg) in enumerate([("delta", "pitch_deg"), ("psi", "yaw_deg"), ("gamma", "roll_deg")]):
             allowed |= {rad, deg, rad + "_dot", rad + "_ddot"}
+            if rad in names and deg in names:
+                raise SceneError(f"base_motion: {path}: columns '{rad}' and '{deg}' are the same angle; give one")
+            for derivative in (rad + "_dot", rad + "_ddot"):
+                if derivative in names and rad not in names and deg not in names:
+                    raise SceneError(f"base_motion: {path}: column '{derivative}' without the angle '{rad}' "
+                                     f"(or '{deg}') would be ignored; add the angle")
             if rad in names or deg in names:
                 q = data[rad] if rad in names else np.radians(data[deg])
                 spline = CubicSpline(t, q)

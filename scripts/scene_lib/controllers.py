@@ -3,7 +3,7 @@ the user's own (type "python": a class of the user's, see UserController).
 
 A controller is called once per communication step with the measured signals at t_k and returns
 the voltages (u_R1, u_R2) computed from them; the master applies them later (one-sample delay,
-seed section 2.5). Axis 1 is the azimuth (alpha, motor 1), axis 2 the elevation (beta, motor 2).
+its zero-order hold). Axis 1 is the azimuth (alpha, motor 1), axis 2 the elevation (beta, motor 2).
 
 Angle references: per axis from references.py, or `reference = "target"` in [controller]: both
 set points by inverse kinematics of the line-of-sight target for the measured base attitude.

@@ -1,4 +1,4 @@
-"""The one error type of scene handling, and small validation helpers shared by the modules."""
+"""The error and warning types of scene handling, and small validation helpers shared by the modules."""
 from __future__ import annotations
 
 import math
@@ -6,6 +6,10 @@ import math
 
 class SceneError(ValueError):
     """A scene that cannot be run; the message says where and why."""
+
+
+class SceneWarning(UserWarning):
+    """A scene that runs, but probably not as its author meant; the message names the key."""
 
 
 def check_keys(where: str, table: dict, allowed: set) -> None:

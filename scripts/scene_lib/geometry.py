@@ -1,4 +1,4 @@
-"""Line-of-sight geometry (MODEL.md section 1).
+"""Line-of-sight geometry.
 
 Frames: G inertial with z_G up; the base attitude is GT0 = Rx(delta) Rz(psi) Ry(gamma) (pitch, yaw,
 roll); the line of sight is the y axis of body 2, so in G it points along

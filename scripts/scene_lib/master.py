@@ -1,5 +1,5 @@
 """The co-simulation master: one FMU2Slave, fixed communication steps, the controller with the
-seed's zero-order-hold delay (section 2.5).
+zero-order-hold delay of the voltages.
 
 At each communication point t_k the master reads the FMU's outputs, lets the sensors measure and
 the controller compute u_k from them, and then steps the FMU over [t_k, t_{k+1}] with

@@ -1,16 +1,22 @@
 """PNG plots of a run: angles, rates, voltages, currents, backlash, line-of-sight error, base motion.
 
 Default panels depend on the scene (no LOS panel without a target, no base panel on a fixed base);
-the scene's [plot] table adds panels, or replaces a default panel of the same name.
+the scene's [plot] table adds panels, or replaces a default panel of the same name. Every sample is
+drawn as recorded: axis limits come from the data, never the other way round.
 """
 from __future__ import annotations
 
 import math
 import pathlib
+import textwrap
 
 import numpy as np
 
 DEG = 180.0 / math.pi
+# The error angle between two unit vectors of doubles is exact to ~1e-15 rad: below 1e-12 rad
+# (1e-9 mrad) it is zero (a run that starts on target), and a log axis down to there would squash
+# every real error into the top of the panel.
+ROUND_OFF_MRAD = 1e-9
 
 
 def signal_unit(name: str) -> tuple[float, str]:
@@ -57,8 +63,40 @@ LABELS = {"alpha": "alpha (azimuth)", "beta": "beta (elevation)", "alpha_ref": "
           "base.gamma": "roll gamma", "los_error": "LOS error"}
 
 
-def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
-    """Writes the PNG. `limits`: optional {signal: value} drawn as dashed +-lines (i_L, eta)."""
+def draw_los_error(ax, result, t: np.ndarray, values: np.ndarray) -> None:
+    """The line-of-sight error [mrad] on a log axis (a slew of a few rad and a settled error of
+    micro-radians in one panel) whose limits come from the data's own minimum and maximum, so no
+    sample is clipped. Zeros have no logarithm: with errors at round-off (ROUND_OFF_MRAD) or 0 the
+    axis is symlog, linear from 0 up to the smallest error above round-off, and they sit at 0.
+    The RMS line spans the window it is taken over."""
+    ax.plot(t, values, "-", lw=0.9, label=LABELS["los_error"])
+    m = result.los_metrics()
+    in_window = t >= m["from_s"] - 1e-12
+    start = t[in_window][0] if in_window.any() else t[0]   # los_metrics takes the whole run then
+    rms = m["rms"] * 1e3
+    ax.hlines(rms, start, t[-1], color="C1", lw=1.2, ls=":",
+              label=f"RMS over [{start:g}, {t[-1]:g}] s: {rms:.3g} mrad")
+    references = [rms]
+    bound = result.scene.requirements.get("los_rms_max_mrad")
+    if bound:
+        ax.hlines(bound, start, t[-1], color="C3", lw=0.8, ls="--", label=f"required RMS <= {bound:g} mrad")
+        references.append(bound)
+    finite = values[np.isfinite(values)]
+    resolved = np.concatenate([finite[finite > ROUND_OFF_MRAD], [r for r in references if r > ROUND_OFF_MRAD]])
+    if resolved.size == 0:
+        return
+    low, high = resolved.min(), resolved.max()
+    if np.any(finite < low):
+        ax.set_yscale("symlog", linthresh=low)
+        ax.set_ylim(min(finite.min(), 0.0), high * 1.5)
+    else:
+        ax.set_yscale("log")
+        ax.set_ylim(low / 1.5, high * 1.5)
+
+
+def figure(result, limits: dict | None = None):
+    """The figure of a run (matplotlib, Agg). `limits`: optional {signal: value} drawn as dashed
+    +-lines (i_L, eta)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -68,7 +106,7 @@ def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
     panels.update(scene.plot)
     limits = limits or {}
     t = s["time"]
-    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(10, 1.9 * len(panels) + 0.8), squeeze=False)
+    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(12, 1.9 * len(panels) + 0.8), squeeze=False)
     for ax, (panel, names) in zip(axes[:, 0], panels.items()):
         units = set()
         for name in names:
@@ -76,15 +114,8 @@ def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
             units.add(unit)
             style = "--" if name.endswith("_ref") else "-"
             values = np.asarray(s[name], dtype=float) * scale
-            if name == "los_error":
-                floor = max(np.percentile(values, 2), 1e-4 * values.max(), 1e-9)
-                ax.semilogy(t, np.maximum(values, floor), style, lw=0.9, label=LABELS.get(name, name))
-                m = result.los_metrics()
-                ax.axhline(m["rms"] * 1e3, color="C1", lw=0.8, ls=":",
-                           label=f"RMS from {m['from_s']:g} s: {m['rms'] * 1e3:.3g} mrad")
-                bound = scene.requirements.get("los_rms_max_mrad")
-                if bound:
-                    ax.axhline(bound, color="C3", lw=0.8, ls="--", label=f"required RMS <= {bound:g} mrad")
+            if name == "los_error" and result.has_target:
+                draw_los_error(ax, result, t, values)
             else:
                 ax.plot(t, values, style, lw=0.9, label=LABELS.get(name, name))
             if name in limits:
@@ -92,11 +123,23 @@ def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
                     ax.axhline(sign * limits[name] * scale, color="gray", lw=0.7, ls="--")
         ax.set_ylabel(f"{panel}\n[{', '.join(sorted(u for u in units if u)) or '-'}]", fontsize="small")
         ax.grid(True, alpha=0.3, which="both")
-        ax.legend(loc="upper right", fontsize="x-small", ncol=2)
+        # outside the axes: a legend box inside would cover samples
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0, fontsize="x-small")
     axes[-1, 0].set_xlabel("time [s]")
     axes[-1, 0].set_xlim(t[0], t[-1])
-    title = f"{scene.name}: {scene.description}"
-    fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize="medium")
+    title = f"{scene.title}: {scene.description}" if scene.description else scene.title
+    if scene.title != scene.name:
+        title = f"{title} ({scene.path.name})"
+    fig.suptitle("\n".join(textwrap.wrap(title, 130)), fontsize="medium")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    return fig
+
+
+def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
+    """Writes the PNG of `figure(result, limits)`."""
+    fig = figure(result, limits)
+    import matplotlib.pyplot as plt
+    try:
+        fig.savefig(path, dpi=100)
+    finally:
+        plt.close(fig)

@@ -1,7 +1,9 @@
 """Scene files: loading and validation.
 
-A scene is a TOML file (comments allowed). Top level: name, description, stop_time [s],
-step_size [s] (communication step), output_interval [s] (CSV rows; default every step). Tables:
+A scene is a TOML file (comments allowed). Top level: name (the title of the plot; default the
+file's name), description, stop_time [s], step_size [s] (communication step), output_interval [s]
+(CSV rows; default every step). The result files are named after the scene file, not after `name`
+(scenes/x.toml -> x.csv, x.png), so a copy of a scene never overwrites the original's results. Tables:
 
   [fidelity]      structural parameters of the FMU (gear1.model, gear2.model, motor1.model,
                   motor2.model, dry_friction, base.fixed); absent = the FMU's defaults (full model)
@@ -11,7 +13,8 @@ step_size [s] (communication step), output_interval [s] (CSV rows; default every
   [base_motion]   type = "fixed" | "sinusoids" | "sea_state" | "recorded" (base_motion.py)
   [target]        azimuth_deg, elevation_deg: the fixed inertial direction the line of sight should
                   hold (geometry.py); start_on_target = true starts the gimbal pointing at it
-  [controller]    type = "none" | "pid" | "state_feedback", delay_steps (default 1) (controllers.py)
+  [controller]    type = "none" | "pid" | "state_feedback" | "python", delay_steps (default 1)
+                  (controllers.py)
   [sensors]       encoder quantization, gyro and IMU noise (sensors.py; default ideal)
   [requirements]  los_rms_max_mrad, los_final_max_mrad, from_s: line-of-sight bounds the run must meet
   [test]          stop_time: the shortened end time the test suite runs the scene to
@@ -19,12 +22,16 @@ step_size [s] (communication step), output_interval [s] (CSV rows; default every
 
 Validation has two levels: `load_scene` checks everything a file alone can say; `check_against_fmu`
 checks the FMU variable names, causalities and types (the FMU's model description is the truth).
+A scene that runs, but likely not as meant (no controller, a motor the controller leaves at 0 V, a
+moving-base model with no base motion), loads with a SceneWarning per finding (Python's warnings
+module, so it shows on stderr; the list is also Scene.warnings).
 """
 from __future__ import annotations
 
 import math
 import pathlib
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,7 +39,7 @@ import numpy as np
 from . import geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
-from .errors import SceneError, check_keys, number, positive
+from .errors import SceneError, SceneWarning, check_keys, number, positive
 from .fmu import FIDELITY, FMU, STATES
 from .sensors import Sensors
 
@@ -43,7 +50,8 @@ TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", 
 @dataclass
 class Scene:
     path: pathlib.Path
-    name: str
+    name: str                 # the scene file's stem: names the result files and the FMU instance
+    title: str                # the file's `name`: the title of the plot
     description: str
     stop_time: float
     step_size: float
@@ -59,6 +67,7 @@ class Scene:
     test: dict
     plot: dict
     raw: dict = field(repr=False, default_factory=dict)
+    warnings: list = field(repr=False, default_factory=list)
 
     @property
     def n_steps(self) -> int:
@@ -123,11 +132,12 @@ def load_scene(path: pathlib.Path | str) -> Scene:
         raise SceneError(f"{path}: not valid TOML: {exc}") from None
     try:
         check_keys("top level", raw, TOP_KEYS)
-        for key in ("name", "stop_time", "step_size"):
+        for key in ("stop_time", "step_size"):
             if key not in raw:
                 raise SceneError(f"missing required key '{key}'")
-        if not isinstance(raw["name"], str) or not raw["name"].replace("_", "").replace("-", "").isalnum():
-            raise SceneError("'name' must be a string of letters, digits, '_' and '-' (it names the output files)")
+        title = raw.get("name", path.stem)
+        if not isinstance(title, str) or not title.strip():
+            raise SceneError("'name' (the title of the plot) must be a non-empty string")
         step = positive("step_size", raw["step_size"])
         target = raw.get("target")
         if target is not None:
@@ -135,7 +145,7 @@ def load_scene(path: pathlib.Path | str) -> Scene:
             target = {"azimuth_deg": number("target.azimuth_deg", target.get("azimuth_deg", 0.0)),
                       "elevation_deg": number("target.elevation_deg", target.get("elevation_deg", 0.0)),
                       "start_on_target": bool(target.get("start_on_target", False))}
-        scene = Scene(path=path, name=raw["name"], description=str(raw.get("description", "")),
+        scene = Scene(path=path, name=path.stem, title=title, description=str(raw.get("description", "")),
                       stop_time=positive("stop_time", raw["stop_time"]), step_size=step,
                       output_interval=positive("output_interval", raw.get("output_interval", step)),
                       fidelity=_table(raw, "fidelity", True), parameters=_table(raw, "parameters", True),
@@ -146,6 +156,9 @@ def load_scene(path: pathlib.Path | str) -> Scene:
         _validate(scene)
     except SceneError as exc:
         raise SceneError(f"{path}: {exc}") from None
+    for message in scene.warnings:
+        # stacklevel 1: one registry entry per message, so loading a scene twice warns once
+        warnings.warn(SceneWarning(f"{path}: {message}"))
     return scene
 
 
@@ -162,9 +175,27 @@ def _validate(scene: Scene) -> None:
         if name not in STATES:
             raise SceneError(f"[initial]: '{name}' is not a state (states: {STATES})")
         number(f"initial.{name}", value)
+    overlap = sorted(set(scene.fidelity) & set(scene.parameters))
+    if overlap:
+        # start_values would let [parameters] win without a word
+        raise SceneError(f"{', '.join(repr(n) for n in overlap)} set in both [fidelity] and [parameters]: "
+                         "set each FMU variable in one table only")
+    if scene.target_spec is not None:
+        elevation = number("target.elevation_deg", scene.target_spec["elevation_deg"])
+        if not -90.0 <= elevation <= 90.0:
+            raise SceneError(f"target.elevation_deg = {elevation:g} is outside [-90, 90] deg (0 = horizon, "
+                             f"90 = straight up); the direction behind is azimuth_deg + 180 with elevation "
+                             f"{math.copysign(180.0, elevation) - elevation:g}")
     delay = scene.controller_spec.get("delay_steps", 1)
     if not isinstance(delay, int) or isinstance(delay, bool) or delay < 0:
-        raise SceneError("[controller] delay_steps must be an integer >= 0 (1 = the seed's one-sample delay)")
+        raise SceneError("[controller] delay_steps must be an integer >= 0 (1 = a one-sample delay: the voltage "
+                         "computed at t_k is applied over [t_k+1, t_k+2])")
+    found = _check_controller(scene.controller_spec)
+    if not scene.base_motion_spec and scene.fidelity.get("base.fixed") is not True:
+        setting = "= false" if "base.fixed" in scene.fidelity else "is not set (the FMU's default is false)"
+        found.append(f"no [base_motion] while [fidelity] base.fixed {setting}: the base stays still, but the FMU "
+                     "runs its moving-base model; for a fixed base say [base_motion] type = \"fixed\" and "
+                     "\"base.fixed\" = true, for a moving one give the motion")
     motion = scene.base_motion()
     if scene.fidelity.get("base.fixed") is True and not motion.fixed:
         raise SceneError("[fidelity] base.fixed = true needs a fixed base: [base_motion] type = 'fixed'")
@@ -172,6 +203,7 @@ def _validate(scene: Scene) -> None:
         raise SceneError(f"[base_motion] the recording covers [{motion.t_start:g}, {motion.t_end:g}] s, "
                          f"not [0, {scene.stop_time:g}] s")
     scene.controller()
+    scene.warnings = found
     scene.sensors()
     check_keys("requirements", scene.requirements, {"los_rms_max_mrad", "los_final_max_mrad", "from_s"})
     for key, value in scene.requirements.items():
@@ -184,6 +216,71 @@ def _validate(scene: Scene) -> None:
     for panel, names in scene.plot.items():
         if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
             raise SceneError(f"[plot] {panel} must be a list of signal names")
+
+
+AXIS_MOTOR = {"azimuth": "u_R1", "elevation": "u_R2"}
+PID_GAINS = ("kp", "ki", "kd", "k_gyro", "k_ff")
+WHY_NOT_NEGATIVE = {
+    "kp": "a negative gain pushes the axis away from its set point",
+    "ki": "a negative gain integrates the axis away from its set point",
+    "kd": "a negative gain feeds the error's rate back with the wrong sign",
+    "k_gyro": "negative rate feedback undamps the axis",
+    "k_ff": "the feed-forward cancels the motor's back-emf (k_ff = N k_emf); a negative one adds to it",
+    "d_filter_s": "it is the time constant of the derivative filter",
+    "i_limit_V": "it bounds |ki * integral|",
+}
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check_controller(spec: dict) -> list[str]:
+    """Refuses gains of the wrong sign in the built-in controllers; returns warnings for a scene
+    without a controller and for motors a controller leaves at 0 V. Values that are not numbers
+    are left to the controller's own checks (make_controller), which run next. A "python"
+    controller's options are its own business."""
+    if "type" not in spec:
+        where = "no [controller]" if not spec else "[controller] has no type"
+        return [f"{where}: the gimbal runs open loop, both motors at 0 V (say [controller] type = \"none\" "
+                "if that is the point)"]
+    found = []
+    kind = spec["type"]
+    if kind == "pid":
+        for axis in AXIS_MOTOR:
+            table = spec.get(axis)
+            if table is None:
+                found.append(f"[controller] type = \"pid\" has no [controller.{axis}] table: the {axis} motor "
+                             f"({AXIS_MOTOR[axis]}) gets 0 V")
+                continue
+            if not isinstance(table, dict):
+                raise SceneError(f"[controller] '{axis}' must be a table ([controller.{axis}]), got {table!r}")
+            for key, why in WHY_NOT_NEGATIVE.items():
+                value = table.get(key, 0.0)
+                if _is_number(value) and value < 0:
+                    raise SceneError(f"controller.{axis}.{key} = {value:g} is negative: {why}")
+            if all(table.get(key, 0.0) == 0 for key in PID_GAINS):
+                found.append(f"[controller.{axis}] has no nonzero gain ({', '.join(PID_GAINS)}): the {axis} "
+                             f"motor ({AXIS_MOTOR[axis]}) gets 0 V")
+    elif kind == "state_feedback":
+        K, ki = spec.get("K"), spec.get("ki", [0.0, 0.0])
+        if not (isinstance(ki, list) and len(ki) == 2):
+            raise SceneError(f"controller.ki must be [ki of u_R1, ki of u_R2], got {ki!r}")
+        if not (isinstance(K, list) and len(K) == 2 and all(isinstance(row, list) and len(row) == 4 for row in K)):
+            return found
+        for i, axis in enumerate(AXIS_MOTOR):
+            motor = AXIS_MOTOR[axis]
+            # u = -K x: the gains of an axis's own angle error and rate must be >= 0 to pull it back
+            for j, what in ((i, "angle error"), (2 + i, "rate")):
+                if _is_number(K[i][j]) and K[i][j] < 0:
+                    raise SceneError(f"controller.K[{i}][{j}] = {K[i][j]:g} ({motor} per {axis} {what}) is negative: "
+                                     f"u = -K x then pushes the {axis} away from its set point")
+            if _is_number(ki[i]) and ki[i] < 0:
+                raise SceneError(f"controller.ki[{i}] = {ki[i]:g} ({motor}) is negative: "
+                                 f"{WHY_NOT_NEGATIVE['ki']}")
+            if all(k == 0 for k in K[i]) and ki[i] == 0:
+                found.append(f"[controller] K[{i}] and ki[{i}] are all zero: the {axis} motor ({motor}) gets 0 V")
+    return found
 
 
 def check_against_fmu(scene: Scene, fmu: FMU) -> None:
