@@ -1,43 +1,84 @@
 #!/usr/bin/env python3
-"""Run a parameter sweep / Monte Carlo of a scene on Dask: every case of SWEEP.toml (grid and/or
-seeded random sampling) applied to SCENE.toml, in parallel on a local cluster (processes, one
-thread each) or on an existing Dask scheduler; each worker extracts the FMU once and reuses its
-instance (fmi2Reset). Writes <out>/<sweep>__<scene>.parquet and .csv (one row per case:
-parameters, seeds, metrics, status, FMU log of failures) and .png (each metric against each swept
-parameter). A rerun skips the cases already in the table.
+"""Run a parameter sweep or Monte Carlo study of a scene on Dask.
 
-Usage: sweep.py SCENE.toml SWEEP.toml [--scheduler ADDRESS] [--workers N] [--out DIR] [--quiet]
-                [--fmu build/Gimbal2Axis.fmu] [--serial] [--threads] [--redo failed|all]
+Every case of SWEEP.toml (a grid and/or seeded random draws) is applied to SCENE.toml and run, in
+parallel on a local cluster (worker processes of one thread each) or on the workers of an existing
+Dask scheduler. Each worker extracts the FMU once and reuses its instance (fmi2Reset) case after case.
+
+Writes <out>/<sweep>__<scene>.parquet and .csv (one row per case: parameters, seeds, metrics,
+status, and the error and FMU log of a failed case) and .png (a summary plot). A rerun skips the
+cases already in the table, so an interrupted sweep (Ctrl-C, SIGTERM) continues where it stopped.
 """
-import argparse
-import pathlib
-import sys
+import signal
+
+if __name__ == "__mp_main__":
+    # A worker process of the local cluster: multiprocessing runs this file in it before anything
+    # else. A terminal's Ctrl-C reaches the whole process group; the sweep process (alone) saves
+    # the table and closes the cluster in order, and a worker dying of it would only print a
+    # traceback and lose the FMU the cases need.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+import argparse  # noqa: E402
+import pathlib  # noqa: E402
+import sys  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 from scene_lib import SceneError  # noqa: E402
 from sweep_lib import SweepError, run_sweep  # noqa: E402
+from sweep_lib.runner import Stopped  # noqa: E402
+
+EPILOG = """\
+sweep file:
+  [grid] (every combination) and/or [random] (seeded draws) tables of parameters, named by
+  their path into the scene (controller.azimuth.kp, base_motion.seed) or as FMU parameters
+  (gear1.k_s); a 'cases' limit; optional stop_time and metrics_from_s. The format in full:
+  README.md, section "Sweeps and Monte Carlo on Dask", and scripts/sweep_lib/spec.py.
+
+exit status:
+  0  every case of the sweep ran to the end (status ok)
+  1  some cases failed: their rows in the table have status = failed, the error in
+     the column 'message' and the FMU's log in 'fmu_log'
+  2  nothing ran: the scene, the sweep file or the options were refused
+     (a misspelt parameter name, a scheduler that does not answer, ...)
+  130, 143  interrupted by Ctrl-C or SIGTERM: the cases finished so far are kept
+
+example:
+  .venv/bin/python scripts/sweep.py scenes/ship_stabilization.toml sweeps/gains_1000.toml --workers 2
+"""
+
+
+def _terminated(signum, frame):
+    raise Stopped("terminated (SIGTERM)")
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scene", help="scene file (scenes/*.toml)")
-    parser.add_argument("sweep", help="sweep description (sweeps/*.toml)")
+    doc = __doc__.split("\n\n")
+    parser = argparse.ArgumentParser(description=doc[0] + "\n\n" + "\n\n".join(doc[1:]), epilog=EPILOG,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", metavar="SCENE.toml", help="scene file (scenes/*.toml)")
+    parser.add_argument("sweep", metavar="SWEEP.toml", help="sweep file (sweeps/*.toml): what to vary and how")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="an existing Dask scheduler (e.g. tcp://10.0.0.5:8786); default: a local cluster")
-    parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
-    parser.add_argument("--out", default=str(REPO / "results" / "sweeps"), help="output directory")
-    parser.add_argument("--fmu", default=str(REPO / "build" / "Gimbal2Axis.fmu"))
-    parser.add_argument("--quiet", action="store_true", help="no progress counter")
-    parser.add_argument("--serial", action="store_true", help="no Dask: run the cases one after the other here")
+                        help="run on the workers of this Dask scheduler (e.g. tcp://10.0.0.5:8786) instead of a "
+                             "local cluster")
+    parser.add_argument("--workers", type=int, default=2, metavar="N",
+                        help="worker processes of the local cluster (default 2)")
+    parser.add_argument("--out", default=str(REPO / "results" / "sweeps"), metavar="DIR",
+                        help="directory of the table and plot (default results/sweeps)")
+    parser.add_argument("--fmu", default=str(REPO / "build" / "Gimbal2Axis.fmu"),
+                        help="the FMU to run (default build/Gimbal2Axis.fmu)")
+    parser.add_argument("--quiet", action="store_true", help="no progress counter (warnings are still shown)")
+    parser.add_argument("--serial", action="store_true", help="no Dask: run the cases one after the other in this "
+                                                              "process")
     parser.add_argument("--threads", action="store_true",
                         help="local cluster of threads in this process instead of worker processes")
     parser.add_argument("--redo", choices=["failed", "all"], default=None,
-                        help="rerun the failed cases (or all) even though they are in the table")
+                        help="run the failed cases (or all cases) again, although the table has them")
     args = parser.parse_args()
     if args.workers < 1:
         parser.error("--workers must be >= 1")
+    signal.signal(signal.SIGTERM, _terminated)
     try:
         outcome = run_sweep(args.scene, args.sweep, args.fmu, args.out, scheduler=args.scheduler,
                             workers=args.workers, serial=args.serial, progress=not args.quiet, redo=args.redo,
@@ -45,15 +86,24 @@ def main() -> int:
     except (SceneError, SweepError) as exc:
         print(f"sweep.py: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as exc:
+        if not getattr(exc, "reported", False):
+            print(f"\nsweep: {str(exc) or 'interrupted'}", file=sys.stderr)
+        return 128 + (signal.SIGTERM if isinstance(exc, Stopped) else signal.SIGINT)
     total = outcome.ran + outcome.skipped
     print(f"{total} cases ({outcome.ran} run, {outcome.skipped} already done): {total - outcome.failed} ok, "
           f"{outcome.failed} failed; {outcome.wall_time:.1f} s")
-    if outcome.failed:
-        failed = [r for r in outcome.rows if r.get("status") != "ok"][:3]
-        for r in failed:
-            print(f"  failed case {r['case']} ({r['case_id']}): {r['message'].splitlines()[0][:200]}")
     print(f"wrote {outcome.parquet}, {outcome.csv} and {outcome.png}")
-    return 0
+    if not outcome.failed:
+        return 0
+    for r in [r for r in outcome.rows if r.get("status") != "ok"][:3]:
+        print(f"  failed case {r['case']} ({r['case_id']}): {r['message'].splitlines()[0][:200]}")
+    before = (f" ({outcome.failed_before} of them from an earlier run; --redo failed runs them again)"
+              if outcome.failed_before else "")
+    print(f"sweep.py: {outcome.failed} of {total} cases failed{before}: their rows in {outcome.csv} (and "
+          f".parquet) have status = failed, the error in the column 'message' and the FMU's log in 'fmu_log'",
+          file=sys.stderr)
+    return 1
 
 
 if __name__ == "__main__":

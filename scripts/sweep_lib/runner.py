@@ -6,8 +6,10 @@ import logging
 import math
 import os
 import pathlib
+import signal
 import sys
 import tempfile
+import threading
 import time
 import zipfile
 from dataclasses import dataclass
@@ -17,10 +19,17 @@ from scene_lib.fmu import FMU
 from scene_lib.scene import check_against_fmu, load_scene
 
 from . import table
-from .spec import SweepError, apply_case, case_key, load_sweep, resolve_names, scene_hash
+from .names import check_cases_accepted, resolve_names
+from .spec import SweepError, apply_case, case_key, load_sweep, scene_hash
 from .worker import fmu_digest, run_case
 
 SCRIPTS = pathlib.Path(__file__).resolve().parents[1]
+SCHEDULER_TIMEOUT_S = 5.0   # a scheduler that does not answer by then is not coming
+
+
+class Stopped(KeyboardInterrupt):
+    """SIGTERM, ending the sweep as Ctrl-C does (the cases finished so far are kept); its message
+    names the signal, and sweep.py's exit status tells the two apart."""
 
 
 @dataclass
@@ -33,6 +42,7 @@ class Outcome:
     skipped: int          # cases found in the table already
     failed: int           # failed cases among those of this sweep
     wall_time: float
+    failed_before: int = 0   # of `failed`, those kept from an earlier run (not rerun now)
 
 
 @dataclass
@@ -88,7 +98,7 @@ def prepare(scene_path, sweep_path, fmu: FMU):
     scene = load_scene(scene_path)
     check_against_fmu(scene, fmu)
     sweep = load_sweep(sweep_path)
-    resolved = resolve_names(sweep, fmu)
+    resolved, candidates = resolve_names(sweep, scene, fmu)
     digest = scene_hash(scene)
     cases = []
     for index, values in enumerate(sweep.expand()):
@@ -98,7 +108,10 @@ def prepare(scene_path, sweep_path, fmu: FMU):
             check_against_fmu(case.scene, fmu)
         except SceneError as exc:
             case.scene, case.error = None, f"invalid case: {exc}"
+        except (TypeError, ValueError, KeyError) as exc:   # a value of a type the scene's checks do not expect
+            case.scene, case.error = None, f"invalid case: {type(exc).__name__}: {exc}"
         cases.append(case)
+    check_cases_accepted(scene, sweep, fmu, resolved, cases, candidates)
     return scene, sweep, cases
 
 
@@ -129,7 +142,14 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
     from distributed import Client, LocalCluster
 
     if scheduler:
-        client = Client(scheduler)
+        try:
+            client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
+        except ValueError as exc:
+            raise SweepError(f"--scheduler {scheduler}: {exc}") from None
+        except (OSError, TimeoutError):
+            raise SweepError(f"no Dask scheduler answered at {scheduler} within {SCHEDULER_TIMEOUT_S:g} s; start one "
+                             f"(dask scheduler; dask worker ADDRESS --nthreads 1), or leave out --scheduler for a "
+                             f"local cluster") from None
         try:   # workers elsewhere may not have this checkout on their path
             client.upload_file(str(_zip_packages()))
         except Exception as exc:  # pragma: no cover - depends on the remote cluster
@@ -139,9 +159,45 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
     path = os.environ.get("PYTHONPATH", "")
     if str(SCRIPTS) not in path.split(os.pathsep):   # spawned worker processes import sweep_lib
         os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(SCRIPTS), path) if p)
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes, dashboard_address=None,
-                           silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+    cluster = None
+    try:
+        with _StopRequests():   # a half-started cluster cannot be closed in order
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+        return Client(cluster), cluster
+    except BaseException:
+        if cluster is not None:
+            cluster.close()
+        raise
+
+
+class _StopRequests:
+    """While active (in the main thread), Ctrl-C and SIGTERM are only recorded; check() raises them
+    (KeyboardInterrupt, Stopped) where the sweep can stop in order, never inside Dask's own code,
+    where an exception leaves a half-started cluster or a scheduler writing to a closed client. On
+    leaving, a request not raised yet is delivered again."""
+
+    def __init__(self):
+        self.pending: list = []
+        self.previous: dict = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.previous = {sig: signal.signal(sig, lambda signum, frame: self.pending.append(signum))
+                             for sig in (signal.SIGINT, signal.SIGTERM)}
+        return self
+
+    def check(self) -> None:
+        if self.pending:
+            signum = self.pending.pop(0)
+            self.pending.clear()
+            raise Stopped("terminated (SIGTERM)") if signum == signal.SIGTERM else KeyboardInterrupt()
+
+    def __exit__(self, *exc):
+        for sig, handler in self.previous.items():
+            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
+        for sig in dict.fromkeys(self.pending):
+            signal.raise_signal(sig)
 
 
 def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None = None, workers: int = 2,
@@ -178,6 +234,9 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
         table.write(table.merge(existing, new_rows), parameters, parquet, csv)
 
     bar = Progress(len(todo), enabled=progress and bool(todo))
+    warning = sweep.limit_warning()
+    if warning:
+        print(f"sweep: warning: {warning}", file=sys.stderr)
     if progress:
         print(f"sweep {sweep.name} on scene {scene.name}: {len(cases)} cases, {skipped} already done, "
               f"{len(todo)} to run" + ("" if not todo else " serially" if serial else
@@ -204,6 +263,9 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
         else:
             runnable.append(case)
     own_client = cluster = None
+    futures: list = []
+    scattered: list = []
+    interrupted = False
     try:
         if serial:
             for case in runnable:
@@ -211,43 +273,76 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
         elif runnable:
             from distributed import as_completed
 
-            if client is None:
-                own_client, cluster = make_client(scheduler, workers, processes)
-                client = own_client
-            fmu_future = client.scatter(fmu_bytes, broadcast=True, hash=False)
-            bar.start = time.perf_counter()   # the rate counts from here, not from the cluster's start
-            futures, cases_of = [], {}
-            for case in runnable:
-                future = client.submit(run_case, case.scene, case.case_id, fmu_future, digest, from_s,
-                                       key=f"gimbal-case-{digest[:8]}-{case.case_id}", pure=False, retries=1)
-                futures.append(future)
-                cases_of[future.key] = case
-            for future in as_completed(futures):
-                case = cases_of[future.key]
-                try:
-                    result = future.result()
-                except Exception as exc:   # the task itself died (e.g. its worker crashed twice)
-                    result = {"case_id": case.case_id, "status": "failed", "message": f"{type(exc).__name__}: {exc}",
-                              "fmu_log": "", "wall_time_s": math.nan, "worker": "?"}
-                future.release()
-                finish(case, result)
-    except KeyboardInterrupt:
-        save()
-        print(f"\nsweep: interrupted; {len(new_rows)} new cases kept in {parquet} (a rerun continues)",
-              file=sys.stderr)
+            with _StopRequests() as stop:
+                if client is None:
+                    own_client, cluster = make_client(scheduler, workers, processes)
+                    client = own_client
+                stop.check()
+                fmu_future = client.scatter(fmu_bytes, broadcast=True, hash=False)
+                scattered.append(fmu_future)
+                bar.start = time.perf_counter()   # the rate counts from here, not from the cluster's start
+                cases_of = {}
+                for case in runnable:
+                    future = client.submit(run_case, case.scene, case.case_id, fmu_future, digest, from_s,
+                                           key=f"gimbal-case-{digest[:8]}-{case.case_id}", pure=False, retries=1)
+                    futures.append(future)
+                    cases_of[future.key] = case
+                completed = as_completed(futures)
+                while not completed.is_empty():
+                    stop.check()
+                    batch = completed.next_batch(block=False)
+                    if not batch:
+                        time.sleep(0.05)
+                    for future in batch:
+                        case = cases_of[future.key]
+                        try:
+                            result = future.result()
+                        except Exception as exc:   # the task itself died (e.g. its worker crashed twice)
+                            result = {"case_id": case.case_id, "status": "failed",
+                                      "message": f"{type(exc).__name__}: {exc}", "fmu_log": "",
+                                      "wall_time_s": math.nan, "worker": "?"}
+                        future.release()
+                        finish(case, result)
+        rows = table.merge(existing, new_rows)
+        table.write(rows, parameters, parquet, csv)
+    except KeyboardInterrupt as exc:
+        interrupted = True
+        reason = str(exc) or "interrupted"
+        if new_rows:
+            save()
+            print(f"\nsweep: {reason}; the {len(new_rows)} cases finished in this run are kept in {parquet} (with "
+                  f"those of earlier runs); the same command again runs the rest", file=sys.stderr)
+        else:
+            print(f"\nsweep: {reason} before any case of this run finished; the same command again runs them",
+                  file=sys.stderr)
+        exc.reported = True   # for sweep.py: this message was the last word
         raise
     finally:
+        if interrupted and futures:
+            try:   # queued cases would keep a shared scheduler's workers busy
+                client.cancel(futures + scattered)
+            except Exception:
+                pass
+        if cluster is not None and interrupted:
+            # Our own cluster, dropped with cases still running: its scheduler's complaints about
+            # the work and the scattered FMU it loses are no news to the user who stopped it.
+            disabled = logging.root.manager.disable
+            logging.disable(logging.CRITICAL)
+            try:
+                cluster.close()
+            finally:
+                logging.disable(disabled)
         if own_client is not None:
             own_client.close()
-        if cluster is not None:
+        if cluster is not None and not interrupted:
             cluster.close()
-    rows = table.merge(existing, new_rows)
-    table.write(rows, parameters, parquet, csv)
     ids = {c.case_id for c in cases}
     mine = [r for r in rows if r["case_id"] in ids]
     failed = sum(r.get("status") != "ok" for r in mine)
+    ran_now = {c.case_id for c in todo}
+    failed_before = sum(r.get("status") != "ok" and r["case_id"] not in ran_now for r in mine)
     if plot:
         table.plot_summary(mine, parameters, png, f"sweep {sweep.name} on {scene.name}: {len(mine)} cases, "
-                                                 f"{len(mine) - failed} ok, {failed} failed")
-    return Outcome(parquet, csv, png, rows, len(todo), skipped, failed, time.perf_counter() - wall0)
+                                                 f"{len(mine) - failed} ok, {failed} failed", grid=list(sweep.grid))
+    return Outcome(parquet, csv, png, rows, len(todo), skipped, failed, time.perf_counter() - wall0, failed_before)
 

@@ -23,8 +23,9 @@ A sweep file (TOML, comments allowed):
   "base_motion.seed" = { integers = [0, 9999] }      # inclusive
   "gear1.model" = { choice = [0, 1, 2] }
 
-Cases: grid points x samples, the grid varying slowest, then truncated to `cases`. Sample j of
-every grid point uses the same random draws (common random numbers); each parameter has its own
+Cases: grid points x samples, the first grid parameter varying slowest, then truncated to `cases`
+(Sweep.limit_warning says what that leaves out; the runner prints it). Sample j of every grid
+point uses the same random draws (common random numbers); each parameter has its own
 random stream (seeded by `seed` and its name), so adding a parameter or raising `cases`/`samples`
 leaves the draws of the others, and the cases already run, unchanged.
 
@@ -52,8 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from scene_lib.errors import SceneError
-from scene_lib.fmu import FIDELITY
+from scene_lib.errors import SceneError, positive
 from scene_lib.scene import Scene
 
 TOP_KEYS = {"name", "description", "cases", "seed", "samples", "stop_time", "metrics_from_s", "grid", "random"}
@@ -61,6 +61,8 @@ FLAT_SECTIONS = {"parameters", "fidelity", "initial"}
 NESTED_SECTIONS = {"controller": "controller_spec", "base_motion": "base_motion_spec", "sensors": "sensors_spec",
                    "target": "target_spec"}
 DISTRIBUTIONS = {"uniform", "loguniform", "normal", "integers", "choice"}
+# A swept target.* on a scene without [target] starts from load_scene's defaults of a [target].
+NO_TARGET = {"azimuth_deg": 0.0, "elevation_deg": 0.0, "start_on_target": False}
 
 
 class SweepError(ValueError):
@@ -85,14 +87,29 @@ class Sweep:
     def parameters(self) -> list[str]:
         return list(self.grid) + [n for n in self.random if n not in self.grid]
 
+    @property
+    def grid_points(self) -> int:
+        return math.prod(len(values) for values in self.grid.values())
+
+    @property
+    def samples_per_point(self) -> int:
+        if not self.random:
+            return 1
+        if self.samples is not None:
+            return self.samples
+        return max(1, self.cases_limit // self.grid_points) if self.cases_limit else 1
+
+    @property
+    def full_size(self) -> int:
+        """Cases before the `cases` limit: grid points x samples."""
+        return self.grid_points * self.samples_per_point
+
     def expand(self) -> list[dict]:
         """The cases: one dict {parameter name: value} per case, in a fixed order."""
         names = list(self.grid)
         points = [dict(zip(names, combo)) for combo in itertools.product(*(self.grid[n] for n in names))]
         if self.random:
-            samples = self.samples
-            if samples is None:
-                samples = max(1, self.cases_limit // len(points)) if self.cases_limit else 1
+            samples = self.samples_per_point
             draws = {name: draw(name, spec, samples, self.seed) for name, spec in self.random.items()}
             cases = [dict(point, **{name: values[j] for name, values in draws.items()})
                      for point in points for j in range(samples)]
@@ -101,6 +118,40 @@ class Sweep:
         if self.cases_limit is not None:
             cases = cases[:self.cases_limit]
         return cases
+
+    def limit_warning(self) -> str | None:
+        """What a `cases` limit below grid points x samples leaves out, in words; None when nothing."""
+        limit, full = self.cases_limit, self.full_size
+        if limit is None or limit >= full:
+            return None
+        points, samples = self.grid_points, self.samples_per_point
+        shape = " x ".join(str(len(v)) for v in self.grid.values())
+        grid = f"{shape} = {points} grid points" if len(self.grid) > 1 else f"{points} grid points"
+        order = "the cases go in order, the first grid parameter varying slowest, so the limit keeps"
+        if not self.grid:
+            text = f"cases = {limit} runs the first {limit} of the {samples} samples"
+        elif samples == 1:
+            text = f"cases = {limit} runs {limit} of the {grid}: {order} the first {limit} and drops the last " \
+                   f"{points - limit}"
+        else:
+            whole, part = divmod(limit, samples)
+            dropped = points - whole - (part > 0)
+            kept = [f"{'grid point 1' if whole == 1 else f'the first {whole} grid points'} with all {samples} "
+                    f"samples"] if whole else []
+            kept += [f"grid point {whole + 1} with {part} of its {samples} samples"] if part else []
+            text = (f"cases = {limit} runs {limit} of the {full} cases ({grid} x {samples} samples): {order} "
+                    + " and ".join(kept)
+                    + (f", and drops the last {dropped} grid point{'s' * (dropped != 1)}" if dropped else ""))
+        kept_cases = self.expand()
+        missing = []
+        for name, values in self.grid.items():
+            seen = {repr(c[name]) for c in kept_cases}
+            absent = [f"{v:g}" if isinstance(v, float) else str(v) for v in values if repr(v) not in seen]
+            if absent:
+                missing.append(f"{name} = {', '.join(absent)}")
+        if missing:
+            text += f"; never run: {'; '.join(missing)}"
+        return text + f". Raise 'cases' to {full} (or leave it out) to run them all."
 
 
 def _plain(value):
@@ -221,7 +272,8 @@ def _flatten_names(table: dict, prefix: str = "") -> dict:
 
 def parse_name(name: str) -> tuple[str, list]:
     """(section, path): section one of FLAT_SECTIONS, NESTED_SECTIONS, 'stop_time' or 'fmu' (a bare
-    FMU name, resolved against the FMU later); path the key (flat) or list of keys (nested)."""
+    FMU name, resolved against the FMU by names.resolve_names); path the key (flat) or list of keys
+    (nested)."""
     head, _, rest = name.partition(".")
     if name == "stop_time":
         return "stop_time", []
@@ -234,24 +286,6 @@ def parse_name(name: str) -> tuple[str, list]:
             raise SweepError(f"'{name}': give the key, e.g. {head}.<key>")
         return head, [int(k) if k.isdigit() else k for k in rest.split(".")]
     return "fmu", [name]
-
-
-def resolve_names(sweep: Sweep, fmu) -> dict:
-    """name -> (section, path) with bare FMU names resolved (structural switches to fidelity);
-    names the FMU does not have are refused here, before anything runs."""
-    resolved = {}
-    for name in sweep.parameters:
-        section, path = parse_name(name)
-        if section == "fmu":
-            if not fmu.has(name):
-                raise SweepError(f"{sweep.path}: '{name}' is neither a scene section (parameters., fidelity., "
-                                 f"initial., controller., base_motion., sensors., target., stop_time) nor a "
-                                 f"variable of {fmu.path}")
-            section = "fidelity" if name in FIDELITY else "parameters"
-        elif section in FLAT_SECTIONS and section != "initial" and not fmu.has(path[0]):
-            raise SweepError(f"{sweep.path}: '{name}': '{path[0]}' is not a variable of {fmu.path}")
-        resolved[name] = (section, path)
-    return resolved
 
 
 def _set_nested(table, path: list, value, name: str):
@@ -280,14 +314,14 @@ def apply_case(scene: Scene, resolved: dict, case: dict, stop_time: float | None
     for name, value in case.items():
         section, path = resolved[name]
         if section == "stop_time":
-            changes["stop_time"] = float(value)
+            changes["stop_time"] = positive("stop_time", value)
         elif section in FLAT_SECTIONS:
             table = changes.setdefault(section, dict(getattr(scene, section)))
             table[path[0]] = value
         else:
             attr = NESTED_SECTIONS[section]
             if attr not in changes:
-                changes[attr] = copy.deepcopy(getattr(scene, attr) or {})
+                changes[attr] = copy.deepcopy(getattr(scene, attr) or ({} if section != "target" else NO_TARGET))
             _set_nested(changes[attr], path, value, name)
     return scene.with_changes(**changes)
 

@@ -76,63 +76,178 @@ def write(rows: list[dict], parameters: list[str], parquet_path: pathlib.Path, c
     tmp.replace(csv_path)
 
 
-def plot_summary(rows: list[dict], parameters: list[str], path: pathlib.Path, title: str = "") -> None:
-    """Each metric (rows of panels) against each swept parameter (columns); failed cases as red
-    crosses on the lower edge of the panels, so they are visible too."""
+LABELS = {"los_rms_mrad": "LOS RMS [mrad]", "los_peak_mrad": "LOS peak [mrad]", "i_peak_A": "peak |i| [A]",
+          "events": "events", "wall_time_s": "wall time [s]"}
+
+
+def is_seed(name: str) -> bool:
+    """A random seed: its values are labels, not an ordered quantity (no trend, no log scale)."""
+    last = name.rpartition(".")[2]
+    return last == "seed" or last.endswith("_seed")
+
+
+def _wrap(name: str, width: int = 22) -> str:
+    """A long dotted name on several lines, broken after dots, so neighbouring labels stay apart."""
+    lines, line = [], ""
+    for part in name.split("."):
+        piece = part if not line else "." + part
+        if line and len(line) + len(piece) > width:
+            lines.append(line + ".")
+            line = part
+        else:
+            line += piece
+    return "\n".join(lines + [line])
+
+
+def _tick(value) -> str:
+    """A grid value in at most 4 significant digits, without an exponent where it is avoidable
+    (16000, not 1.6e+04)."""
+    if isinstance(value, int) or not (1e-3 <= abs(value) < 1e6):
+        return f"{value:.4g}"
+    text = f"{value:.{max(0, 3 - math.floor(math.log10(abs(value))))}f}"
+    return text.rstrip("0").rstrip(".") if "." in text else text
+
+
+def _finite(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _numeric(rows: list[dict], name: str) -> bool:
+    values = [r.get(name) for r in rows if r.get(name) is not None]
+    return bool(values) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+
+
+def _log_scale(values, ratio: float = 50.0) -> bool:
+    """All positive and spanning `ratio` or more."""
+    positive = [v for v in values if _finite(v) and v > 0]
+    return bool(positive) and len(positive) == len(values) and max(positive) / min(positive) >= ratio
+
+
+def plot_summary(rows: list[dict], parameters: list[str], path: pathlib.Path, title: str = "",
+                 grid: list[str] | None = None) -> None:
+    """Writes the summary plot of a sweep (summary_figure) to `path`."""
+    import matplotlib.pyplot as plt
+
+    fig = summary_figure(rows, parameters, title, grid)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def summary_figure(rows: list[dict], parameters: list[str], title: str = "", grid: list[str] | None = None):
+    """The summary plot of a sweep. A grid of exactly two numeric parameters (e.g. two gains): a heat
+    map per metric over the two (the median over the samples of each grid point). Otherwise each
+    metric (rows of panels) against each swept parameter (columns), with the median per value of a
+    grid parameter; a seed gets no trend line. Failed cases are marked in red either way."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
-    numeric = []
-    for p in parameters:
-        vals = [r.get(p) for r in rows if r.get(p) is not None]
-        if vals and all(isinstance(v, (int, float)) for v in vals):
-            numeric.append(p)
-    metrics = [m for m in METRICS if any(r.get(m) is not None and r.get("status") == "ok"
-                                         and not (isinstance(r.get(m), float) and math.isnan(r[m])) for r in rows)]
-    if not numeric or not metrics:
-        numeric = numeric or ["case"]
-        metrics = metrics or ["wall_time_s"]
+    metrics = [m for m in METRICS if any(r.get("status") == "ok" and _finite(r.get(m)) for r in rows)]
     ok = [r for r in rows if r.get("status") == "ok"]
     failed = [r for r in rows if r.get("status") != "ok"]
-    fig, axes = plt.subplots(len(metrics), len(numeric), figsize=(3.2 * len(numeric) + 1.0, 2.3 * len(metrics) + 0.8),
-                             squeeze=False, sharex="col")
-    labels = {"los_rms_mrad": "LOS RMS [mrad]", "los_peak_mrad": "LOS peak [mrad]", "i_peak_A": "peak |i| [A]",
-              "events": "events", "wall_time_s": "wall time [s]"}
+    title = title or f"{len(rows)} cases: {len(ok)} ok, {len(failed)} failed"
+    pair = [p for p in (grid or []) if _numeric(rows, p) and not is_seed(p)
+            and len({r[p] for r in rows if r.get(p) is not None}) > 1]
+    if len(grid or []) == 2 and len(pair) == 2 and metrics:
+        return _heat_maps(plt, rows, pair[0], pair[1], metrics, title)
+    numeric = [p for p in parameters if _numeric(rows, p)] or ["case"]
+    return _scatter_panels(plt, rows, ok, failed, numeric, metrics or ["wall_time_s"], title)
+
+
+def _scatter_panels(plt, rows, ok, failed, numeric, metrics, title):
+    import numpy as np
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
+
+    fig, axes = plt.subplots(len(metrics), len(numeric), figsize=(3.3 * len(numeric) + 0.9, 2.3 * len(metrics) + 1.0),
+                             squeeze=False, sharex="col", layout="constrained")
     for j, p in enumerate(numeric):
-        x_all = np.array([float(r[p]) for r in rows if r.get(p) is not None])
+        seed = is_seed(p)
         floats = any(isinstance(r.get(p), float) for r in rows)
-        log_x = floats and x_all.size and np.all(x_all > 0) and x_all.max() / x_all.min() >= 10
+        log_x = not seed and floats and _log_scale([float(r[p]) for r in rows if r.get(p) is not None], 10.0)
         for i, m in enumerate(metrics):
             ax = axes[i, j]
-            x = np.array([float(r[p]) for r in ok if r.get(p) is not None and r.get(m) is not None])
-            y = np.array([float(r[m]) for r in ok if r.get(p) is not None and r.get(m) is not None])
+            pairs = [(float(r[p]), float(r[m])) for r in ok if r.get(p) is not None and _finite(r.get(m))]
+            x = np.array([a for a, _ in pairs])
+            y = np.array([b for _, b in pairs])
             ax.plot(x, y, ".", ms=3 if len(x) > 200 else 5, alpha=0.5 if len(x) > 200 else 0.9, color="tab:blue")
             levels = np.unique(x)
-            if 1 < len(levels) <= 12 and len(x) > len(levels):   # a grid parameter: median per value
-                med = [np.nanmedian(y[x == v]) for v in levels]
-                ax.plot(levels, med, "-o", color="k", ms=3, lw=1, label="median")
-            positive = y[np.isfinite(y) & (y > 0)]
-            if m.startswith("los") and positive.size and positive.max() / positive.min() >= 50:
+            if not seed and 1 < len(levels) <= 12 and len(x) > len(levels):   # a grid parameter
+                ax.plot(levels, [np.median(y[x == v]) for v in levels], "-o", color="k", ms=3, lw=1, label="median")
+            if m.startswith("los") and _log_scale(list(y)):
                 ax.set_yscale("log")
             xf = [float(r[p]) for r in failed if r.get(p) is not None]
             if xf:
                 ax.plot(xf, [0.0] * len(xf), "x", color="tab:red", transform=ax.get_xaxis_transform(), clip_on=False,
                         label=f"failed ({len(failed)})")
-                if i == 0 and j == 0:
-                    ax.legend(fontsize=7, loc="upper right")
+            if i == 0 and j == 0 and ax.get_legend_handles_labels()[0]:
+                ax.legend(fontsize=7, loc="upper right")
             if log_x:
                 ax.set_xscale("log")
+            else:   # few ticks, no offset text: long values (seeds, 0.53308) would run together
+                ax.xaxis.set_major_locator(MaxNLocator(nbins=4, integer=seed))
+                ax.xaxis.set_major_formatter(FuncFormatter(lambda v, pos: f"{v:.6g}"))
             if j == 0:
-                ax.set_ylabel(labels.get(m, m), fontsize=8)
+                ax.set_ylabel(LABELS.get(m, m), fontsize=8)
             if i == len(metrics) - 1:
-                ax.set_xlabel(p, fontsize=8)
+                ax.set_xlabel(_wrap(p) + (" (a seed)" if seed else ""), fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(True, alpha=0.3)
-    fig.suptitle(title or f"{len(rows)} cases: {len(ok)} ok, {len(failed)} failed", fontsize=10)
-    fig.subplots_adjust(left=0.8 / fig.get_figwidth(), right=0.98, bottom=0.6 / fig.get_figheight(),
-                        top=1 - 0.45 / fig.get_figheight(), wspace=0.3, hspace=0.12)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def _heat_maps(plt, rows, px, py, metrics, title):
+    import numpy as np
+    from matplotlib import colormaps
+    from matplotlib.colors import LogNorm
+
+    cmap = colormaps["viridis"].with_extremes(bad="0.85")   # grey: no case of the grid point ran to the end
+
+    xs = sorted({r[px] for r in rows if r.get(px) is not None})
+    ys = sorted({r[py] for r in rows if r.get(py) is not None})
+    cells = {(x, y): [r for r in rows if r.get(px) == x and r.get(py) == y] for x in xs for y in ys}
+    samples = max(len(c) for c in cells.values())
+    cols = min(len(metrics), 3)
+    nrows = -(-len(metrics) // cols)
+    width = max(3.8, 0.55 * len(xs) + 2.6)
+    fig, axes = plt.subplots(nrows, cols, figsize=(width * cols, max(3.2, 0.4 * len(ys) + 2.2) * nrows + 0.6),
+                             squeeze=False, layout="constrained")
+    for k, m in enumerate(metrics):
+        ax = axes[k // cols, k % cols]
+        z = np.full((len(ys), len(xs)), np.nan)
+        fails = np.zeros((len(ys), len(xs)), dtype=int)
+        for (x, y), members in cells.items():
+            i, j = ys.index(y), xs.index(x)
+            values = [float(r[m]) for r in members if r.get("status") == "ok" and _finite(r.get(m))]
+            fails[i, j] = sum(r.get("status") != "ok" for r in members)
+            if values:
+                z[i, j] = np.median(values)
+        finite = z[np.isfinite(z)]
+        norm = LogNorm(finite.min(), finite.max()) if m.startswith("los") and _log_scale(list(finite)) else None
+        image = ax.imshow(np.ma.masked_invalid(z), origin="lower", aspect="auto", cmap=cmap, norm=norm,
+                          interpolation="nearest")
+        if len(xs) * len(ys) <= 80:   # the numbers too, while they fit in the cells
+            for i in range(len(ys)):
+                for j in range(len(xs)):
+                    text = f"{z[i, j]:.3g}" if np.isfinite(z[i, j]) else ""
+                    if fails[i, j]:
+                        text += ("\n" if text else "") + f"{fails[i, j]} failed"
+                    bright = np.isfinite(z[i, j]) and image.norm(z[i, j]) > 0.5   # viridis: yellow at the top
+                    color = "tab:red" if fails[i, j] else "k" if bright else "w"
+                    ax.text(j, i, text, ha="center", va="center", fontsize=7, color=color)
+        ax.set_xticks(range(len(xs)), [_tick(v) for v in xs], fontsize=7, rotation=45 if len(xs) > 6 else 0)
+        ax.set_yticks(range(len(ys)), [_tick(v) for v in ys], fontsize=7)
+        ax.set_xlabel(_wrap(px, 40), fontsize=8)
+        if k % cols == 0:   # the same parameter along every row: once, clear of the colour bars
+            ax.set_ylabel(_wrap(py, 30), fontsize=8)
+        label = LABELS.get(m, m)
+        bar = fig.colorbar(image, ax=ax)
+        bar.set_label(label + (f", median of {samples}" if samples > 1 else ""), fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+        ax.set_title(label, fontsize=9)
+    for k in range(len(metrics), nrows * cols):
+        axes[k // cols, k % cols].set_visible(False)
+    fig.get_layout_engine().set(wspace=0.08, hspace=0.06)
+    fig.suptitle(title, fontsize=10)
+    return fig
