@@ -62,7 +62,13 @@ class _SumOfSines(BaseMotion):
         amplitude, omega, phase = terms
         arg = np.outer(t, omega) + phase
         s, c = np.sin(arg), np.cos(arg)
-        return s @ amplitude, c @ (amplitude * omega), -(s @ (amplitude * omega**2))
+        # Not `s @ amplitude`: a BLAS matrix-vector product sums in an order that depends on its thread
+        # count (Dask workers run BLAS single-threaded), so a case would give other bits on a worker
+        # than in a serial sweep. einsum's own loop sums the same way everywhere.
+        def weighted(values, weights):
+            return np.einsum("ij,j->i", values, weights)
+
+        return weighted(s, amplitude), weighted(c, amplitude * omega), -weighted(s, amplitude * omega**2)
 
     def sample(self, t):
         t = np.atleast_1d(np.asarray(t, dtype=float))
