@@ -21,7 +21,7 @@ from scene_lib.scene import check_against_fmu, load_scene
 from . import table
 from .names import check_cases_accepted, resolve_names
 from .spec import SweepError, apply_case, case_key, load_sweep, scene_hash
-from .worker import fmu_digest, run_case
+from .worker import fmu_digest, run_case, run_cases
 
 SCRIPTS = pathlib.Path(__file__).resolve().parents[1]
 SCHEDULER_TIMEOUT_S = 5.0   # a scheduler that does not answer by then is not coming
@@ -200,6 +200,19 @@ class _StopRequests:
             signal.raise_signal(sig)
 
 
+def cases_per_task(cases: int, workers: int, most: int = 16) -> int:
+    """Cases a Dask task runs one after the other: up to `most`, while every worker still gets at
+    least 8 tasks (the last ones balance the load)."""
+    return max(1, min(most, cases // (8 * max(workers, 1))))
+
+
+def _worker_count(client) -> int:
+    try:
+        return max(1, len(client.scheduler_info().get("workers", {})))
+    except Exception:
+        return 1
+
+
 def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None = None, workers: int = 2,
               serial: bool = False, progress: bool = True, redo: str | None = None, processes: bool = True,
               client=None, checkpoint_s: float = 20.0, plot: bool = True) -> Outcome:
@@ -282,11 +295,16 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
                 scattered.append(fmu_future)
                 bar.start = time.perf_counter()   # the rate counts from here, not from the cluster's start
                 cases_of = {}
-                for case in runnable:
-                    future = client.submit(run_case, case.scene, case.case_id, fmu_future, digest, from_s,
-                                           key=f"gimbal-case-{digest[:8]}-{case.case_id}", pure=False, retries=1)
+                # Several cases per task: a short case costs the scheduler about as much as it costs to
+                # run, so tasks carry a few (at least 8 tasks per worker remain, to balance the load).
+                per_task = cases_per_task(len(runnable), _worker_count(client))
+                for first in range(0, len(runnable), per_task):
+                    chunk = runnable[first:first + per_task]
+                    future = client.submit(run_cases, [(c.scene, c.case_id) for c in chunk], fmu_future, digest,
+                                           from_s, key=f"gimbal-cases-{digest[:8]}-{chunk[0].case_id}-{len(chunk)}",
+                                           pure=False, retries=1)
                     futures.append(future)
-                    cases_of[future.key] = case
+                    cases_of[future.key] = chunk
                 completed = as_completed(futures)
                 while not completed.is_empty():
                     stop.check()
@@ -294,15 +312,16 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
                     if not batch:
                         time.sleep(0.05)
                     for future in batch:
-                        case = cases_of[future.key]
+                        chunk = cases_of[future.key]
                         try:
-                            result = future.result()
+                            results = future.result()
                         except Exception as exc:   # the task itself died (e.g. its worker crashed twice)
-                            result = {"case_id": case.case_id, "status": "failed",
-                                      "message": f"{type(exc).__name__}: {exc}", "fmu_log": "",
-                                      "wall_time_s": math.nan, "worker": "?"}
+                            results = [{"case_id": case.case_id, "status": "failed",
+                                        "message": f"{type(exc).__name__}: {exc}", "fmu_log": "",
+                                        "wall_time_s": math.nan, "worker": "?"} for case in chunk]
                         future.release()
-                        finish(case, result)
+                        for case, result in zip(chunk, results):
+                            finish(case, result)
         rows = table.merge(existing, new_rows)
         table.write(rows, parameters, parquet, csv)
     except KeyboardInterrupt as exc:

@@ -167,3 +167,9 @@ def _worker_name() -> str:
         return get_worker().address
     except (ImportError, ValueError):
         return f"serial-{os.getpid()}"
+
+
+def run_cases(cases: list, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> list:
+    """run_case for each (scene, case_id), one after the other on this worker's instance: one Dask
+    task for several short cases."""
+    return [run_case(scene, case_id, fmu_bytes, digest, from_s) for scene, case_id in cases]
