@@ -55,27 +55,36 @@ class Case:
 
 
 class Progress:
-    """Cases done of the total, ok and failed, rate and time left, through tqdm: redrawn in place on a
-    terminal, else a line at most every 30 s (a log stays readable)."""
+    """A counter on stderr: done/total, ok/failed, rate and time left; redrawn in place on a
+    terminal, else a line every 10 % (or 30 s)."""
 
     def __init__(self, total: int, enabled: bool = True, stream=sys.stderr):
-        from tqdm import tqdm
-
-        tty = hasattr(stream, "isatty") and stream.isatty()
-        self.failed = 0
-        self.bar = tqdm(total=total, disable=not enabled, file=stream, unit="case", mininterval=0.2 if tty else 30.0,
-                        ascii=not tty, dynamic_ncols=tty, leave=True)
-
-    def restart_clock(self) -> None:
-        """The rate counts from now (not from the cluster's start)."""
-        self.bar.start_t = self.bar.last_print_t = time.time()
+        self.total, self.enabled, self.stream = total, enabled, stream
+        self.done = self.failed = 0
+        self.start = time.perf_counter()
+        self.tty = hasattr(stream, "isatty") and stream.isatty()
+        self.last_draw = 0.0
+        self.last_decile = -1
 
     def update(self, status: str) -> None:
+        self.done += 1
         self.failed += status != "ok"
-        self.bar.set_postfix_str(f"ok {self.bar.n + 1 - self.failed}, failed {self.failed}", refresh=False)
-        self.bar.update(1)
-        if self.bar.n >= self.bar.total:
-            self.bar.close()
+        if not self.enabled:
+            return
+        now = time.perf_counter() - self.start
+        decile = int(10 * self.done / max(self.total, 1))
+        final = self.done == self.total
+        if self.tty and (now - self.last_draw < 0.2 and not final):
+            return
+        if not self.tty and not final and decile == self.last_decile and now - self.last_draw < 30:
+            return
+        self.last_draw, self.last_decile = now, decile
+        rate = self.done / now if now > 0 else 0.0
+        left = (self.total - self.done) / rate if rate > 0 else math.inf
+        text = (f"[{self.done:>{len(str(self.total))}}/{self.total}] {100 * self.done / max(self.total, 1):5.1f} %  "
+                f"ok {self.done - self.failed}  failed {self.failed}  {rate:6.2f} cases/s  ~{left:5.0f} s left")
+        self.stream.write(("\r" + text + ("\n" if final else "")) if self.tty else text + "\n")
+        self.stream.flush()
 
 
 def _effective_seed(scene) -> int | None:
@@ -284,7 +293,7 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
                 stop.check()
                 fmu_future = client.scatter(fmu_bytes, broadcast=True, hash=False)
                 scattered.append(fmu_future)
-                bar.restart_clock()
+                bar.start = time.perf_counter()   # the rate counts from here, not from the cluster's start
                 cases_of = {}
                 # Several cases per task: a short case costs the scheduler about as much as it costs to
                 # run, so tasks carry a few (at least 8 tasks per worker remain, to balance the load).
