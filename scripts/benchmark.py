@@ -192,7 +192,7 @@ def fmt(x, spec=".3g"):
     return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
 
-def main() -> int:
+def parse_args(argv=None) -> argparse.Namespace:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build-dir", type=pathlib.Path, default=REPO / "build")
     ap.add_argument("--bench", type=pathlib.Path, help="gimbal_bench executable (default BUILD/benchmarks/gimbal_bench)")
@@ -213,31 +213,22 @@ def main() -> int:
     ap.add_argument("--out", type=pathlib.Path, default=REPO / "benchmarks" / "results")
     ap.add_argument("--quick", action="store_true", help="smoke test: 1 s runs, 3 tolerances, no long durations")
     ap.add_argument("--replot", action="store_true", help="only redraw the PNG and the tables from OUT/results.json")
-    args = ap.parse_args()
-
-    if args.replot:
-        results = json.loads((args.out / "results.json").read_text())
-        methods = [None if m == "None" else int(m) for m in results["methods"]]
-        fidelities = list(results["references"])
-        plot(results, args.out / "work_precision.png", methods, fidelities, results["settings"]["duration_s"])
-        summary(results, methods, fidelities, results["settings"]["duration_s"])
-        return 0
-
+    args = ap.parse_args(argv)
     if args.quick:
         args.duration = 1.0
         args.rtols = "1e-4,1e-6,1e-8"
         args.durations = "1,2"
         args.overhead_steps = 20000
+    return args
 
-    build = args.build_dir.resolve()
-    bench = (args.bench or build / "benchmarks" / "gimbal_bench").resolve()
-    so = build / "fmu_staging" / "binaries" / "linux64" / "Gimbal2Axis.so"
-    md = build / "fmu_staging" / "modelDescription.xml"
-    missing = [p for p in (bench, so, md) if not p.exists()]
-    if missing:
-        print("benchmark: missing " + ", ".join(str(p) for p in missing) + ".\n"
-              "Build first: `bash scripts/setup.sh` (fresh machine) or `cmake --build build` "
-              "(the top-level CMakeLists.txt must contain add_subdirectory(benchmarks)).", file=sys.stderr)
+
+def main(argv=None) -> int:
+    """The steps of the module's docstring, one function each; results.json, the plot, the tables."""
+    args = parse_args(argv)
+    if args.replot:
+        return replot(args.out)
+    binaries = find_binaries(args)
+    if binaries is None:
         return 2
 
     t_start = time.time()
@@ -249,155 +240,219 @@ def main() -> int:
         "reference": "rtol 1e-12, atol 1e-14", "error": "max abs over communication points"}}
 
     with tempfile.TemporaryDirectory(prefix="gimbal_bench_") as tmp:
-        drv = Driver(bench, so, md, pathlib.Path(tmp), args.run_timeout)
+        drv = Driver(*binaries, pathlib.Path(tmp), args.run_timeout)
         results["fmu_guid"] = drv.guid
-        if args.methods is not None:
-            methods = [int(m) for m in args.methods.split(",")]
-            if not drv.has_method:
-                print("benchmark: --methods given but the FMU has no parameter solver.method", file=sys.stderr)
-                return 2
-        elif drv.has_method:
-            methods = [4, 5, 6, 0, 3] if drv.default_method == 4 else [0, 1, 2, 3]
-        else:
-            methods = [None]
-            log("note: the FMU has no parameter 'solver.method': only its default integrator is measured")
+        methods = choose_methods(drv, args.methods)
+        if methods is None:
+            return 2
         results["methods"] = {str(m): METHOD_NAMES.get(m, f"method {m}") for m in methods}
-
-        # ---------------------------------------------------------------- references
-        references: dict = {}
         results["references"] = {}
-        ref_method = 0 if drv.has_method else None
-        for fid in fidelities:
-            log(f"[reference] {fid}: rtol 1e-12, atol 1e-14, {args.duration:g} s ...")
-            ref = drv.run(method=ref_method, fidelity=fid, rtol=1e-12, atol=1e-14, duration=args.duration,
-                          step=args.step, trajectory=True, timeout=max(args.run_timeout, 600))
-            if ref.get("failure") or "_trajectory" not in ref:
-                log(f"  reference failed: {ref.get('failure')}")
-                return 1
-            references[fid] = ref["_trajectory"]
-            # A second solution to bound the reference's own error: another method, or rtol 1e-11.
-            # ARKODE's explicit RK (method 3) shares nothing with CVODE BDF but the model.
-            check_method = 3 if drv.has_method else None
-            check = drv.run(method=check_method, fidelity=fid, rtol=1e-12 if drv.has_method else 1e-11,
-                            atol=1e-14 if drv.has_method else 1e-13, duration=args.duration, step=args.step,
-                            trajectory=True, timeout=max(args.run_timeout, 600))
-            spread = errors_against(check, references[fid])
-            results["references"][fid] = {"run": strip(ref), "check_run": strip(check), "check_difference": spread}
-            log(f"  cpu {ref['cpu_s']:.2f} s; second solution differs by beta {fmt(spread['err_beta'])} rad, "
-                f"alpha {fmt(spread['err_alpha'])} rad, omega {fmt(spread['err_omega'])} rad/s")
-
-        # ---------------------------------------------------------------- work-precision sweep
-        sweep = []
-        for fid in fidelities:
-            for m in methods:
-                for rtol in rtols:
-                    atol = rtol * args.atol_factor
-                    run = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
-                                  step=args.step, trajectory=True)
-                    # Cheap runs are noisy: keep the fastest of up to three.
-                    if not run.get("failure") and run["cpu_s"] < 0.5:
-                        for _ in range(2):
-                            again = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
-                                            step=args.step)
-                            if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
-                                for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
-                                    run[key] = again[key]
-                    if not run.get("failure"):
-                        fmu_cpu = run["cpu_s"] - (run.get("master_cpu_s") or 0.0)
-                        run["fmu_cpu_s"] = fmu_cpu
-                        run["fmu_rtf"] = run["simulated"] / fmu_cpu if fmu_cpu > 0 else None
-                    point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol,
-                             **errors_against(run, references[fid]), **strip(run)}
-                    sweep.append(point)
-                    log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} rtol {rtol:.0e}: "
-                        + (f"FAILED {run['failure']}" if run.get("failure") else
-                           f"cpu {run['cpu_s']:.3f} s  rtf {run['rtf']:9.1f}  err beta {fmt(point['err_beta'])}  "
-                           f"alpha {fmt(point['err_alpha'])}  omega {fmt(point['err_omega'])}  "
-                           f"steps {run['solver_steps']}  rhs {run['rhs_evaluations']}  jac {run['jacobian_evaluations']}"))
-                    if run.get("failure", "").startswith("timeout"):
-                        log("  (tighter tolerances of this method skipped)")
-                        break
-        results["sweep"] = sweep
-
-        # Cheapest run meeting the beta target, per method and fidelity.
-        best = []
-        for fid in fidelities:
-            for m in methods:
-                ok = [p for p in sweep if p["fidelity"] == fid and p["method"] == m and p["err_beta"] is not None
-                      and p["err_beta"] <= TARGET_BETA_ERROR]
-                if ok:
-                    p = min(ok, key=lambda p: p["cpu_s"])
-                    best.append({"fidelity": fid, "method": m, "rtol": p["rtol"], "cpu_s": p["cpu_s"],
-                                 "rtf": p["rtf"], "fmu_rtf": p.get("fmu_rtf"),
-                                 "cpu_us_per_step": p["cpu_us_per_step"], "err_beta": p["err_beta"], "err_alpha": p["err_alpha"],
-                                 "err_omega": p["err_omega"], "target_rtf": TARGET_RTF.get(fid),
-                                 "meets_target": p["rtf"] >= TARGET_RTF.get(fid, 0)})
-                else:
-                    best.append({"fidelity": fid, "method": m, "rtol": None, "cpu_s": None, "rtf": None,
-                                 "err_beta": None, "target_rtf": TARGET_RTF.get(fid), "meets_target": False})
-        results["at_target_error"] = best
-
-        # ---------------------------------------------------------------- cost against duration
-        # The FMU's default integrator at the loosest swept tolerance that meets the beta target.
-        full_default = [p for p in best if p["fidelity"] == "full" and p["method"] == drv.default_method]
-        default_rtol = full_default[0]["rtol"] if full_default and full_default[0]["rtol"] else None
-        durations = [float(x) for x in args.durations.split(",")]
-        growth = []
-        rate = None
-        for d in durations:
-            planned = d
-            if rate is not None and d / rate > args.duration_budget:
-                planned = max(durations[0], math.floor(args.duration_budget * rate / 10.0) * 10.0)
-                log(f"[duration] {d:g} s would take ~{d / rate:.0f} s CPU: running {planned:g} s instead")
-            run = drv.run(fidelity="full", rtol=default_rtol, atol=None if default_rtol is None else default_rtol * args.atol_factor,
-                          duration=planned, step=args.step, timeout=max(args.run_timeout, 4 * args.duration_budget))
-            if run.get("failure"):
-                log(f"[duration] {planned:g} s: FAILED {run['failure']}")
-                growth.append({"requested_s": d, "simulated_s": planned, "failure": run["failure"]})
-                continue
-            rate = run["simulated"] / run["cpu_s"]
-            growth.append({"requested_s": d, "simulated_s": run["simulated"], "cpu_s": run["cpu_s"],
-                           "cpu_us_per_simulated_ms": 1e3 * run["cpu_s"] / run["simulated"], "rtf": run["rtf"],
-                           "solver_steps": run["solver_steps"], "rhs_evaluations": run["rhs_evaluations"],
-                           "events": run["events"], "dostep_allocations": run["dostep_allocations"]})
-            log(f"[duration] {run['simulated']:g} s: cpu {run['cpu_s']:.3f} s = "
-                f"{1e3 * run['cpu_s'] / run['simulated']:.2f} us per simulated ms, rtf {run['rtf']:.1f}")
-        results["cost_vs_duration"] = {"method": drv.default_method, "fidelity": "full", "rtol": default_rtol,
-                                       "runs": growth}
-
-        # ---------------------------------------------------------------- FMI overhead, allocations
-        overhead = {}
-        for fid in fidelities:
-            run = drv.run(fidelity=fid, overhead=True, overhead_steps=args.overhead_steps, trace=True)
-            overhead[fid] = strip(run)
-            if run.get("failure"):
-                log(f"[overhead] {fid}: FAILED {run['failure']}")
-            else:
-                log(f"[overhead] {fid}: {run['ns_per_dostep']:.0f} ns per doStep (CPU), "
-                    f"{run['rhs_evaluations'] / max(1, run['dostep_calls']):.2f} rhs per doStep; instance "
-                    f"{run['instance_bytes']} bytes in {run['instance_allocations']} allocations; "
-                    f"{run['dostep_allocations']} allocations in {run['dostep_calls']} doSteps")
-        results["fmi_overhead"] = overhead
-        alloc = {}
-        for fid in fidelities:
-            run = drv.run(fidelity=fid, duration=2.0, step=args.step, trace=True)
-            alloc[fid] = {k: run.get(k) for k in ("dostep_calls", "first_step_allocations", "dostep_allocations",
-                                                  "dostep_alloc_bytes", "events", "allocation_sites", "failure")}
-            log(f"[allocations] {fid}: {run.get('dostep_allocations')} allocations in "
-                f"{run.get('dostep_calls')} doSteps after the first ({run.get('events')} events)")
-        results["allocations_in_dostep"] = alloc
+        references = measure_references(drv, fidelities, args, results["references"])
+        if references is None:
+            return 1
+        results["sweep"] = work_precision_sweep(drv, methods, fidelities, rtols, args, references)
+        results["at_target_error"] = best = at_target_error(results["sweep"], methods, fidelities)
+        results["cost_vs_duration"] = cost_vs_duration(drv, best, args)
+        results["fmi_overhead"] = fmi_overhead(drv, fidelities, args.overhead_steps)
+        results["allocations_in_dostep"] = allocations_in_dostep(drv, fidelities, args.step)
         results["stiff_cases"] = stiff_cases(drv, args.stiff_duration, args.step, args.run_timeout)
 
     results["elapsed_s"] = round(time.time() - t_start, 1)
-    args.out.mkdir(parents=True, exist_ok=True)
-    out_json = args.out / "results.json"
+    write_results(results, args.out, methods, fidelities, args.duration)
+    return 0
+
+
+def replot(out: pathlib.Path) -> int:
+    """--replot: the PNG and the tables again, from OUT/results.json."""
+    results = json.loads((out / "results.json").read_text())
+    methods = [None if m == "None" else int(m) for m in results["methods"]]
+    fidelities = list(results["references"])
+    plot(results, out / "work_precision.png", methods, fidelities, results["settings"]["duration_s"])
+    summary(results, methods, fidelities, results["settings"]["duration_s"])
+    return 0
+
+
+def find_binaries(args) -> tuple | None:
+    """(gimbal_bench, the FMU's shared object, its modelDescription.xml), or None when one is
+    missing (said on stderr)."""
+    build = args.build_dir.resolve()
+    bench = (args.bench or build / "benchmarks" / "gimbal_bench").resolve()
+    so = build / "fmu_staging" / "binaries" / "linux64" / "Gimbal2Axis.so"
+    md = build / "fmu_staging" / "modelDescription.xml"
+    missing = [p for p in (bench, so, md) if not p.exists()]
+    if missing:
+        print("benchmark: missing " + ", ".join(str(p) for p in missing) + ".\n"
+              "Build first: `bash scripts/setup.sh` (fresh machine) or `cmake --build build` "
+              "(the top-level CMakeLists.txt must contain add_subdirectory(benchmarks)).", file=sys.stderr)
+        return None
+    return bench, so, md
+
+
+def choose_methods(drv: Driver, requested: str | None) -> list | None:
+    """The solver.method values to measure: `requested` (comma-separated), else the FMU's own
+    methods and the SUNDIALS references; [None] (the default integrator) for an FMU without the
+    parameter; None when methods are requested of such an FMU (said on stderr)."""
+    if requested is not None:
+        methods = [int(m) for m in requested.split(",")]
+        if not drv.has_method:
+            print("benchmark: --methods given but the FMU has no parameter solver.method", file=sys.stderr)
+            return None
+        return methods
+    if drv.has_method:
+        return [4, 5, 6, 0, 3] if drv.default_method == 4 else [0, 1, 2, 3]
+    log("note: the FMU has no parameter 'solver.method': only its default integrator is measured")
+    return [None]
+
+
+def measure_references(drv: Driver, fidelities, args, record: dict) -> dict | None:
+    """Step 1: the reference trajectory per fidelity (rtol 1e-12), and a second solution to bound
+    its own error, each put in `record`; returns the trajectories, None if a reference failed."""
+    references: dict = {}
+    ref_method = 0 if drv.has_method else None
+    for fid in fidelities:
+        log(f"[reference] {fid}: rtol 1e-12, atol 1e-14, {args.duration:g} s ...")
+        ref = drv.run(method=ref_method, fidelity=fid, rtol=1e-12, atol=1e-14, duration=args.duration,
+                      step=args.step, trajectory=True, timeout=max(args.run_timeout, 600))
+        if ref.get("failure") or "_trajectory" not in ref:
+            log(f"  reference failed: {ref.get('failure')}")
+            return None
+        references[fid] = ref["_trajectory"]
+        # A second solution to bound the reference's own error: another method, or rtol 1e-11.
+        # ARKODE's explicit RK (method 3) shares nothing with CVODE BDF but the model.
+        check_method = 3 if drv.has_method else None
+        check = drv.run(method=check_method, fidelity=fid, rtol=1e-12 if drv.has_method else 1e-11,
+                        atol=1e-14 if drv.has_method else 1e-13, duration=args.duration, step=args.step,
+                        trajectory=True, timeout=max(args.run_timeout, 600))
+        spread = errors_against(check, references[fid])
+        record[fid] = {"run": strip(ref), "check_run": strip(check), "check_difference": spread}
+        log(f"  cpu {ref['cpu_s']:.2f} s; second solution differs by beta {fmt(spread['err_beta'])} rad, "
+            f"alpha {fmt(spread['err_alpha'])} rad, omega {fmt(spread['err_omega'])} rad/s")
+    return references
+
+
+def work_precision_sweep(drv: Driver, methods, fidelities, rtols, args, references: dict) -> list:
+    """Step 2: every method x fidelity x rtol, its CPU time and its errors against the reference
+    (the tighter tolerances of a method that timed out are skipped)."""
+    sweep = []
+    for fid in fidelities:
+        for m in methods:
+            for rtol in rtols:
+                atol = rtol * args.atol_factor
+                run = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
+                              step=args.step, trajectory=True)
+                # Cheap runs are noisy: keep the fastest of up to three.
+                if not run.get("failure") and run["cpu_s"] < 0.5:
+                    for _ in range(2):
+                        again = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
+                                        step=args.step)
+                        if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
+                            for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
+                                run[key] = again[key]
+                if not run.get("failure"):
+                    fmu_cpu = run["cpu_s"] - (run.get("master_cpu_s") or 0.0)
+                    run["fmu_cpu_s"] = fmu_cpu
+                    run["fmu_rtf"] = run["simulated"] / fmu_cpu if fmu_cpu > 0 else None
+                point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol,
+                         **errors_against(run, references[fid]), **strip(run)}
+                sweep.append(point)
+                log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} rtol {rtol:.0e}: "
+                    + (f"FAILED {run['failure']}" if run.get("failure") else
+                       f"cpu {run['cpu_s']:.3f} s  rtf {run['rtf']:9.1f}  err beta {fmt(point['err_beta'])}  "
+                       f"alpha {fmt(point['err_alpha'])}  omega {fmt(point['err_omega'])}  "
+                       f"steps {run['solver_steps']}  rhs {run['rhs_evaluations']}  jac {run['jacobian_evaluations']}"))
+                if run.get("failure", "").startswith("timeout"):
+                    log("  (tighter tolerances of this method skipped)")
+                    break
+    return sweep
+
+
+def at_target_error(sweep: list, methods, fidelities) -> list:
+    """The cheapest run meeting the beta target, per method and fidelity."""
+    best = []
+    for fid in fidelities:
+        for m in methods:
+            ok = [p for p in sweep if p["fidelity"] == fid and p["method"] == m and p["err_beta"] is not None
+                  and p["err_beta"] <= TARGET_BETA_ERROR]
+            if ok:
+                p = min(ok, key=lambda p: p["cpu_s"])
+                best.append({"fidelity": fid, "method": m, "rtol": p["rtol"], "cpu_s": p["cpu_s"],
+                             "rtf": p["rtf"], "fmu_rtf": p.get("fmu_rtf"),
+                             "cpu_us_per_step": p["cpu_us_per_step"], "err_beta": p["err_beta"], "err_alpha": p["err_alpha"],
+                             "err_omega": p["err_omega"], "target_rtf": TARGET_RTF.get(fid),
+                             "meets_target": p["rtf"] >= TARGET_RTF.get(fid, 0)})
+            else:
+                best.append({"fidelity": fid, "method": m, "rtol": None, "cpu_s": None, "rtf": None,
+                             "err_beta": None, "target_rtf": TARGET_RTF.get(fid), "meets_target": False})
+    return best
+
+
+def cost_vs_duration(drv: Driver, best: list, args) -> dict:
+    """Step 3: the FMU's default integrator, full fidelity, at the loosest swept tolerance that
+    meets the beta target, for each of --durations (shortened to fit --duration-budget)."""
+    full_default = [p for p in best if p["fidelity"] == "full" and p["method"] == drv.default_method]
+    default_rtol = full_default[0]["rtol"] if full_default and full_default[0]["rtol"] else None
+    durations = [float(x) for x in args.durations.split(",")]
+    growth = []
+    rate = None
+    for d in durations:
+        planned = d
+        if rate is not None and d / rate > args.duration_budget:
+            planned = max(durations[0], math.floor(args.duration_budget * rate / 10.0) * 10.0)
+            log(f"[duration] {d:g} s would take ~{d / rate:.0f} s CPU: running {planned:g} s instead")
+        run = drv.run(fidelity="full", rtol=default_rtol, atol=None if default_rtol is None else default_rtol * args.atol_factor,
+                      duration=planned, step=args.step, timeout=max(args.run_timeout, 4 * args.duration_budget))
+        if run.get("failure"):
+            log(f"[duration] {planned:g} s: FAILED {run['failure']}")
+            growth.append({"requested_s": d, "simulated_s": planned, "failure": run["failure"]})
+            continue
+        rate = run["simulated"] / run["cpu_s"]
+        growth.append({"requested_s": d, "simulated_s": run["simulated"], "cpu_s": run["cpu_s"],
+                       "cpu_us_per_simulated_ms": 1e3 * run["cpu_s"] / run["simulated"], "rtf": run["rtf"],
+                       "solver_steps": run["solver_steps"], "rhs_evaluations": run["rhs_evaluations"],
+                       "events": run["events"], "dostep_allocations": run["dostep_allocations"]})
+        log(f"[duration] {run['simulated']:g} s: cpu {run['cpu_s']:.3f} s = "
+            f"{1e3 * run['cpu_s'] / run['simulated']:.2f} us per simulated ms, rtf {run['rtf']:.1f}")
+    return {"method": drv.default_method, "fidelity": "full", "rtol": default_rtol, "runs": growth}
+
+
+def fmi_overhead(drv: Driver, fidelities, overhead_steps: int) -> dict:
+    """Step 4: doStep of a model at rest (1 us steps) per fidelity, and the instance's memory."""
+    overhead = {}
+    for fid in fidelities:
+        run = drv.run(fidelity=fid, overhead=True, overhead_steps=overhead_steps, trace=True)
+        overhead[fid] = strip(run)
+        if run.get("failure"):
+            log(f"[overhead] {fid}: FAILED {run['failure']}")
+        else:
+            log(f"[overhead] {fid}: {run['ns_per_dostep']:.0f} ns per doStep (CPU), "
+                f"{run['rhs_evaluations'] / max(1, run['dostep_calls']):.2f} rhs per doStep; instance "
+                f"{run['instance_bytes']} bytes in {run['instance_allocations']} allocations; "
+                f"{run['dostep_allocations']} allocations in {run['dostep_calls']} doSteps")
+    return overhead
+
+
+def allocations_in_dostep(drv: Driver, fidelities, step: float) -> dict:
+    """Step 5: heap allocations inside doStep after the first (2 s of the scene) and their call sites."""
+    alloc = {}
+    for fid in fidelities:
+        run = drv.run(fidelity=fid, duration=2.0, step=step, trace=True)
+        alloc[fid] = {k: run.get(k) for k in ("dostep_calls", "first_step_allocations", "dostep_allocations",
+                                              "dostep_alloc_bytes", "events", "allocation_sites", "failure")}
+        log(f"[allocations] {fid}: {run.get('dostep_allocations')} allocations in "
+            f"{run.get('dostep_calls')} doSteps after the first ({run.get('events')} events)")
+    return alloc
+
+
+def write_results(results: dict, out: pathlib.Path, methods, fidelities, duration: float) -> None:
+    """OUT/results.json and OUT/work_precision.png; the tables on stdout."""
+    out.mkdir(parents=True, exist_ok=True)
+    out_json = out / "results.json"
     out_json.write_text(json.dumps(results, indent=1) + "\n")
-    png = args.out / "work_precision.png"
-    plot(results, png, methods, fidelities, args.duration)
-    summary(results, methods, fidelities, args.duration)
+    png = out / "work_precision.png"
+    plot(results, png, methods, fidelities, duration)
+    summary(results, methods, fidelities, duration)
     log(f"\nwrote {out_json.relative_to(REPO) if out_json.is_relative_to(REPO) else out_json} and "
         f"{png.relative_to(REPO) if png.is_relative_to(REPO) else png} in {results['elapsed_s']:.0f} s")
-    return 0
 
 
 def stiff_cases(drv: Driver, duration: float, step: float, timeout: float) -> list:
