@@ -20,6 +20,7 @@ from scene_lib.scene import check_against_fmu, load_scene
 
 from . import table
 from .names import check_cases_accepted, resolve_names
+from .progress import Progress
 from .spec import SweepError, apply_case, case_key, load_sweep, scene_hash
 from .worker import fmu_digest, run_case, run_cases
 
@@ -52,39 +53,6 @@ class Case:
     values: dict
     scene: object = None       # the scene with the values put in, or None when invalid
     error: str = ""
-
-
-class Progress:
-    """A counter on stderr: done/total, ok/failed, rate and time left; redrawn in place on a
-    terminal, else a line every 10 % (or 30 s)."""
-
-    def __init__(self, total: int, enabled: bool = True, stream=sys.stderr):
-        self.total, self.enabled, self.stream = total, enabled, stream
-        self.done = self.failed = 0
-        self.start = time.perf_counter()
-        self.tty = hasattr(stream, "isatty") and stream.isatty()
-        self.last_draw = 0.0
-        self.last_decile = -1
-
-    def update(self, status: str) -> None:
-        self.done += 1
-        self.failed += status != "ok"
-        if not self.enabled:
-            return
-        now = time.perf_counter() - self.start
-        decile = int(10 * self.done / max(self.total, 1))
-        final = self.done == self.total
-        if self.tty and (now - self.last_draw < 0.2 and not final):
-            return
-        if not self.tty and not final and decile == self.last_decile and now - self.last_draw < 30:
-            return
-        self.last_draw, self.last_decile = now, decile
-        rate = self.done / now if now > 0 else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else math.inf
-        text = (f"[{self.done:>{len(str(self.total))}}/{self.total}] {100 * self.done / max(self.total, 1):5.1f} %  "
-                f"ok {self.done - self.failed}  failed {self.failed}  {rate:6.2f} cases/s  ~{left:5.0f} s left")
-        self.stream.write(("\r" + text + ("\n" if final else "")) if self.tty else text + "\n")
-        self.stream.flush()
 
 
 def _effective_seed(scene) -> int | None:
@@ -246,7 +214,6 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
     def save():
         table.write(table.merge(existing, new_rows), parameters, parquet, csv)
 
-    bar = Progress(len(todo), enabled=progress and bool(todo))
     warning = sweep.limit_warning()
     if warning:
         print(f"sweep: warning: {warning}", file=sys.stderr)
@@ -255,6 +222,7 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
               f"{len(todo)} to run" + ("" if not todo else " serially" if serial else
                                         f" on {scheduler or f'a local cluster of {workers} workers'}"),
               file=sys.stderr)
+    bar = Progress(len(todo), enabled=progress and bool(todo))   # after the header: on a terminal it shows at once
     last_save = time.perf_counter()
     from_s = sweep.metrics_from_s
 
@@ -293,7 +261,7 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
                 stop.check()
                 fmu_future = client.scatter(fmu_bytes, broadcast=True, hash=False)
                 scattered.append(fmu_future)
-                bar.start = time.perf_counter()   # the rate counts from here, not from the cluster's start
+                bar.restart_clock()   # the rate counts from here, not from the cluster's start
                 cases_of = {}
                 # Several cases per task: a short case costs the scheduler about as much as it costs to
                 # run, so tasks carry a few (at least 8 tasks per worker remain, to balance the load).
@@ -326,6 +294,7 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
         table.write(rows, parameters, parquet, csv)
     except KeyboardInterrupt as exc:
         interrupted = True
+        bar.close()
         reason = str(exc) or "interrupted"
         if new_rows:
             save()
@@ -337,6 +306,7 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
         exc.reported = True   # for sweep.py: this message was the last word
         raise
     finally:
+        bar.close()
         if interrupted and futures:
             try:   # queued cases would keep a shared scheduler's workers busy
                 client.cancel(futures + scattered)

@@ -1,0 +1,74 @@
+"""Progress of a sweep on stderr, through tqdm (as scene_lib/progress.py for a scene run): cases
+done of the total, ok and failed, the rate and the time left. On a terminal a bar redrawn in
+place; into a pipe or a log file one plain line per 10 % of the cases (or per 30 s), starting
+"[done/total]", and never a carriage return."""
+from __future__ import annotations
+
+import sys
+import time
+
+from tqdm import tqdm
+
+LOG_EVERY_S = 30.0   # into a log, a line at least this often (besides one per 10 % of the cases)
+
+
+class _LogLines(tqdm):
+    """A tqdm that writes whole lines instead of redrawing one: at the first finished case, when
+    another 10 % of the cases are done or LOG_EVERY_S passed, and at the last case."""
+
+    def __init__(self, counts: dict, **kwargs):
+        self.counts = counts   # ok and failed, for the line
+        self.line_decile, self.line_n, self.line_t = -1, 0, time.monotonic()
+        # Every update reaches display(), which decides; leave=False: closing draws nothing more
+        # (the last case has its line already) and writes no "\r".
+        super().__init__(mininterval=0, leave=False, **kwargs)
+
+    def display(self, msg=None, pos=None):
+        if msg is not None:           # tqdm clearing or overwriting its line: nothing to clear here
+            return None
+        n, total = self.n, self.total or 0
+        decile = 10 * n // max(total, 1)
+        due = decile != self.line_decile or time.monotonic() - self.line_t >= LOG_EVERY_S or n == total
+        if n == 0 or n == self.line_n or not due:
+            return None
+        self.line_decile, self.line_n, self.line_t = decile, n, time.monotonic()
+        self.fp.write(self.format_meter(**self.format_dict, **self.counts) + "\n")
+        self.fp.flush()
+        return None
+
+
+class Progress:
+    """`update(status)` per finished case ("ok" or else failed); `restart_clock()` where the
+    cases start running (the rate counts from there); `close()` at the end."""
+
+    def __init__(self, total: int, enabled: bool = True, stream=sys.stderr):
+        self.counts = {"ok": 0, "failed": 0}
+        # smoothing=0: the rate is the average since the start; miniters=1: no tqdm guess of how
+        # often to look at the clock
+        common = dict(total=total, disable=not enabled, file=stream, unit=" cases", smoothing=0, miniters=1)
+        if hasattr(stream, "isatty") and stream.isatty():
+            self.bar = tqdm(**common, mininterval=0.2, dynamic_ncols=True, leave=True, postfix=self._postfix(),
+                            bar_format="{l_bar}{bar}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}, "
+                                       "{rate_noinv_fmt}{postfix}]")
+        else:
+            width = len(str(total))
+            self.bar = _LogLines(self.counts, **common,
+                                 bar_format=f"[{{n_fmt:>{width}}}/{{total_fmt}}] {{percentage:5.1f}} %  ok {{ok}}  "
+                                            "failed {failed}  {rate_noinv_fmt}  ~{remaining} left")
+
+    def _postfix(self) -> str:
+        return f"ok {self.counts['ok']}, failed {self.counts['failed']}"
+
+    def update(self, status: str) -> None:
+        self.counts["ok" if status == "ok" else "failed"] += 1
+        if not isinstance(self.bar, _LogLines):
+            self.bar.set_postfix_str(self._postfix(), refresh=False)
+        self.bar.update(1)
+
+    def restart_clock(self) -> None:
+        """The time from the last update to now (a cluster's start-up) does not count: the rate and
+        the time left are those of the cases running."""
+        self.bar.unpause()
+
+    def close(self) -> None:
+        self.bar.close()
