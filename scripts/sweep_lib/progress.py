@@ -4,6 +4,7 @@ place; into a pipe or a log file one plain line per 10 % of the cases (or per 30
 "[done/total]", and never a carriage return."""
 from __future__ import annotations
 
+import os
 import sys
 import time
 
@@ -37,6 +38,13 @@ class _LogLines(tqdm):
         return None
 
 
+def _columns(stream) -> int:
+    try:
+        return os.get_terminal_size(stream.fileno()).columns
+    except (AttributeError, OSError, ValueError):
+        return 0
+
+
 class Progress:
     """`update(status)` per finished case ("ok" or else failed); `restart_clock()` where the
     cases start running (the rate counts from there); `close()` at the end."""
@@ -47,7 +55,12 @@ class Progress:
         # often to look at the clock
         common = dict(total=total, disable=not enabled, file=stream, unit=" cases", smoothing=0, miniters=1)
         if hasattr(stream, "isatty") and stream.isatty():
-            self.bar = tqdm(**common, mininterval=0.2, dynamic_ncols=True, leave=True, postfix=self._postfix(),
+            # the terminal's width, followed as it changes; 80 columns if it reports none (a pty
+            # without a size, e.g. `script` run without a terminal, where tqdm would draw nothing)
+            known = _columns(stream) > 0
+            self.bar = tqdm(**common, mininterval=0.2, dynamic_ncols=known, ncols=None if known else 80,
+                            nrows=None if known else 20,
+                            leave=True, postfix=self._postfix(),
                             bar_format="{l_bar}{bar}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}, "
                                        "{rate_noinv_fmt}{postfix}]")
         else:
