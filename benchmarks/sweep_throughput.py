@@ -21,7 +21,7 @@ import time
 REPO = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
 
-from sweep_lib import make_client, run_sweep  # noqa: E402
+from sweep_lib import SweepOptions, make_client, run_sweep  # noqa: E402
 from sweep_lib.table import read_rows  # noqa: E402
 
 SWEEP = """
@@ -65,12 +65,12 @@ def main() -> int:
         try:
             for rep in range(args.repeat):   # alternated, so a burst of load elsewhere hits both alike
                 t0 = time.perf_counter()
-                serial = run_sweep(args.scene, sweep, fmu, tmp / f"serial{rep}", serial=True, progress=False,
-                                   plot=False)
+                serial = run_sweep(args.scene, sweep, fmu, tmp / f"serial{rep}",
+                                   SweepOptions(serial=True, progress=False, plot=False))
                 serial_times.append(time.perf_counter() - t0)
                 t0 = time.perf_counter()
-                dask = run_sweep(args.scene, sweep, fmu, tmp / f"dask{rep}", client=client, progress=False,
-                                 plot=False)
+                dask = run_sweep(args.scene, sweep, fmu, tmp / f"dask{rep}",
+                                 SweepOptions(client=client, progress=False, plot=False))
                 dask_times.append(time.perf_counter() - t0)
         finally:
             client.close()

@@ -26,7 +26,7 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 from scene_lib import SceneError  # noqa: E402
-from sweep_lib import SweepError, run_sweep  # noqa: E402
+from sweep_lib import SweepError, SweepOptions, run_sweep  # noqa: E402
 from sweep_lib.runner import Stopped  # noqa: E402
 
 EPILOG = """\
@@ -80,9 +80,9 @@ def main() -> int:
         parser.error("--workers must be >= 1")
     signal.signal(signal.SIGTERM, _terminated)
     try:
-        outcome = run_sweep(args.scene, args.sweep, args.fmu, args.out, scheduler=args.scheduler,
-                            workers=args.workers, serial=args.serial, progress=not args.quiet, redo=args.redo,
-                            processes=not args.threads)
+        options = SweepOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
+                               serial=args.serial, redo=args.redo, progress=not args.quiet)
+        outcome = run_sweep(args.scene, args.sweep, args.fmu, args.out, options)
     except (SceneError, SweepError) as exc:
         print(f"sweep.py: error: {exc}", file=sys.stderr)
         return 2

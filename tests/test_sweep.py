@@ -14,7 +14,7 @@ pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
 from scene_lib import FMU, run  # noqa: E402
-from sweep_lib import SweepError, load_sweep, prepare, run_sweep  # noqa: E402
+from sweep_lib import SweepError, SweepOptions, load_sweep, prepare, run_sweep  # noqa: E402
 from sweep_lib.table import read_rows  # noqa: E402
 from sweep_lib.worker import metrics  # noqa: E402
 
@@ -116,7 +116,8 @@ def test_unknown_parameter_is_refused_before_anything_runs(tmp_path, fmu_path):
 
 def test_local_cluster_of_two_workers_equals_serial_runs_case_by_case(tmp_path, fmu_path, client):
     sweep_path = write(tmp_path, SMALL, "small")
-    outcome = run_sweep(SCENE, sweep_path, fmu_path, tmp_path / "out", client=client, progress=False, plot=False)
+    outcome = run_sweep(SCENE, sweep_path, fmu_path, tmp_path / "out",
+                        SweepOptions(client=client, progress=False, plot=False))
     assert outcome.ran == 8 and outcome.failed == 0
     rows = {r["case_id"]: r for r in read_rows(outcome.parquet)}
     assert len(rows) == 8 and all(r["status"] == "ok" for r in rows.values())
@@ -131,14 +132,15 @@ def test_local_cluster_of_two_workers_equals_serial_runs_case_by_case(tmp_path, 
     # the cases differ from each other (the parameters really reached the FMU and the controller)
     assert len({r["los_rms_mrad"] for r in rows.values()}) == 8
     # the serial mode of the sweep runner (one process, one reused instance) agrees too
-    serial = run_sweep(SCENE, sweep_path, fmu_path, tmp_path / "serial", serial=True, progress=False, plot=False)
+    serial = run_sweep(SCENE, sweep_path, fmu_path, tmp_path / "serial",
+                       SweepOptions(serial=True, progress=False, plot=False))
     for r in read_rows(serial.parquet):
         assert all(_same(r[k], rows[r["case_id"]][k]) for k in METRICS)
 
 
 def test_invalid_case_is_reported_with_the_fmu_message_and_the_others_complete(tmp_path, fmu_path, client):
-    outcome = run_sweep(SCENE, write(tmp_path, INVALID, "invalid"), fmu_path, tmp_path, client=client,
-                        progress=False)
+    outcome = run_sweep(SCENE, write(tmp_path, INVALID, "invalid"), fmu_path, tmp_path,
+                        SweepOptions(client=client, progress=False))
     rows = read_rows(outcome.parquet)
     assert [r["body2.m"] for r in rows] == [2.0, -1.0, 2.5] and outcome.failed == 1
     bad = rows[1]
@@ -153,14 +155,14 @@ def test_invalid_case_is_reported_with_the_fmu_message_and_the_others_complete(t
 
 def test_rerun_skips_the_cases_already_done(tmp_path, fmu_path, client):
     sweep_path = write(tmp_path, SMALL.replace("samples = 2", "samples = 1"), "small")
-    first = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, client=client, progress=False, plot=False)
+    first = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, SweepOptions(client=client, progress=False, plot=False))
     assert first.ran == 4
     before = read_rows(first.parquet)
-    again = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, client=client, progress=False, plot=False)
+    again = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, SweepOptions(client=client, progress=False, plot=False))
     assert again.ran == 0 and again.skipped == 4
     after = read_rows(again.parquet)
     assert len(after) == len(before) and all(all(_same(a[k], b[k]) for k in a) for a, b in zip(before, after))
     # more samples: only the new cases run, the table grows by them
     sweep_path.write_text(SMALL)
-    more = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, client=client, progress=False, plot=False)
+    more = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, SweepOptions(client=client, progress=False, plot=False))
     assert more.ran == 4 and more.skipped == 4 and len(read_rows(more.parquet)) == 8

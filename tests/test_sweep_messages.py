@@ -22,7 +22,7 @@ pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
 from scene_lib import FMU  # noqa: E402
-from sweep_lib import SweepError, load_sweep, prepare, run_sweep  # noqa: E402
+from sweep_lib import SweepError, SweepOptions, load_sweep, prepare, run_sweep  # noqa: E402
 from sweep_lib import table  # noqa: E402
 from sweep_lib.table import read_rows  # noqa: E402
 
@@ -216,7 +216,7 @@ def test_two_swept_gains_give_a_heat_map_with_labelled_axes_and_a_colour_bar(tmp
     summary = table.summary_figure
     monkeypatch.setattr(table, "summary_figure", lambda *a, **k: figures.append(summary(*a, **k)) or figures[-1])
     path = write(tmp_path, LIMITED.replace("cases = 2\n", ""), "gains")
-    run_sweep(SCENE, path, fmu_path, tmp_path / "out", serial=True, progress=False)
+    run_sweep(SCENE, path, fmu_path, tmp_path / "out", SweepOptions(serial=True, progress=False))
     fig, = figures
     heat = fig.axes[0]
     assert heat.images, "no heat map"

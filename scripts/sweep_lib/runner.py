@@ -1,5 +1,6 @@
-"""A sweep end to end: expand the cases, skip those already in the table, run the others on Dask
-(or serially), merge, write the table (Parquet + CSV) and the summary plot."""
+"""A sweep end to end, in phases: plan (expand the cases, skip those already in the table), run
+the others on Dask or serially while recording each result (the table written as they come), finish
+(the merged table, Parquet + CSV, and the summary plot)."""
 from __future__ import annotations
 
 import logging
@@ -181,26 +182,58 @@ def _worker_count(client) -> int:
         return 1
 
 
-def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None = None, workers: int = 2,
-              serial: bool = False, progress: bool = True, redo: str | None = None, processes: bool = True,
-              client=None, checkpoint_s: float = 20.0, plot: bool = True) -> Outcome:
-    """Runs the sweep; `serial` runs in this process without Dask (one reused instance); `client`:
-    use this Dask client (else one is made from `scheduler`/`workers`/`processes` and closed after).
-    `redo`: None, 'failed' (rerun failed cases) or 'all'."""
-    wall0 = time.perf_counter()
-    out = pathlib.Path(out_dir)
+@dataclass(frozen=True)
+class SweepOptions:
+    """How a sweep runs (none of these change its results)."""
+    scheduler: str | None = None   # address of a Dask scheduler to run on; None: a new local cluster
+    workers: int = 2               # workers of that local cluster, one thread each
+    processes: bool = True         # its workers are processes (False: threads of this process)
+    serial: bool = False           # no Dask: the cases one after the other in this process (one reused instance)
+    client: object = None          # a Dask client to use (left open); None: one is made and closed after
+    redo: str | None = None        # None, 'failed' (rerun the failed cases) or 'all'
+    progress: bool = True          # what runs where, and how far it got, on stderr
+    checkpoint_s: float = 20.0     # while cases finish, the table is written at least this often
+    plot: bool = True              # write the summary plot (.png)
+
+
+@dataclass
+class Plan:
+    """What a sweep is to do: its cases, which of them run now, and where the table goes."""
+    scene: object
+    sweep: object
+    cases: list            # every case of the sweep
+    todo: list             # those to run now: not in the table yet, or to run again (redo)
+    skipped: int           # cases the table has already
+    existing: list         # the table's rows before this run
+    fmu_bytes: bytes
+    fmu_sha: str
+    scene_digest: str
+    parquet: pathlib.Path
+    csv: pathlib.Path
+    png: pathlib.Path
+
+
+def plan_sweep(scene_path, sweep_path, fmu_path, out_dir, redo: str | None = None) -> Plan:
+    """Expands and checks the cases (SceneError, SweepError before anything runs) and reads the
+    table of earlier runs to leave out the cases done already."""
     with FMU(fmu_path) as fmu:
         scene, sweep, cases = prepare(scene_path, sweep_path, fmu)
     fmu_bytes = pathlib.Path(fmu_path).read_bytes()
-    digest = fmu_digest(fmu_bytes)
-    scene_digest = scene_hash(scene)
-    stem = f"{sweep.name}__{scene.name}"
-    parquet, csv, png = out / f"{stem}.parquet", out / f"{stem}.csv", out / f"{stem}.png"
+    out, stem = pathlib.Path(out_dir), f"{sweep.name}__{scene.name}"
+    parquet = out / f"{stem}.parquet"
     existing = table.read_rows(parquet)
+    todo, skipped = cases_to_run(cases, existing, redo)
+    return Plan(scene, sweep, cases, todo, skipped, existing, fmu_bytes, fmu_digest(fmu_bytes), scene_hash(scene),
+                parquet, out / f"{stem}.csv", out / f"{stem}.png")
+
+
+def cases_to_run(cases: list, existing: list, redo: str | None) -> tuple[list, int]:
+    """(todo, skipped): the cases without a row in `existing`, and those `redo` asks for again
+    ('failed' or 'all'); the same values twice (e.g. a repeated grid value) are one case."""
     done = {r["case_id"]: r for r in existing}
     todo, skipped, seen = [], 0, set()
     for case in cases:
-        if case.case_id in seen:   # the same values twice (e.g. a repeated grid value): one case
+        if case.case_id in seen:
             continue
         seen.add(case.case_id)
         old = done.get(case.case_id)
@@ -208,130 +241,205 @@ def run_sweep(scene_path, sweep_path, fmu_path, out_dir, scheduler: str | None =
             skipped += 1
         else:
             todo.append(case)
-    parameters = sweep.parameters
-    new_rows: list[dict] = []
+    return todo, skipped
 
-    def save():
-        table.write(table.merge(existing, new_rows), parameters, parquet, csv)
 
-    warning = sweep.limit_warning()
+def announce(plan: Plan, options: SweepOptions) -> None:
+    """On stderr: the sweep's warning (a `cases` limit that drops grid points), and with progress,
+    how many cases run where."""
+    warning = plan.sweep.limit_warning()
     if warning:
         print(f"sweep: warning: {warning}", file=sys.stderr)
-    if progress:
-        print(f"sweep {sweep.name} on scene {scene.name}: {len(cases)} cases, {skipped} already done, "
-              f"{len(todo)} to run" + ("" if not todo else " serially" if serial else
-                                        f" on {scheduler or f'a local cluster of {workers} workers'}"),
-              file=sys.stderr)
-    bar = Progress(len(todo), enabled=progress and bool(todo))   # after the header: on a terminal it shows at once
-    last_save = time.perf_counter()
-    from_s = sweep.metrics_from_s
+    if options.progress:
+        todo = plan.todo
+        where = ("" if not todo else " serially" if options.serial else
+                 f" on {options.scheduler or f'a local cluster of {options.workers} workers'}")
+        print(f"sweep {plan.sweep.name} on scene {plan.scene.name}: {len(plan.cases)} cases, {plan.skipped} already "
+              f"done, {len(todo)} to run{where}", file=sys.stderr)
 
-    def finish(case: Case, result: dict):
-        nonlocal last_save
-        row = _base_row(case, scene, sweep, scene_digest, digest)
+
+class Recorder:
+    """The rows of the cases finished in this run, one per result as it comes, with the progress
+    display; the table (the earlier rows and these) is written every `checkpoint_s` seconds, at
+    the end, and when the sweep is interrupted: leaving the `with` block by Ctrl-C or SIGTERM saves
+    the rows and says so (the exception is marked `reported` for sweep.py)."""
+
+    def __init__(self, plan: Plan, checkpoint_s: float = 20.0, progress: bool = True):
+        self.plan, self.checkpoint_s = plan, checkpoint_s
+        self.rows: list[dict] = []
+        self.last_save = time.perf_counter()
+        self.progress = Progress(len(plan.todo), enabled=progress and bool(plan.todo))
+
+    def record(self, case: Case, result: dict) -> None:
+        plan = self.plan
+        row = _base_row(case, plan.scene, plan.sweep, plan.scene_digest, plan.fmu_sha)
         row.update(result)
-        new_rows.append(row)
-        bar.update(row["status"])
-        if time.perf_counter() - last_save > checkpoint_s:
-            save()
-            last_save = time.perf_counter()
+        self.rows.append(row)
+        self.progress.update(row["status"])
+        if time.perf_counter() - self.last_save > self.checkpoint_s:
+            self.save()
+            self.last_save = time.perf_counter()
 
+    def save(self) -> list[dict]:
+        """Writes the table (Parquet and CSV); returns its rows."""
+        rows = table.merge(self.plan.existing, self.rows)
+        table.write(rows, self.plan.sweep.parameters, self.plan.parquet, self.plan.csv)
+        return rows
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        self.progress.close()
+        if isinstance(exc, KeyboardInterrupt):
+            reason = str(exc) or "interrupted"
+            if self.rows:
+                self.save()
+                print(f"\nsweep: {reason}; the {len(self.rows)} cases finished in this run are kept in "
+                      f"{self.plan.parquet} (with those of earlier runs); the same command again runs the rest",
+                      file=sys.stderr)
+            else:
+                print(f"\nsweep: {reason} before any case of this run finished; the same command again runs them",
+                      file=sys.stderr)
+            exc.reported = True   # for sweep.py: this message was the last word
+        return False
+
+
+def run_planned(plan: Plan, options: SweepOptions, recorder: Recorder, dask: DaskRun) -> None:
+    """Runs the cases of `plan.todo`, serially or on Dask, each result to `recorder` as it comes;
+    a case refused before running is recorded as failed with the reason."""
     runnable = []
-    for case in todo:
+    for case in plan.todo:
         if case.scene is None:
-            finish(case, {"case_id": case.case_id, "status": "failed", "message": case.error, "fmu_log": "",
-                          "wall_time_s": 0.0, "worker": "client"})
+            recorder.record(case, {"case_id": case.case_id, "status": "failed", "message": case.error, "fmu_log": "",
+                                   "wall_time_s": 0.0, "worker": "client"})
         else:
             runnable.append(case)
-    own_client = cluster = None
-    futures: list = []
-    scattered: list = []
-    interrupted = False
-    try:
-        if serial:
-            for case in runnable:
-                finish(case, run_case(case.scene, case.case_id, fmu_bytes, digest, from_s))
-        elif runnable:
-            from distributed import as_completed
+    if options.serial:
+        for case in runnable:
+            recorder.record(case, run_case(case.scene, case.case_id, plan.fmu_bytes, plan.fmu_sha,
+                                           plan.sweep.metrics_from_s))
+    elif runnable:
+        dask.run(plan, runnable, recorder)
 
-            with _StopRequests() as stop:
-                if client is None:
-                    own_client, cluster = make_client(scheduler, workers, processes)
-                    client = own_client
+
+class DaskRun:
+    """Cases on Dask: on `options.client`, else on a client it makes (of `options.scheduler` or of
+    a new local cluster); the FMU is scattered to the workers once, the cases go in tasks of a few
+    each. Leaving the `with` block cancels what an interruption left queued, and closes the
+    client and cluster it made."""
+
+    def __init__(self, options: SweepOptions):
+        self.options = options
+        self.client = options.client
+        self.own_client = self.cluster = None
+        self.futures: list = []     # the tasks
+        self.scattered: list = []   # the FMU on the workers
+
+    def run(self, plan: Plan, cases: list, recorder: Recorder) -> None:
+        from distributed import as_completed
+
+        with _StopRequests() as stop:
+            if self.client is None:
+                options = self.options
+                self.own_client, self.cluster = make_client(options.scheduler, options.workers, options.processes)
+                self.client = self.own_client
+            stop.check()
+            fmu_future = self.client.scatter(plan.fmu_bytes, broadcast=True, hash=False)
+            self.scattered.append(fmu_future)
+            recorder.progress.restart_clock()   # the rate counts from here, not from the cluster's start
+            cases_of = self._submit(plan, cases, fmu_future)
+            completed = as_completed(self.futures)
+            while not completed.is_empty():
                 stop.check()
-                fmu_future = client.scatter(fmu_bytes, broadcast=True, hash=False)
-                scattered.append(fmu_future)
-                bar.restart_clock()   # the rate counts from here, not from the cluster's start
-                cases_of = {}
-                # Several cases per task: a short case costs the scheduler about as much as it costs to
-                # run, so tasks carry a few (at least 8 tasks per worker remain, to balance the load).
-                per_task = cases_per_task(len(runnable), _worker_count(client))
-                for first in range(0, len(runnable), per_task):
-                    chunk = runnable[first:first + per_task]
-                    future = client.submit(run_cases, [(c.scene, c.case_id) for c in chunk], fmu_future, digest,
-                                           from_s, key=f"gimbal-cases-{digest[:8]}-{chunk[0].case_id}-{len(chunk)}",
-                                           pure=False, retries=1)
-                    futures.append(future)
-                    cases_of[future.key] = chunk
-                completed = as_completed(futures)
-                while not completed.is_empty():
-                    stop.check()
-                    batch = completed.next_batch(block=False)
-                    if not batch:
-                        time.sleep(0.05)
-                    for future in batch:
-                        chunk = cases_of[future.key]
-                        try:
-                            results = future.result()
-                        except Exception as exc:   # the task itself died (e.g. its worker crashed twice)
-                            results = [{"case_id": case.case_id, "status": "failed",
-                                        "message": f"{type(exc).__name__}: {exc}", "fmu_log": "",
-                                        "wall_time_s": math.nan, "worker": "?"} for case in chunk]
-                        future.release()
-                        for case, result in zip(chunk, results):
-                            finish(case, result)
-        rows = table.merge(existing, new_rows)
-        table.write(rows, parameters, parquet, csv)
-    except KeyboardInterrupt as exc:
-        interrupted = True
-        bar.close()
-        reason = str(exc) or "interrupted"
-        if new_rows:
-            save()
-            print(f"\nsweep: {reason}; the {len(new_rows)} cases finished in this run are kept in {parquet} (with "
-                  f"those of earlier runs); the same command again runs the rest", file=sys.stderr)
-        else:
-            print(f"\nsweep: {reason} before any case of this run finished; the same command again runs them",
-                  file=sys.stderr)
-        exc.reported = True   # for sweep.py: this message was the last word
-        raise
-    finally:
-        bar.close()
-        if interrupted and futures:
+                batch = completed.next_batch(block=False)
+                if not batch:
+                    time.sleep(0.05)
+                for future in batch:
+                    chunk = cases_of[future.key]
+                    for case, result in zip(chunk, _task_results(future, chunk)):
+                        recorder.record(case, result)
+
+    def _submit(self, plan: Plan, cases: list, fmu_future) -> dict:
+        """Submits the tasks; returns the cases of each task by its key. Several cases per task: a
+        short case costs the scheduler about as much as it costs to run, so tasks carry a few (at
+        least 8 tasks per worker remain, to balance the load)."""
+        cases_of = {}
+        per_task = cases_per_task(len(cases), _worker_count(self.client))
+        for first in range(0, len(cases), per_task):
+            chunk = cases[first:first + per_task]
+            future = self.client.submit(run_cases, [(c.scene, c.case_id) for c in chunk], fmu_future, plan.fmu_sha,
+                                        plan.sweep.metrics_from_s,
+                                        key=f"gimbal-cases-{plan.fmu_sha[:8]}-{chunk[0].case_id}-{len(chunk)}",
+                                        pure=False, retries=1)
+            self.futures.append(future)
+            cases_of[future.key] = chunk
+        return cases_of
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        interrupted = isinstance(exc, KeyboardInterrupt)
+        if interrupted and self.futures:
             try:   # queued cases would keep a shared scheduler's workers busy
-                client.cancel(futures + scattered)
+                self.client.cancel(self.futures + self.scattered)
             except Exception:
                 pass
-        if cluster is not None and interrupted:
+        if self.cluster is not None and interrupted:
             # Our own cluster, dropped with cases still running: its scheduler's complaints about
             # the work and the scattered FMU it loses are no news to the user who stopped it.
             disabled = logging.root.manager.disable
             logging.disable(logging.CRITICAL)
             try:
-                cluster.close()
+                self.cluster.close()
             finally:
                 logging.disable(disabled)
-        if own_client is not None:
-            own_client.close()
-        if cluster is not None and not interrupted:
-            cluster.close()
-    ids = {c.case_id for c in cases}
+        if self.own_client is not None:
+            self.own_client.close()
+        if self.cluster is not None and not interrupted:
+            self.cluster.close()
+        return False
+
+
+def _task_results(future, chunk: list) -> list[dict]:
+    """The results of a task's cases; all failed if the task itself died (e.g. its worker crashed
+    twice)."""
+    try:
+        results = future.result()
+    except Exception as exc:
+        results = [{"case_id": case.case_id, "status": "failed", "message": f"{type(exc).__name__}: {exc}",
+                    "fmu_log": "", "wall_time_s": math.nan, "worker": "?"} for case in chunk]
+    future.release()
+    return results
+
+
+def finish(plan: Plan, rows: list, plot: bool, wall0: float) -> Outcome:
+    """The outcome of the sweep's own cases in the table (which may hold others of an earlier,
+    longer version of the sweep), and the summary plot."""
+    ids = {c.case_id for c in plan.cases}
     mine = [r for r in rows if r["case_id"] in ids]
     failed = sum(r.get("status") != "ok" for r in mine)
-    ran_now = {c.case_id for c in todo}
+    ran_now = {c.case_id for c in plan.todo}
     failed_before = sum(r.get("status") != "ok" and r["case_id"] not in ran_now for r in mine)
     if plot:
-        table.plot_summary(mine, parameters, png, f"sweep {sweep.name} on {scene.name}: {len(mine)} cases, "
-                                                 f"{len(mine) - failed} ok, {failed} failed", grid=list(sweep.grid))
-    return Outcome(parquet, csv, png, rows, len(todo), skipped, failed, time.perf_counter() - wall0, failed_before)
+        sweep = plan.sweep
+        table.plot_summary(mine, sweep.parameters, plan.png, f"sweep {sweep.name} on {plan.scene.name}: {len(mine)} "
+                                                             f"cases, {len(mine) - failed} ok, {failed} failed",
+                           grid=list(sweep.grid))
+    return Outcome(plan.parquet, plan.csv, plan.png, rows, len(plan.todo), plan.skipped, failed,
+                   time.perf_counter() - wall0, failed_before)
 
+
+def run_sweep(scene_path, sweep_path, fmu_path, out_dir, options: SweepOptions = SweepOptions()) -> Outcome:
+    """Runs the sweep SWEEP.toml of the scene on the FMU, the table and plot in `out_dir`: plan
+    (the cases, those done already), run (serially or on Dask) while recording each result, finish
+    (the table, the plot, the outcome). Ctrl-C, SIGTERM (Stopped): the finished cases are kept."""
+    wall0 = time.perf_counter()
+    plan = plan_sweep(scene_path, sweep_path, fmu_path, out_dir, options.redo)
+    announce(plan, options)
+    # Leaving the block, the recorder saves and reports first, then Dask's cancelling and closing.
+    with DaskRun(options) as dask, Recorder(plan, options.checkpoint_s, options.progress) as recorder:
+        run_planned(plan, options, recorder, dask)
+        rows = recorder.save()
+    return finish(plan, rows, options.plot, wall0)
