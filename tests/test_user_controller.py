@@ -64,11 +64,12 @@ def test_the_example_controller_stabilizes_the_line_of_sight(fmu):
     assert np.all(np.isfinite(result.signals["alpha_ref"][1:]))
 
 
-def test_a_user_class_gives_the_built_in_controllers_run_bit_for_bit(tmp_path, fmu):
-    pid_table = """[controller]
+def pid_tables(reference: str) -> tuple[str, str]:
+    """The scene's PID as a built-in table and as the user class's options."""
+    built_in = f"""[controller]
 type = "pid"
 delay_steps = 1
-reference = "target"
+reference = {reference}
 [controller.azimuth]
 kp = 400.0
 ki = 8000.0
@@ -80,23 +81,51 @@ ki = 8000.0
 k_gyro = 8.0
 k_ff = 2.4
 """
-    user_table = """[controller]
+    user = f"""[controller]
 type = "python"
 delay_steps = 1
 module = "user_module.py"
 class = "PIDAsUser"
-options = { reference = "target", azimuth = { kp = 400.0, ki = 8000.0, k_gyro = 8.0, k_ff = 4.8 }, elevation = { kp = 400.0, ki = 8000.0, k_gyro = 8.0, k_ff = 2.4 } }
+options = {{ reference = {reference}, azimuth = {{ kp = 400.0, ki = 8000.0, k_gyro = 8.0, k_ff = 4.8 }}, elevation = {{ kp = 400.0, ki = 8000.0, k_gyro = 8.0, k_ff = 2.4 }} }}
 """
+    return built_in, user
+
+
+STEP_REFERENCE = '{ type = "step", from_deg = 30.0, to_deg = 31.0, at_s = 0.1 }'
+
+
+def test_a_user_class_gives_the_built_in_controllers_run_bit_for_bit(tmp_path, fmu):
+    # Step references: the user class computes them as the built-in one does, so every signal of
+    # the two runs (measurements, delay, saturation, records) must agree to the bit.
+    pid_table, user_table = pid_tables(STEP_REFERENCE)
     built_in = run(scene_with_controller(tmp_path, pid_table), fmu)
     user_scene = scene_with_controller(tmp_path, user_table, PID_AS_USER_CLASS)
     controller = user_scene.controller((fmu.start("motor1.U_L"), fmu.start("motor2.U_L")))
     user = run(user_scene, fmu, controller=controller)
+    assert built_in.loop == "compiled" and user.loop == "python"
     for name, values in built_in.signals.items():
         assert np.array_equal(values, user.signals[name], equal_nan=True), name
     # reset() before every run: a second run with the same controller object starts afresh.
     again = run(user_scene, fmu, controller=controller)
     assert controller.user.resets == 2
     assert np.array_equal(again.signals["beta"], user.signals["beta"])
+
+
+def test_a_user_class_tracking_the_target_gets_the_measured_base_attitude(tmp_path, fmu):
+    # reference "target": the set points come from the measured base attitude the user's step()
+    # receives. The built-in PID evaluates them vectorised for the whole run, the user class step by
+    # step with scalar functions: the set points agree to an ulp; their rates (the feed-forward),
+    # differences over 1e-6 s of attitude, to the rounding of that difference (~1e-10 rad/s), which
+    # the loop passes on to voltages, currents and rates at that level.
+    pid_table, user_table = pid_tables('"target"')
+    built_in = run(scene_with_controller(tmp_path, pid_table), fmu)
+    user = run(scene_with_controller(tmp_path, user_table, PID_AS_USER_CLASS), fmu)
+    for name, atol in (("alpha_ref", 1e-15), ("beta_ref", 1e-15), ("alpha", 1e-11), ("beta", 1e-11),
+                       ("alpha_dot", 1e-8), ("beta_dot", 1e-8), ("i_R1", 1e-8), ("i_R2", 1e-8), ("u_R1", 1e-7),
+                       ("u_R2", 1e-7)):
+        np.testing.assert_allclose(user.signals[name], built_in.signals[name], rtol=0, atol=atol, err_msg=name)
+    # without the base attitude the user's set points would be off by the ship's motion
+    assert np.ptp(built_in.signals["alpha_ref"]) > 1e-3
 
 
 @pytest.mark.parametrize("table, module, message", [

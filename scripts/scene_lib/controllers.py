@@ -24,6 +24,7 @@ import sys
 from . import geometry
 from .errors import SceneError, check_keys, number
 from .references import Reference
+from .setpoints import plan_set_points
 
 AXES = ("azimuth", "elevation")
 PID_KEYS = {"kp", "ki", "kd", "k_gyro", "k_ff", "d_filter_s", "i_limit_V", "reference"}
@@ -46,7 +47,12 @@ class Controller:
     def start(self, step_size: float, scene_name: str) -> None:
         """Called by the master before every run (the built-in controllers need nothing)."""
 
-    def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude, base_rates) -> tuple:
+    def prepare(self, times, h: float, attitude, rates) -> None:
+        """Called by the master before the loop with the measured base attitude and rates of the
+        whole run ((n + 1) x 3 arrays): the built-in controllers compute their set points here."""
+
+    def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude, base_rates,
+                 step: int | None = None) -> tuple:
         return self.voltage
 
     def clamp(self, u: float, axis: int) -> float:
@@ -55,6 +61,15 @@ class Controller:
 
 
 class _ReferenceMixin:
+    set_points = None   # SetPoints of the run, once prepared
+
+    def prepare(self, times, h, attitude, rates) -> None:
+        self.set_points = plan_set_points(self.refs, self.target, times, h, attitude, rates)
+
+    def _prepared_references(self, step: int, alpha: float, beta: float):
+        points = self.set_points
+        return points.at(step, 0, alpha), points.at(step, 1, beta), points.rate_rows[step]
+
     def _setup_references(self, spec: dict, target):
         self.target = target
         self.refs = []
@@ -123,7 +138,7 @@ class AxisPID:
         return min(max(u, -self.u_limit), self.u_limit)
 
 
-class PID(Controller, _ReferenceMixin):
+class PID(_ReferenceMixin, Controller):
     kind = "pid"
 
     def __init__(self, spec: dict, target, u_limit):
@@ -131,14 +146,17 @@ class PID(Controller, _ReferenceMixin):
         self.axes = [AxisPID(f"controller.{axis}", spec.get(axis, {}), u_limit[i]) for i, axis in enumerate(AXES)]
         self._setup_references(spec, target)
 
-    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates):
-        r1, r2, r1_dot, r2_dot = self._references(t, alpha, base_attitude, base_rates, h)
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
+        if step is None or self.set_points is None:
+            r1, r2, r1_dot, r2_dot = self._references(t, alpha, base_attitude, base_rates, h)
+        else:
+            r1, r2, (r1_dot, r2_dot) = self._prepared_references(step, alpha, beta)
         self.reference = (r1, r2)
         w_az, w_el = gyro_axis_rates(gyro, beta)
         return self.axes[0](r1 - alpha, w_az, h, r1_dot), self.axes[1](r2 - beta, w_el, h, r2_dot)
 
 
-class StateFeedback(Controller, _ReferenceMixin):
+class StateFeedback(_ReferenceMixin, Controller):
     """u = -K x + ki * int(reference - angle), x = [alpha - alpha_ref, beta - beta_ref, w_az, w_el],
     K a 2x4 matrix [V/rad, V s/rad]; rates from the gyro (rate_source = "gyro") or from backward
     differences of the encoder angles ("encoder")."""
@@ -160,8 +178,11 @@ class StateFeedback(Controller, _ReferenceMixin):
         self.integral = [0.0, 0.0]
         self.prev = None
 
-    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates):
-        r1, r2 = self._references(t, alpha, base_attitude)
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
+        if step is None or self.set_points is None:
+            r1, r2 = self._references(t, alpha, base_attitude)
+        else:
+            r1, r2, _ = self._prepared_references(step, alpha, beta)
         self.reference = (r1, r2)
         if self.rate_source == "gyro":
             w_az, w_el = gyro_axis_rates(gyro, beta)
@@ -177,6 +198,24 @@ class StateFeedback(Controller, _ReferenceMixin):
                 self.integral[i] += -x[i] * h
             u.append(limited)
         return tuple(u)
+
+
+class Replay(Controller):
+    """Voltages given in advance, one row per communication point ((n + 1) x 2): replays a run's
+    commands, for measuring what the FMU alone costs (scripts/bench_scene_runner.py)."""
+    kind = "replay"
+
+    def __init__(self, voltages, u_limit=(math.inf, math.inf)):
+        import numpy as np
+
+        super().__init__(u_limit=u_limit)
+        self.voltages = np.ascontiguousarray(voltages, dtype=float)
+        self.rows = None
+
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
+        if self.rows is None:
+            self.rows = [tuple(row) for row in self.voltages.tolist()]
+        return self.rows[step]
 
 
 class Measurements:
@@ -240,7 +279,7 @@ class UserController(Controller):
     def start(self, step_size: float, scene_name: str) -> None:
         self.user.reset(ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name))
 
-    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates):
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
         u = self.user.step(t, Measurements(alpha, beta, gyro, base_attitude, base_rates))
         try:
             u1, u2 = float(u[0]), float(u[1])

@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 
+from . import compiled_loop
 from .base_motion import INPUTS as BASE_INPUTS
 from .errors import SceneError
 from .fmu import FMU, STATES
@@ -63,11 +64,14 @@ class Plan:
         self.times = np.arange(self.n + 1) * self.h
         self.motion = scene.base_motion()
         self.base = self.motion.sample(self.times)
-        self.base_rows = self.base.tolist()
         u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
         self.controller = controller or scene.controller(u_limit)
         self.sensors = scene.sensors()
         self.delay = scene.delay_steps
+        # What the IMU measures (the sensors' noise of the whole run drawn here), and from it the
+        # built-in controllers' set points of the whole run.
+        self.measured_attitude = self.sensors.prepare(self.base[:, :3])
+        self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
 
         self.real_names = [name for name in REAL_OUTPUTS if fmu.has(name)]
         self.mode_names = [name for name in MODE_OUTPUTS if fmu.has(name) and fmu.variables[name].type == "Integer"]
@@ -96,7 +100,7 @@ def initialize(slave, scene: Scene, fmu: FMU, plan: Plan) -> None:
     base_eps = plan.motion.sample(np.array([1e-6]))[0]
     fmu.set(slave, start_values(scene, fmu, plan.base[0], base_eps))
     slave.enterInitializationMode()
-    slave.setReal(plan.input_vrs, [0.0, 0.0] + ([] if plan.motion.fixed else plan.base_rows[0]))
+    slave.setReal(plan.input_vrs, [0.0, 0.0] + ([] if plan.motion.fixed else plan.base[0].tolist()))
     slave.exitInitializationMode()
 
 
@@ -114,7 +118,9 @@ def step_loop(slave, plan: Plan, bar: Progress) -> None:
     component = slave.component
     get_real, get_integer, set_real, do_step = calls.get_real, calls.get_integer, calls.set_real, calls.do_step
     measure, controller = plan.sensors.measure, plan.controller
-    h, n, delay, base_rows = plan.h, plan.n, plan.delay, plan.base_rows
+    h, n, delay = plan.h, plan.n, plan.delay
+    # Python floats: reading them per step costs less than indexing numpy rows
+    attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
     i_alpha, i_beta, i_gyro = plan.i_alpha, plan.i_beta, plan.i_gyro
     u_cmd, refs = plan.u_cmd, plan.refs
     zero = (0.0, 0.0)
@@ -126,8 +132,8 @@ def step_loop(slave, plan: Plan, bar: Progress) -> None:
         if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
             raise FMUCallFailed("fmi2GetInteger")
         y = rec_real[k].tolist()
-        row = base_rows[k]
-        u = controller(t, h, *measure(y[i_alpha], y[i_beta], [y[i] for i in i_gyro], row[:3], row[3:6]))
+        alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro])
+        u = controller(t, h, alpha, beta, gyro, attitude_rows[k], rate_rows[k], step=k)
         u_cmd.append(u)
         refs.append(controller.reference)
         applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
@@ -140,6 +146,32 @@ def step_loop(slave, plan: Plan, bar: Progress) -> None:
             raise FMUCallFailed("fmi2DoStep")
         if k % 256 == 0:
             bar.update((k + 1) * h)
+
+
+def compiled_step_loop(slave, plan: Plan, bar: Progress) -> None:
+    """step_loop for the built-in controllers, compiled (compiled_loop.py): the same results."""
+    loop = compiled_loop.CompiledLoop(slave, RawCalls(slave), plan)
+    chunk = 4096   # steps between progress updates (and chances to take Ctrl-C)
+    for first in range(0, plan.n + 1, chunk):
+        last = min(first + chunk - 1, plan.n)
+        loop.run(first, last)
+        bar.update(min(last + 1, plan.n) * plan.h)
+    plan.u_cmd, plan.refs = loop.u_cmd, loop.refs
+
+
+def choose_loop(controller, compiled: bool | None) -> str:
+    """'compiled' or 'python': `compiled` None takes the compiled loop where it can run this
+    controller, True insists on it (an error says why it cannot), False takes the Python loop."""
+    if compiled is False:
+        return "python"
+    why_not = compiled_loop.available()
+    if why_not is None and not compiled_loop.supports(controller):
+        why_not = f"the compiled loop runs the built-in controllers only, not {type(controller).__name__}"
+    if why_not is None:
+        return "compiled"
+    if compiled:
+        raise SceneError(why_not)
+    return "python"
 
 
 def recorded_signals(plan: Plan) -> dict:
@@ -161,14 +193,16 @@ def recorded_signals(plan: Plan) -> dict:
 
 
 def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None = None,
-        controller=None, slave=None, log: list | None = None) -> RunResult:
+        controller=None, slave=None, log: list | None = None, compiled: bool | None = None) -> RunResult:
     """Runs `scene` (to `stop_time` if given) and returns the recorded signals (recorded_signals),
     with line-of-sight signals added.
 
     `slave` (with the `log` list its logger appends to, from `fmu.instantiate(name, log)`): reuse this
     instance instead of instantiating a fresh one; it is reset first (fmi2Reset: back to the start
-    values, state 'instantiated'), the log is cleared, and the instance is left alive for the next run."""
+    values, state 'instantiated'), the log is cleared, and the instance is left alive for the next run.
+    `compiled`: which loop (choose_loop); the result's `loop` says which ran."""
     plan = Plan(scene, fmu, stop_time, controller)
+    loop = choose_loop(plan.controller, compiled)
     owned = slave is None
     if owned:
         log = []
@@ -182,7 +216,7 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     try:
         initialize(slave, scene, fmu, plan)
         plan.controller.start(plan.h, scene.name)
-        step_loop(slave, plan, bar)
+        (compiled_step_loop if loop == "compiled" else step_loop)(slave, plan, bar)
         bar.close()
         slave.terminate()
     except SceneError:
@@ -196,4 +230,5 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     wall, loop_cpu = time.perf_counter() - wall0, time.process_time() - cpu0
     result = RunResult(scene, recorded_signals(plan), wall, plan.t_end)
     result.loop_cpu_time = loop_cpu  # set-up, initialization and the loop; not the base motion's evaluation
+    result.loop = loop
     return result

@@ -1,48 +1,14 @@
 """Progress of a sweep on stderr, through tqdm (as scene_lib/progress.py for a scene run): cases
 done of the total, ok and failed, the rate and the time left. On a terminal a bar redrawn in
 place; into a pipe or a log file one plain line per 10 % of the cases (or per 30 s), starting
-"[done/total]", and never a carriage return."""
+"[done/total]" (scene_lib.progress.LineLog), and never a carriage return."""
 from __future__ import annotations
 
-import os
 import sys
-import time
 
 from tqdm import tqdm
 
-LOG_EVERY_S = 30.0   # into a log, a line at least this often (besides one per 10 % of the cases)
-
-
-class _LogLines(tqdm):
-    """A tqdm that writes whole lines instead of redrawing one: at the first finished case, when
-    another 10 % of the cases are done or LOG_EVERY_S passed, and at the last case."""
-
-    def __init__(self, counts: dict, **kwargs):
-        self.counts = counts   # ok and failed, for the line
-        self.line_decile, self.line_n, self.line_t = -1, 0, time.monotonic()
-        # Every update reaches display(), which decides; leave=False: closing draws nothing more
-        # (the last case has its line already) and writes no "\r".
-        super().__init__(mininterval=0, leave=False, **kwargs)
-
-    def display(self, msg=None, pos=None):
-        if msg is not None:           # tqdm clearing or overwriting its line: nothing to clear here
-            return None
-        n, total = self.n, self.total or 0
-        decile = 10 * n // max(total, 1)
-        due = decile != self.line_decile or time.monotonic() - self.line_t >= LOG_EVERY_S or n == total
-        if n == 0 or n == self.line_n or not due:
-            return None
-        self.line_decile, self.line_n, self.line_t = decile, n, time.monotonic()
-        self.fp.write(self.format_meter(**self.format_dict, **self.counts) + "\n")
-        self.fp.flush()
-        return None
-
-
-def _columns(stream) -> int:
-    try:
-        return os.get_terminal_size(stream.fileno()).columns
-    except (AttributeError, OSError, ValueError):
-        return 0
+from scene_lib.progress import LineLog, is_terminal, terminal_columns
 
 
 class Progress:
@@ -54,10 +20,10 @@ class Progress:
         # smoothing=0: the rate is the average since the start; miniters=1: no tqdm guess of how
         # often to look at the clock
         common = dict(total=total, disable=not enabled, file=stream, unit=" cases", smoothing=0, miniters=1)
-        if hasattr(stream, "isatty") and stream.isatty():
+        if is_terminal(stream):
             # the terminal's width, followed as it changes; 80 columns if it reports none (a pty
             # without a size, e.g. `script` run without a terminal, where tqdm would draw nothing)
-            known = _columns(stream) > 0
+            known = terminal_columns(stream) > 0
             self.bar = tqdm(**common, mininterval=0.2, dynamic_ncols=known, ncols=None if known else 80,
                             nrows=None if known else 20,
                             leave=True, postfix=self._postfix(),
@@ -65,7 +31,7 @@ class Progress:
                                        "{rate_noinv_fmt}{postfix}]")
         else:
             width = len(str(total))
-            self.bar = _LogLines(self.counts, **common,
+            self.bar = LineLog(self.counts, **common,
                                  bar_format=f"[{{n_fmt:>{width}}}/{{total_fmt}}] {{percentage:5.1f}} %  ok {{ok}}  "
                                             "failed {failed}  {rate_noinv_fmt}  ~{remaining} left")
 
@@ -74,7 +40,7 @@ class Progress:
 
     def update(self, status: str) -> None:
         self.counts["ok" if status == "ok" else "failed"] += 1
-        if not isinstance(self.bar, _LogLines):
+        if not isinstance(self.bar, LineLog):
             self.bar.set_postfix_str(self._postfix(), refresh=False)
         self.bar.update(1)
 

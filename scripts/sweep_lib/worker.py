@@ -12,6 +12,7 @@ import atexit
 import hashlib
 import math
 import os
+import sys
 import pathlib
 import tempfile
 import threading
@@ -161,6 +162,8 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
 
 
 def _worker_name() -> str:
+    if "distributed" not in sys.modules:   # a serial sweep: no worker, and no need to import Dask for that
+        return f"serial-{os.getpid()}"
     try:
         from distributed import get_worker
 
