@@ -26,13 +26,12 @@ import time
 
 import numpy as np
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
+from scene_lib import FMU, load_scene, run
+from scene_lib.base_motion import INPUTS as BASE_INPUTS
+from scene_lib.master import REAL_OUTPUTS, RawCalls
+from scene_lib.scene import start_values
 
-from scene_lib import FMU, load_scene, run  # noqa: E402
-from scene_lib.base_motion import INPUTS as BASE_INPUTS  # noqa: E402
-from scene_lib.master import REAL_OUTPUTS, RawCalls  # noqa: E402
-from scene_lib.scene import start_values  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 
 def master_loop_cpu(scene, fmu, stop_time: float) -> tuple[float, float, object]:

@@ -1,13 +1,11 @@
 """Shared fixtures: where the build lives and the artefacts the tests drive."""
 import os
 import pathlib
-import sys
 
 import pytest
 
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 BUILD_DIR = pathlib.Path(os.environ.get("GIMBAL_BUILD_DIR", REPO_ROOT / "build")).resolve()
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 
 @pytest.fixture(scope="session")
