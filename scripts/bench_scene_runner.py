@@ -60,7 +60,7 @@ def replay_cpu(scene, fmu, result) -> tuple[float, np.ndarray]:
         # The start values exactly as the master computes them (numpy's vectorised sin may differ in
         # the last bit between array lengths).
         base = motion.sample(np.arange(n + 1) * h)
-        fmu.set(slave, start_values(scene, fmu, base[0], motion.sample(np.array([1e-6]))[0]))
+        fmu.set_values(slave, start_values(scene, fmu, base[0], motion.sample(np.array([1e-6]))[0]))
         slave.enterInitializationMode()
         slave.setReal(list(map(int, input_vrs)), [0.0, 0.0] + ([] if motion.fixed else base[0].tolist()))
         slave.exitInitializationMode()

@@ -34,8 +34,7 @@ def probe_lib_path(build_dir) -> pathlib.Path:
 @pytest.fixture(scope="session")
 def gimbal_fmu(fmu_path):
     """The packaged FMU, extracted once for the whole session."""
-    from fmu_driver import LoadedFMU
+    from scene_lib.fmu import FMU
 
-    fmu = LoadedFMU.load(fmu_path)
-    yield fmu
-    fmu.cleanup()
+    with FMU(fmu_path) as fmu:
+        yield fmu
