@@ -18,11 +18,10 @@ import sys
 import tempfile
 import time
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
+from sweep_lib import SweepOptions, make_client, run_sweep
+from sweep_lib.table import read_rows
 
-from sweep_lib import SweepOptions, make_client, run_sweep  # noqa: E402
-from sweep_lib.table import read_rows  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 SWEEP = """
 name = "throughput"

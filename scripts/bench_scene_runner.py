@@ -25,13 +25,11 @@ import time
 
 import numpy as np
 
+from scene_lib import FMU, load_scene, run
+from scene_lib.controllers import Replay
+from scene_lib.master import REAL_OUTPUTS
+
 REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
-
-from scene_lib import FMU, load_scene, run  # noqa: E402
-from scene_lib.controllers import Replay  # noqa: E402
-from scene_lib.master import REAL_OUTPUTS  # noqa: E402
-
 LOOPS = ("compiled", "python")
 
 

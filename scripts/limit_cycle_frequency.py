@@ -15,10 +15,9 @@ import sys
 
 import numpy as np
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from scene_lib import FMU, SceneError, load_scene, run
 
-from scene_lib import FMU, SceneError, load_scene, run  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 
 def oscillation_frequency(t: np.ndarray, x: np.ndarray, from_s: float) -> dict:

@@ -17,9 +17,9 @@ import sys
 import numpy as np
 from fmpy.fmi1 import FMICallException
 
+from scene_lib.fmu import FMU, simulate
+
 REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tests"))
-from fmu_driver import LoadedFMU, simulate  # noqa: E402
 
 OUTPUTS = ["alpha", "beta", "alpha_dot", "beta_dot", "events.total", "solver.method_switches", "solver.steps",
            "solver.rhs_evaluations", "solver.jacobian_evaluations"]
@@ -66,7 +66,7 @@ def main() -> int:
     if not args.fmu.exists():
         print(f"random_cases: no FMU at {args.fmu}: run `bash scripts/setup.sh` first", file=sys.stderr)
         return 2
-    fmu = LoadedFMU.load(args.fmu)
+    fmu = FMU(args.fmu)
     rng = np.random.default_rng(args.seed)
     flagged = 0
     for case in range(args.cases):

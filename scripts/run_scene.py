@@ -15,11 +15,10 @@ import sys
 import tempfile
 import warnings
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from scene_lib import SceneError, load_scene, run_scene_file
+from scene_lib.errors import SceneWarning
 
-from scene_lib import SceneError, load_scene, run_scene_file  # noqa: E402
-from scene_lib.errors import SceneWarning  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 PROG = "run_scene.py"
 EXIT_ERROR, EXIT_INTERRUPTED = 2, 130

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what a fresh machine lacks (Debian packages, a Python virtual environment), then
-# configures and builds. Safe to run again: it only does what is missing.
+# Installs what a fresh machine lacks (Debian packages, a Python virtual environment with the
+# project's package of pyproject.toml), then configures and builds. Safe to run again: it only does
+# what is missing.
 #   GIMBAL_SETUP_FOR=run   what running needs (scripts/run.sh): requirements-run.txt, the FMU only
 #   GIMBAL_SETUP_FOR=test  (default) also the test tool chain and the other masters, and every target
 set -euo pipefail
@@ -50,6 +51,22 @@ if ! "$venv/bin/python" -c "import $modules" >/dev/null 2>&1 || [ "$requirements
   # ecospy's wheel ships its proxyfmu server without the executable bit.
   chmod +x "$venv"/lib/python3*/site-packages/ecospy/binaries/proxyfmu "$venv"/lib/python3*/site-packages/ecospy/binaries/ecos 2>/dev/null || true
   touch "$marker"
+fi
+# The project's own package (pyproject.toml: scene_lib and sweep_lib, which stay in scripts/), installed
+# editable: .venv imports them from this checkout, so the scripts, the tests, the notebook's kernel and
+# the sweeps' worker processes always run the working tree's code (a copy in site-packages would go
+# stale at the first edit; the compiled master loop, a C extension, is rebuilt here when its source
+# changes). --no-deps: its dependencies are requirements-run.txt, installed above.
+# Looked up (not imported) with -I: not fooled by the current directory or PYTHONPATH.
+package_marker="$venv/.package-installed"
+if ! "$venv/bin/python" -I -c "import importlib.util as u, sys
+sys.exit(not (u.find_spec('scene_lib') and u.find_spec('sweep_lib')))" >/dev/null 2>&1 ||
+   [ "$repo/pyproject.toml" -nt "$package_marker" ] || [ "$repo/requirements-run.txt" -nt "$package_marker" ] ||
+   [ "$repo/setup.py" -nt "$package_marker" ] || [ "$repo/scripts/scene_lib/_master_loop.c" -nt "$package_marker" ] ||
+   ! ls "$repo"/scripts/scene_lib/_master_loop*.so >/dev/null 2>&1; then
+  echo "[setup] installing the project's Python package (scene_lib, sweep_lib, the compiled loop) into .venv, editable"
+  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps -e "$repo"
+  touch "$package_marker"
 fi
 
 echo "[setup] building in $build_dir"

@@ -22,12 +22,11 @@ import argparse  # noqa: E402
 import pathlib  # noqa: E402
 import sys  # noqa: E402
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-
 from scene_lib import SceneError  # noqa: E402
 from sweep_lib import SweepError, SweepOptions, run_sweep  # noqa: E402
 from sweep_lib.runner import Stopped  # noqa: E402
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 EPILOG = """\
 sweep file:

@@ -1,13 +1,11 @@
 """Shared fixtures: where the build lives and the artefacts the tests drive."""
 import os
 import pathlib
-import sys
 
 import pytest
 
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 BUILD_DIR = pathlib.Path(os.environ.get("GIMBAL_BUILD_DIR", REPO_ROOT / "build")).resolve()
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 
 @pytest.fixture(scope="session")
@@ -36,8 +34,7 @@ def probe_lib_path(build_dir) -> pathlib.Path:
 @pytest.fixture(scope="session")
 def gimbal_fmu(fmu_path):
     """The packaged FMU, extracted once for the whole session."""
-    from fmu_driver import LoadedFMU
+    from scene_lib.fmu import FMU
 
-    fmu = LoadedFMU.load(fmu_path)
-    yield fmu
-    fmu.cleanup()
+    with FMU(fmu_path) as fmu:
+        yield fmu

@@ -2,16 +2,14 @@
 built-in controller, sensor model and delay, the two runs must agree to the bit in every recorded
 signal; and a failing FMU call must stop both with the same message."""
 import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
 
-from scene_lib import FMU, SceneError, load_scene, run  # noqa: E402
-from scene_lib import compiled_loop  # noqa: E402
+from scene_lib import FMU, SceneError, load_scene, run
+from scene_lib import compiled_loop
 
 SCENES = REPO / "scenes"
 NOISY_SENSORS = {"encoder_resolution_deg": 0.001, "gyro_noise_deg_s": 0.02, "imu_attitude_noise_deg": 0.01, "seed": 3}

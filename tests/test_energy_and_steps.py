@@ -4,12 +4,12 @@ Both scenes drive the non-smooth parts on purpose (backlash traversals, current 
 releasing, rotor stick-slip, voltage clamp) and assert that they did, since a balance or an agreement
 over a scene that never switches a mode would prove little about the hybrid integrator.
 
-`fmu_driver.simulate` only sets and reads Reals; these tests need the Boolean parameter
-`energy_accounting` and the Integer event counters, so they run their own small fmpy master loop.
+They run their own small fmpy master loop rather than `scene_lib.fmu.simulate`, which returns every
+output as a float: the Integer event counters stay integers here, and inputs are chosen by step index.
 """
 import numpy as np
 
-from fmu_driver import STATE_NAMES
+from scene_lib.fmu import STATES
 
 STORED = ["energy.kinetic", "energy.potential", "energy.spring", "energy.magnetic"]
 DISSIPATED = ["energy.resistive", "energy.viscous", "energy.shaft_damping", "energy.dry_friction"]
@@ -28,12 +28,12 @@ def run(fmu, stop_time, step_size, start_values, step_inputs, reals, integers=()
     slave = fmu.instantiate("energy_and_steps")
     try:
         slave.setupExperiment(startTime=0.0)
-        slave.setReal([fmu.vr[n] for n in start_values], [float(v) for v in start_values.values()])
+        slave.setReal([fmu.vr(n) for n in start_values], [float(v) for v in start_values.values()])
         if booleans:
-            slave.setBoolean([fmu.vr[n] for n in booleans], [bool(v) for v in booleans.values()])
+            slave.setBoolean([fmu.vr(n) for n in booleans], [bool(v) for v in booleans.values()])
         slave.enterInitializationMode()
         slave.exitInitializationMode()
-        real_vrs, integer_vrs = [fmu.vr[n] for n in reals], [fmu.vr[n] for n in integers]
+        real_vrs, integer_vrs = [fmu.vr(n) for n in reals], [fmu.vr(n) for n in integers]
         n_steps = int(round(stop_time / step_size))
         real_rows = [slave.getReal(real_vrs)]
         integer_rows = [slave.getInteger(integer_vrs) if integers else []]
@@ -41,7 +41,7 @@ def run(fmu, stop_time, step_size, start_values, step_inputs, reals, integers=()
             t = k * step_size
             values = step_inputs(k, t, dict(zip(reals, real_rows[-1])))
             if values:
-                slave.setReal([fmu.vr[n] for n in values], [float(v) for v in values.values()])
+                slave.setReal([fmu.vr(n) for n in values], [float(v) for v in values.values()])
             slave.doStep(currentCommunicationPoint=t, communicationStepSize=step_size)
             real_rows.append(slave.getReal(real_vrs))
             integer_rows.append(slave.getInteger(integer_vrs) if integers else [])
@@ -82,7 +82,7 @@ def powered_run(fmu, rtol):
     }
     return run(fmu, 2.0, 0.01, start,
                lambda k, t, y: dict(zip(("u_R1", "u_R2"), program_voltages(t))),
-               STATE_NAMES + ENERGY, COUNTERS + MODES, booleans={"energy_accounting": True})
+               STATES + ENERGY, COUNTERS + MODES, booleans={"energy_accounting": True})
 
 
 def balance_residual(r):
@@ -187,7 +187,7 @@ def closed_loop_run(fmu, step_size, rtol, stop_time=1.5):
         return values
 
     r = run(fmu, stop_time, step_size, {"solver.rtol": rtol, "solver.atol": rtol * 1e-2}, step_inputs,
-            STATE_NAMES, COUNTERS)
+            STATES, COUNTERS)
     return {n: v[::per_sample] for n, v in r.items()}
 
 
@@ -204,7 +204,7 @@ def step_differences(fine, coarse):
     """
     assert np.allclose(fine["time"], coarse["time"], rtol=0.0, atol=1e-12)
     fraction = {}
-    for name in STATE_NAMES:
+    for name in STATES:
         bound = 1e-5 * ETA if name.startswith("theta_b") else 1e-6 * np.max(np.abs(coarse[name]))
         fraction[name] = np.max(np.abs(fine[name] - coarse[name])) / bound
     return fraction

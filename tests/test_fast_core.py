@@ -7,7 +7,7 @@ turns stiff and back when it stops being so, and the first stage is refreshed af
 import numpy as np
 import pytest
 
-from fmu_driver import simulate
+from scene_lib.fmu import simulate
 
 RECORDED = ["alpha", "beta", "alpha_dot", "beta_dot", "i_R1", "i_R2", "theta_b1", "theta_b2", "T_E1",
             "los.omega[1]", "los.omega[2]", "los.omega[3]", "events.total", "solver.steps",
@@ -25,7 +25,7 @@ def ship_inputs(t, y):
 
 
 def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapshot=None):
-    """Like fmu_driver.simulate, with a start time and an optional FMU-state action at every step:
+    """Like scene_lib.fmu.simulate, with a start time and an optional FMU-state action at every step:
     'get' (take and free a state), 'get-set' (take it, set it back, free it)."""
     slave = fmu.instantiate()
     try:
@@ -153,7 +153,7 @@ def test_a_ramp_starting_exactly_on_the_voltage_clamp_leaves_it(gimbal_fmu):
             for k in range(100):
                 slave.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
             gimbal_fmu.set_values(slave, {"u_R1": start_voltage})
-            slave.setRealInputDerivatives([gimbal_fmu.vr["u_R1"]], [1], [-2000.0])
+            slave.setRealInputDerivatives([gimbal_fmu.vr("u_R1")], [1], [-2000.0])
             slave.doStep(currentCommunicationPoint=0.1, communicationStepSize=0.01)
             current = gimbal_fmu.get_values(slave, ["i_R1"])[0]
             slave.terminate()

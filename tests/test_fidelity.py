@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from fmu_driver import simulate
+from scene_lib.fmu import simulate
 
 ANGLES = ["alpha", "beta", "alpha_dot", "beta_dot"]
 COUNTERS = ["solver.states", "solver.steps", "solver.rhs_evaluations"]

@@ -6,9 +6,9 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2DoStepStatus
 
-from fmu_driver import STATE_NAMES, simulate
+from scene_lib.fmu import STATES, simulate
 
-OUTPUTS = STATE_NAMES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
+OUTPUTS = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
 START = {"beta": 0.3, "beta_m": 18.0, "solver.rtol": 1e-8, "solver.atol": 1e-10}
 STEP = 1e-3
 ERROR, DISCARD = 3, 2
@@ -214,7 +214,7 @@ def test_calls_in_the_wrong_state_are_refused_and_named(gimbal_fmu):
             slave.doStep(0.0, STEP)
         assert "fmi2DoStep is not allowed in state 'instantiated'" in log[-1][2]
         with pytest.raises(FMICallException):
-            slave.getReal([gimbal_fmu.vr["alpha"]])
+            slave.getReal([gimbal_fmu.vr("alpha")])
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
         slave.exitInitializationMode()

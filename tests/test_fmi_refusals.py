@@ -11,7 +11,7 @@ def initialized(fmu, log, start_values=None):
     slave = fmu.instantiate("refusals", log=log)
     slave.setupExperiment(startTime=0.0)
     if start_values:
-        slave.setReal([fmu.vr[n] for n in start_values], list(start_values.values()))
+        slave.setReal([fmu.vr(n) for n in start_values], list(start_values.values()))
     slave.enterInitializationMode()
     return slave
 
@@ -34,7 +34,7 @@ def test_invalid_parameter_is_refused_at_initialization(gimbal_fmu, name, value,
         prefix = name.split(".")[0]
         assert any((name in text or prefix in text) and rule in text for text in errors), errors
         # The instance is not corrupted: fix the value and initialize.
-        slave.setReal([gimbal_fmu.vr[name]], [float(_start(gimbal_fmu, name))])
+        slave.setReal([gimbal_fmu.vr(name)], [float(_start(gimbal_fmu, name))])
         slave.exitInitializationMode()
         slave.doStep(0.0, 1e-3)
     finally:
@@ -52,11 +52,11 @@ def test_non_finite_input_is_refused_and_state_kept(gimbal_fmu, value):
     try:
         slave.exitInitializationMode()
         slave.doStep(0.0, 1e-3)
-        before = slave.getReal([gimbal_fmu.vr["u_R1"]])[0]
+        before = slave.getReal([gimbal_fmu.vr("u_R1")])[0]
         with pytest.raises(FMICallException):
-            slave.setReal([gimbal_fmu.vr["u_R1"]], [value])
+            slave.setReal([gimbal_fmu.vr("u_R1")], [value])
         assert any(status == ERROR and "u_R1" in text for status, _, text in log), log
-        assert slave.getReal([gimbal_fmu.vr["u_R1"]])[0] == before
+        assert slave.getReal([gimbal_fmu.vr("u_R1")])[0] == before
         slave.doStep(1e-3, 1e-3)  # still usable
     finally:
         slave.freeInstance()
@@ -85,7 +85,7 @@ def test_fixed_parameter_cannot_change_after_initialization(gimbal_fmu):
     try:
         slave.exitInitializationMode()
         with pytest.raises(FMICallException):
-            slave.setReal([gimbal_fmu.vr["gear1.k_s"]], [1.0])
+            slave.setReal([gimbal_fmu.vr("gear1.k_s")], [1.0])
         assert "gear1.k_s" in log[-1][2] and "cannot be set" in log[-1][2]
     finally:
         slave.freeInstance()

@@ -36,7 +36,7 @@ k h, and the same interpolated inputs, computed operation by operation as fmi-si
 and the time column then agree to the last bit; that is asserted for every scene. The one argument
 not copied is `visible = true`, which this FMU ignores.
 
-For a fixed base, fmi-sim's calls differ from `fmu_driver.simulate` only in where the start values
+For a fixed base, fmi-sim's calls differ from `scene_lib.fmu.simulate` only in where the start values
 are set (before instead of after `fmi2SetupExperiment`, both in the instantiated state) and in
 `loggingOn`; neither changes the solution, and the plain `simulate` agrees bit for bit too.
 With inputs from a table, the interpolated values are not always the scene function's: for the
@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from fmu_driver import LoadedFMU, simulate
+from scene_lib.fmu import FMU, simulate
 from test_other_masters import GAMMA_DOT, OUTPUTS, START, STOP_TIME, assert_bitwise_equal
 
 pytestmark = pytest.mark.skipif(
@@ -190,13 +190,13 @@ def fmi_sim_interpolation(times: list, values: list, t: float) -> float:
     return values[index] + fraction * (values[index + 1] - values[index])
 
 
-def set_table_inputs(fmu: LoadedFMU, slave, table: dict, t: float) -> None:
+def set_table_inputs(fmu: FMU, slave, table: dict, t: float) -> None:
     inputs = [v.name for v in fmu.model_description.modelVariables if v.causality == "input" and v.name in table]
     for name in inputs:  # one fmi2SetReal each, in modelDescription order
-        slave.setReal([fmu.vr[name]], [fmi_sim_interpolation(table["time"], table[name], t)])
+        slave.setReal([fmu.vr(name)], [fmi_sim_interpolation(table["time"], table[name], t)])
 
 
-def fmpy_as_fmi_sim(fmu: LoadedFMU, scene: Scene, step: float) -> tuple[np.ndarray, np.ndarray]:
+def fmpy_as_fmi_sim(fmu: FMU, scene: Scene, step: float) -> tuple[np.ndarray, np.ndarray]:
     """fmi-sim's calls, in its order (module docstring): (times, (points, OUTPUTS) matrix)."""
     log = []
     slave = fmu.instantiate("inst1", log=log, logging_on=True)

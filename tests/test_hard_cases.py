@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from fmu_driver import STATE_NAMES, simulate
+from scene_lib.fmu import STATES, simulate
 
 COST = ["solver.steps", "solver.rhs_evaluations"]
 STORED = ["energy.kinetic", "energy.potential", "energy.spring", "energy.magnetic"]
@@ -193,14 +193,14 @@ def test_shaft_damping_1e6_with_explicit_rk_is_discarded_not_garbage(gimbal_fmu)
         slave.enterInitializationMode()
         slave.exitInitializationMode()
         gimbal_fmu.set_values(slave, {"u_R1": 10.0, "u_R2": -10.0})
-        before = gimbal_fmu.get_values(slave, STATE_NAMES)
+        before = gimbal_fmu.get_values(slave, STATES)
         outcome = "completed"
         try:
             for k in range(20):
                 slave.doStep(k * 1e-3, 1e-3)
         except FMICallException:
             outcome = "discarded"
-        after = gimbal_fmu.get_values(slave, STATE_NAMES + ["theta_b1", "theta_b2"])
+        after = gimbal_fmu.get_values(slave, STATES + ["theta_b1", "theta_b2"])
     finally:
         slave.freeInstance()
     wall = time.perf_counter() - t0
@@ -513,7 +513,7 @@ def test_heavy_sea_results_do_not_depend_on_step_or_jacobian(gimbal_fmu):
             values.update(held)
             return values
         return inputs
-    out = STATE_NAMES + ["los.omega[1]", "los.omega[2]", "los.omega[3]", "events.backlash1", "events.backlash2",
+    out = STATES + ["los.omega[1]", "los.omega[2]", "los.omega[3]", "events.backlash1", "events.backlash2",
                          "events.zeno_guard", "motor1.limited"]
     start = {"solver.rtol": 1e-9, "solver.atol": 1e-11}
     fine = timed(gimbal_fmu, 2.0, 1e-3, start, make_inputs(1e-3), out)
@@ -541,7 +541,7 @@ def test_base_shock_step_in_acceleration(gimbal_fmu):
         v = 30 * 9.81 * min(max(t - 0.05, 0.0), 0.02)
         return {"base.a_a[1]": a, "base.v_a[1]": v, "base.a_a[2]": 0.5 * a, "base.v_a[2]": 0.5 * v}
     start = {"beta": 0.2, "beta_m": 12.0, "solver.rtol": 1e-9, "solver.atol": 1e-11}
-    out = STATE_NAMES + ["T_E1", "T_E2", "gear1.contact", "gear2.contact", "events.backlash1", "events.backlash2",
+    out = STATES + ["T_E1", "T_E2", "gear1.contact", "gear2.contact", "events.backlash1", "events.backlash2",
                          "events.zeno_guard"]
     coarse = timed(gimbal_fmu, 0.15, 1e-3, start, shock, out)
     fine = timed(gimbal_fmu, 0.15, 1e-4, start, shock, out)
@@ -559,7 +559,7 @@ def test_base_shock_step_in_acceleration(gimbal_fmu):
 # 7. Communication steps, events on communication points, a long run
 
 COMM_SCENE = {"beta": 0.2, "beta_m": 12.0, "solver.rtol": 1e-10, "solver.atol": 1e-12}
-COMM_OUT = STATE_NAMES + ["events.backlash1", "events.backlash2", "events.current_limit1", "events.current_limit2",
+COMM_OUT = STATES + ["events.backlash1", "events.backlash2", "events.current_limit1", "events.current_limit2",
                           "events.stick_slip"] + COST
 
 
@@ -593,7 +593,7 @@ def test_communication_steps_from_1e6_to_0_1_give_the_same_result(gimbal_fmu):
         for name in ("events.backlash1", "events.backlash2", "events.current_limit1", "events.current_limit2",
                      "events.stick_slip"):
             assert r[name] == ref[name], (h, name, r[name], ref[name])
-        for name in STATE_NAMES:
+        for name in STATES:
             scale = 2e-4 if name.startswith("theta_b") else max(1.0, abs(ref[name]))
             worst = max(worst, abs(r[name] - ref[name]) / scale)
     fine = {"solver.steps": [results[1e-6]["solver.steps"]], "solver.rhs_evaluations": [results[1e-6]["solver.rhs_evaluations"]]}
@@ -716,7 +716,7 @@ def stepped(fmu, inputs, log=None, steps=20, start=None):
             except FMICallException as e:
                 error = e
                 break
-        return np.array(fmu.get_values(slave, STATE_NAMES + ["T_E1", "energy.kinetic"])), error
+        return np.array(fmu.get_values(slave, STATES + ["T_E1", "energy.kinetic"])), error
     finally:
         slave.freeInstance()
 

@@ -28,7 +28,7 @@ def run(fmu, steps, with_derivatives, step=STEP, log=None, **overrides):
     slave.enterInitializationMode()
     slave.exitInitializationMode()
     rows = []
-    vr = [fmu.vr["u_R1"], fmu.vr["u_R2"]]
+    vr = [fmu.vr("u_R1"), fmu.vr("u_R2")]
     try:
         for k in range(steps):
             t = k * step
@@ -70,12 +70,12 @@ def test_only_voltages_take_first_derivatives(gimbal_fmu):
         slave.enterInitializationMode()
         slave.exitInitializationMode()
         with pytest.raises(FMICallException):
-            slave.setRealInputDerivatives([gimbal_fmu.vr["base.gamma"]], [1], [0.1])
+            slave.setRealInputDerivatives([gimbal_fmu.vr("base.gamma")], [1], [0.1])
         assert "base.gamma takes no derivative" in log[-1][2]
         with pytest.raises(FMICallException):
-            slave.setRealInputDerivatives([gimbal_fmu.vr["u_R1"]], [2], [0.1])
+            slave.setRealInputDerivatives([gimbal_fmu.vr("u_R1")], [2], [0.1])
         assert "order 2" in log[-1][2]
-        slave.setRealInputDerivatives([gimbal_fmu.vr["u_R1"]], [1], [100.0])
+        slave.setRealInputDerivatives([gimbal_fmu.vr("u_R1")], [1], [100.0])
         slave.doStep(0.0, STEP)
     finally:
         slave.freeInstance()

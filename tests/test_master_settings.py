@@ -109,13 +109,13 @@ def test_unsupported_functions_name_the_declaration_that_says_so(gimbal_fmu):
     log = []
     slave = initialized(gimbal_fmu, log)
     try:
-        vr = (ctypes.c_uint * 1)(gimbal_fmu.vr["beta"])
+        vr = (ctypes.c_uint * 1)(gimbal_fmu.vr("beta"))
         order = (ctypes.c_int * 1)(1)
         value = (ctypes.c_double * 1)()
         with pytest.raises(FMICallException):
             slave.fmi2GetRealOutputDerivatives(slave.component, vr, 1, order, value)
         assert 'maxOutputDerivativeOrder="0"' in log[-1][2]
-        known = (ctypes.c_uint * 1)(gimbal_fmu.vr["u_R1"])
+        known = (ctypes.c_uint * 1)(gimbal_fmu.vr("u_R1"))
         seed = (ctypes.c_double * 1)(1.0)
         with pytest.raises(FMICallException):
             slave.fmi2GetDirectionalDerivative(slave.component, vr, 1, known, 1, seed, value)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from fmu_driver import STATE_NAMES, simulate
+from scene_lib.fmu import STATES, simulate
 
 CONSERVATIVE = {
     # Fixed base, no friction, no damping, motors that exert no torque: only gravity and gear springs act
@@ -24,7 +24,7 @@ def total_energy(result):
 
 def test_energy_is_conserved_without_dissipation(gimbal_fmu):
     result = simulate(gimbal_fmu, stop_time=10.0, step_size=0.01, start_values=CONSERVATIVE,
-                      outputs=STATE_NAMES + ENERGY)
+                      outputs=STATES + ENERGY)
     energy = total_energy(result)
     # The energy really moves between its forms (else conservation would prove nothing)...
     kinetic_scale = np.max(result["energy.kinetic"])
@@ -71,7 +71,7 @@ def moving_base_inputs(t, outputs, velocity=(0.0, 0.0, 0.0)):
 
 
 def test_constant_base_velocity_changes_no_trajectory(gimbal_fmu):
-    outputs = STATE_NAMES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]", "energy.kinetic"]
+    outputs = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]", "energy.kinetic"]
     runs = [simulate(gimbal_fmu, 1.0, 1e-3, {"solver.rtol": 1e-9, "solver.atol": 1e-11},
                      lambda t, y, v=v: moving_base_inputs(t, y, v), outputs)
             for v in [(0.0, 0.0, 0.0), (12.0, -7.0, 3.0)]]

@@ -2,14 +2,9 @@
 through tqdm: into a pipe or a log whole lines and never a carriage return; on a terminal a bar
 redrawn in place, also on one that reports no size."""
 import io
-import pathlib
-import sys
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
-
-from scene_lib.progress import Progress as SceneProgress  # noqa: E402
-from sweep_lib.progress import Progress as SweepProgress  # noqa: E402
+from scene_lib.progress import Progress as SceneProgress
+from sweep_lib.progress import Progress as SweepProgress
 
 
 class Terminal(io.StringIO):

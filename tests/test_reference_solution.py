@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from fmu_driver import STATE_NAMES, simulate
+from scene_lib.fmu import STATES, simulate
 from reference_model import ReferenceModel
 
 STEP = 2e-3
@@ -47,7 +47,7 @@ def test_closed_loop_on_moving_base_matches_independent_solution(gimbal_fmu):
     start.update(smooth)
     overrides = dict(smooth, **{"solver.rtol": 1e-8, "solver.atol": 1e-10, "beta": 0.1,
                                 "beta_m": 0.1 * start["gear2.N"]})
-    fmu = simulate(gimbal_fmu, STOP, STEP, overrides, DelayedPD(), STATE_NAMES)
+    fmu = simulate(gimbal_fmu, STOP, STEP, overrides, DelayedPD(), STATES)
 
     model = ReferenceModel(start)
     x = np.zeros(12)
@@ -56,17 +56,17 @@ def test_closed_loop_on_moving_base_matches_independent_solution(gimbal_fmu):
     states = [x]
     for k in range(int(round(STOP / STEP))):
         t = k * STEP
-        outputs = dict(zip(STATE_NAMES, x))
+        outputs = dict(zip(STATES, x))
         x = model.step(x, t, STEP, controller(t, outputs))
         states.append(x)
     reference = np.array(states)
 
     # The loop really moved the gimbal and the gears really flexed, else agreement would prove little.
     assert np.ptp(reference[:, 0]) > 0.1 and np.ptp(reference[:, 2]) > 0.1
-    for j, name in enumerate(STATE_NAMES[:4]):
+    for j, name in enumerate(STATES[:4]):
         error = np.max(np.abs(fmu[name] - reference[:, j]))
         print(f"{name}: max error against the reference {error:.2e} rad")
         assert error < 1e-7, f"{name}: max error {error:.3e} rad"
-    for j, name in enumerate(STATE_NAMES[4:8], start=4):
+    for j, name in enumerate(STATES[4:8], start=4):
         error = np.max(np.abs(fmu[name] - reference[:, j]))
         assert error < 1e-5, f"{name}: max error {error:.3e} rad/s"

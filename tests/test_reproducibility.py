@@ -7,11 +7,12 @@ import sys
 
 import numpy as np
 
+from scene_lib import load_scene
+
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
 SAMPLE = """
 import sys, numpy as np
-sys.path.insert(0, {scripts!r})
 from scene_lib import load_scene
 motion = load_scene({scene!r}).base_motion()
 np.save(sys.argv[1], motion.sample(np.arange(20001) * 1e-3))
@@ -19,7 +20,7 @@ np.save(sys.argv[1], motion.sample(np.arange(20001) * 1e-3))
 
 
 def test_the_base_motion_does_not_depend_on_the_blas_thread_count(tmp_path):
-    code = SAMPLE.format(scripts=str(REPO / "scripts"), scene=str(REPO / "scenes" / "ship_stabilization.toml"))
+    code = SAMPLE.format(scene=str(REPO / "scenes" / "ship_stabilization.toml"))
     samples = []
     for threads in ("1", "2", "4"):
         out = tmp_path / f"threads{threads}.npy"
@@ -33,9 +34,6 @@ def test_the_base_motion_does_not_depend_on_the_blas_thread_count(tmp_path):
 def test_the_blockwise_sum_of_sines_matches_the_direct_formula():
     """On a uniform grid the sea state is evaluated block by block (rotations of each block's start);
     anywhere else with sin and cos of every entry. The two agree to round-off."""
-    sys.path.insert(0, str(REPO / "scripts"))
-    from scene_lib import load_scene
-
     motion = load_scene(REPO / "scenes" / "ship_stabilization.toml").base_motion()
     grid = np.arange(30001) * 1e-3
     irregular = grid.copy()
@@ -48,9 +46,6 @@ def test_the_blockwise_sum_of_sines_matches_the_direct_formula():
 
 
 def test_a_shortened_run_sees_the_same_base_motion_bits():
-    sys.path.insert(0, str(REPO / "scripts"))
-    from scene_lib import load_scene
-
     motion = load_scene(REPO / "scenes" / "ship_stabilization.toml").base_motion()
     full = motion.sample(np.arange(60001) * 1e-3)
     for rows in (2, 100, 129, 3001, 8193):

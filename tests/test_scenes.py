@@ -1,17 +1,15 @@
 """Scenes (scenes/*.toml) and the scene runner (scripts/run_scene.py, scripts/scene_lib/)."""
 import math
 import pathlib
-import sys
 
 import numpy as np
 import pytest
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
+from scene_lib import FMU, SceneError, check_against_fmu, load_scene, run, run_scene_file
+from scene_lib import geometry
+from scene_lib.base_motion import INPUTS, make_base_motion
 
-from scene_lib import FMU, SceneError, check_against_fmu, load_scene, run, run_scene_file  # noqa: E402
-from scene_lib import geometry  # noqa: E402
-from scene_lib.base_motion import INPUTS, make_base_motion  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 SCENES = sorted((REPO / "scenes").glob("*.toml"))
 REQUIRED = {"free_swing", "pointing_step", "ship_stabilization", "backlash_limit_cycle", "stick_slip_slow_tracking"}

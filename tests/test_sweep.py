@@ -3,12 +3,10 @@ of 2 workers against serial runs case by case, failed cases reported with the FM
 that skip the cases already done."""
 import math
 import pathlib
-import sys
 
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
 
 pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")

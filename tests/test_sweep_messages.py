@@ -16,7 +16,6 @@ import time
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
 
 pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")

@@ -2,15 +2,13 @@
 options. The plumbing is checked by re-implementing the built-in PID as a user class: the run must
 equal the built-in one bit for bit (same measurements, delay, saturation and records)."""
 import pathlib
-import sys
 
 import numpy as np
 import pytest
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
+from scene_lib import FMU, SceneError, load_scene, run
 
-from scene_lib import FMU, SceneError, load_scene, run  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 EXAMPLE = REPO / "examples" / "user_controller.toml"
 

@@ -1,7 +1,7 @@
 """Scenes for the Gimbal2Axis FMU: loading and validation (scene), base motions (base_motion),
 angle references (references), controllers (controllers), sensors (sensors), line-of-sight
-geometry (geometry), the FMU wrapper (fmu), the co-simulation master loop (master), results and
-metrics (results), plots (plotting), a progress bar (progress)."""
+geometry (geometry), the FMU wrapper and a plain fixed-step master (fmu), the co-simulation master
+loop (master), results and metrics (results), plots (plotting), a progress bar (progress)."""
 from .errors import SceneError
 from .fmu import FMU
 from .master import run

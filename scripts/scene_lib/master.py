@@ -98,7 +98,7 @@ def initialize(slave, scene: Scene, fmu: FMU, plan: Plan) -> None:
     """Set-up and initialization: start values, the first inputs (0 V, the base at t = 0)."""
     slave.setupExperiment(startTime=0.0, stopTime=plan.t_end)
     base_eps = plan.motion.sample(np.array([1e-6]))[0]
-    fmu.set(slave, start_values(scene, fmu, plan.base[0], base_eps))
+    fmu.set_values(slave, start_values(scene, fmu, plan.base[0], base_eps))
     slave.enterInitializationMode()
     slave.setReal(plan.input_vrs, [0.0, 0.0] + ([] if plan.motion.fixed else plan.base[0].tolist()))
     slave.exitInitializationMode()
@@ -222,7 +222,7 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     except SceneError:
         raise
     except Exception as exc:   # a refused FMI call, or fmpy raising on fmi2Error / fmi2Discard
-        details = "; ".join((log or [])[-5:]) or "no log message"
+        details = "; ".join(map(str, (log or [])[-5:])) or "no log message"
         raise SceneError(f"{scene.name}: the FMU failed at t = {plan.k * plan.h:.6g} s ({exc}): {details}") from None
     finally:
         if owned:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import logging
 import math
-import os
 import pathlib
 import signal
 import sys
@@ -25,7 +24,6 @@ from .progress import Progress
 from .spec import SweepError, apply_case, case_key, load_sweep, scene_hash
 from .worker import fmu_digest, run_case, run_cases
 
-SCRIPTS = pathlib.Path(__file__).resolve().parents[1]
 SCHEDULER_TIMEOUT_S = 5.0   # a scheduler that does not answer by then is not coming
 
 
@@ -97,11 +95,15 @@ def _base_row(case: Case, scene, sweep, scene_digest: str, fmu_sha: str) -> dict
 
 def _zip_packages() -> pathlib.Path:
     """scene_lib and sweep_lib in a zip, for client.upload_file to workers of an existing scheduler."""
+    import scene_lib
+    import sweep_lib
+
     path = pathlib.Path(tempfile.mkdtemp(prefix="gimbal_sweep_upload_")) / "gimbal_sweep_libs.zip"
     with zipfile.ZipFile(path, "w") as z:
-        for package in ("scene_lib", "sweep_lib"):
-            for file in sorted((SCRIPTS / package).glob("*.py")):
-                z.write(file, f"{package}/{file.name}")
+        for package in (scene_lib, sweep_lib):   # from wherever this process imported them
+            directory = pathlib.Path(package.__file__).resolve().parent
+            for file in sorted(directory.glob("*.py")):
+                z.write(file, f"{package.__name__}/{file.name}")
     return path
 
 
@@ -123,11 +125,9 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
             client.upload_file(str(_zip_packages()))
         except Exception as exc:  # pragma: no cover - depends on the remote cluster
             print(f"sweep: warning: could not upload scene_lib/sweep_lib to the workers ({exc}); they must "
-                  f"import them (PYTHONPATH={SCRIPTS})", file=sys.stderr)
+                  "have them installed (pip install the repository there)", file=sys.stderr)
         return client, None
-    path = os.environ.get("PYTHONPATH", "")
-    if str(SCRIPTS) not in path.split(os.pathsep):   # spawned worker processes import sweep_lib
-        os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(SCRIPTS), path) if p)
+    # The local workers are processes of this Python: they import the installed scene_lib and sweep_lib.
     cluster = None
     try:
         with _StopRequests():   # a half-started cluster cannot be closed in order

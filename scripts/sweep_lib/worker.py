@@ -142,17 +142,17 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
         row["status"] = "ok"
         row["wall_time_s"] = time.perf_counter() - wall0   # the whole case: set-up, run, metrics
         if loaded.log:   # warnings of a run that went through
-            row["fmu_log"] = "\n".join(loaded.log)
+            row["fmu_log"] = "\n".join(map(str, loaded.log))
     except SceneError as exc:
         row["message"] = str(exc)
         row["wall_time_s"] = time.perf_counter() - wall0
         if loaded is not None:
-            row["fmu_log"] = "\n".join(loaded.log)
+            row["fmu_log"] = "\n".join(map(str, loaded.log))
     except Exception as exc:   # anything else: report it, and do not trust the instance any more
         row["message"] = f"{type(exc).__name__}: {exc}"
         row["wall_time_s"] = time.perf_counter() - wall0
         if loaded is not None:
-            row["fmu_log"] = "\n".join(loaded.log)
+            row["fmu_log"] = "\n".join(map(str, loaded.log))
             loaded.discard_instance()
     row["cpu_time_s"] = time.thread_time() - cpu0   # less than wall_time_s when the CPU is shared
     if loaded is not None:
