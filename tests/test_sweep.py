@@ -164,3 +164,28 @@ def test_rerun_skips_the_cases_already_done(tmp_path, fmu_path, client):
     sweep_path.write_text(SMALL)
     more = run_sweep(SCENE, sweep_path, fmu_path, tmp_path, SweepOptions(client=client, progress=False, plot=False))
     assert more.ran == 4 and more.skipped == 4 and len(read_rows(more.parquet)) == 8
+
+
+USER_GAINS = """
+name = "user_gains"
+stop_time = 0.1
+metrics_from_s = 0.02
+[grid]
+"controller.options.kp" = [100.0, 400.0]
+"controller.options.k_gyro" = [2.0, 8.0]
+"""
+
+
+def test_a_user_controller_sweeps_on_the_workers_like_a_built_in_one(tmp_path, fmu_path, client):
+    # examples/user_controller.toml names examples/gyro_stabilizer.py; its options are swept
+    scene = REPO / "examples" / "user_controller.toml"
+    sweep_path = write(tmp_path, USER_GAINS, "user_gains")
+    outcome = run_sweep(scene, sweep_path, fmu_path, tmp_path / "out", SweepOptions(client=client, progress=False,
+                                                                                      plot=False))
+    rows = {r["case_id"]: r for r in read_rows(outcome.parquet)}
+    assert outcome.failed == 0 and len(rows) == 4
+    assert len({r["los_rms_mrad"] for r in rows.values()}) == 4   # each case got its own options
+    reference = serial_reference(scene, sweep_path, fmu_path)
+    for case_id, expected in reference.items():
+        for key in METRICS:
+            assert _same(rows[case_id][key], expected[key]), (case_id, key)
