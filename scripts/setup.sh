@@ -55,16 +55,16 @@ fi
 # The project's own package (pyproject.toml: scene_lib and sweep_lib, which stay in scripts/), installed
 # editable: .venv imports them from this checkout, so the scripts, the tests, the notebook's kernel and
 # the sweeps' worker processes always run the working tree's code (a copy in site-packages would go
-# stale at the first edit; the compiled master loop, a C extension, is rebuilt here when its source
-# changes). --no-deps: its dependencies are requirements-run.txt, installed above.
+# stale at the first edit; its C kernels, an extension, are rebuilt here when their sources change).
+# --no-deps: its dependencies are requirements-run.txt, installed above.
 # Looked up (not imported) with -I: not fooled by the current directory or PYTHONPATH.
 package_marker="$venv/.package-installed"
 if ! "$venv/bin/python" -I -c "import importlib.util as u, sys
 sys.exit(not (u.find_spec('scene_lib') and u.find_spec('sweep_lib')))" >/dev/null 2>&1 ||
    [ "$repo/pyproject.toml" -nt "$package_marker" ] || [ "$repo/requirements-run.txt" -nt "$package_marker" ] ||
-   [ "$repo/setup.py" -nt "$package_marker" ] || [ "$repo/scripts/scene_lib/_master_loop.c" -nt "$package_marker" ] ||
-   ! ls "$repo"/scripts/scene_lib/_master_loop*.so >/dev/null 2>&1; then
-  echo "[setup] installing the project's Python package (scene_lib, sweep_lib, the compiled loop) into .venv, editable"
+   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/scripts/scene_lib/native" -newer "$package_marker" 2>/dev/null)" ] ||
+   ! ls "$repo"/scripts/scene_lib/_native*.so >/dev/null 2>&1; then
+  echo "[setup] installing the project's Python package (scene_lib, sweep_lib, their C kernels) into .venv, editable"
   "$venv/bin/pip" install -q --disable-pip-version-check --no-deps -e "$repo"
   touch "$package_marker"
 fi

@@ -1,4 +1,4 @@
-"""The compiled communication loop (_master_loop.c) for the built-in controllers, through ctypes.
+"""The compiled communication loop (native/master_loop.c) for the built-in controllers, through ctypes.
 
 It does what master.step_loop does with a built-in controller, with the same arithmetic: the tests
 check both give the same bits. A scene with a user controller (type "python") runs the Python loop;
@@ -10,6 +10,7 @@ import ctypes
 
 import numpy as np
 
+from . import native
 from .controllers import PID, Controller, Replay, StateFeedback
 
 _pointer, _long, _double, _int = ctypes.c_void_p, ctypes.c_long, ctypes.c_double, ctypes.c_int
@@ -37,32 +38,16 @@ class _MasterLoop(ctypes.Structure):
 
 
 FAILED_CALLS = {1: "fmi2GetReal", 2: "fmi2GetInteger", 3: "fmi2SetReal", 4: "fmi2DoStep"}
-_library = None
-_why_not = None
-
-
-def _load():
-    global _library, _why_not
-    if _library is not None or _why_not is not None:
-        return _library
-    try:
-        from . import _master_loop   # built by `pip install` of the package (pyproject.toml)
-        library = ctypes.CDLL(_master_loop.__file__)
-        library.gimbal_master_loop.argtypes = [ctypes.POINTER(_MasterLoop), _long, _long]
-        library.gimbal_master_loop.restype = _int
-        library.gimbal_master_loop_struct_size.restype = _long
-        if library.gimbal_master_loop_struct_size() != ctypes.sizeof(_MasterLoop):
-            raise ImportError("its MasterLoop struct does not match compiled_loop.py (rebuild: pip install -e .)")
-        _library = library
-    except (ImportError, OSError, AttributeError) as exc:
-        _why_not = f"the compiled loop is not available ({exc})"
-    return _library
 
 
 def available() -> str | None:
     """None when the compiled loop can be used, else why not."""
-    _load()
-    return _why_not
+    loaded = native.library()
+    if loaded is None:
+        return native.why_not()
+    if loaded.gimbal_master_loop_struct_size() != ctypes.sizeof(_MasterLoop):
+        return "the compiled loop's MasterLoop struct does not match compiled_loop.py (rebuild: pip install -e .)"
+    return None
 
 
 def supports(controller) -> bool:
@@ -73,7 +58,7 @@ class CompiledLoop:
     """One run's loop state; `run(first, last)` steps k = first .. last like master.step_loop."""
 
     def __init__(self, slave, calls, plan):
-        self.library = _load()
+        self.library = native.library()
         self.plan = plan   # keeps every array the struct points into alive
         controller, sensors = plan.controller, plan.sensors
         self.vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
@@ -122,7 +107,7 @@ class CompiledLoop:
                 m.prev_angle[:] = controller.prev
 
     def run(self, first: int, last: int) -> None:
-        failed = self.library.gimbal_master_loop(ctypes.byref(self.loop), first, last)
+        failed = self.library.gimbal_master_loop(ctypes.addressof(self.loop), first, last)
         self.plan.k = self.loop.failed_step
         if failed:
             from .master import FMUCallFailed

@@ -14,8 +14,6 @@
 #include <math.h>
 #include <stddef.h>
 
-#include <Python.h>
-
 typedef int (*ArrayCall)(void* component, const unsigned* refs, size_t count, void* values);
 typedef int (*DoStepCall)(void* component, double t, double h, int no_set_prior_state);
 
@@ -165,8 +163,3 @@ int gimbal_master_loop(MasterLoop* m, long first, long last) {
 }
 
 long gimbal_master_loop_struct_size(void) { return (long)sizeof(MasterLoop); }
-
-/* A Python extension only so that pip builds it with the package; it is used through ctypes. */
-static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_master_loop", "the compiled master loop (ctypes)", -1,
-                                    NULL, NULL, NULL, NULL, NULL};
-PyMODINIT_FUNC PyInit__master_loop(void) { return PyModule_Create(&module); }
