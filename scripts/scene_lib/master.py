@@ -6,7 +6,8 @@ the controller compute u_k from them, and then steps the FMU over [t_k, t_{k+1}]
   - the voltages u_{k-d} (d = delay_steps, default 1: the voltage computed from the sensors at t_k
     is applied over [t_{k+1}, t_{k+2}]; before the first command is due, 0 V), held constant;
   - the base inputs at t_k (attitude, rates, accelerations, v_a, a_a), exact values of the base
-    motion; the FMU extrapolates them inside the step with constant acceleration (INTERFACE.md).
+    motion; the FMU extrapolates them inside the step with constant acceleration (docs/physics.md,
+    section 2).
 With a fixed base the base inputs are never set (they stay 0).
 """
 from __future__ import annotations
