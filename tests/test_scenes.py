@@ -216,3 +216,17 @@ def test_stabilization_loop_reduces_the_line_of_sight_error(fmu):
     off = run(off_scene, fmu, stop_time=4.0).los_metrics(from_s=1.0)
     assert on["rms"] < 1e-3                       # well under a milliradian
     assert on["rms"] < off["rms"] / 20, (on, off)  # the open gimbal drifts with the ship
+
+
+def test_surge_runs_along_the_bow_the_axis_the_ship_rolls_about():
+    # roll is gamma, a turn about y_0: the bow points along y, so surge moves point a along y_G and
+    # sway along x_G (the FMU's base.v_a[1..3] are the x, y, z components in G)
+    wave = {"amplitude_m": 0.5, "period_s": 4.0}
+    t = np.arange(101) * 0.01
+    surge = make_base_motion({"type": "sinusoids", "surge": wave}).sample(t)
+    sway = make_base_motion({"type": "sinusoids", "sway": wave}).sample(t)
+    velocity = [INPUTS.index(f"base.v_a[{j}]") for j in (1, 2, 3)]
+    assert np.all(surge[:, velocity[0]] == 0.0) and np.ptp(surge[:, velocity[1]]) > 0.1
+    assert np.all(sway[:, velocity[1]] == 0.0) and np.ptp(sway[:, velocity[0]]) > 0.1
+    roll = make_base_motion({"type": "sinusoids", "roll": {"amplitude_deg": 5.0, "period_s": 8.0}}).sample(t)
+    assert np.ptp(roll[:, INPUTS.index("base.gamma")]) > 0.01   # roll drives gamma, the turn about y_0

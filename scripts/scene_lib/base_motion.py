@@ -4,7 +4,8 @@ Every generator returns, for an array of times, the 15 base inputs of the FMU in
 INPUTS: attitude (pitch delta, yaw psi, roll gamma), their rates and accelerations, the velocity
 v_a and acceleration a_a of point a in G. Analytic motions give exact derivatives, so the values
 the master sets at each step start are kinematically consistent (the FMU extrapolates them inside
-the step with constant acceleration). Translations: surge = x_G, sway = y_G, heave = z_G.
+the step with constant acceleration). Translations: the bow points along y (roll gamma turns about
+y_0, pitch delta about x), so surge = y_G, sway = x_G, heave = z_G (for a zero mean yaw).
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ INPUTS = ["base.delta", "base.psi", "base.gamma",
 
 # scene axis name -> (index of the angle / translation, is an angle)
 ANGLE_AXES = {"pitch": 0, "yaw": 1, "roll": 2}           # delta, psi, gamma
-TRANSLATION_AXES = {"surge": 0, "sway": 1, "heave": 2}   # x_G, y_G, z_G
+TRANSLATION_AXES = {"sway": 0, "surge": 1, "heave": 2}   # x_G, y_G, z_G: the bow along y, as roll is about y
 
 
 class BaseMotion:
