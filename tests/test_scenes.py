@@ -223,10 +223,10 @@ def test_surge_runs_along_the_bow_the_axis_the_ship_rolls_about():
     # sway along x_G (the FMU's base.v_a[1..3] are the x, y, z components in G)
     wave = {"amplitude_m": 0.5, "period_s": 4.0}
     t = np.arange(101) * 0.01
-    surge = make_base_motion({"type": "sinusoids", "surge": wave}).sample(t)
-    sway = make_base_motion({"type": "sinusoids", "sway": wave}).sample(t)
+    surge = make_base_motion({"type": "sinusoids", "surge": wave}, REPO).sample(t)
+    sway = make_base_motion({"type": "sinusoids", "sway": wave}, REPO).sample(t)
     velocity = [INPUTS.index(f"base.v_a[{j}]") for j in (1, 2, 3)]
     assert np.all(surge[:, velocity[0]] == 0.0) and np.ptp(surge[:, velocity[1]]) > 0.1
     assert np.all(sway[:, velocity[1]] == 0.0) and np.ptp(sway[:, velocity[0]]) > 0.1
-    roll = make_base_motion({"type": "sinusoids", "roll": {"amplitude_deg": 5.0, "period_s": 8.0}}).sample(t)
+    roll = make_base_motion({"type": "sinusoids", "roll": {"amplitude_deg": 5.0, "period_s": 8.0}}, REPO).sample(t)
     assert np.ptp(roll[:, INPUTS.index("base.gamma")]) > 0.01   # roll drives gamma, the turn about y_0
