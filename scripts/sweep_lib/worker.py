@@ -53,13 +53,20 @@ class _Loaded:
         self.fmu.close()
 
 
-def _cache() -> dict:
+def _dask_worker():
+    """The Dask worker this runs on, or None (a serial sweep: Dask is then not even imported)."""
+    if "distributed" not in sys.modules:
+        return None
     try:
         from distributed import get_worker
 
-        worker = get_worker()
+        return get_worker()
     except (ImportError, ValueError):
-        worker = None
+        return None
+
+
+def _cache() -> dict:
+    worker = _dask_worker()
     if worker is not None:
         if not hasattr(worker, "_gimbal_sweep_cache"):
             worker._gimbal_sweep_cache = {}
@@ -70,12 +77,8 @@ def _cache() -> dict:
 
 
 def _workdir() -> pathlib.Path:
-    try:
-        from distributed import get_worker
-
-        return pathlib.Path(get_worker().local_directory)
-    except (ImportError, ValueError):
-        return pathlib.Path(tempfile.gettempdir())
+    worker = _dask_worker()
+    return pathlib.Path(worker.local_directory) if worker is not None else pathlib.Path(tempfile.gettempdir())
 
 
 def loaded_fmu(fmu_bytes: bytes, digest: str) -> _Loaded:
@@ -162,14 +165,8 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
 
 
 def _worker_name() -> str:
-    if "distributed" not in sys.modules:   # a serial sweep: no worker, and no need to import Dask for that
-        return f"serial-{os.getpid()}"
-    try:
-        from distributed import get_worker
-
-        return get_worker().address
-    except (ImportError, ValueError):
-        return f"serial-{os.getpid()}"
+    worker = _dask_worker()
+    return worker.address if worker is not None else f"serial-{os.getpid()}"
 
 
 def run_cases(cases: list, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> list:
