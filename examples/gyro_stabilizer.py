@@ -58,29 +58,37 @@ class GyroStabilizer:
 class GyroStabilizerBatch(GyroStabilizer):
     """GyroStabilizer for N cases at once. The options arrive as numbers (equal in all cases) or as
     arrays of shape (N,) (swept ones); reset() gets context.cases = N and step() arrays: alpha, beta
-    (N,), gyro, base_attitude, base_rates (N, 3); it returns the voltages as (N, 2)."""
+    (N,), gyro, base_attitude, base_rates (N, 3); it returns the voltages as (u_R1, u_R2), two
+    arrays of shape (N,) (an (N, 2) array would do as well). The same arithmetic as the scalar
+    form, element by element, but numpy's atan2 and hypot may differ from the math module's in
+    the last bit."""
     batch = True
 
     def reset(self, context):
         if context.target is None:
             raise ValueError("GyroStabilizerBatch points at a target: the scene needs a [target] table")
         self.h, self.target = context.step_size, np.asarray(context.target, dtype=float)
-        self.u_limit = np.column_stack(np.broadcast_arrays(*context.u_limit, np.zeros(context.cases))[:2])
-        self.gains = np.broadcast_arrays(*(np.asarray(g, dtype=float) for g in (self.kp, self.ki, self.k_gyro)),
-                                         np.zeros(context.cases))[:3]
-        self.integral = np.zeros((context.cases, 2))
+        zeros = np.zeros(context.cases)
+        self.u_limit = [zeros + limit for limit in context.u_limit]   # per axis, (N,)
+        self.gains = [zeros + gain for gain in (self.kp, self.ki, self.k_gyro)]
+        self.integral = [zeros.copy(), zeros.copy()]
         self.reference = (math.nan, math.nan)
 
     def step(self, t, m):
-        references = np.column_stack(gimbal_angles(self.target, m.base_attitude, m.alpha))
-        self.reference = (references[:, 0], references[:, 1])
-        rates = np.column_stack((m.gyro[:, 2] / np.maximum(np.cos(m.beta), 0.2), m.gyro[:, 0]))
-        kp, ki, k_gyro = (g[:, None] for g in self.gains)
-        error = references - np.column_stack((m.alpha, m.beta))
-        u = kp * error + ki * self.integral - k_gyro * rates
-        unsaturated = np.abs(u) < self.u_limit   # anti-windup, per case and axis
-        self.integral += np.where(unsaturated, error * self.h, 0.0)
-        return np.clip(u, -self.u_limit, self.u_limit)
+        references = gimbal_angles(self.target, m.base_attitude, m.alpha)
+        self.reference = references
+        gyro = m.gyro
+        rates = (gyro[:, 2] / np.maximum(np.cos(m.beta), 0.2), gyro[:, 0])
+        kp, ki, k_gyro = self.gains
+        voltages = []
+        for axis, (reference, angle, rate) in enumerate(zip(references, (m.alpha, m.beta), rates)):
+            error = reference - angle
+            u = kp * error + ki * self.integral[axis] - k_gyro * rate
+            limit = self.u_limit[axis]
+            unsaturated = np.abs(u) < limit   # anti-windup, per case
+            self.integral[axis] += np.where(unsaturated, error * self.h, 0.0)
+            voltages.append(np.minimum(np.maximum(u, -limit), limit))
+        return voltages   # (u_R1, u_R2), two arrays of shape (N,)
 
 
 def gimbal_angles(target, attitude, alpha_near):

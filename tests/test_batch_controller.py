@@ -116,7 +116,7 @@ spec.loader.exec_module(example)
 class NanAfter(example.GyroStabilizerBatch):
     """The example, with NaN voltages from t = 0.05 s for the cases with kp = 200."""
     def step(self, t, m):
-        u = super().step(t, m)
+        u = np.column_stack(super().step(t, m))   # (N, 2)
         if t >= 0.05:
             u[np.broadcast_to(self.kp, (len(u),)) == 200.0] = math.nan
         return u

@@ -249,8 +249,16 @@ def batch_voltages(label: str, t: float, u, cases: int):
     Anything else is refused with a message naming the class."""
     import numpy as np
 
+    if type(u) is np.ndarray and u.shape == (cases, 2) and u.dtype == np.float64:
+        return u
     try:
         if isinstance(u, (tuple, list)) and len(u) == 2:
+            try:   # the common case first: two (N,) arrays
+                pair = np.array(u, dtype=float)
+                if pair.shape == (2, cases):
+                    return pair.T
+            except ValueError:
+                pass
             columns = [np.asarray(c, dtype=float) for c in u]
             if all(c.shape in ((), (cases,)) for c in columns):
                 return np.column_stack([np.broadcast_to(c, (cases,)) for c in columns])
@@ -275,6 +283,14 @@ def batch_reference(label: str, user, cases: int):
     reference = getattr(user, "reference", None)
     if reference is None:
         return np.full((cases, 2), math.nan)
+    try:
+        pair = np.array(reference, dtype=float)
+        if pair.shape == (2, cases):
+            return pair.T
+        if pair.shape == (2,):
+            return np.broadcast_to(pair, (cases, 2))
+    except ValueError:   # an array and a number: below
+        pass
     try:
         first, second = reference
         return np.column_stack([np.broadcast_to(np.asarray(c, dtype=float), (cases,)) for c in (first, second)])

@@ -101,7 +101,6 @@ class _Case:
         self.scene, self.fmu, self.plan, self.u_limit = scene, fmu, plan, u_limit
         self.slave = self.log = None
         self.error = None      # the SceneError once failed
-        self.last = None       # the last measurements (alpha, beta, gyro, attitude, rates)
 
     def wire(self):
         plan = self.plan
@@ -219,62 +218,76 @@ def _run(cases: list) -> None:
     first = cases[0].plan
     h, n, delay, count = first.h, first.n, first.delay, len(cases)
     zero = (0.0, 0.0)
-    for case in cases:
-        if case.last is None:   # failed before the loop: a row of zeros in the arrays
-            case.last = (0.0, 0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    rows = [[0.0, 0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]] for _ in cases]  # last measurements
+    # Per case the locals of its loop in one tuple (unpacking costs less than attribute look-ups).
+    slots = [(case, case.plan, case.component, case.get_real, case.real_refs, case.real_count, case.real_row,
+              case.real_stride, case.get_integer, case.mode_refs, case.mode_count, case.mode_row, case.mode_stride,
+              case.set_real, case.input_refs, case.input_count, case.input_row, case.input_stride, case.do_step,
+              case.plan.rec_real, case.plan.inputs, None if case.plan.sensors.ideal else case.plan.sensors.measure,
+              case.plan.i_alpha, case.plan.i_beta, case.plan.i_gyro, case.attitude_rows, case.rate_rows,
+              case.plan.u_cmd, case.plan.refs, case.u_limit[0], case.u_limit[1], rows[case.position])
+             for case in alive]
+    isfinite, array, Measurements = math.isfinite, np.array, controllers.Measurements
     for k in range(n + 1):
         t = k * h
-        for case in list(alive):
-            plan = case.plan
+        failed = []
+        for slot in slots:
+            (case, plan, component, get_real, real_refs, real_count, real_row, real_stride, get_integer, mode_refs,
+             mode_count, mode_row, mode_stride, _, _, _, _, _, _, rec_real, _, measure, i_alpha, i_beta, (g1, g2, g3),
+             attitude_rows, rate_rows, _, _, _, _, row) = slot
             plan.k = k
-            if case.get_real(case.component, case.real_refs, case.real_count, case.real_row + k * case.real_stride) > 1:
+            if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
                 case.fail(FMUCallFailed("fmi2GetReal"))
-                alive.remove(case)
+                failed.append(slot)
                 continue
-            if case.mode_count and case.get_integer(case.component, case.mode_refs, case.mode_count,
-                                                    case.mode_row + k * case.mode_stride) > 1:
+            if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
                 case.fail(FMUCallFailed("fmi2GetInteger"))
-                alive.remove(case)
+                failed.append(slot)
                 continue
-            y = plan.rec_real[k].tolist()
-            alpha, beta, gyro = plan.sensors.measure(k, y[plan.i_alpha], y[plan.i_beta], [y[i] for i in plan.i_gyro])
-            case.last = (alpha, beta, gyro, case.attitude_rows[k], case.rate_rows[k])
-        if not alive:
+            y = rec_real[k].tolist()
+            if measure is None:
+                row[0], row[1], row[2] = y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]]
+            else:
+                row[0], row[1], row[2] = measure(k, y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]])
+            row[3], row[4] = attitude_rows[k], rate_rows[k]
+        if failed:
+            slots = [slot for slot in slots if slot not in failed]
+        if not slots:
             return
-        rows = [case.last for case in cases]
-        m = controllers.Measurements(np.array([r[0] for r in rows]), np.array([r[1] for r in rows]),
-                                     np.array([r[2] for r in rows]), np.array([r[3] for r in rows]),
-                                     np.array([r[4] for r in rows]))
+        m = Measurements(array([r[0] for r in rows]), array([r[1] for r in rows]), array([r[2] for r in rows]),
+                         array([r[3] for r in rows]), array([r[4] for r in rows]))
         try:
             voltages = controllers.batch_voltages(label, t, user.step(t, m), count).tolist()
             references = controllers.batch_reference(label, user, count).tolist()
         except Exception as exc:
-            return _fail_all(alive, exc)
-        for case in list(alive):
-            plan = case.plan
-            u1, u2 = voltages[case.position]
-            if not (math.isfinite(u1) and math.isfinite(u2)):
+            return _fail_all([slot[0] for slot in slots], exc)
+        failed = []
+        for slot in slots:
+            (case, plan, component, _, _, _, _, _, _, _, _, _, _, set_real, input_refs, input_count, input_row,
+             input_stride, do_step, _, inputs, _, _, _, _, _, _, u_cmd, refs, limit1, limit2, _) = slot
+            position = case.position
+            u1, u2 = voltages[position]
+            if not (isfinite(u1) and isfinite(u2)):
                 case.fail(SceneError(f"{label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite"))
-                alive.remove(case)
+                failed.append(slot)
                 continue
-            limit1, limit2 = case.u_limit
             u = (min(max(u1, -limit1), limit1), min(max(u2, -limit2), limit2))
-            u_cmd = plan.u_cmd
             u_cmd.append(u)
-            plan.refs.append(tuple(references[case.position]))
-            applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
+            refs.append(tuple(references[position]))
             if k == n:
                 continue
-            inputs = plan.inputs
+            applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
             inputs[k, 0], inputs[k, 1] = applied
-            if case.set_real(case.component, case.input_refs, case.input_count,
-                             case.input_row + k * case.input_stride) > 1:
+            if set_real(component, input_refs, input_count, input_row + k * input_stride) > 1:
                 case.fail(FMUCallFailed("fmi2SetReal"))
-                alive.remove(case)
-            elif case.do_step(case.component, t, h, 1) > 1:
+                failed.append(slot)
+            elif do_step(component, t, h, 1) > 1:
                 case.fail(FMUCallFailed("fmi2DoStep"))
-                alive.remove(case)
-    for case in alive:
+                failed.append(slot)
+        if failed:
+            slots = [slot for slot in slots if slot not in failed]
+    for slot in slots:
+        case = slot[0]
         try:
             case.slave.terminate()
         except Exception as exc:
