@@ -13,8 +13,14 @@ every run and step(t, measurements) at every communication point; step returns t
 voltages. Here: per axis, PI on the error between the set point that points the line of sight at
 the target (inverse kinematics for the measured carrier attitude) and the encoder angle, plus
 damping on the payload gyro, which rejects the carrier's motion directly.
+
+GyroStabilizerBatch below is the same controller in the batch form (`batch = True`): numpy arrays
+with one entry per case, so that a sweep steps the cases of a task together (lockstep). Name it as
+`class = "GyroStabilizerBatch"`; it runs single scenes too (arrays of one case).
 """
 import math
+
+import numpy as np
 
 from scene_lib.controllers import gyro_axis_rates
 from scene_lib.geometry import gimbal_angles_for
@@ -47,3 +53,56 @@ class GyroStabilizer:
                 self.integral[axis] += error * self.h
             voltages.append(min(max(u, -limit), limit))
         return voltages
+
+
+class GyroStabilizerBatch(GyroStabilizer):
+    """GyroStabilizer for N cases at once. The options arrive as numbers (equal in all cases) or as
+    arrays of shape (N,) (swept ones); reset() gets context.cases = N and step() arrays: alpha, beta
+    (N,), gyro, base_attitude, base_rates (N, 3); it returns the voltages as (u_R1, u_R2), two
+    arrays of shape (N,) (an (N, 2) array would do as well). The same arithmetic as the scalar
+    form, element by element, but numpy's atan2 and hypot may differ from the math module's in
+    the last bit."""
+    batch = True
+
+    def reset(self, context):
+        if context.target is None:
+            raise ValueError("GyroStabilizerBatch points at a target: the scene needs a [target] table")
+        self.h, self.target = context.step_size, np.asarray(context.target, dtype=float)
+        zeros = np.zeros(context.cases)
+        self.u_limit = [zeros + limit for limit in context.u_limit]   # per axis, (N,)
+        self.gains = [zeros + gain for gain in (self.kp, self.ki, self.k_gyro)]
+        self.integral = [zeros.copy(), zeros.copy()]
+        self.reference = (math.nan, math.nan)
+
+    def step(self, t, m):
+        references = gimbal_angles(self.target, m.base_attitude, m.alpha)
+        self.reference = references
+        gyro = m.gyro
+        rates = (gyro[:, 2] / np.maximum(np.cos(m.beta), 0.2), gyro[:, 0])
+        kp, ki, k_gyro = self.gains
+        voltages = []
+        for axis, (reference, angle, rate) in enumerate(zip(references, (m.alpha, m.beta), rates)):
+            error = reference - angle
+            u = kp * error + ki * self.integral[axis] - k_gyro * rate
+            limit = self.u_limit[axis]
+            unsaturated = np.abs(u) < limit   # anti-windup, per case
+            self.integral[axis] += np.where(unsaturated, error * self.h, 0.0)
+            voltages.append(np.minimum(np.maximum(u, -limit), limit))
+        return voltages   # (u_R1, u_R2), two arrays of shape (N,)
+
+
+def gimbal_angles(target, attitude, alpha_near):
+    """scene_lib.geometry.gimbal_angles_for on arrays: target (3,) or (N, 3), attitude (N, 3)
+    [delta, psi, gamma], alpha_near (N,) -> alpha, beta (N,)."""
+    x, y, z = np.asarray(target, dtype=float).T
+    delta, psi, gamma = attitude.T
+    c, s = np.cos(delta), np.sin(delta)
+    x, y, z = x, c * y + s * z, -s * y + c * z
+    c, s = np.cos(psi), np.sin(psi)
+    x, y = c * x + s * y, -s * x + c * y
+    c, s = np.cos(gamma), np.sin(gamma)
+    x, z = c * x - s * z, s * x + c * z
+    beta = np.arctan2(z, np.hypot(x, y))
+    alpha = np.arctan2(-x, y)
+    alpha += 2.0 * math.pi * np.round((alpha_near - alpha) / (2.0 * math.pi))
+    return alpha, beta

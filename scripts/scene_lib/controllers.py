@@ -233,12 +233,70 @@ class Measurements:
 class ControllerContext:
     """What a user controller's reset() is told about the run: the communication step h [s], the
     motors' voltage limits (U_L1, U_L2) [V], the target direction in G (or None), the delay of the
-    voltages in steps, and the scene's name."""
-    __slots__ = ("step_size", "u_limit", "target", "delay_steps", "scene_name")
+    voltages in steps, the scene's name, and `cases`: how many cases step() gets at once (1 for a
+    single run; N for a batch class run in lockstep, where u_limit is a pair of (N,) arrays and the
+    target an (N, 3) array if they differ between the cases: see scene_lib/lockstep.py)."""
+    __slots__ = ("step_size", "u_limit", "target", "delay_steps", "scene_name", "cases")
 
-    def __init__(self, step_size, u_limit, target, delay_steps, scene_name):
+    def __init__(self, step_size, u_limit, target, delay_steps, scene_name, cases=1):
         self.step_size, self.u_limit, self.target = step_size, tuple(u_limit), target
-        self.delay_steps, self.scene_name = delay_steps, scene_name
+        self.delay_steps, self.scene_name, self.cases = delay_steps, scene_name, cases
+
+
+def batch_voltages(label: str, t: float, u, cases: int):
+    """The voltages a batch class's step() returned, as an (N, 2) float array: an array of shape
+    (N, 2), or a tuple/list (u_R1, u_R2) of two arrays of shape (N,) (or scalars, for all cases).
+    Anything else is refused with a message naming the class."""
+    import numpy as np
+
+    if type(u) is np.ndarray and u.shape == (cases, 2) and u.dtype == np.float64:
+        return u
+    try:
+        if isinstance(u, (tuple, list)) and len(u) == 2:
+            try:   # the common case first: two (N,) arrays
+                pair = np.array(u, dtype=float)
+                if pair.shape == (2, cases):
+                    return pair.T
+            except ValueError:
+                pass
+            columns = [np.asarray(c, dtype=float) for c in u]
+            if all(c.shape in ((), (cases,)) for c in columns):
+                return np.column_stack([np.broadcast_to(c, (cases,)) for c in columns])
+            shape = f"({', '.join(str(c.shape) for c in columns)})"
+        else:
+            array = np.asarray(u, dtype=float)
+            if array.shape == (cases, 2):
+                return array
+            shape = str(array.shape)
+    except (TypeError, ValueError):
+        shape = repr(u)
+    raise SceneError(f"{label}.step(t = {t:.6g}) returned {shape}; a batch controller (batch = True) must return "
+                     f"the voltages as an array of shape ({cases}, 2) or as (u_R1, u_R2), two arrays of shape "
+                     f"({cases},)")
+
+
+def batch_reference(label: str, user, cases: int):
+    """A batch class's `reference` as an (N, 2) float array (NaN if it sets none): a pair
+    (alpha_ref, beta_ref) of (N,) arrays or scalars."""
+    import numpy as np
+
+    reference = getattr(user, "reference", None)
+    if reference is None:
+        return np.full((cases, 2), math.nan)
+    try:
+        pair = np.array(reference, dtype=float)
+        if pair.shape == (2, cases):
+            return pair.T
+        if pair.shape == (2,):
+            return np.broadcast_to(pair, (cases, 2))
+    except ValueError:   # an array and a number: below
+        pass
+    try:
+        first, second = reference
+        return np.column_stack([np.broadcast_to(np.asarray(c, dtype=float), (cases,)) for c in (first, second)])
+    except (TypeError, ValueError):
+        raise SceneError(f"{label}.reference must be (alpha_ref, beta_ref), two arrays of shape ({cases},) or "
+                         f"numbers; got {reference!r}") from None
 
 
 class UserController(Controller):
@@ -255,7 +313,12 @@ class UserController(Controller):
         step(self, t, measurements)     # at every communication point t_k -> (u_R1, u_R2) [V]
     and may set `self.reference = (alpha_ref, beta_ref)` for the record. The master applies the
     voltages with the scene's delay and saturates them at +-U_L like a DAC; a voltage that is not a
-    finite number stops the run with a message naming the class."""
+    finite number stops the run with a message naming the class.
+
+    A class with the class attribute `batch = True` is written for N cases at once (arrays; a
+    sweep runs its cases in lockstep, scene_lib/lockstep.py). In a single run like this one it is
+    built with the options as given, and step() gets arrays of one case: alpha, beta of shape (1,),
+    gyro, base_attitude, base_rates of shape (1, 3); it returns (1, 2) voltages (batch_voltages)."""
     kind = "python"
 
     def __init__(self, spec: dict, target, u_limit, base_dir: pathlib.Path | None):
@@ -275,11 +338,14 @@ class UserController(Controller):
                 raise SceneError(f"[controller] {self.label} has no method {method}(); a controller class needs "
                                  "reset(context) and step(t, measurements)")
         self.delay_steps = int(spec.get("delay_steps", 1))
+        self.batch = getattr(cls, "batch", False) is True
 
     def start(self, step_size: float, scene_name: str) -> None:
         self.user.reset(ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name))
 
     def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
+        if self.batch:
+            return self._call_batch_of_one(t, alpha, beta, gyro, base_attitude, base_rates)
         u = self.user.step(t, Measurements(alpha, beta, gyro, base_attitude, base_rates))
         try:
             u1, u2 = float(u[0]), float(u[1])
@@ -288,6 +354,17 @@ class UserController(Controller):
         if not (math.isfinite(u1) and math.isfinite(u2)):
             raise SceneError(f"{self.label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite")
         self.reference = getattr(self.user, "reference", (math.nan, math.nan))
+        return self.clamp(u1, 0), self.clamp(u2, 1)
+
+    def _call_batch_of_one(self, t, alpha, beta, gyro, base_attitude, base_rates):
+        import numpy as np
+
+        m = Measurements(np.array([alpha]), np.array([beta]), np.array([gyro], dtype=float),
+                         np.array([base_attitude], dtype=float), np.array([base_rates], dtype=float))
+        u1, u2 = batch_voltages(self.label, t, self.user.step(t, m), 1)[0].tolist()
+        if not (math.isfinite(u1) and math.isfinite(u2)):
+            raise SceneError(f"{self.label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite")
+        self.reference = tuple(batch_reference(self.label, self.user, 1)[0].tolist())
         return self.clamp(u1, 0), self.clamp(u2, 1)
 
 

@@ -175,6 +175,12 @@ def choose_loop(controller, compiled: bool | None) -> str:
     return "python"
 
 
+def failure_message(scene: Scene, plan: Plan, exc: Exception, log: list | None) -> str:
+    """The message of a run stopped by `exc` at step plan.k, with the FMU's last log messages."""
+    details = "; ".join(map(str, (log or [])[-5:])) or "no log message"
+    return f"{scene.name}: the FMU failed at t = {plan.k * plan.h:.6g} s ({exc}): {details}"
+
+
 def recorded_signals(plan: Plan) -> dict:
     """'time' and one array per signal; row k: outputs at t_k, the voltage applied over
     [t_k, t_k+1], the controller's output at t_k, the base inputs at t_k."""
@@ -223,8 +229,7 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
     except SceneError:
         raise
     except Exception as exc:   # a refused FMI call, or fmpy raising on fmi2Error / fmi2Discard
-        details = "; ".join(map(str, (log or [])[-5:])) or "no log message"
-        raise SceneError(f"{scene.name}: the FMU failed at t = {plan.k * plan.h:.6g} s ({exc}): {details}") from None
+        raise SceneError(failure_message(scene, plan, exc, log)) from None
     finally:
         if owned:
             slave.freeInstance()

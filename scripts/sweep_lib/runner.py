@@ -316,11 +316,37 @@ def run_planned(plan: Plan, options: SweepOptions, recorder: Recorder, dask: Das
         else:
             runnable.append(case)
     if options.serial:
-        for case in runnable:
-            recorder.record(case, run_case(case.scene, case.case_id, plan.fmu_bytes, plan.fmu_sha,
-                                           plan.sweep.metrics_from_s))
+        for chunk in _serial_chunks(runnable):
+            if len(chunk) == 1:
+                results = [run_case(chunk[0].scene, chunk[0].case_id, plan.fmu_bytes, plan.fmu_sha,
+                                    plan.sweep.metrics_from_s)]
+            else:   # cases of a batch user controller: together, as a Dask task runs them
+                results = run_cases([(c.scene, c.case_id) for c in chunk], plan.fmu_bytes, plan.fmu_sha,
+                                    plan.sweep.metrics_from_s)
+            for case, result in zip(chunk, results):
+                recorder.record(case, result)
     elif runnable:
         dask.run(plan, runnable, recorder)
+
+
+def _serial_chunks(cases: list, most: int = 16):
+    """The cases of a serial sweep in the order given: one by one, except consecutive cases of a
+    batch user controller (scene_lib.lockstep.batch_key equal), up to `most` together."""
+    from scene_lib.lockstep import batch_key
+
+    chunk, chunk_key = [], None
+    for case in cases:
+        key = batch_key(case.scene)
+        if chunk and (key is None or key != chunk_key or len(chunk) == most):
+            yield chunk
+            chunk = []
+        chunk.append(case)
+        chunk_key = key
+        if key is None:
+            yield chunk
+            chunk = []
+    if chunk:
+        yield chunk
 
 
 class DaskRun:

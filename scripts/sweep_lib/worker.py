@@ -5,6 +5,10 @@ instantiates it once; every further case reuses that instance through fmi2Reset 
 with `slave=`). The cache is an attribute of the Dask worker (`get_worker()`), else thread-local, and is
 keyed by the FMU's SHA-256: a rebuilt FMU is loaded afresh. The FMU's logger messages of a case
 are collected and returned with a failure.
+
+A task's cases whose controller is a user class with `batch = True` run together in lockstep
+(scene_lib.lockstep: one instance per case, one step() call for all), on a pool of instances the
+worker keeps and reuses through fmi2Reset like its single one.
 """
 from __future__ import annotations
 
@@ -32,8 +36,24 @@ class _Loaded:
         self.fmu = FMU(fmu_path, workdir=workdir)
         self.log: list = []
         self.slave = None
+        self.pool: list = []   # (instance, its log) for lockstep batches
         self.cases = 0
         atexit.register(self.close)
+
+    def instances(self, count: int) -> list:
+        """`count` (instance, log) pairs of the pool, instantiating what is missing."""
+        while len(self.pool) < count:
+            log: list = []
+            self.pool.append((self.fmu.instantiate(f"sweep-{len(self.pool)}", log), log))
+        return self.pool[:count]
+
+    def discard_pool(self):
+        for slave, _ in self.pool:
+            try:
+                slave.freeInstance()
+            except Exception:
+                pass
+        self.pool = []
 
     def instance(self):
         if self.slave is None:
@@ -50,6 +70,7 @@ class _Loaded:
 
     def close(self):
         self.discard_instance()
+        self.discard_pool()
         self.fmu.close()
 
 
@@ -169,7 +190,67 @@ def _worker_name() -> str:
     return worker.address if worker is not None else f"serial-{os.getpid()}"
 
 
+def run_batch(cases: list, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> list:
+    """The (scene, case_id) pairs of one lockstep batch (scene_lib.lockstep.batch_key equal) run
+    together on this worker's pool of instances; the rows as run_case gives them, with the batch's
+    wall and CPU time shared out evenly and `batch_size`. Never raises for a failing case."""
+    from scene_lib.errors import SceneError
+    from scene_lib.lockstep import run_lockstep
+
+    wall0, cpu0 = time.perf_counter(), time.thread_time()
+    scenes = [scene for scene, _ in cases]
+    loaded, outcomes = None, None
+    try:
+        loaded = loaded_fmu(fmu_bytes, digest)
+        try:
+            outcomes = run_lockstep(scenes, loaded.fmu, loaded.instances(len(scenes)))
+        except SceneError:
+            raise
+        except Exception:   # an instance would not reset: once more on fresh ones
+            loaded.discard_pool()
+            outcomes = run_lockstep(scenes, loaded.fmu, loaded.instances(len(scenes)))
+    except Exception as exc:   # the batch as a whole could not run: every case fails with the reason
+        message = str(exc) if isinstance(exc, SceneError) else f"{type(exc).__name__}: {exc}"
+        outcomes = [SceneError(message)] * len(cases)
+        if loaded is not None and not isinstance(exc, SceneError):
+            loaded.discard_pool()
+    wall, cpu = (time.perf_counter() - wall0) / len(cases), (time.thread_time() - cpu0) / len(cases)
+    rows = []
+    for position, ((scene, case_id), outcome) in enumerate(zip(cases, outcomes)):
+        row = {"case_id": case_id, "status": "failed", "message": "", "fmu_log": "", "wall_time_s": wall,
+               "worker": _worker_name()}
+        log = loaded.pool[position][1] if loaded is not None and position < len(loaded.pool) else []
+        if isinstance(outcome, Exception):
+            row["message"] = str(outcome)
+        else:
+            row.update(metrics(outcome, from_s))
+            row["status"] = "ok"
+        if log:
+            row["fmu_log"] = "\n".join(map(str, log))
+        row["cpu_time_s"] = cpu
+        row["batch_size"] = len(cases)
+        if loaded is not None:
+            loaded.cases += 1
+            row["instance_use"] = loaded.cases
+        rows.append(row)
+    return rows
+
+
 def run_cases(cases: list, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> list:
-    """run_case for each (scene, case_id), one after the other on this worker's instance: one Dask
-    task for several short cases."""
-    return [run_case(scene, case_id, fmu_bytes, digest, from_s) for scene, case_id in cases]
+    """The (scene, case_id) pairs of a Dask task: those whose controller is a user class with
+    `batch = True` together in lockstep (run_batch, grouped by scene_lib.lockstep.batch_key), the
+    others one after the other on this worker's instance (run_case). The rows in the given order."""
+    from scene_lib.lockstep import batch_key
+
+    rows: list = [None] * len(cases)
+    batches: dict = {}
+    for position, (scene, case_id) in enumerate(cases):
+        key = batch_key(scene)
+        if key is None:
+            rows[position] = run_case(scene, case_id, fmu_bytes, digest, from_s)
+        else:
+            batches.setdefault(key, []).append(position)
+    for positions in batches.values():
+        for position, row in zip(positions, run_batch([cases[p] for p in positions], fmu_bytes, digest, from_s)):
+            rows[position] = row
+    return rows
