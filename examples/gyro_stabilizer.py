@@ -24,6 +24,7 @@ import numpy as np
 
 from scene_lib.controllers import gyro_axis_rates
 from scene_lib.geometry import gimbal_angles_for
+from scene_lib.setpoints import target_angles
 
 
 class GyroStabilizer:
@@ -94,15 +95,6 @@ class GyroStabilizerBatch(GyroStabilizer):
 def gimbal_angles(target, attitude, alpha_near):
     """scene_lib.geometry.gimbal_angles_for on arrays: target (3,) or (N, 3), attitude (N, 3)
     [delta, psi, gamma], alpha_near (N,) -> alpha, beta (N,)."""
-    x, y, z = np.asarray(target, dtype=float).T
-    delta, psi, gamma = attitude.T
-    c, s = np.cos(delta), np.sin(delta)
-    x, y, z = x, c * y + s * z, -s * y + c * z
-    c, s = np.cos(psi), np.sin(psi)
-    x, y = c * x + s * y, -s * x + c * y
-    c, s = np.cos(gamma), np.sin(gamma)
-    x, z = c * x - s * z, s * x + c * z
-    beta = np.arctan2(z, np.hypot(x, y))
-    alpha = np.arctan2(-x, y)
-    alpha += 2.0 * math.pi * np.round((alpha_near - alpha) / (2.0 * math.pi))
+    alpha, beta = target_angles(target, *np.asarray(attitude).T)
+    alpha = alpha + 2.0 * math.pi * np.round((alpha_near - alpha) / (2.0 * math.pi))
     return alpha, beta

@@ -24,26 +24,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
+from scene_lib.geometry import rx, ry, rz  # noqa: E402
+
 REPO = pathlib.Path(__file__).resolve().parents[1]
 # No software version or date in the files: rerunning with another matplotlib changes fewer bytes.
 PNG_METADATA = {"Software": None}
 
 AXIS_COLOURS = {"x": "#c0392b", "y": "#1e8449", "z": "#1f4e99"}
-
-
-def rx(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def ry(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rz(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 class Pose:

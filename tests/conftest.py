@@ -38,3 +38,15 @@ def gimbal_fmu(fmu_path):
 
     with FMU(fmu_path) as fmu:
         yield fmu
+
+
+@pytest.fixture(scope="module")
+def client():
+    """A local Dask cluster of 2 worker processes (the product's default), 1 thread each."""
+    from sweep_lib import make_client
+
+    client, cluster = make_client(workers=2, processes=True)
+    client.wait_for_workers(2, timeout=60)
+    yield client
+    client.close()
+    cluster.close()

@@ -60,17 +60,6 @@ def fmu(fmu_path):
         yield loaded
 
 
-@pytest.fixture(scope="module")
-def client():
-    from sweep_lib import make_client
-
-    client, cluster = make_client(workers=2, processes=True)
-    client.wait_for_workers(2, timeout=60)
-    yield client
-    client.close()
-    cluster.close()
-
-
 def test_a_batch_sweep_equals_the_scalar_form_case_by_case_and_dask_equals_serial(tmp_path, fmu_path, fmu, client):
     scene_path, sweep_path = scene_file(tmp_path), tmp_path / "gains.toml"
     sweep_path.write_text(GAINS)

@@ -60,18 +60,6 @@ def fmu_path(fmu_path, tmp_path_factory):
     return copy
 
 
-@pytest.fixture(scope="module")
-def client():
-    """A local cluster of 2 worker processes (the product's default), 1 thread each."""
-    from sweep_lib import make_client
-
-    client, cluster = make_client(workers=2, processes=True)
-    client.wait_for_workers(2, timeout=60)
-    yield client
-    client.close()
-    cluster.close()
-
-
 def _same(a, b) -> bool:
     if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
         return True

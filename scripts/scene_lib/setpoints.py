@@ -20,9 +20,10 @@ RATE_STEP_S = 1e-6   # the attitude difference for the target's rate
 
 
 def target_angles(target, delta, psi, gamma):
-    """Principal (alpha, beta) pointing the line of sight along `target` (unit vector in G) for base
-    attitudes given as arrays: the vectorised form of geometry.gimbal_angles_for."""
-    x, y, z = (np.full(np.shape(delta), float(c)) for c in target)
+    """Principal (alpha, beta) pointing the line of sight along `target` (a unit vector in G, (3,),
+    or one per attitude, (N, 3)) for base attitudes given as arrays: the vectorised form of
+    geometry.gimbal_angles_for."""
+    x, y, z = (np.broadcast_to(component, np.shape(delta)) for component in np.asarray(target, dtype=float).T)
     c, s = np.cos(delta), np.sin(delta)
     x, y, z = x, c * y + s * z, -s * y + c * z
     c, s = np.cos(psi), np.sin(psi)
