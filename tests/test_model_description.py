@@ -1,0 +1,121 @@
+"""modelDescription.xml as importers read it: Enumeration types for the structural selectors, display
+units, the default experiment."""
+import math
+
+import pytest
+
+ENUMERATIONS = {  # name: (declared type, value reference, item names by value)
+    "gear1.model": ("GearModel", 20, ["rigid", "compliant", "backlash"]),
+    "gear2.model": ("GearModel", 21, ["rigid", "compliant", "backlash"]),
+    "motor1.model": ("MotorModel", 22, ["quasi_static", "inductive"]),
+    "motor2.model": ("MotorModel", 23, ["quasi_static", "inductive"]),
+    "solver.method": ("IntegrationMethod", 24, ["cvode_bdf", "cvode_bdf_dq", "cvode_adams", "arkode_erk", "automatic",
+                                                "dormand_prince", "rodas4"]),
+}
+DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}
+
+
+@pytest.fixture(scope="module")
+def md(gimbal_fmu):
+    return gimbal_fmu.model_description
+
+
+@pytest.fixture(scope="module")
+def by_name(md):
+    return {v.name: v for v in md.modelVariables}
+
+
+# --- types -------------------------------------------------------------------------------------
+
+def test_selectors_are_enumerations_with_named_items(md, by_name):
+    types = {t.name: t for t in md.typeDefinitions}
+    for name, (declared, vr, items) in ENUMERATIONS.items():
+        v = by_name[name]
+        assert v.type == "Enumeration", name
+        assert v.valueReference == vr, f"{name}: the value reference users set with fmi2SetInteger moved"
+        assert v.declaredType is types[declared]
+        assert [(item.name, int(item.value)) for item in v.declaredType.items] == list(zip(items, range(len(items))))
+        assert all(item.description for item in v.declaredType.items)
+        assert int(v.start) in range(len(items))
+    assert len(types) == 3
+
+
+def test_other_discrete_variables_keep_their_types(by_name):
+    for name in ("solver.max_steps", "gear1.contact", "motor2.limited", "body1.stick_slip", "events.total",
+                 "solver.steps", "solver.method_switches"):
+        assert by_name[name].type == "Integer", name
+    for name in ("energy_accounting", "dry_friction", "base.fixed"):
+        assert by_name[name].type == "Boolean", name
+
+
+def test_enumerations_are_set_and_read_as_integers(gimbal_fmu):
+    """In FMI 2.0 an Enumeration goes through fmi2SetInteger/fmi2GetInteger, by its value reference."""
+    slave = gimbal_fmu.instantiate("enumerations")
+    try:
+        slave.setupExperiment(startTime=0.0)
+        vrs = [vr for _, vr, _ in ENUMERATIONS.values()]
+        slave.setInteger(vrs, [0, 1, 0, 1, 6])
+        slave.enterInitializationMode()
+        assert slave.getInteger(vrs) == [0, 1, 0, 1, 6]
+        slave.exitInitializationMode()
+        slave.doStep(0.0, 1e-3)
+        assert slave.getInteger([gimbal_fmu.vr("solver.states")]) == [7]   # rigid gear 1, quasi-static motor 1
+    finally:
+        slave.freeInstance()
+    assert gimbal_fmu.start("solver.method") == 4
+    values = {"gear1.model": 1, "solver.method": 5, "u_R1": 1.0, "dry_friction": False}
+    slave = gimbal_fmu.instantiate("set_values")
+    try:
+        slave.setupExperiment(startTime=0.0)
+        gimbal_fmu.set_values(slave, values)
+        slave.enterInitializationMode()
+        assert gimbal_fmu.get_values(slave, list(values)) == [1.0, 5.0, 1.0, 0.0]
+    finally:
+        slave.freeInstance()
+
+
+# --- display units -----------------------------------------------------------------------------
+
+def test_every_angle_rate_and_acceleration_has_its_display_unit(md):
+    units = {u.name: u for u in md.unitDefinitions}
+    for unit, display in DISPLAY_UNITS.items():
+        (shown,) = units[unit].displayUnits
+        assert shown.name == display
+        assert math.isclose(shown.factor, 180 / math.pi, rel_tol=1e-15) and shown.offset == 0
+    checked = 0
+    for v in md.modelVariables:
+        if v.type == "Real" and v.unit in DISPLAY_UNITS:
+            assert v.displayUnit == DISPLAY_UNITS[v.unit], f"{v.name} ({v.unit}) has displayUnit {v.displayUnit!r}"
+            checked += 1
+        else:
+            assert v.displayUnit is None, v.name
+    assert checked == 28
+    for name in ("body1.w_min", "rotor2.w_min", "gear1.eta", "base.delta_ddot", "base.gamma_ddot"):
+        assert next(v for v in md.modelVariables if v.name == name).displayUnit is not None, name
+
+
+# --- default experiment ------------------------------------------------------------------------
+
+def test_default_experiment(md, by_name):
+    e = md.defaultExperiment
+    assert float(e.startTime) == 0.0 and float(e.stopTime) == 2.0
+    assert float(e.stepSize) == 1e-3   # the 1 kHz loop of the scenes
+    assert float(e.tolerance) == float(by_name["solver.rtol"].start)
+
+
+def test_default_experiment_tolerance_gives_the_default_run(gimbal_fmu):
+    """A master that hands the default tolerance to fmi2SetupExperiment gets the FMU's default run."""
+    runs = []
+    for tolerance in (None, float(gimbal_fmu.model_description.defaultExperiment.tolerance)):
+        slave = gimbal_fmu.instantiate("tolerance")
+        try:
+            slave.setupExperiment(tolerance=tolerance, startTime=0.0)
+            gimbal_fmu.set_values(slave, {"beta": 0.3, "beta_m": 18.0, "u_R1": 3.0})
+            slave.enterInitializationMode()
+            slave.exitInitializationMode()
+            for k in range(50):
+                slave.doStep(k * 1e-3, 1e-3)
+            runs.append(gimbal_fmu.get_values(slave, ["alpha", "beta", "i_R1"]))
+        finally:
+            slave.freeInstance()
+    assert runs[0] == runs[1]
