@@ -1,8 +1,17 @@
 """modelDescription.xml as importers read it: Enumeration types for the structural selectors, display
-units, the default experiment."""
+units, the default experiment, the header (author, licence, version, tool, date)."""
+import datetime
 import math
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import zipfile
 
 import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 ENUMERATIONS = {  # name: (declared type, value reference, item names by value)
     "gear1.model": ("GearModel", 20, ["rigid", "compliant", "backlash"]),
@@ -13,6 +22,12 @@ ENUMERATIONS = {  # name: (declared type, value reference, item names by value)
                                                 "dormand_prince", "rodas4"]),
 }
 DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}
+
+
+def cmake_version() -> str:
+    match = re.search(r"project\(\s*Gimbal2Axis\s+VERSION\s+([0-9]+\.[0-9]+\.[0-9]+)", (REPO / "CMakeLists.txt").read_text())
+    assert match, "CMakeLists.txt: project(Gimbal2Axis VERSION x.y.z ...) not found"
+    return match.group(1)
 
 
 @pytest.fixture(scope="module")
@@ -119,3 +134,51 @@ def test_default_experiment_tolerance_gives_the_default_run(gimbal_fmu):
         finally:
             slave.freeInstance()
     assert runs[0] == runs[1]
+
+
+# --- header ------------------------------------------------------------------------------------
+
+def test_header_attributes(md):
+    version = cmake_version()
+    assert md.fmiVersion == "2.0"
+    assert md.version == version
+    assert md.generationTool == f"Gimbal2Axis {version} (model_description_generator)"
+    assert md.author == "the Gimbal2Axis authors"
+    assert re.fullmatch(r"Copyright \(c\) 20[0-9]{2} the Gimbal2Axis authors", md.copyright)
+    assert md.license.startswith("BSD-3-Clause")
+    assert re.fullmatch(r"[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9]{2}:[0-9]{2}:[0-9]{2}Z", md.generationDateAndTime)
+
+
+def _configure(build_dir, tmp_path, environment):
+    """Runs the build's last step (the template filled with the generator's fragments) again."""
+    fragments = build_dir / "model_description_fragments"
+    output = tmp_path / "modelDescription.xml"
+    git = shutil.which("git") or ""
+    subprocess.run(["cmake", f"-DTEMPLATE={REPO / 'modelDescription.xml.in'}", f"-DOUTPUT={output}",
+                    f"-DFRAGMENTS={fragments}", "-DMODEL_IDENTIFIER=Gimbal2Axis", "-DGIMBAL_GUID={x}",
+                    "-DPROJECT_NAME=Gimbal2Axis", "-DPROJECT_VERSION=0", f"-DSOURCE_DIR={REPO}",
+                    f"-DGIT_EXECUTABLE={git}", "-P", str(REPO / "scripts" / "configure_model_description.cmake")],
+                   check=True, capture_output=True, env=environment)
+    return re.search(r'generationDateAndTime="([^"]*)"', output.read_text()).group(1)
+
+
+def test_generation_date_is_source_date_epoch_else_the_last_commit(build_dir, tmp_path):
+    environment = {k: v for k, v in os.environ.items() if k != "SOURCE_DATE_EPOCH"}
+    assert _configure(build_dir, tmp_path, {**environment, "SOURCE_DATE_EPOCH": "1700000000"}) == "2023-11-14T22:13:20Z"
+    commit = subprocess.run(["git", "-C", str(REPO), "log", "-1", "--format=%ct"], capture_output=True, text=True)
+    if commit.returncode != 0 or not commit.stdout.strip():
+        pytest.skip("not a git checkout: the date is the build time")
+    expected = datetime.datetime.fromtimestamp(int(commit.stdout), datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    assert _configure(build_dir, tmp_path, environment) == expected
+
+
+def test_licence_file():
+    text = (REPO / "LICENSE").read_text()
+    assert text.startswith("BSD 3-Clause License")
+    assert "the Gimbal2Axis authors" in text
+    assert "Neither the name of the copyright holder nor the names of its" in text
+
+
+def test_packaged_description_is_the_staged_one(fmu_path, build_dir):
+    packaged = zipfile.ZipFile(fmu_path).read("modelDescription.xml").decode()
+    assert packaged == (build_dir / "fmu_staging" / "modelDescription.xml").read_text()
