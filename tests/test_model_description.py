@@ -1,12 +1,15 @@
 """modelDescription.xml as importers read it: Enumeration types for the structural selectors, display
-units, the default experiment, the header (author, licence, version, tool, date)."""
+units, the default experiment, the header (author, licence, version, tool, date), and one version
+number across CMake, the Python package, the FMU, the README and the changelog."""
 import datetime
+import importlib.metadata
 import math
 import os
 import pathlib
 import re
 import shutil
 import subprocess
+import tomllib
 import zipfile
 
 import pytest
@@ -170,6 +173,22 @@ def test_generation_date_is_source_date_epoch_else_the_last_commit(build_dir, tm
         pytest.skip("not a git checkout: the date is the build time")
     expected = datetime.datetime.fromtimestamp(int(commit.stdout), datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     assert _configure(build_dir, tmp_path, environment) == expected
+
+
+# --- one version -------------------------------------------------------------------------------
+
+def test_one_version_everywhere(md):
+    version = cmake_version()
+    pyproject = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    assert "version" not in pyproject and "version" in pyproject["dynamic"], \
+        "pyproject.toml takes its version from CMakeLists.txt (setup.py), it does not state one"
+    installed = importlib.metadata.version("gimbal2axis")
+    assert installed == version, f"the installed package says {installed}: run scripts/setup.sh again"
+    assert md.version == version
+    assert f"Version {version}" in (REPO / "README.md").read_text()
+    changelog = (REPO / "CHANGELOG.md").read_text()
+    releases = re.findall(r"^## \[([0-9]+\.[0-9]+\.[0-9]+)\] - ([0-9]{4}-[0-9]{2}-[0-9]{2})$", changelog, re.M)
+    assert releases and releases[0][0] == version, "CHANGELOG.md's latest release is the project's version"
 
 
 def test_licence_file():
