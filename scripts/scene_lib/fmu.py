@@ -111,10 +111,13 @@ class FMU:
                 ok = isinstance(value, int) and not isinstance(value, bool)
             elif v.type == "Enumeration":
                 items = enumeration_items(v)
-                if isinstance(value, int) and not isinstance(value, bool) and value not in items:
-                    listed = ", ".join(f"{k} ({n})" for k, n in sorted(items.items()))
+                listed = ", ".join(f"{k} ({n})" for k, n in sorted(items.items()))
+                if not isinstance(value, int) or isinstance(value, bool):
+                    raise SceneError(f"[{where}] '{name}' is an Enumeration in the FMU, given by its integer value: "
+                                     f"{listed}; got {value!r}")
+                if value not in items:
                     raise SceneError(f"[{where}] '{name}' = {value} is none of its values: {listed}")
-                ok = isinstance(value, int) and not isinstance(value, bool)
+                ok = True
             elif v.type == "Boolean":
                 ok = isinstance(value, bool)
             else:
