@@ -243,7 +243,8 @@ struct ModelDescription {
             ref.vr = static_cast<fmi2ValueReference>(std::strtoul(vr.c_str(), nullptr, 10));
             const std::string body = text.substr(end_tag, close - end_tag);
             if (body.find("<Real") != std::string::npos) ref.type = 'R';
-            else if (body.find("<Integer") != std::string::npos) ref.type = 'I';
+            else if (body.find("<Integer") != std::string::npos || body.find("<Enumeration") != std::string::npos)
+                ref.type = 'I';  // an FMI 2.0 Enumeration is set and read with fmi2SetInteger/fmi2GetInteger
             else if (body.find("<Boolean") != std::string::npos) ref.type = 'B';
             else if (body.find("<String") != std::string::npos) ref.type = 'S';
             variables[name] = ref;
@@ -498,9 +499,9 @@ void usage() {
         "  --duration T             simulated time [s] (default 10)\n"
         "  --step H                 communication step [s] (default 1e-3)\n"
         "  --rtol R, --atol A       solver.rtol, solver.atol (default: the FMU's)\n"
-        "  --method M               Integer parameter solver.method: 4 automatic (the FMU's default), 5 Dormand-\n"
-        "                           Prince, 6 RODAS4; SUNDIALS: 0 CVODE BDF analytic Jacobian, 1 CVODE BDF finite-\n"
-        "                           difference Jacobian, 2 CVODE Adams, 3 ARKODE explicit RK (default: FMU's)\n"
+        "  --method M               solver.method (an Enumeration, set as an integer): 4 automatic (the FMU's\n"
+        "                           default), 5 Dormand-Prince, 6 RODAS4; SUNDIALS: 0 CVODE BDF analytic Jacobian,\n"
+        "                           1 CVODE BDF finite-difference Jacobian, 2 CVODE Adams, 3 ARKODE explicit RK\n"
         "  --fidelity full|reduced  reduced: rigid gears (gear*.model = 0), quasi-static motors (motor*.model = 0)\n"
         "  --set NAME=VALUE         a Real parameter, e.g. --set motor1.L=1e-7 (repeatable): the stiff variants\n"
         "  --trajectory FILE        write t, alpha, beta, los.omega[1..3] at every communication point\n"

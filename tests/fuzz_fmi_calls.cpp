@@ -230,7 +230,7 @@ bool read_model(const char* path, Model& model) {
             while (name_end < text.size() && std::isalpha(static_cast<unsigned char>(text[name_end]))) ++name_end;
             const std::string element = text.substr(child + 1, name_end - child - 1);
             if (element == "Real") v.type = VarType::Real;
-            else if (element == "Integer") v.type = VarType::Integer;
+            else if (element == "Integer" || element == "Enumeration") v.type = VarType::Integer;  // fmi2SetInteger both
             else if (element == "Boolean") v.type = VarType::Boolean;
             else if (element == "String") v.type = VarType::String;
             size_t attribute_pos = name_end;

@@ -1,5 +1,7 @@
 // Every refusal names the variable and the rule; the defaults are valid.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -32,6 +34,79 @@ std::string refusal(RealVariable vr, double value) {
 }
 
 bool names(const std::string& message, const char* name) { return message.find(name) != std::string::npos; }
+
+// The outcome of the defaults with some values changed: "" if accepted, else the refusal.
+std::string outcome(const Values& values) {
+    ModelParameters params;
+    std::string error;
+    if (build_model_parameters(values.v, values.integers, values.flags, params, error) &&
+        validate_start_state(values.v, params, error))
+        return "";
+    return error;
+}
+
+// The min and max columns of the tables (modelDescription.xml's bounds) are what the validation
+// enforces: just outside a bound refused (naming the variable), the bound itself accepted. A bound
+// alone does not lift the rules that tie variables together: T_max = 0 needs T_din = 0.
+void check_declared_bounds() {
+    int bounds = 0;
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
+        const VariableInfo& info = kRealVariables[vr];
+        const double limits[2] = {info.min, info.max};
+        for (int side = 0; side < 2; ++side) {
+            const double bound = limits[side];
+            if (!std::isfinite(bound)) continue;
+            ++bounds;
+            Values at;
+            at.v[vr] = bound;
+            const std::string name = info.name;
+            if (name.size() > 6 && name.compare(name.size() - 6, 6, ".T_max") == 0) {
+                const std::string slip = name.substr(0, name.size() - 6) + ".T_din";
+                for (unsigned other = 0; other < kRealVariableCount; ++other)
+                    if (slip == kRealVariables[other].name) at.v[other] = 0.0;
+            }
+            const std::string accepted = outcome(at);
+            if (!accepted.empty()) std::fprintf(stderr, "%s = %.17g (its bound) refused: %s\n", info.name, bound, accepted.c_str());
+            CHECK(accepted.empty());
+            Values outside;
+            outside.v[vr] = std::nextafter(bound, side == 0 ? -HUGE_VAL : HUGE_VAL);
+            const std::string refused = outcome(outside);
+            if (!names(refused, info.name)) std::fprintf(stderr, "%s = %.17g (beyond its bound) not refused by name\n", info.name, outside.v[vr]);
+            CHECK(names(refused, info.name));
+        }
+    }
+    CHECK(bounds == 42);  // 41 parameters, solver.rtol bounded on both sides
+    for (unsigned vi = 0; vi < kIntegerVariableCount; ++vi) {
+        const VariableInfo& info = kIntegerVariables[vi];
+        int low = 0, high = 0;
+        if (info.declared_type[0] != '\0') {
+            low = 1 << 30, high = -(1 << 30);
+            for (const EnumerationItem& item : kEnumerationItems) {
+                if (std::string(item.type) != info.declared_type) continue;
+                Values at;
+                at.integers[vi] = item.value;
+                CHECK(outcome(at).empty());
+                low = std::min(low, item.value), high = std::max(high, item.value);
+            }
+        } else if (std::isfinite(info.min)) {
+            low = static_cast<int>(info.min);
+            high = std::isfinite(info.max) ? static_cast<int>(info.max) : std::numeric_limits<int>::max();
+            Values at;
+            at.integers[vi] = low;
+            CHECK(outcome(at).empty());
+        } else {
+            continue;
+        }
+        Values below;
+        below.integers[vi] = low - 1;
+        CHECK(names(outcome(below), info.name));
+        if (high < std::numeric_limits<int>::max()) {
+            Values above;
+            above.integers[vi] = high + 1;
+            CHECK(names(outcome(above), info.name));
+        }
+    }
+}
 
 }  // namespace
 
@@ -85,5 +160,9 @@ int main() {
     CHECK(refusal(vr_theta_b1, -2e-4).empty());  // exactly at a stop is valid
     // Inputs are not parameters: any finite value is accepted here.
     CHECK(refusal(vr_u_R1, 1e9).empty());
+    // "> 0" refuses 0 and the subnormal numbers below its declared min, the least normal double.
+    CHECK(names(refusal(vr_motor1_R, 5e-324), "> 0") && refusal(vr_motor1_R, kAboveZero).empty());
+    CHECK(names(refusal(vr_solver_rtol, 1.0), "(0, 1)") && refusal(vr_solver_rtol, kBelowOne).empty());
+    check_declared_bounds();
     return check_report("parameter_validation");
 }

@@ -226,6 +226,16 @@ def test_scenes_that_cannot_be_right_are_refused_naming_the_key(tmp_path, edit, 
         load_scene(scene_file(tmp_path, edit(PID_TARGET.format(elevation=0.0, kp=30.0))))
 
 
+@pytest.mark.parametrize("value, fragments", [
+    ("5", ["'gear1.model' = 5 is none of its values", "0 (rigid), 1 (compliant), 2 (backlash)"]),
+    ('"rigid"', ["'gear1.model' is an Enumeration in the FMU, given by its integer value", "got 'rigid'"]),
+], ids=["no_item", "item_name"])
+def test_a_structural_selector_is_one_of_its_enumeration_values(tmp_path, fmu_path, value, fragments):
+    path = scene_file(tmp_path, QUIET.replace('[fidelity]\n', f'[fidelity]\n"gear1.model" = {value}\n'))
+    done = run_cli(path, "--fmu", fmu_path, "--out", tmp_path / "out", cwd=tmp_path)
+    assert_one_line_error(done, *fragments)
+
+
 def test_the_edges_of_the_elevation_range_are_accepted(tmp_path):
     for elevation in (-90.0, 90.0):
         load_quietly(scene_file(tmp_path, PID_TARGET.format(elevation=elevation, kp=30.0)))

@@ -29,8 +29,67 @@ struct Checker {
         return fail(s.str());
     }
     bool non_negative(RealVariable vr) { return require(vr, values[vr] >= 0.0, "it must be >= 0"); }
-    bool positive(RealVariable vr) { return require(vr, values[vr] > 0.0, "it must be > 0"); }
+    // "> 0" as modelDescription.xml's min = kAboveZero states it: subnormal numbers are refused too.
+    bool positive(RealVariable vr) { return require(vr, values[vr] >= kAboveZero, "it must be > 0 (and not subnormal)"); }
 };
+
+// The Enumeration items of modelDescription.xml (enumeration_types.def) are the core's enum values
+// and exactly the values accepted below.
+namespace enumeration {
+#define TYPE(id, description)
+#define ITEM(type, item, value, description) constexpr int type##_##item = value;
+#include "gimbal/enumeration_types.def"
+#undef ITEM
+#undef TYPE
+
+struct Item {
+    const char* type;
+    int value;
+};
+constexpr Item kItems[] = {
+#define TYPE(id, description)
+#define ITEM(type, item, value, description) {#type, value},
+#include "gimbal/enumeration_types.def"
+#undef ITEM
+#undef TYPE
+};
+
+// The items of `type` are first, first + 1, ..., last, each once.
+constexpr bool items_are(const char* type, int first, int last) {
+    int count = 0;
+    for (const Item& item : kItems) {
+        if (!variable_table::joins(item.type, type, "")) continue;
+        ++count;
+        if (item.value < first || item.value > last) return false;
+        for (const Item& other : kItems)
+            if (&other != &item && variable_table::joins(other.type, type, "") && other.value == item.value) return false;
+    }
+    return count == last - first + 1;
+}
+
+static_assert(GearModel_rigid == static_cast<int>(GearModel::rigid) &&
+                  GearModel_compliant == static_cast<int>(GearModel::compliant) &&
+                  GearModel_backlash == static_cast<int>(GearModel::backlash) && items_are("GearModel", 0, 2),
+              "GearModel items: rigid, compliant, backlash, and the validation accepts 0..2");
+static_assert(MotorModel_quasi_static == static_cast<int>(MotorModel::quasi_static) &&
+                  MotorModel_inductive == static_cast<int>(MotorModel::inductive) && items_are("MotorModel", 0, 1),
+              "MotorModel items: quasi_static, inductive, and the validation accepts 0..1");
+static_assert(IntegrationMethod_cvode_bdf == static_cast<int>(IntegrationMethod::bdf_analytic_jacobian) &&
+                  IntegrationMethod_cvode_bdf_dq == static_cast<int>(IntegrationMethod::bdf_difference_jacobian) &&
+                  IntegrationMethod_cvode_adams == static_cast<int>(IntegrationMethod::adams) &&
+                  IntegrationMethod_arkode_erk == static_cast<int>(IntegrationMethod::explicit_runge_kutta) &&
+                  IntegrationMethod_automatic == static_cast<int>(IntegrationMethod::automatic) &&
+                  IntegrationMethod_dormand_prince == static_cast<int>(IntegrationMethod::dormand_prince) &&
+                  IntegrationMethod_rodas4 == static_cast<int>(IntegrationMethod::rosenbrock) &&
+                  items_are("IntegrationMethod", 0, kIntegrationMethodCount - 1),
+              "IntegrationMethod items are the core's methods, and the validation accepts 0..kIntegrationMethodCount-1");
+static_assert(variable_table::joins(variable_table::kInteger[vi_gear1_model].declared_type, "GearModel", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_gear2_model].declared_type, "GearModel", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_motor1_model].declared_type, "MotorModel", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_motor2_model].declared_type, "MotorModel", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_solver_method].declared_type, "IntegrationMethod", ""),
+              "the structural selectors are declared with the Enumeration types they are validated against");
+}  // namespace enumeration
 
 bool build_inertia(Checker& check, const BodyParameterVariables& body, Mat3& inertia) {
     const InertiaVariables& i = body.inertia;
@@ -111,8 +170,8 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], values[g.eta]};
     }
 
-    if (!check.require(vr_solver_rtol, values[vr_solver_rtol] > 0.0 && values[vr_solver_rtol] < 1.0,
-                       "it must lie in (0, 1)") ||
+    if (!check.require(vr_solver_rtol, values[vr_solver_rtol] >= kAboveZero && values[vr_solver_rtol] <= kBelowOne,
+                       "it must lie in (0, 1) (and not be subnormal)") ||
         !check.positive(vr_solver_atol))
         return false;
     if (integers[vi_solver_max_steps] <= 0) {

@@ -2,8 +2,9 @@
 
 namespace gimbal {
 
-#define X(id, name, causality, variability, initial, unit, display_unit, start, description) \
-    {name, Causality::causality, Variability::variability, Initial::initial, unit, display_unit, start, description},
+#define X(id, name, causality, variability, initial, declared_type, unit, display_unit, start, min, max, description) \
+    {name, Causality::causality, Variability::variability, Initial::initial, declared_type, unit, display_unit, start, \
+     min, max, description},
 
 const VariableInfo kRealVariables[kRealVariableCount] = {
 #include "gimbal/real_variables.def"
@@ -18,5 +19,21 @@ const VariableInfo kBooleanVariables[kBooleanVariableCount] = {
 };
 
 #undef X
+
+const EnumerationType kEnumerationTypes[kEnumerationTypeCount] = {
+#define TYPE(id, description) {#id, description},
+#define ITEM(type, item, value, description)
+#include "gimbal/enumeration_types.def"
+#undef ITEM
+#undef TYPE
+};
+
+const EnumerationItem kEnumerationItems[kEnumerationItemCount] = {
+#define TYPE(id, description)
+#define ITEM(type, item, value, description) {#type, #item, value, description},
+#include "gimbal/enumeration_types.def"
+#undef ITEM
+#undef TYPE
+};
 
 }  // namespace gimbal

@@ -1,7 +1,13 @@
-// Writes the parts of modelDescription.xml that follow from the variable table, so that the names,
-// value references, units and start values the FMU serves can never drift from what it declares.
-// Usage: gimbal_model_description_generator <units.xml> <variables.xml> <structure.xml>
+// Writes the parts of modelDescription.xml that follow from the variable tables, so that the names,
+// value references, types, units, bounds and start values the FMU serves can never drift from what it
+// declares; refuses a table that breaks the rules below (undefined unit, rad-based variable without its
+// display unit, start outside its bounds, unknown enumeration type, ...).
+// Usage: gimbal_model_description_generator <units.xml> <variables.xml> <structure.xml> <types.xml>
+//                                           <default_tolerance.txt>
+// The last is the DefaultExperiment's tolerance: the start value of solver.rtol.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -14,15 +20,18 @@ namespace {
 
 struct UnitDefinition {
     const char* name;
-    const char* base_unit;  // attributes of <BaseUnit>
-    const char* display;    // extra <DisplayUnit> elements
+    const char* base_unit;     // attributes of <BaseUnit>
+    const char* display_unit;  // its <DisplayUnit>, or empty; every variable of the unit must show in it
 };
+
+// value in the display unit = factor * value in the unit (+ offset, 0 for all of these)
+const char* const kDegreesPerRadian = "57.29577951308232";  // 180 / pi
 
 const UnitDefinition kUnits[] = {
     {"1", "", ""},
-    {"rad", "rad=\"1\"", "<DisplayUnit name=\"deg\" factor=\"57.29577951308232\"/>"},
-    {"rad/s", "s=\"-1\" rad=\"1\"", "<DisplayUnit name=\"deg/s\" factor=\"57.29577951308232\"/>"},
-    {"rad/s2", "s=\"-2\" rad=\"1\"", "<DisplayUnit name=\"deg/s2\" factor=\"57.29577951308232\"/>"},
+    {"rad", "rad=\"1\"", "deg"},
+    {"rad/s", "s=\"-1\" rad=\"1\"", "deg/s"},
+    {"rad/s2", "s=\"-2\" rad=\"1\"", "deg/s2"},
     {"s", "s=\"1\"", ""},
     {"m", "m=\"1\"", ""},
     {"m/s", "m=\"1\" s=\"-1\"", ""},
@@ -60,9 +69,13 @@ const char* to_string(gimbal::Variability v) {
     return "";
 }
 
+// The shortest decimal that reads back as the same double ("0.1", not "0.10000000000000001").
 std::string number(double value) {
     char buffer[40];
-    std::snprintf(buffer, sizeof buffer, "%.17g", value);
+    for (int digits = 15; digits <= 17; ++digits) {
+        std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+        if (std::strtod(buffer, nullptr) == value) break;
+    }
     return buffer;
 }
 
@@ -86,47 +99,105 @@ bool write(const char* path, const std::string& text) {
     return static_cast<bool>(out);
 }
 
+const UnitDefinition* find_unit(const std::string& name) {
+    for (const auto& u : kUnits)
+        if (name == u.name) return &u;
+    return nullptr;
+}
+
+bool is_enumeration_type(const std::string& name) {
+    for (const auto& type : gimbal::kEnumerationTypes)
+        if (name == type.name) return true;
+    return false;
+}
+
+bool is_item_value(const std::string& type, double value) {
+    for (const auto& item : gimbal::kEnumerationItems)
+        if (type == item.type && value == item.value) return true;
+    return false;
+}
+
+enum class Type { real, integer, boolean };
+
+// The table's rules, beyond what the compiler checks; an empty string when the variable keeps them.
+std::string broken_rule(const gimbal::VariableInfo& v, Type type) {
+    const std::string unit = v.unit, display_unit = v.display_unit, declared_type = v.declared_type;
+    if (type == Type::real) {
+        const UnitDefinition* u = find_unit(unit);
+        if (u == nullptr) return "uses undefined unit '" + unit + "'";
+        if (display_unit != u->display_unit)
+            return "must have displayUnit '" + std::string(u->display_unit) + "' (the one of its unit " + unit +
+                   "), not '" + display_unit + "'";
+    } else if (!unit.empty() || !display_unit.empty()) {
+        return "is not Real: it has no unit";
+    }
+    if (!declared_type.empty()) {
+        if (type != Type::integer) return "only Integer variables may be enumerations";
+        if (!is_enumeration_type(declared_type)) return "has declaredType '" + declared_type + "', not in enumeration_types.def";
+        if (v.min != gimbal::kNoMin || v.max != gimbal::kNoMax) return "an enumeration's items are its bounds: no min or max";
+        if (!is_item_value(declared_type, v.start)) return "its start value is no item of " + declared_type;
+    }
+    if (std::isnan(v.min) || std::isnan(v.max) || v.min > v.max) return "min and max are not an interval";
+    if (type == Type::boolean && (v.min != gimbal::kNoMin || v.max != gimbal::kNoMax)) return "a Boolean has no bounds";
+    if (type == Type::integer && ((std::isfinite(v.min) && v.min != std::floor(v.min)) ||
+                                  (std::isfinite(v.max) && v.max != std::floor(v.max))))
+        return "an Integer's bounds are integers";
+    if (v.initial != gimbal::Initial::calculated && (v.start < v.min || v.start > v.max))
+        return "its start value lies outside [min, max]";
+    return "";
+}
+
+std::string bound(double value, Type type) {
+    return type == Type::integer ? std::to_string(static_cast<long>(value)) : number(value);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 4) {
-        std::cerr << "usage: " << argv[0] << " <units.xml> <variables.xml> <structure.xml>\n";
+    if (argc != 6) {
+        std::cerr << "usage: " << argv[0]
+                  << " <units.xml> <variables.xml> <structure.xml> <types.xml> <default_tolerance.txt>\n";
         return 2;
     }
-    std::set<std::string> used_units, known_units;
-    for (const auto& u : kUnits) known_units.insert(u.name);
+    std::set<std::string> used_units;
 
     std::ostringstream variables, outputs, initial_unknowns;
     unsigned index = 0;
     struct Table {
         const gimbal::VariableInfo* variables;
         unsigned count;
-        const char* type;
+        Type type;
+        const char* element;
     };
-    const Table tables[] = {{gimbal::kRealVariables, gimbal::kRealVariableCount, "Real"},
-                            {gimbal::kIntegerVariables, gimbal::kIntegerVariableCount, "Integer"},
-                            {gimbal::kBooleanVariables, gimbal::kBooleanVariableCount, "Boolean"}};
+    const Table tables[] = {{gimbal::kRealVariables, gimbal::kRealVariableCount, Type::real, "Real"},
+                            {gimbal::kIntegerVariables, gimbal::kIntegerVariableCount, Type::integer, "Integer"},
+                            {gimbal::kBooleanVariables, gimbal::kBooleanVariableCount, Type::boolean, "Boolean"}};
     for (const Table& table : tables) {
-        const bool real = std::string(table.type) == "Real";
         for (unsigned vr = 0; vr < table.count; ++vr) {
             const gimbal::VariableInfo& v = table.variables[vr];
             ++index;
-            if (real && known_units.count(v.unit) == 0) {
-                std::cerr << "variable " << v.name << " uses undefined unit " << v.unit << "\n";
+            const std::string rule = broken_rule(v, table.type);
+            if (!rule.empty()) {
+                std::cerr << "variable " << v.name << ": " << rule << "\n";
                 return 1;
             }
-            if (real) used_units.insert(v.unit);
+            const bool enumeration = v.declared_type[0] != '\0';
+            if (table.type == Type::real) used_units.insert(v.unit);
             variables << "    <!-- index " << index << " -->\n"
                       << "    <ScalarVariable name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
                       << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
             if (v.initial == gimbal::Initial::exact) variables << " initial=\"exact\"";
             if (v.initial == gimbal::Initial::calculated) variables << " initial=\"calculated\"";
-            variables << "\n      description=\"" << xml_escape(v.description) << "\">\n      <" << table.type;
-            if (real) variables << " unit=\"" << v.unit << "\"";
+            variables << "\n      description=\"" << xml_escape(v.description) << "\">\n      <"
+                      << (enumeration ? "Enumeration" : table.element);
+            if (enumeration) variables << " declaredType=\"" << v.declared_type << "\"";
+            if (table.type == Type::real) variables << " unit=\"" << v.unit << "\"";
             if (v.display_unit[0] != '\0') variables << " displayUnit=\"" << v.display_unit << "\"";
+            if (v.min != gimbal::kNoMin) variables << " min=\"" << bound(v.min, table.type) << "\"";
+            if (v.max != gimbal::kNoMax) variables << " max=\"" << bound(v.max, table.type) << "\"";
             if (v.initial != gimbal::Initial::calculated) {
-                if (std::string(table.type) == "Boolean") variables << " start=\"" << (v.start != 0.0 ? "true" : "false") << "\"";
-                else if (real) variables << " start=\"" << number(v.start) << "\"";
+                if (table.type == Type::boolean) variables << " start=\"" << (v.start != 0.0 ? "true" : "false") << "\"";
+                else if (table.type == Type::real) variables << " start=\"" << number(v.start) << "\"";
                 else variables << " start=\"" << static_cast<long>(v.start) << "\"";
             }
             variables << "/>\n    </ScalarVariable>\n";
@@ -144,10 +215,31 @@ int main(int argc, char** argv) {
         if (used_units.count(u.name) == 0) continue;
         units << "    <Unit name=\"" << u.name << "\">";
         if (u.base_unit[0] != '\0') units << "<BaseUnit " << u.base_unit << "/>";
-        units << u.display << "</Unit>\n";
+        if (u.display_unit[0] != '\0')
+            units << "<DisplayUnit name=\"" << u.display_unit << "\" factor=\"" << kDegreesPerRadian << "\" offset=\"0\"/>";
+        units << "</Unit>\n";
     }
+
+    std::ostringstream types;
+    types << "  <TypeDefinitions>\n";
+    for (const auto& type : gimbal::kEnumerationTypes) {
+        types << "    <SimpleType name=\"" << type.name << "\" description=\"" << xml_escape(type.description)
+              << "\">\n      <Enumeration>\n";
+        for (const auto& item : gimbal::kEnumerationItems) {
+            if (std::string(item.type) != type.name) continue;
+            types << "        <Item name=\"" << item.name << "\" value=\"" << item.value << "\" description=\""
+                  << xml_escape(item.description) << "\"/>\n";
+        }
+        types << "      </Enumeration>\n    </SimpleType>\n";
+    }
+    types << "  </TypeDefinitions>\n";
+
     std::ostringstream structure;
     structure << "    <Outputs>\n" << outputs.str() << "    </Outputs>\n"
               << "    <InitialUnknowns>\n" << initial_unknowns.str() << "    </InitialUnknowns>\n";
-    return write(argv[1], units.str()) && write(argv[2], variables.str()) && write(argv[3], structure.str()) ? 0 : 1;
+    const std::string tolerance = number(gimbal::kRealVariables[gimbal::vr_solver_rtol].start);
+    return write(argv[1], units.str()) && write(argv[2], variables.str()) && write(argv[3], structure.str()) &&
+                   write(argv[4], types.str()) && write(argv[5], tolerance)
+               ? 0
+               : 1;
 }

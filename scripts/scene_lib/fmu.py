@@ -21,6 +21,19 @@ STATES = ["alpha", "alpha_m", "beta", "beta_m", "alpha_dot", "alpha_m_dot", "bet
 _CASTS = {"Real": float, "Integer": int, "Boolean": bool}   # the types set and read by name
 
 
+def value_type(variable) -> str:
+    """The FMI function family a variable is set and read with: an Enumeration (the structural
+    selectors gear1.model, ..., solver.method) goes through fmi2SetInteger/fmi2GetInteger."""
+    return "Integer" if variable.type == "Enumeration" else variable.type
+
+
+def enumeration_items(variable) -> dict:
+    """{value: item name} of an Enumeration variable ({} for other types)."""
+    if variable.type != "Enumeration" or variable.declaredType is None:
+        return {}
+    return {int(item.value): item.name for item in variable.declaredType.items}
+
+
 class LogEntry(NamedTuple):
     """One message the FMU logged: its fmi2Status (0 OK, 1 warning, 2 discard, 3 error, 4 fatal),
     category and text; str() gives '[category] text'."""
@@ -39,8 +52,8 @@ class FMU:
     variables      {name: fmpy ModelVariable} of the model description (`model_description`)
     vr(name)       the value reference; variable(name) the ModelVariable; has(name), start(name)
     check(...)     validates scene values (names, causalities, types) before a run
-    set_values(slave, {name: value})   Real, Integer and Boolean, each with the setter of its type
-    get_values(slave, [names])         Real, Integer and Boolean, as floats, in the order given
+    set_values(slave, {name: value})   Real, Integer (and Enumeration) and Boolean, each with the setter of its type
+    get_values(slave, [names])         Real, Integer (and Enumeration) and Boolean, as floats, in the order given
     instantiate(name, log, logging_on) a new FMU2Slave; the FMU's messages go to `log` as LogEntry
 
     A name the model description does not have is refused with a SceneError naming it and the FMU.
@@ -78,7 +91,7 @@ class FMU:
         v = self.variable(name)
         if v.start is None:
             return None
-        return {"Real": float, "Integer": int, "Boolean": lambda s: str(s).lower() in ("true", "1")}[v.type](v.start)
+        return {"Real": float, "Integer": int, "Boolean": lambda s: str(s).lower() in ("true", "1")}[value_type(v)](v.start)
 
     def has(self, name: str) -> bool:
         return name in self.variables
@@ -96,6 +109,15 @@ class FMU:
                 ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
             elif v.type == "Integer":
                 ok = isinstance(value, int) and not isinstance(value, bool)
+            elif v.type == "Enumeration":
+                items = enumeration_items(v)
+                listed = ", ".join(f"{k} ({n})" for k, n in sorted(items.items()))
+                if not isinstance(value, int) or isinstance(value, bool):
+                    raise SceneError(f"[{where}] '{name}' is an Enumeration in the FMU, given by its integer value: "
+                                     f"{listed}; got {value!r}")
+                if value not in items:
+                    raise SceneError(f"[{where}] '{name}' = {value} is none of its values: {listed}")
+                ok = True
             elif v.type == "Boolean":
                 ok = isinstance(value, bool)
             else:
@@ -104,14 +126,15 @@ class FMU:
                 raise SceneError(f"[{where}] '{name}' is {v.type} in the FMU; got {value!r}")
 
     def _by_type(self, names: Iterable[str]) -> dict:
-        """{type: [(name, value reference), ...]} for Real, Integer and Boolean, in the order given."""
+        """{type: [(name, value reference), ...]} for Real, Integer and Boolean, in the order given;
+        Enumeration variables are with the Integer ones (set and read as integers)."""
         groups = {t: [] for t in _CASTS}
         for name in names:
             v = self.variable(name)
-            if v.type not in groups:
-                raise SceneError(f"'{name}' is a {v.type} variable of {self.path}: only Real, Integer and Boolean "
-                                 f"variables are set and read by name")
-            groups[v.type].append((name, v.valueReference))
+            if value_type(v) not in groups:
+                raise SceneError(f"'{name}' is a {v.type} variable of {self.path}: only Real, Integer, Enumeration "
+                                 f"and Boolean variables are set and read by name")
+            groups[value_type(v)].append((name, v.valueReference))
         return groups
 
     def set_values(self, slave, values: dict) -> None:

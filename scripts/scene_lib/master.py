@@ -75,7 +75,8 @@ class Plan:
         self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
 
         self.real_names = [name for name in REAL_OUTPUTS if fmu.has(name)]
-        self.mode_names = [name for name in MODE_OUTPUTS if fmu.has(name) and fmu.variables[name].type == "Integer"]
+        self.mode_names = [name for name in MODE_OUTPUTS
+                           if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
         for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]"):
             if needed not in self.real_names:
                 raise SceneError(f"{fmu.path} has no output '{needed}', which the sensors need")

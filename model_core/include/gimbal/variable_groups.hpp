@@ -101,8 +101,9 @@ inline constexpr IntegerVariable kEventCounters[7] = {
 namespace variable_table {
 
 inline constexpr VariableInfo kReal[] = {
-#define X(id, name, causality, variability, initial, unit, display_unit, start, description) \
-    {name, Causality::causality, Variability::variability, Initial::initial, unit, display_unit, start, description},
+#define X(id, name, causality, variability, initial, declared_type, unit, display_unit, start, min, max, description) \
+    {name, Causality::causality, Variability::variability, Initial::initial, declared_type, unit, display_unit, start, \
+     min, max, description},
 #include "gimbal/real_variables.def"
 };
 inline constexpr VariableInfo kInteger[] = {
