@@ -23,8 +23,9 @@ if [ "$setup_for" = test ]; then
   # bindgen, which loads libclang.
   dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
   # The FMU's win64 binary is cross-compiled with mingw-w64 (the win32 thread model: no winpthread
-  # DLL); without recommends.
+  # DLL) and tested under Wine; without recommends, which would bring a desktop's worth of libraries.
   command -v x86_64-w64-mingw32-g++ >/dev/null 2>&1 || need_apt_bare+=(g++-mingw-w64-x86-64-win32)
+  { [ -x /usr/lib/wine/wine64 ] || command -v wine64 >/dev/null 2>&1; } || need_apt_bare+=(wine64)
 fi
 if [ $((${#need_apt[@]} + ${#need_apt_bare[@]})) -gt 0 ]; then
   echo "[setup] installing Debian packages: ${need_apt[*]} ${need_apt_bare[*]}"
