@@ -12,6 +12,7 @@
 
 #include "fmi2Functions.h"
 #include "fmu_state.h"
+#include "gimbal_guid.h"
 #include "gimbal/gimbal_c_api.h"
 #include "host_fp_environment.h"
 

@@ -21,4 +21,10 @@ if(NOT DEFINED ENV{SOURCE_DATE_EPOCH} AND GIT_EXECUTABLE)
 endif()
 string(TIMESTAMP GIMBAL_GENERATION_DATE "%Y-%m-%dT%H:%M:%SZ" UTC)
 
+# The source FMU's <SourceFiles> (SOURCE_FILES: comma-separated names relative to sources/).
+set(GIMBAL_SOURCE_FILES "")
+string(REPLACE "," ";" _source_files "${SOURCE_FILES}")
+foreach(_file IN LISTS _source_files)
+  string(APPEND GIMBAL_SOURCE_FILES "      <File name=\"${_file}\"/>\n")
+endforeach()
 configure_file(${TEMPLATE} ${OUTPUT} @ONLY)

@@ -10,6 +10,7 @@ build_dir="${GIMBAL_BUILD_DIR:-$repo/build}"
 setup_for="${GIMBAL_SETUP_FOR:-test}"
 
 need_apt=()
+need_apt_bare=()
 dpkg -s libsundials-dev >/dev/null 2>&1 || need_apt+=(libsundials-dev)
 dpkg -s libeigen3-dev >/dev/null 2>&1 || need_apt+=(libeigen3-dev)
 command -v ninja >/dev/null 2>&1 || need_apt+=(ninja-build)
@@ -21,13 +22,20 @@ if [ "$setup_for" = test ]; then
   # fmi-sim, another master of the test suite, is built by cargo; its FMI bindings are generated with
   # bindgen, which loads libclang.
   dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
+  # The FMU's win64 binary is cross-compiled with mingw-w64 (the win32 thread model: no winpthread
+  # DLL) and tested under Wine; without recommends, which would bring a desktop's worth of libraries.
+  command -v x86_64-w64-mingw32-g++ >/dev/null 2>&1 || need_apt_bare+=(g++-mingw-w64-x86-64-win32)
+  { [ -x /usr/lib/wine/wine64 ] || command -v wine64 >/dev/null 2>&1; } || need_apt_bare+=(wine64)
 fi
-if [ ${#need_apt[@]} -gt 0 ]; then
-  echo "[setup] installing Debian packages: ${need_apt[*]}"
+if [ $((${#need_apt[@]} + ${#need_apt_bare[@]})) -gt 0 ]; then
+  echo "[setup] installing Debian packages: ${need_apt[*]} ${need_apt_bare[*]}"
   sudo_cmd=""
   [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
   $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${need_apt[@]}" >/dev/null
+  [ ${#need_apt[@]} -eq 0 ] ||
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${need_apt[@]}" >/dev/null
+  [ ${#need_apt_bare[@]} -eq 0 ] ||
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${need_apt_bare[@]}" >/dev/null
 fi
 
 venv="$repo/.venv"

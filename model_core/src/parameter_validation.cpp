@@ -187,6 +187,13 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
                 "Runge-Kutta)";
         return false;
     }
+    if (!kSundialsAvailable && is_sundials_method(static_cast<IntegrationMethod>(integers[vi_solver_method]))) {
+        error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
+                " is not available in this binary: it was built without SUNDIALS (as the FMU's win64 binary and "
+                "builds from its sources/ are), and methods 0-3 are SUNDIALS' CVODE and ARKODE; use 4 (automatic: "
+                "Dormand-Prince 5(4), RODAS4 while stiff; the default), 5 (Dormand-Prince 5(4) only) or 6 (RODAS4 only)";
+        return false;
+    }
     params.method = integers[vi_solver_method];
 
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};

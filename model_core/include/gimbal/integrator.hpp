@@ -5,7 +5,8 @@
 // - the project's own one-step methods (one_step_integrator.hpp): Dormand-Prince 5(4) and the
 //   Rosenbrock method RODAS4, alone or switched automatically by stiffness. They keep their step size
 //   across communication points and restart after an input jump at the cost of one right-hand side;
-// - SUNDIALS CVODE (BDF, Adams) and ARKODE (explicit Runge-Kutta), kept as reference methods.
+// - SUNDIALS CVODE (BDF, Adams) and ARKODE (explicit Runge-Kutta), kept as reference methods (in
+//   builds with GIMBAL_WITH_SUNDIALS only).
 #pragma once
 
 #include <functional>
@@ -38,6 +39,15 @@ enum class IntegrationMethod : int {
 constexpr int kIntegrationMethodCount = 7;
 
 inline bool is_sundials_method(IntegrationMethod method) { return static_cast<int>(method) <= 3; }
+
+// Whether this build carries SUNDIALS (CMake option GIMBAL_WITH_SUNDIALS, ON for the native build).
+// Without it (the FMU's win64 binary, a build from the FMU's sources/) the SUNDIALS methods 0-3 are
+// refused with the parameters; the project's own methods 4-6 need nothing else. A compiler invoked
+// without the definition (the source FMU's documented build) builds without SUNDIALS.
+#ifndef GIMBAL_WITH_SUNDIALS
+#define GIMBAL_WITH_SUNDIALS 0
+#endif
+constexpr bool kSundialsAvailable = GIMBAL_WITH_SUNDIALS != 0;
 
 struct IntegratorSettings {
     IntegrationMethod method = IntegrationMethod::automatic;

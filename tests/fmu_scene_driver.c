@@ -1,0 +1,227 @@
+/* A plain C master for one fixed scene, built twice from this file: natively (loads the linux64
+ * shared object with dlopen) and with the mingw-w64 tool chain (loads the win64 DLL with
+ * LoadLibrary/GetProcAddress, run under Wine). tests/test_win64_binary.py runs both and compares
+ * their CSV files, so the two binaries are checked on the same scene.
+ *
+ *   fmu_scene_driver BINARY GUID OUT.csv [REFUSED_METHOD...]
+ *
+ * The scene: 3 s in steps of 1 ms at the default parameters (full fidelity, backlash in both gears),
+ * the carrier rolling, pitching, yawing and heaving (sinusoids with their exact derivatives, set at
+ * each step start), and a PD loop in this driver that slews the gimbal to fixed angles (0.1 rad
+ * azimuth, -0.05 rad elevation) against that motion: the voltages saturate at first and the current
+ * limiters and backlash stops switch. Every 10th step writes a CSV row of outputs and voltages.
+ *
+ * Then, in the same process (one Wine start), each REFUSED_METHOD is set as solver.method on a fresh
+ * instance, and the status of fmi2ExitInitializationMode is printed ("refusal: solver.method = M
+ * status = S") after the FMU's log messages, which go to stdout. Exit status 0 when the scene ran,
+ * 1 otherwise. */
+#if defined(_WIN32) && !defined(__USE_MINGW_ANSI_STDIO)
+#define __USE_MINGW_ANSI_STDIO 1 /* C99 printf (%.17g round trips) in mingw-w64's runtime */
+#endif
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _WIN32
+#include <windows.h>
+typedef HMODULE Library;
+static Library open_library(const char* path) { return LoadLibraryA(path); }
+static void* find_symbol(Library library, const char* name) {
+    FARPROC address = GetProcAddress(library, name);
+    void* pointer;
+    memcpy(&pointer, &address, sizeof pointer);
+    return pointer;
+}
+static void close_library(Library library) { FreeLibrary(library); }
+#else
+#include <dlfcn.h>
+typedef void* Library;
+static Library open_library(const char* path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
+static void* find_symbol(Library library, const char* name) { return dlsym(library, name); }
+static void close_library(Library library) { dlclose(library); }
+#endif
+
+#include "fmi2Functions.h"
+
+/* Value references: the position in the FMU's variable tables (the same tables it is built from). */
+enum {
+#define X(id, ...) VR_##id,
+#include "gimbal/real_variables.def"
+#undef X
+};
+enum {
+#define X(id, ...) VI_##id,
+#include "gimbal/integer_variables.def"
+#undef X
+};
+
+typedef struct {
+    fmi2InstantiateTYPE* instantiate;
+    fmi2FreeInstanceTYPE* free_instance;
+    fmi2SetupExperimentTYPE* setup_experiment;
+    fmi2EnterInitializationModeTYPE* enter_initialization;
+    fmi2ExitInitializationModeTYPE* exit_initialization;
+    fmi2TerminateTYPE* terminate;
+    fmi2SetRealTYPE* set_real;
+    fmi2GetRealTYPE* get_real;
+    fmi2SetIntegerTYPE* set_integer;
+    fmi2GetIntegerTYPE* get_integer;
+    fmi2DoStepTYPE* do_step;
+} Api;
+
+static void logger(fmi2ComponentEnvironment environment, fmi2String instance, fmi2Status status, fmi2String category,
+                   fmi2String message, ...) {
+    (void)environment;
+    printf("[%s] %s (status %d): ", instance, category, (int)status);
+    va_list args;
+    va_start(args, message);
+    vprintf(message, args);
+    va_end(args);
+    printf("\n");
+    fflush(stdout);
+}
+
+static const fmi2CallbackFunctions kCallbacks = {logger, calloc, free, NULL, NULL};
+
+static int load(Library library, Api* api) {
+#define LOAD(field, name)                                                       \
+    do {                                                                        \
+        void* pointer = find_symbol(library, name);                             \
+        if (pointer == NULL) {                                                  \
+            fprintf(stderr, "fmu_scene_driver: %s is not exported\n", name);    \
+            return 0;                                                           \
+        }                                                                       \
+        memcpy(&api->field, &pointer, sizeof pointer);                          \
+    } while (0)
+    LOAD(instantiate, "fmi2Instantiate");
+    LOAD(free_instance, "fmi2FreeInstance");
+    LOAD(setup_experiment, "fmi2SetupExperiment");
+    LOAD(enter_initialization, "fmi2EnterInitializationMode");
+    LOAD(exit_initialization, "fmi2ExitInitializationMode");
+    LOAD(terminate, "fmi2Terminate");
+    LOAD(set_real, "fmi2SetReal");
+    LOAD(get_real, "fmi2GetReal");
+    LOAD(set_integer, "fmi2SetInteger");
+    LOAD(get_integer, "fmi2GetInteger");
+    LOAD(do_step, "fmi2DoStep");
+#undef LOAD
+    return 1;
+}
+
+/* The carrier's motion at time t: attitude, rates, accelerations (pitch delta, yaw psi, roll gamma)
+ * and the velocity and acceleration of point a (heave along z). */
+static void base_motion(double t, double values[15]) {
+    static const double amplitude[3] = {0.03, 0.015, 0.08}; /* rad: pitch, yaw, roll */
+    static const double frequency[3] = {0.9, 0.5, 0.7};     /* rad/s */
+    static const double phase[3] = {0.5, 1.0, 0.0};
+    for (int k = 0; k < 3; ++k) {
+        const double a = amplitude[k], w = frequency[k] * 2.0 * 3.14159265358979323846, p = w * t + phase[k];
+        values[k] = a * sin(p);
+        values[3 + k] = a * w * cos(p);
+        values[6 + k] = -a * w * w * sin(p);
+    }
+    const double heave = 0.5, w = 2.0 * 3.14159265358979323846 / 8.0;
+    values[9] = 0.0;
+    values[10] = 6.0; /* cruising: constant velocity along y */
+    values[11] = heave * w * cos(w * t);
+    values[12] = 0.0;
+    values[13] = 0.0;
+    values[14] = -heave * w * w * sin(w * t);
+}
+
+static const fmi2ValueReference kBaseInputs[15] = {
+    VR_base_delta,      VR_base_psi,        VR_base_gamma,      VR_base_delta_dot, VR_base_psi_dot,
+    VR_base_gamma_dot,  VR_base_delta_ddot, VR_base_psi_ddot,   VR_base_gamma_ddot, VR_base_v_a_1,
+    VR_base_v_a_2,      VR_base_v_a_3,      VR_base_a_a_1,      VR_base_a_a_2,     VR_base_a_a_3};
+
+static const fmi2ValueReference kOutputs[] = {
+    VR_alpha, VR_alpha_m, VR_beta,  VR_beta_m, VR_alpha_dot, VR_alpha_m_dot, VR_beta_dot, VR_beta_m_dot, VR_i_R1,
+    VR_i_R2,  VR_theta_b1, VR_theta_b2, VR_T_E1, VR_T_E2, VR_los_omega_1, VR_los_omega_2, VR_los_omega_3};
+static const char* const kOutputNames =
+    "alpha,alpha_m,beta,beta_m,alpha_dot,alpha_m_dot,beta_dot,beta_m_dot,i_R1,i_R2,theta_b1,theta_b2,T_E1,T_E2,"
+    "los.omega[1],los.omega[2],los.omega[3]";
+enum { OUTPUT_COUNT = sizeof kOutputs / sizeof kOutputs[0] };
+static const fmi2ValueReference kCounters[] = {VI_events_total, VI_solver_steps};
+
+static int run_scene(const Api* api, const char* guid, const char* csv_path) {
+    fmi2Component c = api->instantiate("scene", fmi2CoSimulation, guid, "file:///unused", &kCallbacks, fmi2False,
+                                       fmi2False);
+    if (c == NULL) return 0;
+    FILE* csv = fopen(csv_path, "w");
+    if (csv == NULL) {
+        fprintf(stderr, "fmu_scene_driver: cannot write %s\n", csv_path);
+        api->free_instance(c);
+        return 0;
+    }
+    const double h = 1e-3, alpha_ref = 0.1, beta_ref = -0.05, kp = 400.0, kd = 8.0;
+    const int steps = 3000, every = 10;
+    double base[15], y[OUTPUT_COUNT], u[2] = {0.0, 0.0};
+    fmi2Integer counters[2];
+    int ok = api->setup_experiment(c, fmi2False, 0.0, 0.0, fmi2True, steps * h) <= fmi2Warning &&
+             api->enter_initialization(c) <= fmi2Warning;
+    base_motion(0.0, base);
+    ok = ok && api->set_real(c, kBaseInputs, 15, base) <= fmi2Warning && api->exit_initialization(c) <= fmi2Warning;
+    fprintf(csv, "time,%s,u_R1,u_R2,events.total,solver.steps\n", kOutputNames);
+    for (int k = 0; ok && k <= steps; ++k) {
+        const double t = k * h;
+        ok = api->get_real(c, kOutputs, OUTPUT_COUNT, y) <= fmi2Warning &&
+             api->get_integer(c, kCounters, 2, counters) <= fmi2Warning;
+        if (!ok) break;
+        /* PD on the encoder angles and the joint rates, the new voltages applied over this step. */
+        u[0] = kp * (alpha_ref - y[0]) - kd * y[4];
+        u[1] = kp * (beta_ref - y[2]) - kd * y[6];
+        if (k % every == 0) {
+            fprintf(csv, "%.17g", t);
+            for (int j = 0; j < OUTPUT_COUNT; ++j) fprintf(csv, ",%.17g", y[j]);
+            fprintf(csv, ",%.17g,%.17g,%d,%d\n", u[0], u[1], (int)counters[0], (int)counters[1]);
+        }
+        if (k == steps) break;
+        const fmi2ValueReference voltages[2] = {VR_u_R1, VR_u_R2};
+        base_motion(t, base);
+        ok = api->set_real(c, voltages, 2, u) <= fmi2Warning && api->set_real(c, kBaseInputs, 15, base) <= fmi2Warning &&
+             api->do_step(c, t, h, fmi2True) <= fmi2Warning;
+    }
+    if (ok) api->terminate(c);
+    api->free_instance(c);
+    fclose(csv);
+    if (!ok) fprintf(stderr, "fmu_scene_driver: the scene failed (see the FMU's messages above)\n");
+    return ok;
+}
+
+static void check_refusal(const Api* api, const char* guid, int method) {
+    fmi2Component c = api->instantiate("refusal", fmi2CoSimulation, guid, "file:///unused", &kCallbacks, fmi2False,
+                                       fmi2False);
+    if (c == NULL) {
+        printf("refusal: solver.method = %d: fmi2Instantiate failed\n", method);
+        return;
+    }
+    const fmi2ValueReference vr = VI_solver_method;
+    const fmi2Integer value = method;
+    fmi2Status status = api->setup_experiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0);
+    if (status <= fmi2Warning) status = api->set_integer(c, &vr, 1, &value);
+    if (status <= fmi2Warning) status = api->enter_initialization(c);
+    if (status <= fmi2Warning) status = api->exit_initialization(c);
+    printf("refusal: solver.method = %d status = %d\n", method, (int)status);
+    fflush(stdout);
+    api->free_instance(c);
+}
+
+int main(int argc, char** argv) {
+    if (argc < 4) {
+        fprintf(stderr, "usage: fmu_scene_driver BINARY GUID OUT.csv [REFUSED_METHOD...]\n");
+        return 2;
+    }
+    Library library = open_library(argv[1]);
+    if (library == NULL) {
+        fprintf(stderr, "fmu_scene_driver: cannot load %s\n", argv[1]);
+        return 1;
+    }
+    Api api;
+    if (!load(library, &api)) return 1;
+    const int ok = run_scene(&api, argv[2], argv[3]);
+    for (int k = 4; k < argc; ++k) check_refusal(&api, argv[2], atoi(argv[k]));
+    close_library(library);
+    return ok ? 0 : 1;
+}
