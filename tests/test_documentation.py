@@ -103,6 +103,16 @@ def test_fmu_documentation_is_this_checkouts_physics_page(archive, tmp_path):
     assert body.split("</h1>", 1)[1].strip() in packaged
 
 
+def test_the_fmu_carries_the_licences_of_the_code_in_its_binaries(archive):
+    # the project's own, SUNDIALS' (linked statically into linux64) and Eigen's (compiled into every
+    # binary): BSD-3-Clause, BSD-3-Clause, MPL-2.0
+    licences = {name.rsplit("/", 1)[-1]: data.decode("utf-8", "replace")
+                for name, data in archive.items() if name.startswith("documentation/licenses/")}
+    assert (REPO / "LICENSE").read_text() == licences["Gimbal2Axis.txt"]
+    assert "Redistribution and use in source and binary forms" in licences["SUNDIALS.txt"]
+    assert "Mozilla Public License" in licences["Eigen.txt"]
+
+
 def test_fmu_icon_is_a_png_of_sensible_size(archive):
     assert "model.png" in archive
     width, height = png_size(archive["model.png"])
