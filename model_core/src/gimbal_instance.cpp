@@ -84,11 +84,11 @@ struct SnapshotCheck {
     void flag(const char* field, std::uint8_t value) {
         if (value > 1) fail(std::string(field) + " = " + std::to_string(value) + " is not a boolean");
     }
-    void count(const char* field, long value) {
+    void count(const char* field, std::int64_t value) {
         if (value < 0 || static_cast<double>(value) > kMaxCount)
             fail(std::string(field) + " = " + std::to_string(value) + " is not a count");
     }
-    void within(const char* field, long value, long low, long high) {
+    void within(const char* field, std::int64_t value, std::int64_t low, std::int64_t high) {
         if (value < low || value > high)
             fail(std::string(field) + " = " + std::to_string(value) + " lies outside [" + std::to_string(low) + ", " +
                  std::to_string(high) + "]");
@@ -306,10 +306,10 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_events_stick_slip] = static_cast<int>(events.stick_slip);
     integers_[vi_events_zeno_guard] = static_cast<int>(stats.zeno_holds);
     integers_[vi_solver_states] = params_.layout.size;
-    integers_[vi_solver_steps] = static_cast<int>(std::min<long>(stats.steps, 2147483647L));
-    integers_[vi_solver_rhs_evaluations] = static_cast<int>(std::min<long>(stats.rhs_evaluations, 2147483647L));
-    integers_[vi_solver_jacobian_evaluations] = static_cast<int>(std::min<long>(stats.jacobian_evaluations, 2147483647L));
-    integers_[vi_solver_method_switches] = static_cast<int>(std::min<long>(stats.method_switches, 2147483647L));
+    integers_[vi_solver_steps] = static_cast<int>(std::min<std::int64_t>(stats.steps, 2147483647));
+    integers_[vi_solver_rhs_evaluations] = static_cast<int>(std::min<std::int64_t>(stats.rhs_evaluations, 2147483647));
+    integers_[vi_solver_jacobian_evaluations] = static_cast<int>(std::min<std::int64_t>(stats.jacobian_evaluations, 2147483647));
+    integers_[vi_solver_method_switches] = static_cast<int>(std::min<std::int64_t>(stats.method_switches, 2147483647));
 }
 
 void GimbalInstance::load_start_state() {
@@ -571,14 +571,14 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
             check.within("friction mode", static_cast<long>(modes.friction[body]),
                          static_cast<long>(FrictionMode::none), static_cast<long>(FrictionMode::at_max_negative));
         const EventCounters& c = snap.counters;
-        const long counters[] = {c.total, c.backlash[0], c.backlash[1], c.current_limit[0], c.current_limit[1],
+        const std::int64_t counters[] = {c.total, c.backlash[0], c.backlash[1], c.current_limit[0], c.current_limit[1],
                                  c.stick_slip};
-        for (long value : counters) check.count("event counter", value);
+        for (std::int64_t value : counters) check.count("event counter", value);
         check.finite("last event time", &c.last_event_time, 1);
         const IntegratorStatistics& st = snap.statistics;
-        const long statistics[] = {st.steps, st.rhs_evaluations, st.jacobian_evaluations, st.events, st.zeno_holds,
+        const std::int64_t statistics[] = {st.steps, st.rhs_evaluations, st.jacobian_evaluations, st.events, st.zeno_holds,
                                    st.method_switches, st.rejected_steps};
-        for (long value : statistics) check.count("integrator statistic", value);
+        for (std::int64_t value : statistics) check.count("integrator statistic", value);
         const IntegratorMemory& m = snap.integrator_memory;
         const double memory_reals[] = {m.step_size, m.previous_error, m.last_event_time, m.dwell_until};
         check.finite("integrator memory", memory_reals, 4);
@@ -709,12 +709,12 @@ void GimbalInstance::roll_back(const StepStart& start) {
 GimbalStatus GimbalInstance::report_step_work(double step_size, const IntegratorStatistics& before,
                                               const EventCounters& events_before) {
     const IntegratorStatistics after = integrator_->statistics();
-    const long rhs = after.rhs_evaluations - before.rhs_evaluations;
+    const std::int64_t rhs = after.rhs_evaluations - before.rhs_evaluations;
     if (rhs <= kStepWorkBudget) return GIMBAL_OK;
     ++steps_over_budget_;
     if ((steps_over_budget_ & (steps_over_budget_ - 1)) != 0) return GIMBAL_WARNING;
-    const long steps = after.steps - before.steps, rejected = after.rejected_steps - before.rejected_steps;
-    const long events = system_->counters().total - events_before.total;
+    const std::int64_t steps = after.steps - before.steps, rejected = after.rejected_steps - before.rejected_steps;
+    const std::int64_t events = system_->counters().total - events_before.total;
     const auto method = static_cast<IntegrationMethod>(params_.method);
     std::ostringstream s;
     s.precision(6);

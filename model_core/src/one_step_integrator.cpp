@@ -1,3 +1,4 @@
+#include <cstdint>
 #include "one_step_integrator.hpp"
 
 #include <algorithm>
@@ -586,7 +587,7 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
 
 bool OneStepIntegrator::advance_steps(double end_time, double* state) {
     long attempts = 0;
-    long events_here = 0;
+    std::int64_t events_here = 0;
     while (t_ < end_time) {
         if (memory_.dwell_until > -1e300 && t_ >= memory_.dwell_until && !reselect_after_dwell()) return false;
         if (++attempts > settings_.max_steps) {
@@ -665,7 +666,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         memory_.step_size =
             cut_short ? std::max(proposal_, std::min(memory_.step_size, proposal_ * kMaxGrowth)) : proposal_;
         bool event_found = false;
-        const long events_before = totals_.events;
+        const std::int64_t events_before = totals_.events;
         if (!handle_events(event_found)) return false;
         events_here += totals_.events - events_before;
         if (event_found) continue;

@@ -1,3 +1,4 @@
+#include <cstdint>
 #include "sundials_integrator.hpp"
 
 #include <algorithm>
@@ -207,8 +208,8 @@ bool SundialsIntegrator::advance(double end_time, double* state) {
     double* y = N_VGetArrayPointer(y_);
     // One budget of internal steps for the whole call: restarts after mode changes reset the
     // backend's own count, and switches 10-100 ns apart would otherwise run on without bound.
-    const long steps_at_start = statistics().steps;
-    long events_here = 0;
+    const std::int64_t steps_at_start = statistics().steps;
+    std::int64_t events_here = 0;
     for (;;) {
         double reached = 0.0;
         const Outcome outcome = backend_advance(end_time, reached);

@@ -2,6 +2,7 @@
 // limiter, stick/slip), their event functions and their switching rules.
 #pragma once
 
+#include <cstdint>
 #include "gimbal/gimbal_model.hpp"
 #include "gimbal/hybrid_system.hpp"
 #include "gimbal/switching_elements.hpp"
@@ -11,10 +12,10 @@
 namespace gimbal {
 
 struct EventCounters {
-    long total = 0;
-    long backlash[2] = {0, 0};
-    long current_limit[2] = {0, 0};
-    long stick_slip = 0;
+    std::int64_t total = 0;
+    std::int64_t backlash[2] = {0, 0};
+    std::int64_t current_limit[2] = {0, 0};
+    std::int64_t stick_slip = 0;
     double last_event_time = 0.0;
 };
 

@@ -3,6 +3,7 @@
 // the rest is per-run data).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -101,7 +102,7 @@ private:
     bool master_tolerance_defined_ = false;
     double master_tolerance_ = 0.0;
     bool rtol_set_ = false;            // solver.rtol set by the user: the master's tolerance does not apply
-    long steps_over_budget_ = 0;
+    std::int64_t steps_over_budget_ = 0;
 };
 
 }  // namespace gimbal

@@ -9,6 +9,7 @@
 //   builds with GIMBAL_WITH_SUNDIALS only).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -17,14 +18,16 @@
 
 namespace gimbal {
 
+// 64-bit on every platform (long is 32-bit on Windows: rhs_evaluations would overflow within a day
+// of simulated time at 1 kHz).
 struct IntegratorStatistics {
-    long steps = 0;             // accepted steps
-    long rhs_evaluations = 0;
-    long jacobian_evaluations = 0;
-    long events = 0;            // located mode changes
-    long zeno_holds = 0;        // times the chattering guard engaged
-    long method_switches = 0;   // automatic method: explicit <-> Rosenbrock
-    long rejected_steps = 0;
+    std::int64_t steps = 0;             // accepted steps
+    std::int64_t rhs_evaluations = 0;
+    std::int64_t jacobian_evaluations = 0;
+    std::int64_t events = 0;            // located mode changes
+    std::int64_t zeno_holds = 0;        // times the chattering guard engaged
+    std::int64_t method_switches = 0;   // automatic method: explicit <-> Rosenbrock
+    std::int64_t rejected_steps = 0;
 };
 
 enum class IntegrationMethod : int {
