@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+"""Frequency responses of the Gimbal2Axis FMU by sine dwell (scene_lib.frequency_response; how to read
+the results: docs/frequency_response.md).
+
+  open-loop: the plant from a motor voltage u_R<axis> to the line-of-sight and gimbal rates, on a fixed
+             base, motor voltage = offset + amplitude sin(w t) (no controller)
+  isolation: the carrier's roll/pitch/yaw rate as a sine through the scene's closed loop: LOS inertial
+             rate / carrier rate (the stabilization ratio), for the full model and with backlash and
+             dry friction switched off (gear*.model = 1, dry_friction = false)
+
+Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
+Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
+
+  python scripts/frequency_response.py isolation --axis roll --fmin 0.1 --fmax 100 --points 13
+  python scripts/frequency_response.py open-loop --axis 1 --amplitude 1 --serial
+"""
+from __future__ import annotations
+
+import argparse
+import pathlib
+import sys
+import time
+import warnings
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "scripts"))
+
+from scene_lib import load_scene  # noqa: E402
+from scene_lib.errors import SceneError  # noqa: E402
+from scene_lib import frequency_response as fr  # noqa: E402
+
+
+def with_overrides(scene, assignments: list[str]):
+    """The scene with NAME=VALUE assignments: a name of [fidelity] (gear1.model, dry_friction, ...) goes
+    there, any other name to [parameters]."""
+    from scene_lib.fmu import FIDELITY
+
+    fidelity, parameters = dict(scene.fidelity), dict(scene.parameters)
+    for item in assignments:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise SceneError(f"--set {item!r}: expected NAME=VALUE")
+        low = text.strip().lower()
+        value = True if low == "true" else False if low == "false" else float(text)
+        if isinstance(value, float) and value.is_integer() and name.strip() in FIDELITY:
+            value = int(value)
+        (fidelity if name.strip() in FIDELITY else parameters)[name.strip()] = value
+    return scene.with_changes(fidelity=fidelity, parameters=parameters)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("mode", choices=["open-loop", "isolation"])
+    parser.add_argument("--scene", default=str(REPO / "scenes" / "ship_stabilization.toml"),
+                        help="scene whose parameters, fidelity, step size and controller are used (default: "
+                             "scenes/ship_stabilization.toml)")
+    parser.add_argument("--fmu", default=str(REPO / "build" / "Gimbal2Axis.fmu"))
+    parser.add_argument("--axis", default=None,
+                        help="open-loop: motor 1 or 2 (default 1); isolation: roll, pitch or yaw (default roll)")
+    parser.add_argument("--amplitude", type=float, default=None,
+                        help="open-loop: voltage amplitude in V (default 1); isolation: carrier rate amplitude "
+                             "in deg/s (default 1)")
+    parser.add_argument("--offset", type=float, default=0.0, help="open-loop: constant voltage added, V")
+    parser.add_argument("--fmin", type=float, default=0.1)
+    parser.add_argument("--fmax", type=float, default=100.0)
+    parser.add_argument("--points", type=int, default=13, help="log-spaced frequencies (default 13)")
+    parser.add_argument("--settle-periods", type=float, default=5.0)
+    parser.add_argument("--settle-s", type=float, default=1.0, help="settle at least this long, s (default 1)")
+    parser.add_argument("--measure-periods", type=int, default=4)
+    parser.add_argument("--linear-only", action="store_true",
+                        help="isolation: only the curve without backlash and dry friction")
+    parser.add_argument("--full-only", action="store_true", help="isolation: only the full model's curve")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override an FMU parameter or fidelity switch of the scene, e.g. --set body2.d_bd[3]=0 "
+                             "(repeatable; numbers, true/false)")
+    parser.add_argument("--serial", action="store_true", help="run the frequencies one after the other here")
+    parser.add_argument("--workers", type=int, default=4, help="local Dask workers (default 4)")
+    parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    parser.add_argument("--out", default=str(REPO / "results"))
+    parser.add_argument("--name", default=None, help="file name stem (default frequency_response_<mode>_<axis>)")
+    args = parser.parse_args(argv)
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
+            scene = load_scene(args.scene)
+        scene = with_overrides(scene, args.set)
+        frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
+        dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
+        if args.mode == "open-loop":
+            axis = args.axis or "1"
+            excitation = fr.Excitation("voltage", axis, 1.0 if args.amplitude is None else args.amplitude, args.offset)
+            scene = scene.with_changes(base_motion_spec={"type": "fixed"},
+                                       fidelity={**scene.fidelity, "base.fixed": True},
+                                       controller_spec={"type": "none"})
+            variants = [("open loop, fixed base", None)]
+            outputs = excitation.default_outputs()
+        else:
+            axis = args.axis or "roll"
+            import math
+            excitation = fr.Excitation("base", axis, math.radians(1.0 if args.amplitude is None else args.amplitude))
+            variants = []
+            if not args.linear_only:
+                variants.append(("full model", None))
+            if not args.full_only:
+                variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
+            outputs = None
+        client = cluster = None
+        if not args.serial:
+            from sweep_lib import make_client
+            client, cluster = make_client(args.scheduler, workers=args.workers)
+        rows = []
+        wall = time.perf_counter()
+        try:
+            for label, fidelity in variants:
+                rows += fr.sweep(scene, args.fmu, frequencies, excitation, dwell, outputs, fidelity, client, label)
+        finally:
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+    except SceneError as exc:
+        print(f"frequency_response: {exc}", file=sys.stderr)
+        return 1
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
+    csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
+    fr.write_csv(rows, csv_path)
+    unit = "V" if excitation.kind == "voltage" else "rad/s"
+    title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude {excitation.amplitude:g} {unit}"
+             + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
+    fr.plot_bode(rows, png_path, title)
+    print(f"{len(rows)} points in {time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,269 @@
+"""Frequency responses of the nonlinear FMU by simulation: sine dwell, one run per frequency.
+
+Two excitations:
+  - "voltage": a motor voltage u_R<axis> = offset + amplitude sin(w t), open loop (the Replay
+    controller; the other motor at 0 V). The scene's base motion is used as given (normally fixed).
+  - "base": the carrier's roll, pitch or yaw *rate* is a sine of the given rate amplitude (base motion
+    type "sinusoids" on that one axis, angle amplitude = rate amplitude / w), through the scene's own
+    closed loop (its controller).
+
+Each run settles for max(settle_periods / f, settle_s) and then measures over exactly
+`measure_periods` periods. The frequency is snapped so that those periods span an integer number of
+communication steps (the reported frequency_hz is the one simulated): the single-bin DFT
+    X = (2 / n) sum_k x_k exp(-j w t_k)       (k over the measurement window)
+is then exactly orthogonal to the mean and to every other harmonic. Gain and phase are Y / U.
+
+The input's fundamental is the *continuous-time* one: an applied motor voltage is a staircase
+(held over each step, zero-order hold), whose fundamental is the samples' one times
+exp(-j w h / 2) sin(w h / 2) / (w h / 2); without that correction the phase would be off by w h / 2
+(1.8 deg at 10 Hz with h = 1 ms). The base rates are exact sine values at the step starts (the FMU
+moves the carrier on with the exact acceleration), the outputs are exact samples: no correction.
+
+"coherence" here is the fraction of the output's power (its variance over the window) that is in
+the fundamental: |Y|^2 / 2 / var(y). 1 for a linear response without noise; less when the nonlinear
+plant puts power into harmonics, sub-harmonics or a drift. It is NOT Welch's magnitude-squared
+coherence (a sine dwell has one frequency per run, so that estimator has nothing to average over).
+
+For a base excitation the combined line-of-sight output "los" is sqrt(|G_1|^2 + |G_3|^2) of the two
+gyro components that move the line of sight (los.omega[1], elevation; los.omega[3], cross-elevation):
+the isolation (stabilization) ratio, LOS inertial rate / carrier rate. It has no phase (NaN).
+"""
+from __future__ import annotations
+
+import csv
+import dataclasses
+import hashlib
+import math
+import pathlib
+
+import numpy as np
+
+BASE_AXES = {"pitch": "base.delta_dot", "yaw": "base.psi_dot", "roll": "base.gamma_dot"}
+LOS_OUTPUTS = ["los.omega[1]", "los.omega[3]"]
+LINEAR_FIDELITY = {"gear1.model": 1, "gear2.model": 1, "dry_friction": False}
+
+
+@dataclasses.dataclass(frozen=True)
+class Excitation:
+    kind: str                 # "voltage" or "base"
+    axis: str                 # "1" / "2" (motor) or "roll" / "pitch" / "yaw"
+    amplitude: float          # V, or rad/s (rate amplitude of the carrier)
+    offset: float = 0.0       # V, a constant voltage added (voltage only)
+
+    def __post_init__(self):
+        if self.kind == "voltage" and self.axis not in ("1", "2"):
+            raise ValueError(f"a voltage excitation needs axis '1' or '2', got {self.axis!r}")
+        if self.kind == "base" and self.axis not in BASE_AXES:
+            raise ValueError(f"a base excitation needs axis roll, pitch or yaw, got {self.axis!r}")
+        if self.kind not in ("voltage", "base"):
+            raise ValueError(f"excitation kind must be 'voltage' or 'base', got {self.kind!r}")
+
+    @property
+    def input_signal(self) -> str:
+        return f"u_R{self.axis}" if self.kind == "voltage" else BASE_AXES[self.axis]
+
+    def default_outputs(self) -> list[str]:
+        if self.kind == "voltage":
+            return ["alpha_dot", "los.omega[3]"] if self.axis == "1" else ["beta_dot", "los.omega[1]"]
+        return list(LOS_OUTPUTS)
+
+
+@dataclasses.dataclass(frozen=True)
+class Dwell:
+    settle_periods: float = 5.0
+    settle_s: float = 0.0      # at least this long (for a closed loop slower than a few periods)
+    measure_periods: int = 4
+
+
+def log_frequencies(f_min: float, f_max: float, points: int) -> list[float]:
+    return np.logspace(math.log10(f_min), math.log10(f_max), points).tolist()
+
+
+def snapped_grid(frequency: float, h: float, dwell: Dwell):
+    """(f actually simulated, steps to settle, steps to measure)."""
+    n_measure = max(int(round(dwell.measure_periods / (frequency * h))), 1)
+    f = dwell.measure_periods / (n_measure * h)
+    n_settle = int(math.ceil(max(dwell.settle_periods / f, dwell.settle_s) / h - 1e-9))
+    return f, n_settle, n_measure
+
+
+def fundamental(x: np.ndarray, t: np.ndarray, f: float) -> complex:
+    """Complex amplitude X of x ~ Re(X exp(j w t)) over a window of whole periods (single-bin DFT)."""
+    return complex(2.0 / len(x) * np.sum(x * np.exp(-2j * math.pi * f * t)))
+
+
+def zoh_fundamental(samples_fundamental: complex, f: float, h: float) -> complex:
+    """The continuous-time fundamental of a staircase held over each step from its samples' one."""
+    half = math.pi * f * h
+    return samples_fundamental * complex(math.cos(half), -math.sin(half)) * (math.sin(half) / half)
+
+
+def power_fraction(x: np.ndarray, X: complex) -> float:
+    var = float(np.var(x))
+    return float(abs(X) ** 2 / 2.0 / var) if var > 0 else math.nan
+
+
+def _scene_for(scene, excitation: Excitation, f: float, stop_time: float, fidelity: dict | None):
+    changes = {"stop_time": stop_time}
+    if fidelity:
+        merged = dict(scene.fidelity)
+        merged.update(fidelity)
+        changes["fidelity"] = merged
+    if excitation.kind == "base":
+        changes["base_motion_spec"] = {
+            "type": "sinusoids",
+            excitation.axis: {"amplitude_deg": math.degrees(excitation.amplitude / (2 * math.pi * f)),
+                              "frequency_hz": f}}
+    return scene.with_changes(**changes)
+
+
+def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: Dwell = Dwell(),
+                  outputs: list[str] | None = None, fidelity: dict | None = None, slave=None, log=None) -> list[dict]:
+    """One sine dwell at `frequency`: one row per output (and 'los' for a base excitation)."""
+    from .controllers import Replay
+    from .master import run
+
+    h = scene.step_size
+    f, n_settle, n_measure = snapped_grid(frequency, h, dwell)
+    n = n_settle + n_measure
+    run_scene = _scene_for(scene, excitation, f, n * h, fidelity)
+    controller = None
+    if excitation.kind == "voltage":
+        t = np.arange(n + 1) * h
+        voltages = np.zeros((n + 1, 2))
+        # the command at t_k is applied delay steps later: its phase does not matter, u_R<j> is measured
+        voltages[:, int(excitation.axis) - 1] = excitation.offset + excitation.amplitude * np.sin(2 * math.pi * f * t)
+        controller = Replay(voltages)
+    result = run(run_scene, fmu, controller=controller, slave=slave, log=log)
+    sig = result.signals
+    window = slice(n_settle, n_settle + n_measure)
+    t = sig["time"][window]
+    u = np.asarray(sig[excitation.input_signal])[window]
+    U = fundamental(u, t, f)
+    if excitation.kind == "voltage":
+        U = zoh_fundamental(U, f, h)
+    limited = np.zeros(n_measure, bool)
+    for j in (1, 2):
+        if f"motor{j}.limited" in sig:
+            limited |= np.asarray(sig[f"motor{j}.limited"])[window] != 0
+    common = dict(frequency_hz=f, requested_hz=frequency, input=excitation.input_signal,
+                  input_amplitude=abs(U), samples_per_period=1.0 / (f * h), settle_s=n_settle * h,
+                  measure_periods=dwell.measure_periods, current_limited_fraction=float(limited.mean()))
+    rows, gains = [], {}
+    for name in outputs or excitation.default_outputs():
+        y = np.asarray(sig[name])[window]
+        Y = fundamental(y, t, f)
+        G = Y / U
+        gains[name] = G
+        rows.append(dict(common, output=name, gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                         phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=power_fraction(y, Y),
+                         output_amplitude=abs(Y), output_mean=float(np.mean(y))))
+    if excitation.kind == "base" and all(name in gains for name in LOS_OUTPUTS):
+        g = math.sqrt(sum(abs(gains[name]) ** 2 for name in LOS_OUTPUTS))
+        powers = [r for r in rows if r["output"] in LOS_OUTPUTS]
+        total_var = sum(r["output_amplitude"] ** 2 / 2 / r["coherence"] for r in powers if r["coherence"] > 0)
+        rows.append(dict(common, output="los", gain=g, gain_db=20 * math.log10(g) if g > 0 else -math.inf,
+                         phase_deg=math.nan,
+                         coherence=sum(r["output_amplitude"] ** 2 / 2 for r in powers) / total_var if total_var else math.nan,
+                         output_amplitude=g * abs(U), output_mean=math.nan))
+    return rows
+
+
+# -- many frequencies: serially or on Dask -----------------------------------------------------------
+
+def _point_task(fmu_bytes: bytes, digest: str, scene, frequency, excitation, dwell, outputs, fidelity):
+    from sweep_lib.worker import loaded_fmu
+
+    loaded = loaded_fmu(fmu_bytes, digest)
+    return measure_point(scene, loaded.fmu, frequency, excitation, dwell, outputs, fidelity,
+                         slave=loaded.instance(), log=loaded.log)
+
+
+def sweep(scene, fmu_path, frequencies, excitation: Excitation, dwell: Dwell = Dwell(), outputs=None,
+          fidelity: dict | None = None, client=None, curve: str = "") -> list[dict]:
+    """measure_point at every frequency; on `client` (a Dask Client) in parallel, else serially in this
+    process on one FMU instance. Rows carry `curve` (a label of the variant)."""
+    fmu_path = pathlib.Path(fmu_path)
+    if client is None:
+        from .fmu import FMU
+
+        rows = []
+        with FMU(fmu_path) as fmu:
+            log: list = []
+            slave = fmu.instantiate("frequency_response", log)
+            try:
+                for f in frequencies:
+                    rows += measure_point(scene, fmu, f, excitation, dwell, outputs, fidelity, slave=slave, log=log)
+            finally:
+                slave.freeInstance()
+    else:
+        data = fmu_path.read_bytes()
+        digest = hashlib.sha256(data).hexdigest()
+        data_future = client.scatter(data, broadcast=True)
+        futures = [client.submit(_point_task, data_future, digest, scene, f, excitation, dwell, outputs, fidelity,
+                                 pure=False) for f in frequencies]
+        rows = [row for future in futures for row in future.result()]
+    for row in rows:
+        row["curve"] = curve
+    return rows
+
+
+COLUMNS = ["curve", "input", "output", "requested_hz", "frequency_hz", "gain", "gain_db", "phase_deg", "coherence",
+           "input_amplitude", "output_amplitude", "output_mean", "current_limited_fraction", "samples_per_period",
+           "settle_s", "measure_periods"]
+
+
+def write_csv(rows: list[dict], path) -> None:
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: (f"{v:.10g}" if isinstance(v, float) else v) for k, v in row.items()})
+
+
+def curves(rows: list[dict]) -> dict:
+    """{(curve, output): rows sorted by frequency}."""
+    out: dict = {}
+    for row in rows:
+        out.setdefault((row["curve"], row["output"]), []).append(row)
+    return {key: sorted(value, key=lambda r: r["frequency_hz"]) for key, value in out.items()}
+
+
+def plot_bode(rows: list[dict], path, title: str = "") -> None:
+    """Gain (dB), phase (deg, unwrapped along each curve) and coherence against frequency, every point
+    marked; the axes are autoscaled to every finite value (nothing is clipped). A gain of exactly 0
+    (-inf dB) or a NaN is drawn as an 'x' on the bottom edge and said in the legend."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_g, ax_p, ax_c) = plt.subplots(3, 1, figsize=(9, 10), sharex=True)
+    for (curve, output), cr in curves(rows).items():
+        f = np.array([r["frequency_hz"] for r in cr])
+        g = np.array([r["gain_db"] for r in cr], float)
+        p = np.array([r["phase_deg"] for r in cr], float)
+        c = np.array([r["coherence"] for r in cr], float)
+        label = f"{curve}: {output}" if curve else output
+        bad = ~np.isfinite(g)
+        line, = ax_g.semilogx(f[~bad], g[~bad], "o-", ms=4, label=label + (f" ({bad.sum()} not finite)" if bad.any() else ""))
+        if bad.any():
+            low = np.nanmin(g[~bad]) if (~bad).any() else 0.0
+            ax_g.semilogx(f[bad], np.full(bad.sum(), low), "x", color=line.get_color(), ms=8)
+        finite = np.isfinite(p)
+        if finite.any():
+            unwrapped = p.copy()
+            unwrapped[finite] = np.degrees(np.unwrap(np.radians(p[finite])))
+            ax_p.semilogx(f[finite], unwrapped[finite], "o-", ms=4, color=line.get_color(), label=label)
+        ax_c.semilogx(f, c, "o-", ms=4, color=line.get_color(), label=label)
+    ax_g.set_ylabel("gain [dB]")
+    ax_p.set_ylabel("phase [deg]")
+    ax_c.set_ylabel("power fraction at the fundamental")
+    ax_c.set_xlabel("frequency [Hz]")
+    for ax in (ax_g, ax_p, ax_c):
+        ax.grid(True, which="both", alpha=0.3)
+    ax_g.legend(fontsize=8)
+    ax_g.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

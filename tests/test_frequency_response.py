@@ -1,0 +1,156 @@
+"""Frequency responses by sine dwell (scene_lib.frequency_response) against a known linear case, and the
+backlash's describing-function gain drop."""
+import cmath
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from scene_lib import load_scene
+from scene_lib.frequency_response import Dwell, Excitation, fundamental, measure_point, zoh_fundamental
+
+SCENE = """
+name = "frequency_response_test"
+stop_time = 1.0
+step_size = 1e-3
+
+[fidelity]
+"gear1.model" = {gear1}
+"motor1.model" = 0
+dry_friction = false
+"base.fixed" = true
+
+[parameters]
+"solver.rtol" = 1e-9
+"solver.atol" = 1e-11
+# the payload's centre of mass on the elevation axis: no gravity torque, the elevation axis stays at rest
+"body2.d_bd[2]" = 0.0
+"body2.d_bd[3]" = 0.0
+
+[base_motion]
+type = "fixed"
+
+[controller]
+type = "none"
+"""
+
+
+def scene_file(tmp_path, gear1: int):
+    """The test scene (no controller: its SceneWarning is expected and silenced)."""
+    path = tmp_path / f"fr_gear{gear1}.toml"
+    path.write_text(SCENE.format(gear1=gear1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_scene(path)
+
+
+def value(fmu, scene, name):
+    return float(scene.parameters.get(name, fmu.start(name)))
+
+
+def test_single_bin_dft_and_zero_order_hold():
+    h, f = 1e-3, 12.5
+    t = np.arange(400) * h                       # 5 whole periods
+    x = 0.3 + 2.0 * np.sin(2 * math.pi * f * t + 0.4) + 0.5 * np.sin(2 * math.pi * 3 * f * t)
+    X = fundamental(x, t, f)
+    assert abs(X - 2.0 * cmath.exp(1j * (0.4 - math.pi / 2))) < 1e-12
+    # a staircase of the samples: its continuous fundamental lags by w h / 2 and shrinks by sinc
+    Z = zoh_fundamental(1.0, f, h)
+    assert math.isclose(cmath.phase(Z), -math.pi * f * h, rel_tol=1e-12)
+    assert math.isclose(abs(Z), math.sin(math.pi * f * h) / (math.pi * f * h), rel_tol=1e-12)
+
+
+def test_rigid_axis_with_quasi_static_motor_matches_first_order_transfer_function(gimbal_fmu, tmp_path):
+    """Azimuth axis with a rigid gear (gear1.model = 0) and a quasi-static motor (motor1.model = 0), no dry
+    friction, fixed level base, elevation at rest at beta = 0 (its centre of mass on its axis).
+
+    With q_m = N alpha (docs/physics.md section 6) the rotor's equation, multiplied by N, adds to the load's:
+        (J11 + N^2 J_R1) alpha'' = N T_ele - (c_1 + N^2 c_R1) alpha'
+    (J12 = 0: rotor 1 turns on the carrier, its stator is not on body 1), and the quasi-static current is
+    i = (u - k_emf N alpha') / R, T_ele = k_torque i. So
+        G(s) = alpha'(s) / u(s) = (N k_t / R) / (J s + c + N^2 k_t k_e / R)
+    with J = J11 + N^2 I_zz,R1 and c = c_1 + N^2 c_R1: the motor constants reflected to the load by N.
+    J11 at alpha = beta = 0 about the azimuth axis through b: the z-z inertias of body 1, body 2 and rotor 2
+    (all frames aligned at q = 0) plus m (d_x^2 + d_y^2) of their centres of mass (parallel axes). The
+    products of inertia couple the elevation axis only to second order in the small amplitude."""
+    scene = scene_file(tmp_path, gear1=0)
+    fmu = gimbal_fmu
+    v = lambda name: value(fmu, scene, name)
+    N, R, kt, ke = v("gear1.N"), v("motor1.R"), v("motor1.k_torque"), v("motor1.k_emf")
+    J11 = (v("body1.I_zz") + v("body1.m") * (v("body1.d_bc[1]") ** 2 + v("body1.d_bc[2]") ** 2)
+           + v("body2.I_zz") + v("body2.m") * (v("body2.d_bd[1]") ** 2 + v("body2.d_bd[2]") ** 2)
+           + v("rotor2.I_zz") + v("rotor2.m") * (v("rotor2.d_bf[1]") ** 2 + v("rotor2.d_bf[2]") ** 2))
+    J = J11 + N ** 2 * (v("rotor1.I_zz") + v("rotor1.m") * (v("rotor1.d_be[1]") ** 2 + v("rotor1.d_be[2]") ** 2))
+    c = v("body1.c_visc") + N ** 2 * v("rotor1.c_visc")
+    amplitude = 1.0   # V: |i| <= amplitude / R = 0.5 A, far below i_L; far below U_L
+    for f in (0.5, 2.0, 6.0, 25.0):
+        rows = measure_point(scene, fmu, f, Excitation("voltage", "1", amplitude),
+                             Dwell(settle_periods=2, settle_s=0.25, measure_periods=2), outputs=["alpha_dot"])
+        row = rows[0]
+        w = 2 * math.pi * row["frequency_hz"]
+        G = (N * kt / R) / (J * 1j * w + c + N ** 2 * kt * ke / R)
+        assert row["current_limited_fraction"] == 0.0
+        assert row["gain"] == pytest.approx(abs(G), rel=0.01), f
+        assert abs(row["phase_deg"] - math.degrees(cmath.phase(G))) < 1.0, f
+        assert row["coherence"] > 0.999
+
+
+def play_operator_describing_function(X: float, eta: float) -> complex:
+    """The describing function of the ideal backlash (play operator, half-width eta) for an input X sin(w t):
+    the output stays where it was left until the input takes up the play, then follows it at -+eta."""
+    n = 4000
+    t = np.arange(n) / n * 2.0
+    x = X * np.sin(2 * math.pi * t)
+    y, last = np.zeros(n), 0.0
+    for k in range(n):
+        last = min(max(last, x[k] - eta), x[k] + eta)
+        y[k] = last
+    second = slice(n // 2, n)   # the second period: periodic
+    return fundamental(y[second], t[second], 1.0) / fundamental(x[second], t[second], 1.0)
+
+
+def test_backlash_lowers_the_gain_where_the_motion_is_comparable_to_the_play(gimbal_fmu, tmp_path):
+    """Describing function: a backlash of half-width eta between the gear output theta_1 = alpha_m / N and the
+    load, with a load that stays where the drive leaves it, is the play operator. For an input X sin(w t) its
+    describing function has a gain -> 1 and no lag for X >> eta (the play is taken up in a small part of each
+    period), and for X of the order of eta the load moves during only part of each half period: the gain of
+    the fundamental falls towards 0 as X -> eta, with a growing phase lag (about 0.86 and -15 deg at
+    X = 4.4 eta, 0.63 and -30 deg at 2.1 eta, 0 at X <= eta; play_operator_describing_function).
+
+    The test measures u_R1 -> alpha_dot with the compliant gear with backlash (gear1.model = 2) over the
+    same gear without it (gear1.model = 1), with a small voltage amplitude, at frequencies where the load
+    angle's amplitude X (linear case) is about 9, 2 and 1 eta. The load's viscous friction is raised to
+    body1.c_visc = 10 N.m.s/rad (time constant J11 / c_1 = 20 ms) so that the load stops in the gap, as the
+    play operator assumes. Expected: the gain ratio below 1, falling with X / eta, with a drop 1 - ratio
+    between 0.2 and 1 times the play operator's (smaller than the ideal element's because the motor, unloaded
+    in the gap, speeds up and the gear output's amplitude grows), and a phase lag.
+
+    (With the default, lightly damped load, c_1 = 0.05, time constant 4 s, the load coasts across the gap
+    instead: the gain hardly drops at X >~ eta, only the lag appears, and for X < eta the load rattles
+    between the flanks and its rate's fundamental even exceeds the linear one.)"""
+    fmu = gimbal_fmu
+    excitation = Excitation("voltage", "1", 0.05)
+    dwell = Dwell(settle_periods=3, settle_s=0.5, measure_periods=2)
+    eta = float(fmu.start("gear1.eta"))
+    scenes = {}
+    for model in (1, 2):
+        scene = scene_file(tmp_path, model)
+        scenes[model] = scene.with_changes(parameters={**scene.parameters, "body1.c_visc": 10.0})
+    ratios, amplitudes, lags, expected = [], [], [], []
+    for f in (0.5, 2.0, 4.0):
+        linear = measure_point(scenes[1], fmu, f, excitation, dwell, outputs=["alpha_dot"])[0]
+        play = measure_point(scenes[2], fmu, f, excitation, dwell, outputs=["alpha_dot"])[0]
+        assert play["current_limited_fraction"] == 0.0
+        ratios.append(play["gain"] / linear["gain"])
+        lags.append(play["phase_deg"] - linear["phase_deg"])
+        amplitudes.append(linear["output_amplitude"] / (2 * math.pi * linear["frequency_hz"]) / eta)
+        expected.append(abs(play_operator_describing_function(amplitudes[-1] * eta, eta)))
+    print("X/eta", amplitudes, "gain ratio", ratios, "play operator", expected, "lag", lags)
+    assert amplitudes[0] > 6 and 1.5 < amplitudes[1] < 3 and 0.7 < amplitudes[2] < 1.3
+    assert 0.95 < ratios[0] <= 1.0
+    assert ratios[2] < ratios[1] < ratios[0]
+    for ratio, ideal in zip(ratios, expected):
+        assert 0.2 * (1 - ideal) < 1 - ratio < 1 - ideal + 0.01
+    assert lags[2] < lags[1] < lags[0] < 0
+    assert lags[1] < -8.0
