@@ -2,6 +2,7 @@
 backlash's describing-function gain drop."""
 import cmath
 import math
+import pathlib
 import warnings
 
 import numpy as np
@@ -9,6 +10,8 @@ import pytest
 
 from scene_lib import load_scene
 from scene_lib.frequency_response import Dwell, Excitation, fundamental, measure_point, zoh_fundamental
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 SCENE = """
 name = "frequency_response_test"
@@ -154,3 +157,40 @@ def test_backlash_lowers_the_gain_where_the_motion_is_comparable_to_the_play(gim
         assert 0.2 * (1 - ideal) < 1 - ratio < 1 - ideal + 0.01
     assert lags[2] < lags[1] < lags[0] < 0
     assert lags[1] < -8.0
+
+
+def test_sweep_on_dask_equals_the_serial_sweep(client, fmu_path):
+    """The frequencies of a closed-loop isolation sweep run as Dask tasks give the serial sweep's rows."""
+    from scene_lib.frequency_response import LINEAR_FIDELITY, sweep
+
+    scene = load_scene(REPO / "scenes" / "ship_stabilization.toml")
+    excitation = Excitation("base", "pitch", math.radians(1.0))
+    dwell = Dwell(settle_periods=2, settle_s=0.2, measure_periods=2)
+    frequencies = [20.0, 50.0]
+    serial = sweep(scene, fmu_path, frequencies, excitation, dwell, fidelity=LINEAR_FIDELITY, curve="linear")
+    parallel = sweep(scene, fmu_path, frequencies, excitation, dwell, fidelity=LINEAR_FIDELITY, client=client,
+                     curve="linear")
+    assert [(r["output"], r["frequency_hz"]) for r in serial] == [(r["output"], r["frequency_hz"]) for r in parallel]
+    assert [r["output"] for r in serial[:3]] == ["los.omega[1]", "los.omega[3]", "los"]
+    for a, b in zip(serial, parallel):
+        assert a["gain"] == pytest.approx(b["gain"], rel=1e-12)
+    los = serial[2]
+    assert los["gain"] == pytest.approx(math.hypot(serial[0]["gain"], serial[1]["gain"]))
+
+
+def test_command_writes_a_csv_row_per_point_and_a_bode_plot(fmu_path, tmp_path):
+    import csv
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), "isolation", "--axis", "yaw",
+                          "--fmin", "30", "--fmax", "60", "--points", "2", "--settle-periods", "2", "--settle-s", "0.1",
+                          "--measure-periods", "2", "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path)],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    rows = list(csv.DictReader(open(tmp_path / "frequency_response_isolation_yaw.csv")))
+    # 2 variants x 2 frequencies x (los.omega[1], los.omega[3], los)
+    assert len(rows) == 12
+    assert {r["curve"] for r in rows} == {"full model", "no backlash, no dry friction"}
+    assert all(r["input"] == "base.psi_dot" for r in rows)
+    assert (tmp_path / "frequency_response_isolation_yaw.png").stat().st_size > 10000
