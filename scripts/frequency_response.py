@@ -3,10 +3,11 @@
 the results: docs/frequency_response.md).
 
   open-loop: the plant from a motor voltage u_R<axis> to the line-of-sight and gimbal rates, on a fixed
-             base, motor voltage = offset + amplitude sin(w t) (no controller)
+             base, motor voltage = offset + amplitude sin(w t) (no controller, the other motor at 0 V)
   isolation: the carrier's roll/pitch/yaw rate as a sine through the scene's closed loop: LOS inertial
-             rate / carrier rate (the stabilization ratio), for the full model and with backlash and
-             dry friction switched off (gear*.model = 1, dry_friction = false)
+             rate / carrier rate (the stabilization ratio)
+Both for the scene's model ("full model") and with backlash and dry friction switched off
+(gear*.model = 1, dry_friction = false).
 
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
@@ -68,8 +69,8 @@ def main(argv=None) -> int:
     parser.add_argument("--settle-s", type=float, default=1.0, help="settle at least this long, s (default 1)")
     parser.add_argument("--measure-periods", type=int, default=4)
     parser.add_argument("--linear-only", action="store_true",
-                        help="isolation: only the curve without backlash and dry friction")
-    parser.add_argument("--full-only", action="store_true", help="isolation: only the full model's curve")
+                        help="only the curve without backlash and dry friction")
+    parser.add_argument("--full-only", action="store_true", help="only the scene's model (its own fidelity)")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override an FMU parameter or fidelity switch of the scene, e.g. --set body2.d_bd[3]=0 "
                              "(repeatable; numbers, true/false)")
@@ -93,18 +94,17 @@ def main(argv=None) -> int:
             scene = scene.with_changes(base_motion_spec={"type": "fixed"},
                                        fidelity={**scene.fidelity, "base.fixed": True},
                                        controller_spec={"type": "none"})
-            variants = [("open loop, fixed base", None)]
             outputs = excitation.default_outputs()
         else:
             axis = args.axis or "roll"
             import math
             excitation = fr.Excitation("base", axis, math.radians(1.0 if args.amplitude is None else args.amplitude))
-            variants = []
-            if not args.linear_only:
-                variants.append(("full model", None))
-            if not args.full_only:
-                variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
             outputs = None
+        variants = []
+        if not args.linear_only:
+            variants.append(("full model", None))
+        if not args.full_only:
+            variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
         client = cluster = None
         if not args.serial:
             from sweep_lib import make_client

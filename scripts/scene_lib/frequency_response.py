@@ -157,15 +157,15 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
         gains[name] = G
         rows.append(dict(common, output=name, gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
                          phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=power_fraction(y, Y),
-                         output_amplitude=abs(Y), output_mean=float(np.mean(y))))
+                         output_amplitude=abs(Y), output_mean=float(np.mean(y)), output_variance=float(np.var(y))))
     if excitation.kind == "base" and all(name in gains for name in LOS_OUTPUTS):
         g = math.sqrt(sum(abs(gains[name]) ** 2 for name in LOS_OUTPUTS))
-        powers = [r for r in rows if r["output"] in LOS_OUTPUTS]
-        total_var = sum(r["output_amplitude"] ** 2 / 2 / r["coherence"] for r in powers if r["coherence"] > 0)
+        parts = [r for r in rows if r["output"] in LOS_OUTPUTS]
+        total_var = sum(r["output_variance"] for r in parts)
         rows.append(dict(common, output="los", gain=g, gain_db=20 * math.log10(g) if g > 0 else -math.inf,
                          phase_deg=math.nan,
-                         coherence=sum(r["output_amplitude"] ** 2 / 2 for r in powers) / total_var if total_var else math.nan,
-                         output_amplitude=g * abs(U), output_mean=math.nan))
+                         coherence=sum(r["output_amplitude"] ** 2 / 2 for r in parts) / total_var if total_var > 0 else math.nan,
+                         output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var))
     return rows
 
 
@@ -199,7 +199,9 @@ def sweep(scene, fmu_path, frequencies, excitation: Excitation, dwell: Dwell = D
     else:
         data = fmu_path.read_bytes()
         digest = hashlib.sha256(data).hexdigest()
-        data_future = client.scatter(data, broadcast=True)
+        # a key of its own (hash=False): a second sweep scattering the same bytes must not share the key
+        # the first one releases when it returns
+        data_future = client.scatter(data, broadcast=True, hash=False)
         futures = [client.submit(_point_task, data_future, digest, scene, f, excitation, dwell, outputs, fidelity,
                                  pure=False) for f in frequencies]
         rows = [row for future in futures for row in future.result()]
@@ -209,7 +211,7 @@ def sweep(scene, fmu_path, frequencies, excitation: Excitation, dwell: Dwell = D
 
 
 COLUMNS = ["curve", "input", "output", "requested_hz", "frequency_hz", "gain", "gain_db", "phase_deg", "coherence",
-           "input_amplitude", "output_amplitude", "output_mean", "current_limited_fraction", "samples_per_period",
+           "input_amplitude", "output_amplitude", "output_mean", "output_variance", "current_limited_fraction", "samples_per_period",
            "settle_s", "measure_periods"]
 
 
@@ -229,41 +231,54 @@ def curves(rows: list[dict]) -> dict:
     return {key: sorted(value, key=lambda r: r["frequency_hz"]) for key, value in out.items()}
 
 
+GAIN_RANGE_DB = 120.0   # the gain axis spans at most this far below the largest gain; lower points sit on its floor
+
+
 def plot_bode(rows: list[dict], path, title: str = "") -> None:
     """Gain (dB), phase (deg, unwrapped along each curve) and coherence against frequency, every point
-    marked; the axes are autoscaled to every finite value (nothing is clipped). A gain of exactly 0
-    (-inf dB) or a NaN is drawn as an 'x' on the bottom edge and said in the legend."""
+    marked, each curve with its own marker and line style (coinciding curves stay visible). The phase and
+    coherence axes are autoscaled to every value. The gain axis spans at most GAIN_RANGE_DB below the
+    largest gain: a lower gain (a load that does not move at all gives -200 dB or less) or a gain of exactly 0
+    is drawn on the floor as a downward triangle and counted in the legend; its value is in the CSV."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (ax_g, ax_p, ax_c) = plt.subplots(3, 1, figsize=(9, 10), sharex=True)
-    for (curve, output), cr in curves(rows).items():
+    groups = curves(rows)
+    finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
+    top = max(finite_gains) if finite_gains else 0.0
+    floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
+    markers, styles = "osD^vP*X", ["-", "--", ":", "-."]
+    for index, ((curve, output), cr) in enumerate(groups.items()):
+        marker, style = markers[index % len(markers)], styles[index % len(styles)]
+        size = max(7 - index, 3)
         f = np.array([r["frequency_hz"] for r in cr])
         g = np.array([r["gain_db"] for r in cr], float)
         p = np.array([r["phase_deg"] for r in cr], float)
         c = np.array([r["coherence"] for r in cr], float)
         label = f"{curve}: {output}" if curve else output
-        bad = ~np.isfinite(g)
-        line, = ax_g.semilogx(f[~bad], g[~bad], "o-", ms=4, label=label + (f" ({bad.sum()} not finite)" if bad.any() else ""))
-        if bad.any():
-            low = np.nanmin(g[~bad]) if (~bad).any() else 0.0
-            ax_g.semilogx(f[bad], np.full(bad.sum(), low), "x", color=line.get_color(), ms=8)
+        low = ~(np.isfinite(g) & (g >= floor))
+        if low.any():
+            label += f" ({low.sum()} below {floor:.0f} dB: on the floor)"
+        line, = ax_g.semilogx(f, np.where(low, floor, g), style, marker=marker, ms=size, mfc="none", label=label)
+        if low.any():
+            ax_g.semilogx(f[low], np.full(low.sum(), floor), "v", color=line.get_color(), ms=9)
+        kw = dict(color=line.get_color(), linestyle=style, marker=marker, ms=size, mfc="none")
         finite = np.isfinite(p)
         if finite.any():
-            unwrapped = p.copy()
-            unwrapped[finite] = np.degrees(np.unwrap(np.radians(p[finite])))
-            ax_p.semilogx(f[finite], unwrapped[finite], "o-", ms=4, color=line.get_color(), label=label)
-        ax_c.semilogx(f, c, "o-", ms=4, color=line.get_color(), label=label)
+            unwrapped = np.degrees(np.unwrap(np.radians(p[finite])))
+            ax_p.semilogx(f[finite], unwrapped, **kw)
+        ax_c.semilogx(f, c, **kw)
     ax_g.set_ylabel("gain [dB]")
-    ax_p.set_ylabel("phase [deg]")
+    ax_p.set_ylabel("phase [deg] (unwrapped)")
     ax_c.set_ylabel("power fraction at the fundamental")
     ax_c.set_xlabel("frequency [Hz]")
     for ax in (ax_g, ax_p, ax_c):
         ax.grid(True, which="both", alpha=0.3)
-    ax_g.legend(fontsize=8)
-    ax_g.set_title(title)
+    ax_g.legend(fontsize=7)
+    ax_g.set_title(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
