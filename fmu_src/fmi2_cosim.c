@@ -65,7 +65,8 @@ static const struct {
     [FN_SerializedFMUstateSize] = {"fmi2SerializedFMUstateSize", ANY_STATE},
     [FN_SerializeFMUstate] = {"fmi2SerializeFMUstate", ANY_STATE},
     [FN_DeSerializeFMUstate] = {"fmi2DeSerializeFMUstate", ANY_STATE},
-    [FN_GetDirectionalDerivative] = {"fmi2GetDirectionalDerivative", ANY_STATE},
+    /* After initialization only: the derivatives of the InitialUnknowns are not provided. */
+    [FN_GetDirectionalDerivative] = {"fmi2GetDirectionalDerivative", STATUS_STATES | STATE_ERROR},
     [FN_SetRealInputDerivatives] = {"fmi2SetRealInputDerivatives", STATE_INITIALIZATION | STATE_STEP_COMPLETE},
     [FN_GetRealOutputDerivatives] = {"fmi2GetRealOutputDerivatives", ANY_STATE},
     [FN_DoStep] = {"fmi2DoStep", STATE_STEP_COMPLETE},
@@ -667,16 +668,60 @@ static fmi2Status impl_DeSerializeFMUstate(fmi2Component c, const fmi2Byte seria
     return fmi2OK;
 }
 
+/* Directional derivatives at a communication point (FMI 2.0, section 4.2.1 with 3.2.1): dvUnknown =
+ * (d h / d vKnown) dvKnown, where the unknowns are outputs (ModelStructure <Outputs>) and the knowns
+ * inputs; a Co-Simulation FMU exposes no states, so no <Derivatives> are unknowns or knowns here.
+ * The outputs of this FMU are computed by fmi2DoStep and held until the next one: setting an input
+ * changes no output before the next step, which is why ModelStructure declares every output with
+ * dependencies="". The partial derivatives at the current point are therefore exactly zero (no
+ * difference quotient, no analytic term is needed); what is computed here is the check of the
+ * arguments. The linearization of the continuous model itself (A, B, C, D, with the direct
+ * feedthrough of e.g. a quasi-static motor's current) is a different quantity. */
 static fmi2Status impl_GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[]) {
-    (void)vUnknown_ref;
-    (void)nUnknown;
-    (void)vKnown_ref;
-    (void)nKnown;
-    (void)dvKnown;
-    (void)dvUnknown;
-    return unsupported(c, FN_GetDirectionalDerivative, "providesDirectionalDerivative=\"false\"");
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, FN_GetDirectionalDerivative)) return fmi2Error;
+    const char* function = "fmi2GetDirectionalDerivative";
+    if (nUnknown > 0 && (!not_null(instance, function, vUnknown_ref, "vUnknown_ref") ||
+                         !not_null(instance, function, dvUnknown, "dvUnknown")))
+        return fmi2Error;
+    if (nKnown > 0 && (!not_null(instance, function, vKnown_ref, "vKnown_ref") ||
+                       !not_null(instance, function, dvKnown, "dvKnown")))
+        return fmi2Error;
+    for (size_t i = 0; i < nUnknown; ++i) {
+        GimbalVariableInfo info;
+        if (!gimbal_variable_info(GIMBAL_REAL, vUnknown_ref[i], &info)) {
+            log_message(instance, fmi2Error, "logStatusError", "%s: unknown %zu: value reference %u is not a Real variable",
+                        function, i, (unsigned)vUnknown_ref[i]);
+            return fmi2Error;
+        }
+        if (info.causality != GIMBAL_OUTPUT) {
+            log_message(instance, fmi2Error, "logStatusError",
+                        "%s: unknown %s is not an output: in Co-Simulation the unknowns are the outputs", function,
+                        info.name);
+            return fmi2Error;
+        }
+    }
+    for (size_t j = 0; j < nKnown; ++j) {
+        GimbalVariableInfo info;
+        if (!gimbal_variable_info(GIMBAL_REAL, vKnown_ref[j], &info)) {
+            log_message(instance, fmi2Error, "logStatusError", "%s: known %zu: value reference %u is not a Real variable",
+                        function, j, (unsigned)vKnown_ref[j]);
+            return fmi2Error;
+        }
+        if (info.causality != GIMBAL_INPUT) {
+            log_message(instance, fmi2Error, "logStatusError",
+                        "%s: known %s is not an input: in Co-Simulation the knowns are the inputs", function, info.name);
+            return fmi2Error;
+        }
+        if (!isfinite(dvKnown[j])) {
+            log_message(instance, fmi2Error, "logStatusError", "%s: the seed of %s must be finite", function, info.name);
+            return fmi2Error;
+        }
+    }
+    for (size_t i = 0; i < nUnknown; ++i) dvUnknown[i] = 0.0;
+    return fmi2OK;
 }
 static fmi2Status impl_SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {

@@ -115,11 +115,6 @@ def test_unsupported_functions_name_the_declaration_that_says_so(gimbal_fmu):
         with pytest.raises(FMICallException):
             slave.fmi2GetRealOutputDerivatives(slave.component, vr, 1, order, value)
         assert 'maxOutputDerivativeOrder="0"' in log[-1][2]
-        known = (ctypes.c_uint * 1)(gimbal_fmu.vr("u_R1"))
-        seed = (ctypes.c_double * 1)(1.0)
-        with pytest.raises(FMICallException):
-            slave.fmi2GetDirectionalDerivative(slave.component, vr, 1, known, 1, seed, value)
-        assert 'providesDirectionalDerivative="false"' in log[-1][2]
     finally:
         slave.freeInstance()
 
