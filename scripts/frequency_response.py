@@ -9,6 +9,10 @@ the results: docs/frequency_response.md).
 Both for the scene's model ("full model") and with backlash and dry friction switched off
 (gear*.model = 1, dry_friction = false).
 
+Open loop, the linear model (scene_lib.linearization: A, B, C, D from the core at the operating point,
+without backlash and dry friction) is drawn over the simulated curves as thin lines, and its values at
+the simulated frequencies are rows of curve "linear model" in the CSV (--no-linear: not).
+
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
 
@@ -23,12 +27,11 @@ import sys
 import time
 import warnings
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "scripts"))
+from scene_lib import load_scene
+from scene_lib.errors import SceneError
+from scene_lib import frequency_response as fr
 
-from scene_lib import load_scene  # noqa: E402
-from scene_lib.errors import SceneError  # noqa: E402
-from scene_lib import frequency_response as fr  # noqa: E402
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 
 def with_overrides(scene, assignments: list[str]):
@@ -74,6 +77,8 @@ def main(argv=None) -> int:
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override an FMU parameter or fidelity switch of the scene, e.g. --set body2.d_bd[3]=0 "
                              "(repeatable; numbers, true/false)")
+    parser.add_argument("--no-linear", action="store_true",
+                        help="open-loop: do not add the linear model's curve (it needs build/libgimbal_probe.so)")
     parser.add_argument("--serial", action="store_true", help="run the frequencies one after the other here")
     parser.add_argument("--workers", type=int, default=4, help="local Dask workers (default 4)")
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
@@ -105,6 +110,14 @@ def main(argv=None) -> int:
             variants.append(("full model", None))
         if not args.full_only:
             variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
+        lines, linear = None, None
+        if excitation.kind == "voltage" and not args.no_linear:
+            from scene_lib import linearization
+            from scene_lib.fmu import FMU
+
+            with FMU(args.fmu) as fmu:
+                linear = linearization.linearize(fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY))
+            lines = fr.linear_lines(linear, excitation.input_signal, outputs, args.fmin, args.fmax)
         client = cluster = None
         if not args.serial:
             from sweep_lib import make_client
@@ -122,6 +135,8 @@ def main(argv=None) -> int:
     except SceneError as exc:
         print(f"frequency_response: {exc}", file=sys.stderr)
         return 1
+    if linear is not None:
+        rows += fr.linear_rows(linear, rows)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
@@ -130,7 +145,7 @@ def main(argv=None) -> int:
     unit = "V" if excitation.kind == "voltage" else "rad/s"
     title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude {excitation.amplitude:g} {unit}"
              + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
-    fr.plot_bode(rows, png_path, title)
+    fr.plot_bode(rows, png_path, title, lines)
     print(f"{len(rows)} points in {time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
     return 0
 

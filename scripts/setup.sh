@@ -46,11 +46,11 @@ fi
 if [ "$setup_for" = test ]; then
   requirements="$repo/requirements.txt"
   marker="$venv/.requirements-installed"
-  modules="fmpy, numpy, scipy, sympy, matplotlib, pytest, libcosimpy, ecospy, dask.distributed, pyarrow, tqdm, nbclient, ipykernel"
+  modules="fmpy, numpy, scipy, sympy, matplotlib, pytest, libcosimpy, ecospy, dask.distributed, pyarrow, tqdm, control, nbclient, ipykernel"
 else
   requirements="$repo/requirements-run.txt"
   marker="$venv/.requirements-run-installed"
-  modules="fmpy, numpy, scipy, matplotlib, dask.distributed, pyarrow, tqdm"
+  modules="fmpy, numpy, scipy, matplotlib, dask.distributed, pyarrow, tqdm, control"
 fi
 if ! "$venv/bin/python" -c "import $modules" >/dev/null 2>&1 || [ "$requirements" -nt "$marker" ] ||
    [ "$repo/requirements-run.txt" -nt "$marker" ]; then
@@ -83,6 +83,7 @@ cmake -S "$repo" -B "$build_dir" -G Ninja -DPython3_EXECUTABLE="$venv/bin/python
 if [ "$setup_for" = test ]; then
   cmake --build "$build_dir"
 else
-  cmake --build "$build_dir" --target fmu   # the FMU alone: no tests, no fuzzer, no benchmarks
+  # the FMU, and the analysis library scripts/linearize.py loads; no tests, no fuzzer, no benchmarks
+  cmake --build "$build_dir" --target fmu gimbal_probe
 fi
 echo "[setup] FMU ready: $build_dir/Gimbal2Axis.fmu"

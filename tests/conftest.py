@@ -27,7 +27,7 @@ def fmu_path(build_dir) -> pathlib.Path:
 def probe_lib_path(build_dir) -> pathlib.Path:
     path = build_dir / "libgimbal_probe.so"
     if not path.is_file():
-        pytest.fail(f"{path} is missing: the build did not produce the test probe library")
+        pytest.fail(f"{path} is missing: the build did not produce the probe library")
     return path
 
 

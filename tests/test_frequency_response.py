@@ -194,3 +194,63 @@ def test_command_writes_a_csv_row_per_point_and_a_bode_plot(fmu_path, tmp_path):
     assert {r["curve"] for r in rows} == {"full model", "no backlash, no dry friction"}
     assert all(r["input"] == "base.psi_dot" for r in rows)
     assert (tmp_path / "frequency_response_isolation_yaw.png").stat().st_size > 10000
+
+
+LINEAR_SCENE = """
+name = "frequency_response_linear"
+stop_time = 1.0
+step_size = 1e-3
+
+[fidelity]
+"gear1.model" = 1
+"gear2.model" = 1
+dry_friction = false
+"base.fixed" = true
+
+[parameters]
+"solver.rtol" = 1e-9
+"solver.atol" = 1e-11
+"body2.d_bd[2]" = 0.0
+"body2.d_bd[3]" = 0.0
+
+[base_motion]
+type = "fixed"
+
+[controller]
+type = "none"
+"""
+
+
+@pytest.mark.parametrize("axis", ["1", "2"])
+def test_simulated_response_matches_the_linear_model_from_0p1_to_100_hz(gimbal_fmu, tmp_path, axis):
+    """Compliant gears without backlash, no dry friction, inductive motors (both gear resonances, 84 and
+    122 Hz, and the current poles, 150-260 Hz, inside or near the band), a small voltage (0.5 V): the sine
+    dwell of the nonlinear FMU against the linear model's G(j w) = C (j w I - A)^-1 B + D from the core
+    (scene_lib.linearization), 1 % in gain and 1 deg in phase, 0.1-100 Hz, u_R<axis> -> the axis rate and
+    the line-of-sight rate it moves. (Measured: within 5e-5 and 0.003 deg; against the sampled-data form of
+    the same model, held_frequency_response, within 1e-7: what is left is the hold's aliasing.)"""
+    from scene_lib import linearization
+    from scene_lib.frequency_response import LINEAR_FIDELITY, linear_point, linear_rows
+
+    path = tmp_path / "fr_linear.toml"
+    path.write_text(LINEAR_SCENE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = load_scene(path)
+    excitation = Excitation("voltage", axis, 0.5)
+    model = linearization.linearize(linear_point(scene, gimbal_fmu, excitation, LINEAR_FIDELITY))
+    assert model.modes["gear1.contact"] == 0 and model.modes["rotor1.friction"] == "none"
+    outputs = ["alpha_dot", "los.omega[3]"] if axis == "1" else ["beta_dot", "los.omega[1]"]
+    rows = []
+    for f in (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0):
+        rows += measure_point(scene, gimbal_fmu, f, excitation, Dwell(settle_periods=3, settle_s=1.5, measure_periods=2),
+                              outputs=outputs)
+    predicted = {(r["output"], r["frequency_hz"]): r for r in linear_rows(model, rows)}
+    assert len(predicted) == len(rows)
+    for row in rows:
+        linear = predicted[(row["output"], row["frequency_hz"])]
+        where = f"{row['output']} at {row['frequency_hz']:.3g} Hz"
+        assert row["gain"] == pytest.approx(linear["gain"], rel=0.01), where
+        assert abs((row["phase_deg"] - linear["phase_deg"] + 180) % 360 - 180) < 1.0, where
+        held = model.held_frequency_response([row["frequency_hz"]], row["input"], row["output"], scene.step_size)[0]
+        assert abs(row["gain"] * cmath.exp(1j * math.radians(row["phase_deg"])) - held) < 1e-5 * abs(held), where

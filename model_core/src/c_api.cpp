@@ -4,10 +4,12 @@
 #include "gimbal/gimbal_c_api.h"
 
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <new>
 
 #include "gimbal/gimbal_instance.hpp"
+#include "gimbal/linearization.hpp"
 
 struct GimbalCore {
     GimbalCore(GimbalLogFunction log_function, void* context, gimbal::GimbalInstance::Logger logger,
@@ -157,6 +159,35 @@ GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, 
 
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer) {
     return guarded(core, "fmi2SetFMUstate", [&] { return core->instance.restore(buffer); });
+}
+
+GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
+    return guarded(core, "gimbal_core_linearize", [&] {
+        if (model == nullptr) return GIMBAL_ERROR;
+        static_assert(GIMBAL_LINEAR_MAX_STATES == gimbal::kStateSize && GIMBAL_LINEAR_INPUTS == gimbal::kLinearInputCount &&
+                          GIMBAL_LINEAR_OUTPUTS == gimbal::kLinearOutputCount,
+                      "the C view of the linear model has the core's sizes");
+        gimbal::LinearModel linear;
+        const GimbalStatus status = core->instance.linearize(linear);
+        if (status != GIMBAL_OK) return status;
+        *model = GimbalLinearModel{};
+        model->state_count = linear.state_count;
+        for (int k = 0; k < GIMBAL_LINEAR_MAX_STATES; ++k) model->state_vr[k] = linear.state_variable[k];
+        for (int k = 0; k < GIMBAL_LINEAR_INPUTS; ++k) model->input_vr[k] = gimbal::kLinearFirstInput + k;
+        for (int k = 0; k < GIMBAL_LINEAR_OUTPUTS; ++k) model->output_vr[k] = gimbal::kLinearFirstOutput + k;
+        std::memcpy(model->A, linear.A, sizeof model->A);
+        std::memcpy(model->B, linear.B, sizeof model->B);
+        std::memcpy(model->C, linear.C, sizeof model->C);
+        std::memcpy(model->D, linear.D, sizeof model->D);
+        for (int axis = 0; axis < 2; ++axis) {
+            model->gear_contact[axis] = linear.modes.gear_contact[axis];
+            model->motor_limited[axis] = linear.modes.motor_limited[axis];
+            model->voltage_clamped[axis] = linear.modes.voltage_clamped[axis];
+        }
+        for (int body = 0; body < 4; ++body) model->friction[body] = static_cast<int>(linear.modes.friction[body]);
+        model->time = core->instance.time();
+        return GIMBAL_OK;
+    });
 }
 
 }  // extern "C"

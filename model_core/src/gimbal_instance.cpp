@@ -809,4 +809,20 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
     return GIMBAL_OK;
 }
 
+GimbalStatus GimbalInstance::linearize(LinearModel& model) {
+    if (!system_) return refuse(GIMBAL_ERROR, "linearize: the instance is not initialized (no operating point yet)");
+    const double now = model_time(time_);
+    StepInputs inputs = read_step_inputs(now);
+    inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;
+    // The modes the next step would start in: inputs set since the last step may have switched some.
+    GimbalHybridSystem selector(params_);
+    selector.set_inputs(inputs);
+    selector.restore(system_->modes(), system_->counters());
+    double state[kMaxStateSize];
+    std::copy(state_, state_ + kMaxStateSize, state);
+    selector.update_modes(now, state, nullptr);
+    gimbal::linearize(params_, inputs, selector.modes(), now, state, model);
+    return GIMBAL_OK;
+}
+
 }  // namespace gimbal

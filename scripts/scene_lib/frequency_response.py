@@ -169,6 +169,49 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
     return rows
 
 
+# -- the linear model's prediction ------------------------------------------------------------------
+
+LINEAR_CURVE = "linear model"
+
+
+def linear_point(scene, fmu, excitation: Excitation, fidelity: dict | None = None) -> dict:
+    """The operating point of an open-loop dwell as linearize() takes it: the scene's fidelity (with
+    `fidelity` over it), parameters and initial state, the base fixed, the voltage at its offset."""
+    from .scene import start_values
+
+    if excitation.kind != "voltage":
+        raise ValueError("the linear model's prediction is drawn for the open-loop (voltage) excitation only")
+    values = start_values(scene, fmu, np.zeros(15))
+    values.update(fidelity or {})
+    values["base.fixed"] = True
+    values[excitation.input_signal] = excitation.offset
+    return values
+
+
+def linear_rows(model, rows: list[dict]) -> list[dict]:
+    """The linear model's G(j w) = C (j w I - A)^-1 B + D at the frequencies and for the outputs of the
+    simulated `rows` (one row each, curve LINEAR_CURVE; coherence 1 by definition)."""
+    out, seen = [], set()
+    for row in rows:
+        key = (row["output"], row["frequency_hz"])
+        if key in seen or row["output"] not in model.outputs:
+            continue
+        seen.add(key)
+        G = complex(model.frequency_response([row["frequency_hz"]], row["input"], row["output"])[0])
+        out.append(dict(curve=LINEAR_CURVE, input=row["input"], output=row["output"], requested_hz=row["requested_hz"],
+                        frequency_hz=row["frequency_hz"], gain=abs(G),
+                        gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                        phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=1.0))
+    return out
+
+
+def linear_lines(model, input_signal: str, outputs: list[str], f_min: float, f_max: float, points: int = 400) -> list:
+    """Dense Bode lines of the linear model for plot_bode: [(label, frequencies, complex G), ...]."""
+    f = np.logspace(math.log10(f_min), math.log10(f_max), points)
+    return [(f"{LINEAR_CURVE}: {name}", f, model.frequency_response(f, input_signal, name)) for name in outputs
+            if name in model.outputs]
+
+
 # -- many frequencies: serially or on Dask -----------------------------------------------------------
 
 def _point_task(fmu_bytes: bytes, digest: str, scene, frequency, excitation, dwell, outputs, fidelity):
@@ -234,22 +277,34 @@ def curves(rows: list[dict]) -> dict:
 GAIN_RANGE_DB = 120.0   # the gain axis spans at most this far below the largest gain; lower points sit on its floor
 
 
-def plot_bode(rows: list[dict], path, title: str = "") -> None:
+def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None) -> None:
     """Gain (dB), phase (deg, unwrapped along each curve) and coherence against frequency, every point
     marked, each curve with its own marker and line style (coinciding curves stay visible). The phase and
     coherence axes are autoscaled to every value. The gain axis spans at most GAIN_RANGE_DB below the
     largest gain: a lower gain (a load that does not move at all gives -200 dB or less) or a gain of exactly 0
-    is drawn on the floor as a downward triangle and counted in the legend; its value is in the CSV."""
+    is drawn on the floor as a downward triangle and counted in the legend; its value is in the CSV.
+    `lines` (linear_lines) are drawn as thin continuous lines under the points; the linear model's rows
+    among `rows` are then not drawn again as points."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (ax_g, ax_p, ax_c) = plt.subplots(3, 1, figsize=(9, 10), sharex=True)
+    if lines:
+        rows = [r for r in rows if r.get("curve") != LINEAR_CURVE]
     groups = curves(rows)
     finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
+    for _, _, G in lines or []:
+        finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
     top = max(finite_gains) if finite_gains else 0.0
     floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
+    for index, (label, f, G) in enumerate(lines or []):
+        gain = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
+        shown = gain >= floor
+        ax_g.semilogx(f[shown], gain[shown], ["-", "--"][index % 2], color="k", lw=0.9,
+                      label=label + ("" if shown.all() else f" ({(~shown).sum()} points below {floor:.0f} dB not drawn)"))
+        ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(G))), ["-", "--"][index % 2], color="k", lw=0.9)
     markers, styles = "osD^vP*X", ["-", "--", ":", "-."]
     for index, ((curve, output), cr) in enumerate(groups.items()):
         marker, style = markers[index % len(markers)], styles[index % len(styles)]

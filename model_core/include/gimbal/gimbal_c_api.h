@@ -67,6 +67,35 @@ GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, 
 /* Checks the snapshot as above; a refused one leaves the instance as it was. */
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
 
+/* The continuous model linearized at the instance's current time and state, with its inputs as last
+ * set, within the modes in force there (docs/linearization.md). Not exported by the FMU (it exports
+ * only fmi2*): libgimbal_probe.so offers it to analysis tools. Matrices are row-major with the maximal
+ * sizes as leading dimensions; only state_count rows / columns of the state dimension are used. */
+#define GIMBAL_LINEAR_MAX_STATES 12
+#define GIMBAL_LINEAR_INPUTS 17
+#define GIMBAL_LINEAR_OUTPUTS 17
+typedef struct GimbalLinearModel {
+    int state_count;
+    unsigned state_vr[GIMBAL_LINEAR_MAX_STATES]; /* the Real output that carries each state */
+    unsigned input_vr[GIMBAL_LINEAR_INPUTS];
+    unsigned output_vr[GIMBAL_LINEAR_OUTPUTS];
+    double A[GIMBAL_LINEAR_MAX_STATES][GIMBAL_LINEAR_MAX_STATES];
+    double B[GIMBAL_LINEAR_MAX_STATES][GIMBAL_LINEAR_INPUTS];
+    double C[GIMBAL_LINEAR_OUTPUTS][GIMBAL_LINEAR_MAX_STATES];
+    double D[GIMBAL_LINEAR_OUTPUTS][GIMBAL_LINEAR_INPUTS];
+    /* The modes the model holds in: gear contact -1/0/+1, current limiter -1/0/+1, voltage clamp
+     * -1/0/+1, friction per body q-order: 0 none, 1 slipping +, 2 slipping -, 3 stuck (held),
+     * 4 at the break-away torque +, 5 at the break-away torque -. */
+    int gear_contact[2];
+    int motor_limited[2];
+    int voltage_clamped[2];
+    int friction[4];
+    double time;
+} GimbalLinearModel;
+
+/* Refused (GIMBAL_ERROR) before initialization. */
+GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model);
+
 #ifdef __cplusplus
 }
 #endif

@@ -11,6 +11,7 @@
 #include "gimbal/gimbal_c_api.h"
 #include "gimbal/gimbal_hybrid_system.hpp"
 #include "gimbal/integrator.hpp"
+#include "gimbal/linearization.hpp"
 #include "gimbal/variables.hpp"
 
 namespace gimbal {
@@ -52,6 +53,8 @@ public:
     // (about 25 ms of CPU at the measured 230 ns per evaluation: 5,000 times the default scene's).
     static constexpr long kStepWorkBudget = 100000;
     double time() const { return time_; }
+    // The continuous model linearized at the current time and state, with the inputs as last set.
+    GimbalStatus linearize(LinearModel& model);
 
 private:
     StepInputs read_step_inputs(double step_start) const;

@@ -1,8 +1,15 @@
-/* Test hook into the dynamics core, built as libgimbal_probe.so (never part of the FMU).
- * It lets the Python tests evaluate J(q) and f(q, qd, base motion) of MODEL.md section 2
- * directly, so they can be compared with an independent symbolic derivation. */
+/* Analysis entries into the dynamics core, built as libgimbal_probe.so beside the FMU (never part of
+ * it: the FMU exports only fmi2*).
+ * - The linearization of the continuous model (docs/linearization.md), which scripts/linearize.py
+ *   and scene_lib.linearization use.
+ * - J(q) and f(q, qd, base motion) of the rigid-body equations, which the tests compare with an
+ *   independent symbolic derivation. */
 #ifndef GIMBAL_PROBE_API_H
 #define GIMBAL_PROBE_API_H
+
+#include <stddef.h>
+
+#include "gimbal/gimbal_c_api.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,6 +34,26 @@ typedef struct GimbalProbeRigidBodyInput {
 
 /* Writes J (row-major 4x4) and f (4) such that J qdd = Xi + f. Returns 0 on success. */
 int gimbal_probe_mass_matrix_and_bias(const GimbalProbeRigidBodyInput* input, double J_row_major[16], double f[4]);
+
+/* The FMU's variables, by type (GimbalType) and value reference: 1 and the name, or 0 past the last. */
+int gimbal_probe_variable(int type, unsigned vr, const char** name, int* causality);
+
+/* Size of the core's part of a serialized FMU state (fmi2SerializeFMUstate gives a 128-byte header,
+ * then these bytes). */
+size_t gimbal_probe_snapshot_size(void);
+
+typedef struct GimbalProbeSetting {
+    int type; /* GimbalType */
+    unsigned vr;
+    double value; /* an Integer or Boolean value is converted exactly */
+} GimbalProbeSetting;
+
+/* Linearizes at an operating point. Without a snapshot: a fresh instance gets the settings
+ * (parameters, start values of the states, inputs) and is initialized at time 0. With one: the
+ * instance is restored from it (parameters, state, modes and inputs of a running simulation) and
+ * then gets the settings, which may only be inputs. Returns 0, or 1 with the reason in message. */
+int gimbal_probe_linearize(const GimbalProbeSetting* settings, size_t setting_count, const void* snapshot,
+                           size_t snapshot_size, GimbalLinearModel* model, char* message, size_t message_size);
 
 #ifdef __cplusplus
 }
