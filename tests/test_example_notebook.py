@@ -25,3 +25,5 @@ def test_the_example_notebook_runs(tmp_path, build_dir, monkeypatch):
                       for output in cell.outputs)
     assert "LOS error RMS" in printed and "saved notebook_los_error.png" in printed
     assert (tmp_path / "notebook_los_error.png").stat().st_size > 10_000
+    assert "DC gain u_R1 -> alpha_dot" in printed and "linear vs simulated gain" in printed
+    assert (tmp_path / "notebook_bode.png").stat().st_size > 10_000

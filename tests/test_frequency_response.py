@@ -254,3 +254,27 @@ def test_simulated_response_matches_the_linear_model_from_0p1_to_100_hz(gimbal_f
         assert abs((row["phase_deg"] - linear["phase_deg"] + 180) % 360 - 180) < 1.0, where
         held = model.held_frequency_response([row["frequency_hz"]], row["input"], row["output"], scene.step_size)[0]
         assert abs(row["gain"] * cmath.exp(1j * math.radians(row["phase_deg"])) - held) < 1e-5 * abs(held), where
+
+
+def test_open_loop_command_adds_the_linear_models_curve(fmu_path, build_dir, tmp_path):
+    import csv
+    import os
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), "open-loop", "--axis", "2",
+                          "--fmin", "5", "--fmax", "10", "--points", "2", "--settle-periods", "2", "--settle-s", "0.1",
+                          "--measure-periods", "2", "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path),
+                          "--set", "body2.d_bd[2]=0", "--set", "body2.d_bd[3]=0"],
+                         capture_output=True, text=True, timeout=300, env={**os.environ, "GIMBAL_BUILD_DIR": str(build_dir)})
+    assert out.returncode == 0, out.stderr
+    rows = list(csv.DictReader(open(tmp_path / "frequency_response_open_loop_2.csv")))
+    # (2 variants + the linear model) x 2 frequencies x (beta_dot, los.omega[1])
+    assert len(rows) == 12
+    assert {r["curve"] for r in rows} == {"full model", "no backlash, no dry friction", "linear model"}
+    linear = {(r["output"], r["frequency_hz"]): float(r["gain"]) for r in rows if r["curve"] == "linear model"}
+    simulated = {(r["output"], r["frequency_hz"]): float(r["gain"]) for r in rows
+                 if r["curve"] == "no backlash, no dry friction"}
+    assert linear.keys() == simulated.keys()
+    for key, gain in simulated.items():
+        assert gain == pytest.approx(linear[key], rel=0.01), key

@@ -254,7 +254,10 @@ class LinearModel:
                        point=dict(zip(data["point_names"].tolist(), data["point_values"].tolist())))
 
     def summary(self) -> str:
-        poles = sorted(self.poles(), key=lambda p: (abs(p), p.imag))
+        poles = self.poles()
+        # eigenvalues at round-off level of the largest are zeros (free angles: integrators)
+        floor = 1e-9 * max(float(np.max(np.abs(poles))), 1.0) if len(poles) else 0.0
+        poles = sorted((0j if abs(p) < floor else p for p in poles), key=lambda p: (abs(p), p.imag))
         lines = [f"linear model at t = {self.time:g} s: {len(self.states)} states, {len(self.inputs)} inputs, "
                  f"{len(self.outputs)} outputs",
                  "states: " + ", ".join(self.states),
