@@ -19,8 +19,7 @@ stop_time = 1.0
 step_size = 1e-3
 
 [fidelity]
-"gear1.model" = {gear1}
-"motor1.model" = 0
+{models}
 dry_friction = false
 "base.fixed" = true
 
@@ -42,7 +41,7 @@ type = "none"
 def scene_file(tmp_path, gear1: int):
     """The test scene (no controller: its SceneWarning is expected and silenced)."""
     path = tmp_path / f"fr_gear{gear1}.toml"
-    path.write_text(SCENE.format(gear1=gear1))
+    path.write_text(SCENE.format(models=f'"gear1.model" = {gear1}\n"motor1.model" = 0'))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return load_scene(path)
@@ -196,31 +195,6 @@ def test_command_writes_a_csv_row_per_point_and_a_bode_plot(fmu_path, tmp_path):
     assert (tmp_path / "frequency_response_isolation_yaw.png").stat().st_size > 10000
 
 
-LINEAR_SCENE = """
-name = "frequency_response_linear"
-stop_time = 1.0
-step_size = 1e-3
-
-[fidelity]
-"gear1.model" = 1
-"gear2.model" = 1
-dry_friction = false
-"base.fixed" = true
-
-[parameters]
-"solver.rtol" = 1e-9
-"solver.atol" = 1e-11
-"body2.d_bd[2]" = 0.0
-"body2.d_bd[3]" = 0.0
-
-[base_motion]
-type = "fixed"
-
-[controller]
-type = "none"
-"""
-
-
 @pytest.mark.parametrize("axis", ["1", "2"])
 def test_simulated_response_matches_the_linear_model_from_0p1_to_100_hz(gimbal_fmu, tmp_path, axis):
     """Compliant gears without backlash, no dry friction, inductive motors (both gear resonances, 84 and
@@ -233,7 +207,7 @@ def test_simulated_response_matches_the_linear_model_from_0p1_to_100_hz(gimbal_f
     from scene_lib.frequency_response import LINEAR_FIDELITY, linear_point, linear_rows
 
     path = tmp_path / "fr_linear.toml"
-    path.write_text(LINEAR_SCENE)
+    path.write_text(SCENE.format(models='"gear1.model" = 1\n"gear2.model" = 1'))   # inductive motors
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         scene = load_scene(path)
