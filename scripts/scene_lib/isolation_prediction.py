@@ -1,0 +1,268 @@
+"""The linear prediction of a PID scene's isolation (stabilization) ratio: the line of sight's inertial
+rate per carrier rate, against frequency, for a sinusoidal roll, pitch or yaw of the carrier. It is
+what the sine dwell of frequency_response.py measures with Excitation("base", axis, ...) when the
+motion is small enough for the loop to stay linear (no backlash, no dry friction, no saturation).
+
+Method: the steady-state response of the *sampled-data* closed loop at z = exp(j w h), evaluated per
+frequency. It is not the continuous plant G(j w) with hold corrections: the plant is discretized
+exactly over one communication step with the inputs the FMU really sees inside a step, so the
+prediction holds for the samples at t_k the dwell analyses, up to the linearization itself. (A
+continuous-time approximation, aliasing neglected, would be off near the Nyquist frequency by the
+hold's aliases; this form has no such neglect.)
+
+  - Plant: linearization.linearize at the scene's operating point, all 17 inputs: where its loop holds
+    the gimbal on a level carrier at rest (operating_point: the start_on_target angles, and the steady
+    voltages, currents and gear deflections of the gravity torque, from a short run), with the
+    fidelity override.
+  - Inside a step [t_k, t_k+1] the FMU holds the voltages and extrapolates the carrier from its values
+    at t_k with constant acceleration: angle q_k + qd_k s + qdd_k s^2/2, rate qd_k + qdd_k s,
+    acceleration qdd_k. So x_k+1 = Phi x_k + M0 B u0 + M1 B u1 + M2 B u2, M_n = int_0^h exp(A (h - s))
+    s^n / n! ds (one matrix exponential of a block matrix). The outputs published at t_k are those at
+    the end of the previous step, computed with that step's extrapolated inputs (the D term).
+  - Carrier angle phasor G on one axis: samples q_k = G z^k, qd_k = j w G z^k, qdd_k = -w^2 G z^k
+    (the base motion's exact values at the step starts).
+  - Controller: AxisPID's exact transfer functions at z: kp + ki h / (1 - 1/z) (rectangular integral)
+    + kd a (1 - 1/z) / h / (1 - (1 - a)/z), a = h / (tau + h) (filtered backward difference); the gyro
+    term -k_gyro w with gyro_axis_rates linearized at the operating beta (w_az = w3 / cos(beta0): its
+    derivative in beta multiplies w3 = 0 at rest); feed-forward k_ff on the set point's rate. Set
+    points from the target ("target"): the Jacobian of geometry.gimbal_angles_for in the carrier
+    angles (central differences) times the angle phasor, their rates the same Jacobian times the rate
+    phasor (setpoints.py differentiates along the measured rates). Other references do not depend on
+    the carrier and contribute nothing at its frequency. Saturation and anti-windup are not modelled.
+  - Voltages: u computed at t_k is applied over [t_k+d, t_k+d+1] (d = delay_steps): a factor z^-d.
+  - Ideal sensors (no quantization, no noise).
+
+Gains are referred to the carrier RATE sample phasor (j w G), as measure_point does (output
+fundamental / fundamental of the sampled base.<axis>_dot); "los" is sqrt(|G1|^2 + |G3|^2), no phase.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .errors import SceneError
+from .frequency_response import BASE_AXES, LINEAR_CURVE, LOS_OUTPUTS
+
+CARRIER_ANGLE_INDEX = {"pitch": 0, "yaw": 1, "roll": 2}   # delta, psi, gamma
+LOOP_OUTPUTS = ["alpha", "beta", "los.omega[1]", "los.omega[3]"]
+VOLTAGES = ["u_R1", "u_R2"]
+JACOBIAN_STEP_RAD = 1e-6
+SETTLE_S = 5.0   # s at rest before linearizing: the loop's integrators have taken up the gravity torque
+
+
+@dataclasses.dataclass(frozen=True)
+class AxisGains:
+    """The linear part of one AxisPID."""
+    kp: float
+    ki: float
+    kd: float
+    k_gyro: float
+    k_ff: float
+    tau: float
+
+    def error_transfer(self, z: complex, h: float) -> complex:
+        """u / e at z: proportional, rectangular integral, filtered backward difference."""
+        a = h / (self.tau + h)
+        integral = h / (1.0 - 1.0 / z)
+        derivative = a * (1.0 - 1.0 / z) / h / (1.0 - (1.0 - a) / z)
+        return self.kp + self.ki * integral + self.kd * derivative
+
+
+@dataclasses.dataclass(frozen=True)
+class SampledPlant:
+    """The plant over one step: x_k+1 = Phi x_k + sum_n M[n] B u_n (input polynomial coefficients)."""
+    Phi: np.ndarray
+    MB: tuple          # (M0 B, M1 B, M2 B)
+    C: np.ndarray      # rows LOOP_OUTPUTS
+    D: np.ndarray
+    inputs: list
+
+
+@dataclasses.dataclass(frozen=True)
+class IsolationLoop:
+    """Everything the prediction needs, fixed before the frequencies."""
+    plant: SampledPlant
+    axes: tuple                  # (AxisGains azimuth, AxisGains elevation)
+    reference_jacobian: np.ndarray   # 2 x 3: d(alpha_ref, beta_ref) / d(delta, psi, gamma)
+    cos_beta: float
+    h: float
+    delay: int
+
+
+def pid_gains(scene, fmu) -> tuple:
+    """The two AxisPID's gains of the scene's controller; a SceneError for any other controller."""
+    from .controllers import PID
+    from .scene import parameter_value
+
+    u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+    controller = scene.controller(u_limit)
+    if not isinstance(controller, PID):
+        raise SceneError(f"{scene.name}: the isolation prediction models the PID controller only; this scene's "
+                         f"controller is '{controller.kind}'")
+    axes = tuple(AxisGains(a.kp, a.ki, a.kd, a.k_gyro, a.k_ff, a.tau) for a in controller.axes)
+    return axes, controller.refs
+
+
+def reference_jacobian(target, references, alpha0: float) -> np.ndarray:
+    """d(alpha_ref, beta_ref) / d(delta, psi, gamma) at a level carrier; a zero row for an axis whose
+    reference does not come from the target."""
+    from .geometry import gimbal_angles_for
+
+    jacobian = np.zeros((2, 3))
+    for j in range(3):
+        step = np.zeros(3)
+        step[j] = JACOBIAN_STEP_RAD
+        ahead = np.array(gimbal_angles_for(target, *step, alpha_near=alpha0))
+        behind = np.array(gimbal_angles_for(target, *(-step), alpha_near=alpha0))
+        jacobian[:, j] = (ahead - behind) / (2 * JACOBIAN_STEP_RAD)
+    for axis, reference in enumerate(references):
+        if reference != "target":
+            jacobian[axis] = 0.0
+    return jacobian
+
+
+def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_S) -> dict:
+    """linearize()'s values: where the scene's own loop holds the gimbal on a level carrier at rest, with
+    `fidelity` over the scene's. Found by running the loop for `settle_s` from the scene's start values
+    (start_on_target angles): the steady state is not the start state, since the elevation holds its
+    gravity torque with a steady current and a deflected gear (about 1 V in the ship scene), and the
+    linearization at 0 V misses the coupling that torque adds (1 % in los.omega[3] under roll)."""
+    from .fmu import STATES
+    from .master import run
+    from .scene import start_values
+
+    merged = dict(scene.fidelity)
+    merged.update(fidelity or {})
+    at_rest = scene.with_changes(stop_time=settle_s, fidelity=merged, base_motion_spec={"type": "fixed"})
+    signals = run(at_rest, fmu).signals
+    values = start_values(at_rest, fmu, np.zeros(15))
+    values.update(merged)
+    values.update({name: float(signals[name][-1]) for name in STATES + VOLTAGES if name in signals})
+    return values
+
+
+def sample_plant(model, h: float) -> SampledPlant:
+    """Exact discretization over a step with inputs polynomial (degree 2) in the time s into the step."""
+    from scipy.linalg import expm
+
+    n = len(model.states)
+    block = np.zeros((4 * n, 4 * n))
+    block[:n, :n] = model.A
+    for level in range(3):   # x' = A x + w0, w0' = w1, w1' = w2: the top row gives M0, M1, M2
+        block[level * n:(level + 1) * n, (level + 1) * n:(level + 2) * n] = np.eye(n)
+    transition = expm(block * h)
+    Phi = transition[:n, :n]
+    MB = tuple(transition[:n, (level + 1) * n:(level + 2) * n] @ model.B for level in range(3))
+    rows = [model.outputs.index(name) for name in LOOP_OUTPUTS]
+    return SampledPlant(Phi, MB, model.C[rows], model.D[rows], list(model.inputs))
+
+
+def build_loop(scene, fmu, fidelity: dict | None) -> IsolationLoop:
+    from . import linearization
+
+    axes, references = pid_gains(scene, fmu)
+    values = operating_point(scene, fmu, fidelity)
+    if values.get("base.fixed"):
+        raise SceneError(f"{scene.name}: base.fixed = true: the carrier's motion does not reach the gimbal")
+    model = linearization.linearize(values)
+    alpha0, beta0 = float(values.get("alpha", 0.0)), float(values.get("beta", 0.0))
+    jacobian = reference_jacobian(scene.target, references, alpha0) if scene.target is not None else np.zeros((2, 3))
+    return IsolationLoop(plant=sample_plant(model, scene.step_size), axes=axes, reference_jacobian=jacobian,
+                         cos_beta=max(math.cos(beta0), 0.2), h=scene.step_size, delay=scene.delay_steps)
+
+
+def carrier_input_polynomial(inputs: list, axis: str, w: float, h: float):
+    """Per unit carrier angle phasor: the coefficients (u0, u1, u2) of the base inputs inside a step
+    (u(s) = u0 + u1 s + u2 s^2 / 2) and their values at the step's end."""
+    index = CARRIER_ANGLE_INDEX[axis]
+    names = ["base.delta", "base.psi", "base.gamma"]
+    angle = inputs.index(names[index])
+    rate = inputs.index(names[index] + "_dot")
+    accel = inputs.index(names[index] + "_ddot")
+    jw = 1j * w
+    u0, u1, u2 = (np.zeros(len(inputs), complex) for _ in range(3))
+    u0[[angle, rate, accel]] = 1.0, jw, jw ** 2
+    u1[[angle, rate]] = jw, jw ** 2
+    u2[angle] = jw ** 2
+    return (u0, u1, u2), u0 + u1 * h + u2 * h * h / 2
+
+
+def loop_response(loop: IsolationLoop, axis: str, frequency_hz: float) -> np.ndarray:
+    """Phasors of LOOP_OUTPUTS at t_k per unit phasor of the carrier angle."""
+    plant, h = loop.plant, loop.h
+    w = 2 * math.pi * frequency_hz
+    z = complex(math.cos(w * h), math.sin(w * h))
+    n = plant.Phi.shape[0]
+    resolvent = np.linalg.inv(z * np.eye(n) - plant.Phi)
+    voltage_columns = [plant.inputs.index(name) for name in VOLTAGES]
+    # voltage -> outputs: held over a step, applied `delay` steps late; D sees the previous step's input
+    held = z ** -loop.delay
+    voltage_path = (plant.C @ resolvent @ plant.MB[0][:, voltage_columns] + plant.D[:, voltage_columns] / z) * held
+    (u0, u1, u2), at_end = carrier_input_polynomial(plant.inputs, axis, w, h)
+    carrier_path = plant.C @ resolvent @ sum(MB @ u for MB, u in zip(plant.MB, (u0, u1, u2))) + plant.D @ at_end / z
+    feedback, feedforward = controller_matrices(loop, axis, z, w)
+    closed = np.eye(len(LOOP_OUTPUTS)) - voltage_path @ feedback
+    return np.linalg.solve(closed, voltage_path @ feedforward + carrier_path)
+
+
+def controller_matrices(loop: IsolationLoop, axis: str, z: complex, w: float):
+    """u = feedback @ y + feedforward * G: y the LOOP_OUTPUTS samples, G the carrier angle phasor."""
+    azimuth, elevation = loop.axes
+    c_az, c_el = azimuth.error_transfer(z, loop.h), elevation.error_transfer(z, loop.h)
+    # rows u_R1, u_R2; columns alpha, beta, los.omega[1], los.omega[3]; gyro_axis_rates: (w3 / cos beta, w1)
+    feedback = np.array([[-c_az, 0.0, 0.0, -azimuth.k_gyro / loop.cos_beta],
+                         [0.0, -c_el, -elevation.k_gyro, 0.0]], complex)
+    sensitivity = loop.reference_jacobian[:, CARRIER_ANGLE_INDEX[axis]]
+    feedforward = np.array([(c_az + azimuth.k_ff * 1j * w) * sensitivity[0],
+                            (c_el + elevation.k_ff * 1j * w) * sensitivity[1]])
+    return feedback, feedforward
+
+
+def isolation_gains(loop: IsolationLoop, axis: str, frequencies) -> dict:
+    """{output: complex gains per frequency} for los.omega[1], los.omega[3] (per carrier rate) and
+    'los' (the combined magnitude, real)."""
+    gains = {name: [] for name in LOS_OUTPUTS}
+    for f in np.atleast_1d(np.asarray(frequencies, float)):
+        response = loop_response(loop, axis, f) / (2j * math.pi * f)
+        for name in LOS_OUTPUTS:
+            gains[name].append(complex(response[LOOP_OUTPUTS.index(name)]))
+    gains = {name: np.array(values) for name, values in gains.items()}
+    gains["los"] = np.sqrt(sum(np.abs(gains[name]) ** 2 for name in LOS_OUTPUTS)).astype(complex)
+    return gains
+
+
+def _check_axis(axis: str) -> None:
+    if axis not in CARRIER_ANGLE_INDEX:
+        raise SceneError(f"carrier axis must be roll, pitch or yaw, got {axis!r}")
+
+
+def isolation_rows(scene, fmu, axis: str, frequencies, fidelity: dict | None = None) -> list[dict]:
+    """Rows in frequency_response's CSV format (curve LINEAR_CURVE, coherence 1): los.omega[1],
+    los.omega[3] and 'los' (phase NaN) at each frequency (frequency_hz = requested_hz = the given one:
+    pass the dwell's snapped frequencies to compare point by point)."""
+    _check_axis(axis)
+    gains = isolation_gains(build_loop(scene, fmu, fidelity), axis, frequencies)
+    rows = []
+    for index, f in enumerate(np.atleast_1d(np.asarray(frequencies, float))):
+        for name in LOS_OUTPUTS + ["los"]:
+            G = complex(gains[name][index])
+            rows.append(dict(curve=LINEAR_CURVE, input=BASE_AXES[axis], output=name, requested_hz=float(f),
+                             frequency_hz=float(f), gain=abs(G),
+                             gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                             phase_deg=math.nan if name == "los" else math.degrees(math.atan2(G.imag, G.real)),
+                             coherence=1.0))
+    return rows
+
+
+def isolation_lines(scene, fmu, axis: str, f_min: float, f_max: float, fidelity: dict | None = None,
+                    points: int = 400) -> list:
+    """Dense lines for plot_bode: [(label, frequencies, G), ...]. The 'los' line carries the real,
+    positive magnitude: its gain is right, and plot_bode draws its phase as a flat 0 deg line (the label
+    says it has no phase)."""
+    _check_axis(axis)
+    f = np.logspace(math.log10(f_min), math.log10(f_max), points)
+    gains = isolation_gains(build_loop(scene, fmu, fidelity), axis, f)
+    return [(f"{LINEAR_CURVE}: {name}" + (" (magnitude; no phase)" if name == "los" else ""), f, gains[name])
+            for name in LOS_OUTPUTS + ["los"]]

@@ -1,0 +1,130 @@
+"""The linear prediction of the closed loop's isolation ratio (scene_lib.isolation_prediction) against the
+sine dwell of the nonlinear FMU in the ship-stabilization scene's own PID loop (ideal sensors, 1 ms step,
+delay_steps = 1), without backlash and dry friction and at a small carrier rate (0.1 deg/s)."""
+import dataclasses
+import math
+import pathlib
+
+import numpy as np
+import pytest
+
+from scene_lib import load_scene
+from scene_lib.errors import SceneError
+from scene_lib.frequency_response import LINEAR_CURVE, LINEAR_FIDELITY, Dwell, Excitation, measure_point
+from scene_lib import isolation_prediction
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+FREQUENCIES_HZ = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0)
+RATE_AMPLITUDE = math.radians(0.1)     # rad/s: small enough to stay linear, large against the solver's tolerance
+DWELL = Dwell(settle_periods=3, settle_s=1.0, measure_periods=1)
+OUTPUTS = ("los.omega[1]", "los.omega[3]", "los")
+
+
+@pytest.fixture(scope="module")
+def scene():
+    scene = load_scene(REPO / "scenes" / "ship_stabilization.toml")
+    assert scene.sensors().ideal, "the prediction assumes ideal sensors"
+    return scene
+
+
+@pytest.fixture(scope="module")
+def loop(scene, gimbal_fmu):
+    return isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+
+
+@pytest.fixture(scope="module", params=["roll", "pitch"])
+def dwell_rows(request, scene, gimbal_fmu):
+    """(axis, simulated rows) of a sweep over FREQUENCIES_HZ."""
+    axis = request.param
+    rows = []
+    for f in FREQUENCIES_HZ:
+        rows += measure_point(scene, gimbal_fmu, f, Excitation("base", axis, RATE_AMPLITUDE), DWELL,
+                              fidelity=LINEAR_FIDELITY)
+    return axis, rows
+
+
+def relative_errors(loop, axis: str, rows: list[dict]) -> list[tuple]:
+    """(row, gain ratio - 1, phase difference in deg (NaN for 'los')) of each simulated row against `loop`."""
+    out = []
+    for row in rows:
+        predicted = isolation_prediction.isolation_gains(loop, axis, [row["frequency_hz"]])[row["output"]][0]
+        gain_error = row["gain"] / abs(predicted) - 1
+        phase_error = math.nan if row["output"] == "los" else \
+            (row["phase_deg"] - math.degrees(np.angle(predicted)) + 180) % 360 - 180
+        out.append((row, gain_error, phase_error))
+    return out
+
+
+def test_prediction_matches_the_simulated_isolation_from_0p1_to_100_hz(loop, dwell_rows):
+    """Roll and pitch of the carrier, 0.1-100 Hz: los.omega[1], los.omega[3] and the combined 'los' within
+    1 % in gain and 1 deg in phase (the issue's bar; no relaxation was needed).
+
+    Measured (roll): from 1 to 100 Hz within 3.3e-5 in gain and 0.006 deg, over the whole range of the
+    gain (-57 dB at 1 Hz to +3.6 dB at 100 Hz); 3.8e-4 and 0.012 deg at 0.3 Hz; at 0.1 Hz los.omega[1]
+    (-113 dB of the carrier rate) is off by 1.7e-3 and 0.12 deg: the FMU's integration error (the
+    scene's solver.rtol = 1e-6) on that tiny residual; it drops to 2e-4 and 0.015 deg at rtol = 1e-9.
+    los.omega[3] and 'los' within 1.6e-5 everywhere. Pitch: the same (1.7e-3 and 0.12 deg at 0.1 Hz,
+    3.2e-4 at 0.3 Hz, else within 1.9e-5 and 0.003 deg). The prediction is the exact sampled-data loop,
+    so there is no aliasing residual near Nyquist (100 Hz: 1.6e-6). Two things it had to get right to
+    get there: the operating point is the loop's steady state holding the elevation's gravity torque
+    (about 0.95 V), not 0 V (that left 1 % and 0.05 deg in los.omega[3] under roll); the outputs
+    published at t_k use the carrier inputs extrapolated to the end of the previous step (the exact
+    rate at t_k instead is off by 4 % at 30 Hz).
+
+    Yaw is not checked component by component: its elevation component los.omega[1] is a cross coupling
+    of -41 to -220 dB of the carrier rate, down to the level of the solver's error (8 deg off at a notch
+    near 3 Hz); its los.omega[3] and 'los' agree within 8e-4 and 0.03 deg."""
+    axis, rows = dwell_rows
+    assert {row["output"] for row in rows} == set(OUTPUTS)
+    for row, gain_error, phase_error in relative_errors(loop, axis, rows):
+        where = f"{axis}: {row['output']} at {row['frequency_hz']:.4g} Hz"
+        assert row["coherence"] > 0.99, where          # linear: the response is at the fundamental
+        assert abs(gain_error) < 0.01, where
+        if row["output"] != "los":
+            assert abs(phase_error) < 1.0, where
+
+
+@pytest.mark.parametrize("mistake", ["gyro sign", "one step more delay", "no feed-forward"])
+def test_a_wrong_loop_misses_the_simulation(loop, dwell_rows, mistake):
+    """The comparison can fail: the prediction with a flipped gyro term, an extra step of delay or the
+    feed-forward left out misses the simulated isolation by far more than the tolerance somewhere."""
+    axis, rows = dwell_rows
+    if mistake == "gyro sign":
+        axes = tuple(dataclasses.replace(a, k_gyro=-a.k_gyro) for a in loop.axes)
+        wrong = dataclasses.replace(loop, axes=axes)
+    elif mistake == "one step more delay":
+        wrong = dataclasses.replace(loop, delay=loop.delay + 1)
+    else:
+        wrong = dataclasses.replace(loop, axes=tuple(dataclasses.replace(a, k_ff=0.0) for a in loop.axes))
+    worst = max(max(abs(g), abs(p) / 100 if math.isfinite(p) else 0.0)
+                for _, g, p in relative_errors(wrong, axis, rows))
+    assert worst > 0.05
+
+
+def test_rows_and_lines(scene, gimbal_fmu, tmp_path):
+    """Rows in the CSV format of frequency_response (the 'los' row without phase) and dense lines that
+    plot_bode draws."""
+    from scene_lib.frequency_response import plot_bode, write_csv
+
+    rows = isolation_prediction.isolation_rows(scene, gimbal_fmu, "roll", [1.0, 10.0], LINEAR_FIDELITY)
+    assert [(r["output"], r["frequency_hz"]) for r in rows] == [(o, f) for f in (1.0, 10.0) for o in OUTPUTS]
+    assert all(r["curve"] == LINEAR_CURVE and r["input"] == "base.gamma_dot" and r["coherence"] == 1.0 for r in rows)
+    for f in (1.0, 10.0):
+        parts = {r["output"]: r for r in rows if r["frequency_hz"] == f}
+        assert math.isnan(parts["los"]["phase_deg"])
+        assert parts["los"]["gain"] == pytest.approx(math.hypot(parts["los.omega[1]"]["gain"],
+                                                                parts["los.omega[3]"]["gain"]))
+    lines = isolation_prediction.isolation_lines(scene, gimbal_fmu, "roll", 0.1, 100.0, LINEAR_FIDELITY, points=50)
+    assert len(lines) == 3 and all(len(f) == 50 and len(G) == 50 for _, f, G in lines)
+    assert np.all(lines[2][2].imag == 0) and np.all(lines[2][2].real > 0)
+    write_csv(rows, tmp_path / "iso.csv")
+    plot_bode(rows, tmp_path / "iso.png", "roll isolation", lines)
+    assert (tmp_path / "iso.png").stat().st_size > 0
+
+
+def test_other_controllers_are_refused(scene, gimbal_fmu):
+    none = scene.with_changes(controller_spec={"type": "none"})
+    with pytest.raises(SceneError, match="PID controller only"):
+        isolation_prediction.isolation_rows(none, gimbal_fmu, "roll", [1.0], LINEAR_FIDELITY)
+    with pytest.raises(SceneError, match="roll, pitch or yaw"):
+        isolation_prediction.isolation_rows(scene, gimbal_fmu, "heave", [1.0], LINEAR_FIDELITY)
