@@ -9,9 +9,11 @@ the results: docs/frequency_response.md).
 Both for the scene's model ("full model") and with backlash and dry friction switched off
 (gear*.model = 1, dry_friction = false).
 
-Open loop, the linear model (scene_lib.linearization: A, B, C, D from the core at the operating point,
-without backlash and dry friction) is drawn over the simulated curves as thin lines, and its values at
-the simulated frequencies are rows of curve "linear model" in the CSV (--no-linear: not).
+The linear prediction without backlash and dry friction is drawn over the simulated curves as thin
+lines, and its values at the simulated frequencies are rows of curve "linear model" in the CSV
+(--no-linear: not): open loop, the plant's G(jw) from the core's A, B, C, D (scene_lib.linearization);
+isolation, the sampled-data closed loop of the scene's PID controller (scene_lib.isolation_prediction;
+a scene with another controller: use --no-linear).
 
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
@@ -52,6 +54,27 @@ def with_overrides(scene, assignments: list[str]):
     return scene.with_changes(fidelity=fidelity, parameters=parameters)
 
 
+def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
+    """The linear model's Bode lines and a function giving its rows at the simulated points: open loop,
+    the plant's G(jw) (scene_lib.linearization); isolation, the sampled-data closed loop of the scene's
+    PID controller (scene_lib.isolation_prediction). Both without backlash and dry friction."""
+    from scene_lib.fmu import FMU
+
+    with FMU(fmu_path) as fmu:
+        if excitation.kind == "voltage":
+            from scene_lib import linearization
+
+            model = linearization.linearize(fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY))
+            lines = fr.linear_lines(model, excitation.input_signal, outputs, f_min, f_max)
+            return lines, lambda rows: fr.linear_rows(model, rows)
+        from scene_lib import isolation_prediction as isolation
+
+        loop = isolation.build_loop(scene, fmu, fr.LINEAR_FIDELITY)
+    lines = isolation.isolation_lines(loop, excitation.axis, f_min, f_max)
+    return lines, lambda rows: isolation.isolation_rows(loop, excitation.axis,
+                                                        sorted({r["frequency_hz"] for r in rows}))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("mode", choices=["open-loop", "isolation"])
@@ -78,7 +101,7 @@ def main(argv=None) -> int:
                         help="override an FMU parameter or fidelity switch of the scene, e.g. --set body2.d_bd[3]=0 "
                              "(repeatable; numbers, true/false)")
     parser.add_argument("--no-linear", action="store_true",
-                        help="open-loop: do not add the linear model's curve (it needs build/libgimbal_probe.so)")
+                        help="do not add the linear prediction (it needs build/libgimbal_probe.so; isolation: a PID scene)")
     parser.add_argument("--serial", action="store_true", help="run the frequencies one after the other here")
     parser.add_argument("--workers", type=int, default=4, help="local Dask workers (default 4)")
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
@@ -110,14 +133,9 @@ def main(argv=None) -> int:
             variants.append(("full model", None))
         if not args.full_only:
             variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
-        lines, linear = None, None
-        if excitation.kind == "voltage" and not args.no_linear:
-            from scene_lib import linearization
-            from scene_lib.fmu import FMU
-
-            with FMU(args.fmu) as fmu:
-                linear = linearization.linearize(fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY))
-            lines = fr.linear_lines(linear, excitation.input_signal, outputs, args.fmin, args.fmax)
+        lines, predict_rows = None, None
+        if not args.no_linear:
+            lines, predict_rows = linear_prediction(scene, args.fmu, excitation, outputs, args.fmin, args.fmax)
         client = cluster = None
         if not args.serial:
             from sweep_lib import make_client
@@ -135,8 +153,8 @@ def main(argv=None) -> int:
     except SceneError as exc:
         print(f"frequency_response: {exc}", file=sys.stderr)
         return 1
-    if linear is not None:
-        rows += fr.linear_rows(linear, rows)
+    if predict_rows is not None:
+        rows += predict_rows(rows)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"

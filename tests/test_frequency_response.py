@@ -188,9 +188,11 @@ def test_command_writes_a_csv_row_per_point_and_a_bode_plot(fmu_path, tmp_path):
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     rows = list(csv.DictReader(open(tmp_path / "frequency_response_isolation_yaw.csv")))
-    # 2 variants x 2 frequencies x (los.omega[1], los.omega[3], los)
-    assert len(rows) == 12
-    assert {r["curve"] for r in rows} == {"full model", "no backlash, no dry friction"}
+    # (2 variants + the linear prediction) x 2 frequencies x (los.omega[1], los.omega[3], los)
+    assert len(rows) == 18
+    assert {r["curve"] for r in rows} == {"full model", "no backlash, no dry friction", "linear model"}
+    simulated = {r["frequency_hz"] for r in rows if r["curve"] == "full model"}
+    assert {r["frequency_hz"] for r in rows if r["curve"] == "linear model"} == simulated
     assert all(r["input"] == "base.psi_dot" for r in rows)
     assert (tmp_path / "frequency_response_isolation_yaw.png").stat().st_size > 10000
 

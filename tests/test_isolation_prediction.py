@@ -106,7 +106,8 @@ def test_rows_and_lines(scene, gimbal_fmu, tmp_path):
     plot_bode draws."""
     from scene_lib.frequency_response import plot_bode, write_csv
 
-    rows = isolation_prediction.isolation_rows(scene, gimbal_fmu, "roll", [1.0, 10.0], LINEAR_FIDELITY)
+    loop = isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+    rows = isolation_prediction.isolation_rows(loop, "roll", [1.0, 10.0])
     assert [(r["output"], r["frequency_hz"]) for r in rows] == [(o, f) for f in (1.0, 10.0) for o in OUTPUTS]
     assert all(r["curve"] == LINEAR_CURVE and r["input"] == "base.gamma_dot" and r["coherence"] == 1.0 for r in rows)
     for f in (1.0, 10.0):
@@ -114,8 +115,9 @@ def test_rows_and_lines(scene, gimbal_fmu, tmp_path):
         assert math.isnan(parts["los"]["phase_deg"])
         assert parts["los"]["gain"] == pytest.approx(math.hypot(parts["los.omega[1]"]["gain"],
                                                                 parts["los.omega[3]"]["gain"]))
-    lines = isolation_prediction.isolation_lines(scene, gimbal_fmu, "roll", 0.1, 100.0, LINEAR_FIDELITY, points=50)
-    assert len(lines) == 3 and all(len(f) == 50 and len(G) == 50 for _, f, G in lines)
+    lines = isolation_prediction.isolation_lines(loop, "roll", 0.1, 100.0, points=50)
+    assert len(lines) == 3 and all(len(f) == 50 and len(G) == 50 for _, f, G, _ in lines)
+    assert [has_phase for *_, has_phase in lines] == [True, True, False]
     assert np.all(lines[2][2].imag == 0) and np.all(lines[2][2].real > 0)
     write_csv(rows, tmp_path / "iso.csv")
     plot_bode(rows, tmp_path / "iso.png", "roll isolation", lines)
@@ -125,6 +127,7 @@ def test_rows_and_lines(scene, gimbal_fmu, tmp_path):
 def test_other_controllers_are_refused(scene, gimbal_fmu):
     none = scene.with_changes(controller_spec={"type": "none"})
     with pytest.raises(SceneError, match="PID controller only"):
-        isolation_prediction.isolation_rows(none, gimbal_fmu, "roll", [1.0], LINEAR_FIDELITY)
+        isolation_prediction.build_loop(none, gimbal_fmu, LINEAR_FIDELITY)
+    loop = isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
     with pytest.raises(SceneError, match="roll, pitch or yaw"):
-        isolation_prediction.isolation_rows(scene, gimbal_fmu, "heave", [1.0], LINEAR_FIDELITY)
+        isolation_prediction.isolation_rows(loop, "heave", [1.0])

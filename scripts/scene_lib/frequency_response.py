@@ -206,7 +206,8 @@ def linear_rows(model, rows: list[dict]) -> list[dict]:
 
 
 def linear_lines(model, input_signal: str, outputs: list[str], f_min: float, f_max: float, points: int = 400) -> list:
-    """Dense Bode lines of the linear model for plot_bode: [(label, frequencies, complex G), ...]."""
+    """Dense Bode lines of the linear model for plot_bode: [(label, frequencies, complex G), ...] (a 4th
+    element False marks a line without phase)."""
     f = np.logspace(math.log10(f_min), math.log10(f_max), points)
     return [(f"{LINEAR_CURVE}: {name}", f, model.frequency_response(f, input_signal, name)) for name in outputs
             if name in model.outputs]
@@ -295,16 +296,21 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
         rows = [r for r in rows if r.get("curve") != LINEAR_CURVE]
     groups = curves(rows)
     finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
-    for _, _, G in lines or []:
+    for _, _, G, *_ in lines or []:
         finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
     top = max(finite_gains) if finite_gains else 0.0
     floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
-    for index, (label, f, G) in enumerate(lines or []):
+    for index, line in enumerate(lines or []):
+        label, f, G = line[:3]
+        has_phase = line[3] if len(line) > 3 else True
+        style = ["-", "--", ":"][index % 3]
         gain = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
         shown = gain >= floor
-        ax_g.semilogx(f[shown], gain[shown], ["-", "--"][index % 2], color="k", lw=0.9,
-                      label=label + ("" if shown.all() else f" ({(~shown).sum()} points below {floor:.0f} dB not drawn)"))
-        ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(G))), ["-", "--"][index % 2], color="k", lw=0.9)
+        ax_g.semilogx(f[shown], gain[shown], style, color="k", lw=0.9,
+                      label=label + ("" if has_phase else " (gain only)")
+                      + ("" if shown.all() else f" ({(~shown).sum()} points below {floor:.0f} dB not drawn)"))
+        if has_phase:
+            ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(G))), style, color="k", lw=0.9)
     markers, styles = "osD^vP*X", ["-", "--", ":", "-."]
     for index, ((curve, output), cr) in enumerate(groups.items()):
         marker, style = markers[index % len(markers)], styles[index % len(styles)]

@@ -238,12 +238,12 @@ def _check_axis(axis: str) -> None:
         raise SceneError(f"carrier axis must be roll, pitch or yaw, got {axis!r}")
 
 
-def isolation_rows(scene, fmu, axis: str, frequencies, fidelity: dict | None = None) -> list[dict]:
+def isolation_rows(loop: IsolationLoop, axis: str, frequencies) -> list[dict]:
     """Rows in frequency_response's CSV format (curve LINEAR_CURVE, coherence 1): los.omega[1],
     los.omega[3] and 'los' (phase NaN) at each frequency (frequency_hz = requested_hz = the given one:
-    pass the dwell's snapped frequencies to compare point by point)."""
+    pass the dwell's snapped frequencies to compare point by point). `loop` from build_loop."""
     _check_axis(axis)
-    gains = isolation_gains(build_loop(scene, fmu, fidelity), axis, frequencies)
+    gains = isolation_gains(loop, axis, frequencies)
     rows = []
     for index, f in enumerate(np.atleast_1d(np.asarray(frequencies, float))):
         for name in LOS_OUTPUTS + ["los"]:
@@ -256,13 +256,10 @@ def isolation_rows(scene, fmu, axis: str, frequencies, fidelity: dict | None = N
     return rows
 
 
-def isolation_lines(scene, fmu, axis: str, f_min: float, f_max: float, fidelity: dict | None = None,
-                    points: int = 400) -> list:
-    """Dense lines for plot_bode: [(label, frequencies, G), ...]. The 'los' line carries the real,
-    positive magnitude: its gain is right, and plot_bode draws its phase as a flat 0 deg line (the label
-    says it has no phase)."""
+def isolation_lines(loop: IsolationLoop, axis: str, f_min: float, f_max: float, points: int = 400) -> list:
+    """Dense lines for plot_bode: [(label, frequencies, G, has_phase), ...]. The 'los' line carries the
+    real, positive magnitude and no phase (plot_bode draws its gain only)."""
     _check_axis(axis)
     f = np.logspace(math.log10(f_min), math.log10(f_max), points)
-    gains = isolation_gains(build_loop(scene, fmu, fidelity), axis, f)
-    return [(f"{LINEAR_CURVE}: {name}" + (" (magnitude; no phase)" if name == "los" else ""), f, gains[name])
-            for name in LOS_OUTPUTS + ["los"]]
+    gains = isolation_gains(loop, axis, f)
+    return [(f"{LINEAR_CURVE}: {name}", f, gains[name], name != "los") for name in LOS_OUTPUTS + ["los"]]
