@@ -13,7 +13,7 @@ The linear prediction without backlash and dry friction is drawn over the simula
 lines, and its values at the simulated frequencies are rows of curve "linear model" in the CSV
 (--no-linear: not): open loop, the plant's G(jw) from the core's A, B, C, D (scene_lib.linearization);
 isolation, the sampled-data closed loop of the scene's PID controller (scene_lib.isolation_prediction;
-a scene with another controller: use --no-linear).
+for another controller, or a loop that does not settle, the command says so and measures without it).
 
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
@@ -135,7 +135,10 @@ def main(argv=None) -> int:
             variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
         lines, predict_rows = None, None
         if not args.no_linear:
-            lines, predict_rows = linear_prediction(scene, args.fmu, excitation, outputs, args.fmin, args.fmax)
+            try:
+                lines, predict_rows = linear_prediction(scene, args.fmu, excitation, outputs, args.fmin, args.fmax)
+            except SceneError as exc:   # e.g. not a PID scene, or a loop that does not settle: measure anyway
+                print(f"frequency_response: no linear prediction: {exc}", file=sys.stderr)
         client = cluster = None
         if not args.serial:
             from sweep_lib import make_client

@@ -27,3 +27,5 @@ def test_the_example_notebook_runs(tmp_path, build_dir, monkeypatch):
     assert (tmp_path / "notebook_los_error.png").stat().st_size > 10_000
     assert "DC gain u_R1 -> alpha_dot" in printed and "linear vs simulated gain" in printed
     assert (tmp_path / "notebook_bode.png").stat().st_size > 10_000
+    assert "slowest closed-loop pole" in printed and "saved notebook_isolation.png" in printed
+    assert (tmp_path / "notebook_isolation.png").stat().st_size > 10_000

@@ -131,3 +131,35 @@ def test_other_controllers_are_refused(scene, gimbal_fmu):
     loop = isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
     with pytest.raises(SceneError, match="roll, pitch or yaw"):
         isolation_prediction.isolation_rows(loop, "heave", [1.0])
+
+
+def test_the_closed_loop_poles_are_where_the_frequency_domain_loop_is_singular(loop):
+    """The time-domain closed loop (closed_loop_transition, whose poles decide stability) and the
+    frequency-domain one (loop_response: I - voltage_transfer(z) feedback(z)) are the same system: at each
+    of the slowest closed-loop poles z_p, the return difference I - P(z_p) K(z_p) is singular."""
+    poles = isolation_prediction.closed_loop_poles(loop)
+    assert np.max(np.abs(poles)) < 1.0
+    plant_poles = np.linalg.eigvals(loop.plant.Phi)
+    # the slowest poles that are not also plant or controller poles (there P K itself is infinite)
+    candidates = [p for p in sorted(poles, key=lambda p: -abs(p))
+                  if np.min(np.abs(plant_poles - p)) > 1e-6 and abs(p - 1) > 1e-6 and abs(p) > 0.5][:6]
+    assert len(candidates) >= 4
+    for p in candidates:
+        feedback, _ = isolation_prediction.controller_matrices(loop, "roll", p, 1.0)
+        return_difference = np.eye(4) - isolation_prediction.voltage_transfer(loop, p) @ feedback
+        singular = np.linalg.svd(return_difference, compute_uv=False)
+        assert singular[-1] < 1e-7 * singular[0], (p, singular)
+    # and a point that is no pole is not singular
+    feedback, _ = isolation_prediction.controller_matrices(loop, "roll", 0.3 + 0.2j, 1.0)
+    singular = np.linalg.svd(np.eye(4) - isolation_prediction.voltage_transfer(loop, 0.3 + 0.2j) @ feedback,
+                             compute_uv=False)
+    assert singular[-1] > 1e-3 * singular[0]
+
+
+def test_a_loop_that_does_not_settle_is_refused(scene, gimbal_fmu):
+    """k_gyro = 32 excites the azimuth gear's resonance: the simulated loop ends current-limited, and no
+    isolation ratio is predicted for it."""
+    spec = dict(scene.controller_spec)
+    spec["azimuth"] = dict(spec["azimuth"], k_gyro=32.0)
+    with pytest.raises(SceneError, match="does not come to rest"):
+        isolation_prediction.build_loop(scene.with_changes(controller_spec=spec), gimbal_fmu, LINEAR_FIDELITY)

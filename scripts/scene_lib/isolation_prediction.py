@@ -50,6 +50,7 @@ LOOP_OUTPUTS = ["alpha", "beta", "los.omega[1]", "los.omega[3]"]
 VOLTAGES = ["u_R1", "u_R2"]
 JACOBIAN_STEP_RAD = 1e-6
 SETTLE_S = 5.0   # s at rest before linearizing: the loop's integrators have taken up the gravity torque
+SETTLE_RETRY_FACTOR = 4.0   # a loop not at rest by then gets one run this many times longer
 
 
 @dataclasses.dataclass(frozen=True)
@@ -135,12 +136,37 @@ def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_
 
     merged = dict(scene.fidelity)
     merged.update(fidelity or {})
-    at_rest = scene.with_changes(stop_time=settle_s, fidelity=merged, base_motion_spec={"type": "fixed"})
-    signals = run(at_rest, fmu).signals
+    # a slow but stable loop (a low gyro gain) gets a second, longer run before it is refused
+    for attempt, duration in enumerate((settle_s, SETTLE_RETRY_FACTOR * settle_s)):
+        at_rest = scene.with_changes(stop_time=duration, fidelity=merged, base_motion_spec={"type": "fixed"})
+        signals = run(at_rest, fmu).signals
+        problems = rest_problems(signals)
+        if not problems:
+            break
+        if attempt == 1:
+            raise SceneError(f"{scene.name}: its loop does not come to rest on a carrier at rest within {duration:g} s "
+                             f"({', '.join(problems)} at the end): there is no steady operating point to linearize "
+                             f"(is the loop unstable with these gains?)")
     values = start_values(at_rest, fmu, np.zeros(15))
     values.update(merged)
     values.update({name: float(signals[name][-1]) for name in STATES + VOLTAGES if name in signals})
     return values
+
+
+REST_RATE_RAD_S = 1e-4   # gimbal rates below this at the end of the settling run: the loop holds still
+
+
+def rest_problems(signals: dict) -> list[str]:
+    """What shows that a run has not come to rest at its end (unstable, limit-cycling, current-limited):
+    such a loop has no steady operating point, and an arbitrary moment of its motion is not one."""
+    problems = []
+    for rate in ("alpha_dot", "beta_dot"):
+        if rate in signals and abs(float(signals[rate][-1])) > REST_RATE_RAD_S:
+            problems.append(f"{rate} = {float(signals[rate][-1]):.3g} rad/s")
+    for flag in ("motor1.limited", "motor2.limited"):
+        if flag in signals and float(signals[flag][-1]) != 0:
+            problems.append(f"{flag} = {int(signals[flag][-1])}")
+    return problems
 
 
 def sample_plant(model, h: float) -> SampledPlant:
@@ -167,10 +193,56 @@ def build_loop(scene, fmu, fidelity: dict | None) -> IsolationLoop:
     if values.get("base.fixed"):
         raise SceneError(f"{scene.name}: base.fixed = true: the carrier's motion does not reach the gimbal")
     model = linearization.linearize(values)
+    held = [f"{name} = {value}" for name, value in model.modes.items()
+            if (name.endswith(".limited") or name.endswith(".voltage_clamped")) and value != 0]
+    if held:
+        raise SceneError(f"{scene.name}: at its operating point {', '.join(held)}: the voltage does not act, "
+                         f"a linear loop does not exist there")
     alpha0, beta0 = float(values.get("alpha", 0.0)), float(values.get("beta", 0.0))
     jacobian = reference_jacobian(scene.target, references, alpha0) if scene.target is not None else np.zeros((2, 3))
-    return IsolationLoop(plant=sample_plant(model, scene.step_size), axes=axes, reference_jacobian=jacobian,
+    loop = IsolationLoop(plant=sample_plant(model, scene.step_size), axes=axes, reference_jacobian=jacobian,
                          cos_beta=max(math.cos(beta0), 0.2), h=scene.step_size, delay=scene.delay_steps)
+    radius = float(np.max(np.abs(closed_loop_poles(loop))))
+    if radius >= 1.0:
+        raise SceneError(f"{scene.name}: the linear closed loop is unstable (a pole at |z| = {radius:.6g} >= 1): "
+                         f"it has no steady-state response, hence no isolation ratio")
+    return loop
+
+
+def closed_loop_poles(loop: IsolationLoop) -> np.ndarray:
+    """Eigenvalues of the sampled closed loop (plant over a step, the two AxisPID's states, the delay
+    line), references at rest: inside the unit circle for a stable loop."""
+    return np.linalg.eigvals(closed_loop_transition(loop))
+
+
+def closed_loop_transition(loop: IsolationLoop) -> np.ndarray:
+    """The matrix of xi_k -> xi_k+1 for xi_k = [x_k, v_k-1, u_k-1 .. u_k-d, integral_k-1, filtered
+    derivative_k-1, e_k-1]: the same sampling, hold and delay as loop_response, in the time domain (one
+    step of the loop applied to each unit vector)."""
+    plant, h, d = loop.plant, loop.h, loop.delay
+    n = plant.Phi.shape[0]
+    voltage_columns = [plant.inputs.index(name) for name in VOLTAGES]
+    hold_input, direct = plant.MB[0][:, voltage_columns], plant.D[:, voltage_columns]
+    gains = {key: np.array([getattr(axis, key) for axis in loop.axes]) for key in ("kp", "ki", "kd", "k_gyro")}
+    smoothing = np.array([h / (axis.tau + h) for axis in loop.axes])
+    size = n + 2 + 2 * d + 6
+
+    def step(xi):
+        x, applied_before = xi[:n], xi[n:n + 2]
+        pending = xi[n + 2:n + 2 + 2 * d].reshape(d, 2)
+        integral, derivative, error_before = np.split(xi[n + 2 + 2 * d:], 3)
+        y = plant.C @ x + direct @ applied_before              # alpha, beta, los.omega[1], los.omega[3] at t_k
+        error = -y[:2]
+        gyro = np.array([y[3] / loop.cos_beta, y[2]])
+        derivative = derivative + smoothing * ((error - error_before) / h - derivative)
+        integral = integral + error * h
+        u = gains["kp"] * error + gains["ki"] * integral + gains["kd"] * derivative - gains["k_gyro"] * gyro
+        applied = u if d == 0 else pending[d - 1]
+        pending = np.vstack([u[None, :], pending[:d - 1]]) if d else pending
+        return np.concatenate([plant.Phi @ x + hold_input @ applied, applied, pending.ravel(), integral,
+                               derivative, error])
+
+    return np.column_stack([step(column) for column in np.eye(size)])
 
 
 def carrier_input_polynomial(inputs: list, axis: str, w: float, h: float):
@@ -196,15 +268,23 @@ def loop_response(loop: IsolationLoop, axis: str, frequency_hz: float) -> np.nda
     z = complex(math.cos(w * h), math.sin(w * h))
     n = plant.Phi.shape[0]
     resolvent = np.linalg.inv(z * np.eye(n) - plant.Phi)
-    voltage_columns = [plant.inputs.index(name) for name in VOLTAGES]
-    # voltage -> outputs: held over a step, applied `delay` steps late; D sees the previous step's input
-    held = z ** -loop.delay
-    voltage_path = (plant.C @ resolvent @ plant.MB[0][:, voltage_columns] + plant.D[:, voltage_columns] / z) * held
+    voltage_path = voltage_transfer(loop, z, resolvent)
     (u0, u1, u2), at_end = carrier_input_polynomial(plant.inputs, axis, w, h)
     carrier_path = plant.C @ resolvent @ sum(MB @ u for MB, u in zip(plant.MB, (u0, u1, u2))) + plant.D @ at_end / z
     feedback, feedforward = controller_matrices(loop, axis, z, w)
     closed = np.eye(len(LOOP_OUTPUTS)) - voltage_path @ feedback
     return np.linalg.solve(closed, voltage_path @ feedforward + carrier_path)
+
+
+def voltage_transfer(loop: IsolationLoop, z: complex, resolvent: np.ndarray | None = None) -> np.ndarray:
+    """Computed voltages -> LOOP_OUTPUTS at t_k: held over a step, applied `delay` steps late; D sees the
+    previous step's input."""
+    plant = loop.plant
+    if resolvent is None:
+        resolvent = np.linalg.inv(z * np.eye(plant.Phi.shape[0]) - plant.Phi)
+    voltage_columns = [plant.inputs.index(name) for name in VOLTAGES]
+    path = plant.C @ resolvent @ plant.MB[0][:, voltage_columns] + plant.D[:, voltage_columns] / z
+    return path * z ** -loop.delay
 
 
 def controller_matrices(loop: IsolationLoop, axis: str, z: complex, w: float):
