@@ -24,6 +24,7 @@ Frequencies run in parallel on Dask (a local cluster of --workers, or --schedule
 from __future__ import annotations
 
 import argparse
+import math
 import pathlib
 import sys
 import time
@@ -52,6 +53,11 @@ def with_overrides(scene, assignments: list[str]):
             value = int(value)
         (fidelity if name.strip() in FIDELITY else parameters)[name.strip()] = value
     return scene.with_changes(fidelity=fidelity, parameters=parameters)
+
+
+def unit_of(mode: str) -> str:
+    """The unit of --amplitude."""
+    return "V" if mode == "open-loop" else "deg/s"
 
 
 def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
@@ -84,9 +90,10 @@ def main(argv=None) -> int:
     parser.add_argument("--fmu", default=str(REPO / "build" / "Gimbal2Axis.fmu"))
     parser.add_argument("--axis", default=None,
                         help="open-loop: motor 1 or 2 (default 1); isolation: roll, pitch or yaw (default roll)")
-    parser.add_argument("--amplitude", type=float, default=None,
+    parser.add_argument("--amplitude", type=float, nargs="+", default=None, metavar="A",
                         help="open-loop: voltage amplitude in V (default 1); isolation: carrier rate amplitude "
-                             "in deg/s (default 1)")
+                             "in deg/s (default 1). Several: a curve per amplitude (the nonlinear model's "
+                             "describing function changes with it; the linear one does not)")
     parser.add_argument("--offset", type=float, default=0.0, help="open-loop: constant voltage added, V")
     parser.add_argument("--fmin", type=float, default=0.1)
     parser.add_argument("--fmax", type=float, default=100.0)
@@ -116,18 +123,19 @@ def main(argv=None) -> int:
         scene = with_overrides(scene, args.set)
         frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
         dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
+        amplitudes = args.amplitude or [1.0]
         if args.mode == "open-loop":
             axis = args.axis or "1"
-            excitation = fr.Excitation("voltage", axis, 1.0 if args.amplitude is None else args.amplitude, args.offset)
+            excitations = [fr.Excitation("voltage", axis, a, args.offset) for a in amplitudes]
             scene = scene.with_changes(base_motion_spec={"type": "fixed"},
                                        fidelity={**scene.fidelity, "base.fixed": True},
                                        controller_spec={"type": "none"})
-            outputs = excitation.default_outputs()
+            outputs = excitations[0].default_outputs()
         else:
             axis = args.axis or "roll"
-            import math
-            excitation = fr.Excitation("base", axis, math.radians(1.0 if args.amplitude is None else args.amplitude))
+            excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
             outputs = None
+        excitation = excitations[0]
         variants = []
         if not args.linear_only:
             variants.append(("full model", None))
@@ -146,8 +154,10 @@ def main(argv=None) -> int:
         rows = []
         wall = time.perf_counter()
         try:
-            for label, fidelity in variants:
-                rows += fr.sweep(scene, args.fmu, frequencies, excitation, dwell, outputs, fidelity, client, label)
+            for each, amplitude in zip(excitations, amplitudes):
+                for label, fidelity in variants:
+                    curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode)}"
+                    rows += fr.sweep(scene, args.fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
         finally:
             if client is not None:
                 client.close()
@@ -163,9 +173,9 @@ def main(argv=None) -> int:
     name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
     csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
     fr.write_csv(rows, csv_path)
-    unit = "V" if excitation.kind == "voltage" else "rad/s"
-    title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude {excitation.amplitude:g} {unit}"
-             + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
+    shown = ", ".join(f"{a:g}" for a in amplitudes)
+    title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
+             f"{shown} {unit_of(args.mode)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
     fr.plot_bode(rows, png_path, title, lines)
     print(f"{len(rows)} points in {time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
     return 0

@@ -254,3 +254,22 @@ def test_open_loop_command_adds_the_linear_models_curve(fmu_path, build_dir, tmp
     assert linear.keys() == simulated.keys()
     for key, gain in simulated.items():
         assert gain == pytest.approx(linear[key], rel=0.01), key
+
+
+def test_several_amplitudes_give_a_curve_each(fmu_path, tmp_path):
+    import csv
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), "open-loop", "--axis", "1",
+                          "--fmin", "5", "--fmax", "5", "--points", "1", "--settle-periods", "2", "--settle-s", "0.1",
+                          "--measure-periods", "2", "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path),
+                          "--amplitude", "0.5", "2", "--full-only", "--no-linear"],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    rows = list(csv.DictReader(open(tmp_path / "frequency_response_open_loop_1.csv")))
+    assert {r["curve"] for r in rows} == {"full model, 0.5 V", "full model, 2 V"} and len(rows) == 4
+    amplitude = {r["curve"]: float(r["input_amplitude"]) for r in rows}
+    # the continuous fundamental of the held sine: the amplitude times the hold's sinc (5 Hz, 1 ms: 0.99959)
+    assert amplitude["full model, 2 V"] == pytest.approx(4 * amplitude["full model, 0.5 V"], rel=1e-9)
+    assert amplitude["full model, 0.5 V"] == pytest.approx(0.5, rel=1e-3)
