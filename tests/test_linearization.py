@@ -37,6 +37,15 @@ RIGID_POINT = {
 }
 
 
+# Both rotors stuck by dry friction (the hold mode: numerical damping keeps them still within +-w_min,
+# the friction torque cancels the others), both gears in their backlash gap, a small running current.
+STUCK_POINT = {
+    "solver.rtol": 1e-11, "solver.atol": 1e-13, "base.fixed": True,
+    "body2.d_bd[2]": 0.0, "body2.d_bd[3]": 0.0,
+    "u_R1": 0.02, "u_R2": -0.02, "i_R1": 0.01, "i_R2": -0.01, "alpha_dot": 0.01, "beta_dot": -0.02,
+}
+
+
 def with_contact(fmu, point):
     """The rich point with both backlash positions at their +eta flank."""
     values = dict(point)
@@ -89,7 +98,9 @@ def flow_differences(fmu, slave, values, model):
     start(fmu, slave, values)
     initialized = slave.getFMUstate()
     # At a flank (contact) theta_b cannot move either way without leaving the mode: not perturbed.
-    for name in [s for s in states if not (s.startswith("theta_b") and model.modes[f"gear{s[-1]}.contact"] != 0)] + inputs:
+    # On a fixed base the FMU refuses carrier inputs (their columns are 0, checked by the caller).
+    moved_inputs = [u for u in inputs if not (values.get("base.fixed") and u.startswith("base."))]
+    for name in [s for s in states if not (s.startswith("theta_b") and model.modes[f"gear{s[-1]}.contact"] != 0)] + moved_inputs:
         d = 1e-5 * max(1.0, abs(values.get(name, 0.0)))
         ends, starts = [], []
         for sign in (1, -1):
@@ -132,22 +143,27 @@ def predicted(start_model, end_model, name):
     return np.concatenate([dx, end_model.C @ dx + end_model.D @ du])
 
 
-@pytest.mark.parametrize("point", ["rich", "rigid"])
+@pytest.mark.parametrize("point", ["rich", "rigid", "stuck"])
 def test_matrices_match_central_differences_of_the_fmu(gimbal_fmu, point):
     """A and B: the FMU's state after one step from perturbed start values / inputs against exp of the linear
     model over the step (the inputs' within-step motion included), compared on the change (x(H) - x(0)),
     whose size is A H: a wrong entry of A or B of relative size 1e-3 would show. C and D: the outputs right
     after initialization at perturbed start values / inputs (the FMU evaluates them at the start point)."""
     fmu = gimbal_fmu
-    values = with_contact(fmu, RICH_POINT) if point == "rich" else dict(RIGID_POINT)
+    values = {"rich": with_contact(fmu, RICH_POINT), "rigid": dict(RIGID_POINT), "stuck": dict(STUCK_POINT)}[point]
     model = linearization.linearize(values)
     assert model.time == 0.0
     if point == "rich":
         assert model.modes["gear1.contact"] == 1 and model.modes["gear2.contact"] == 1
         assert model.modes["rotor1.friction"] == "slipping +" and model.modes["rotor2.friction"] == "slipping -"
         assert len(model.states) == 12
-    else:
+    elif point == "rigid":
         assert model.states == ["alpha", "beta", "alpha_dot", "beta_dot"]
+    else:
+        assert model.modes["rotor1.friction"] == "stuck" and model.modes["rotor2.friction"] == "stuck"
+        assert model.modes["gear1.contact"] == 0 and model.modes["gear2.contact"] == 0
+        carrier = [k for k, u in enumerate(model.inputs) if u.startswith("base.")]
+        assert np.all(model.B[:, carrier] == 0) and np.all(model.D[:, carrier] == 0)
     slave = fmu.instantiate("linearization")
     try:
         start(fmu, slave, values)
