@@ -6,20 +6,25 @@ the results: docs/frequency_response.md).
              base, motor voltage = offset + amplitude sin(w t) (no controller, the other motor at 0 V)
   isolation: the carrier's roll/pitch/yaw rate as a sine through the scene's closed loop: LOS inertial
              rate / carrier rate (the stabilization ratio)
-Both for the scene's model ("full model") and with backlash and dry friction switched off
+  loop-gain: the scene's closed loop on a carrier at rest, a sine of --amplitude V injected into motor
+             --axis's computed voltage: the loop gain L = -U/A broken there (U the controller's output,
+             A = U + D what goes on to the motor), the sensitivity A/D and the LOS rate per D
+All for the scene's model ("full model") and with backlash and dry friction switched off
 (gear*.model = 1, dry_friction = false).
 
 The linear prediction without backlash and dry friction is drawn over the simulated curves as thin
 lines, and its values at the simulated frequencies are rows of curve "linear model" in the CSV
 (--no-linear: not): open loop, the plant's G(jw) from the core's A, B, C, D (scene_lib.linearization);
-isolation, the sampled-data closed loop of the scene's PID controller (scene_lib.isolation_prediction;
-for another controller, or a loop that does not settle, the command says so and measures without it).
+isolation and loop-gain, the sampled-data closed loop of the scene's PID controller
+(scene_lib.isolation_prediction; for another controller, or a loop that does not settle, the command says
+so and measures without it). loop-gain also prints the predicted crossover, phase and gain margins.
 
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
 
   python scripts/frequency_response.py isolation --axis roll --fmin 0.1 --fmax 100 --points 13
   python scripts/frequency_response.py open-loop --axis 1 --amplitude 1 --serial
+  python scripts/frequency_response.py loop-gain --axis 1 --amplitude 0.2
 """
 from __future__ import annotations
 
@@ -57,13 +62,14 @@ def with_overrides(scene, assignments: list[str]):
 
 def unit_of(mode: str) -> str:
     """The unit of --amplitude."""
-    return "V" if mode == "open-loop" else "deg/s"
+    return "deg/s" if mode == "isolation" else "V"
 
 
 def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
-    """The linear model's Bode lines and a function giving its rows at the simulated points: open loop,
-    the plant's G(jw) (scene_lib.linearization); isolation, the sampled-data closed loop of the scene's
-    PID controller (scene_lib.isolation_prediction). Both without backlash and dry friction."""
+    """The linear model's Bode lines, a function giving its rows at the simulated points and a line of
+    text to print (or None): open loop, the plant's G(jw) (scene_lib.linearization); isolation and loop
+    gain, the sampled-data closed loop of the scene's PID controller (scene_lib.isolation_prediction),
+    the loop gain with its predicted margins. All without backlash and dry friction."""
     from scene_lib.fmu import FMU
 
     with FMU(fmu_path) as fmu:
@@ -72,27 +78,50 @@ def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
 
             model = linearization.linearize(fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY))
             lines = fr.linear_lines(model, excitation.input_signal, outputs, f_min, f_max)
-            return lines, lambda rows: fr.linear_rows(model, rows)
+            return lines, lambda rows: fr.linear_rows(model, rows), None
         from scene_lib import isolation_prediction as isolation
 
         loop = isolation.build_loop(scene, fmu, fr.LINEAR_FIDELITY)
-    lines = isolation.isolation_lines(loop, excitation.axis, f_min, f_max)
-    return lines, lambda rows: isolation.isolation_rows(loop, excitation.axis,
-                                                        sorted({r["frequency_hz"] for r in rows}))
+    def at_simulated(function):
+        return lambda rows: function(loop, excitation.axis, sorted({r["frequency_hz"] for r in rows}))
+    if excitation.kind == "injection":
+        margins = isolation.predicted_margins(loop, excitation.axis)
+        summary = f"linear model, loop gain at u_R{excitation.axis}: {margins.describe()}"
+        return (isolation.loop_gain_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.loop_gain_rows),
+                summary)
+    return (isolation.isolation_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.isolation_rows),
+            None)
+
+
+def measured_margins(rows: list[dict]) -> list[str]:
+    """A line per simulated curve: the margins of its loop_gain points (interpolated between the dwell's
+    frequencies, so only as fine as its grid; a point of low coherence may place a crossing anywhere)."""
+    from scene_lib.isolation_prediction import stability_margins
+
+    lines = []
+    for (curve, output), points in fr.curves(rows).items():
+        if output != fr.LOOP_GAIN or curve == fr.LINEAR_CURVE or len(points) < 2:
+            continue
+        f = [r["frequency_hz"] for r in points]
+        L = [r["gain"] * complex(math.cos(math.radians(r["phase_deg"])), math.sin(math.radians(r["phase_deg"])))
+             for r in points]
+        lines.append(f"{curve}, from its {len(points)} points: {stability_margins(f, L).describe()}")
+    return lines
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("mode", choices=["open-loop", "isolation"])
+    parser.add_argument("mode", choices=["open-loop", "isolation", "loop-gain"])
     parser.add_argument("--scene", default=str(REPO / "scenes" / "ship_stabilization.toml"),
                         help="scene whose parameters, fidelity, step size and controller are used (default: "
                              "scenes/ship_stabilization.toml)")
     parser.add_argument("--fmu", default=str(REPO / "build" / "Gimbal2Axis.fmu"))
     parser.add_argument("--axis", default=None,
-                        help="open-loop: motor 1 or 2 (default 1); isolation: roll, pitch or yaw (default roll)")
+                        help="open-loop, loop-gain: motor 1 or 2 (default 1); isolation: roll, pitch or yaw "
+                             "(default roll)")
     parser.add_argument("--amplitude", type=float, nargs="+", default=None, metavar="A",
                         help="open-loop: voltage amplitude in V (default 1); isolation: carrier rate amplitude "
-                             "in deg/s (default 1). Several: a curve per amplitude (the nonlinear model's "
+                             "in deg/s (default 1); loop-gain: injected voltage amplitude in V (default 0.2). Several: a curve per amplitude (the nonlinear model's "
                              "describing function changes with it; the linear one does not)")
     parser.add_argument("--offset", type=float, default=0.0, help="open-loop: constant voltage added, V")
     parser.add_argument("--fmin", type=float, default=0.1)
@@ -123,7 +152,7 @@ def main(argv=None) -> int:
         scene = with_overrides(scene, args.set)
         frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
         dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
-        amplitudes = args.amplitude or [1.0]
+        amplitudes = args.amplitude or [0.2 if args.mode == "loop-gain" else 1.0]
         if args.mode == "open-loop":
             axis = args.axis or "1"
             excitations = [fr.Excitation("voltage", axis, a, args.offset) for a in amplitudes]
@@ -131,6 +160,12 @@ def main(argv=None) -> int:
                                        fidelity={**scene.fidelity, "base.fixed": True},
                                        controller_spec={"type": "none"})
             outputs = excitations[0].default_outputs()
+        elif args.mode == "loop-gain":
+            axis = args.axis or "1"
+            if axis not in fr.MOTOR_AXES:
+                raise SceneError(f"loop-gain --axis must be 1 or 2, got {axis!r}")
+            excitations = [fr.Excitation("injection", axis, a) for a in amplitudes]
+            outputs = None
         else:
             axis = args.axis or "roll"
             excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
@@ -144,7 +179,10 @@ def main(argv=None) -> int:
         lines, predict_rows = None, None
         if not args.no_linear:
             try:
-                lines, predict_rows = linear_prediction(scene, args.fmu, excitation, outputs, args.fmin, args.fmax)
+                lines, predict_rows, summary = linear_prediction(scene, args.fmu, excitation, outputs, args.fmin,
+                                                                 args.fmax)
+                if summary:
+                    print(summary)
             except SceneError as exc:   # e.g. not a PID scene, or a loop that does not settle: measure anyway
                 print(f"frequency_response: no linear prediction: {exc}", file=sys.stderr)
         client = cluster = None
@@ -174,9 +212,21 @@ def main(argv=None) -> int:
     csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
     fr.write_csv(rows, csv_path)
     shown = ", ".join(f"{a:g}" for a in amplitudes)
-    title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
-             f"{shown} {unit_of(args.mode)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
-    fr.plot_bode(rows, png_path, title, lines)
+    if excitation.kind == "injection":
+        title = (f"{scene.name}: loop gain L = -U/A at u_R{axis}_cmd (other axis closed) and sensitivity A/D, "
+                 f"injection {shown} V")
+    else:
+        title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
+                 f"{shown} {unit_of(args.mode)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
+    plotted_rows, plotted_lines = rows, lines
+    if excitation.kind == "injection":   # the LOS rate per D (-90 dB) would squeeze L and S: it is in the CSV
+        shown_outputs = (fr.LOOP_GAIN, fr.SENSITIVITY)
+        plotted_rows = [r for r in rows if r["output"] in shown_outputs]
+        plotted_lines = lines and [line for line in lines if line[0].rsplit(": ", 1)[-1] in shown_outputs]
+    fr.plot_bode(plotted_rows, png_path, title, plotted_lines)
+    if excitation.kind == "injection":
+        for line in measured_margins(rows):
+            print(line)
     print(f"{len(rows)} points in {time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
     return 0
 

@@ -1,11 +1,18 @@
 """Frequency responses of the nonlinear FMU by simulation: sine dwell, one run per frequency.
 
-Two excitations:
+Three excitations:
   - "voltage": a motor voltage u_R<axis> = offset + amplitude sin(w t), open loop (the Replay
     controller; the other motor at 0 V). The scene's base motion is used as given (normally fixed).
   - "base": the carrier's roll, pitch or yaw *rate* is a sine of the given rate amplitude (base motion
     type "sinusoids" on that one axis, angle amplitude = rate amplitude / w), through the scene's own
     closed loop (its controller).
+  - "injection": the loop gain of the scene's own closed loop broken at one motor's voltage (the
+    control engineer's voltage injection): the scene's controller runs, wrapped (InjectingController)
+    so that D_k = amplitude sin(w t_k) is added to axis <axis>'s *computed* voltage at t_k, after the
+    controller's own clamp and before the master's delay and hold. What the master records as the
+    command u_R<axis>_cmd is then A = U + D, U the controller's own output; A is what the delay line
+    and the hold pass on to the motor. The loop gain at that point is L = -U / A (the other axis's loop
+    closed), the sensitivity A / D = 1 / (1 + L). The base is fixed (a carrier at rest).
 
 Each run settles for max(settle_periods / f, settle_s) and then measures over exactly
 `measure_periods` periods. The frequency is snapped so that those periods span an integer number of
@@ -38,34 +45,99 @@ import pathlib
 
 import numpy as np
 
+from .errors import SceneError
+
 BASE_AXES = {"pitch": "base.delta_dot", "yaw": "base.psi_dot", "roll": "base.gamma_dot"}
 LOS_OUTPUTS = ["los.omega[1]", "los.omega[3]"]
 LINEAR_FIDELITY = {"gear1.model": 1, "gear2.model": 1, "dry_friction": False}
 
 
+MOTOR_AXES = ("1", "2")
+LOOP_GAIN = "loop_gain"        # output: -U / A at the injection point
+SENSITIVITY = "sensitivity"    # output: A / D = 1 / (1 + L)
+INJECTION_OUTPUTS = {"1": ["los.omega[3]"], "2": ["los.omega[1]"]}   # the LOS rate each motor moves
+
+
 @dataclasses.dataclass(frozen=True)
 class Excitation:
-    kind: str                 # "voltage" or "base"
+    kind: str                 # "voltage", "base" or "injection"
     axis: str                 # "1" / "2" (motor) or "roll" / "pitch" / "yaw"
     amplitude: float          # V, or rad/s (rate amplitude of the carrier)
     offset: float = 0.0       # V, a constant voltage added (voltage only)
 
     def __post_init__(self):
-        if self.kind == "voltage" and self.axis not in ("1", "2"):
-            raise ValueError(f"a voltage excitation needs axis '1' or '2', got {self.axis!r}")
+        if self.kind not in ("voltage", "base", "injection"):
+            raise ValueError(f"excitation kind must be 'voltage', 'base' or 'injection', got {self.kind!r}")
+        if self.kind in ("voltage", "injection") and self.axis not in MOTOR_AXES:
+            raise ValueError(f"a {self.kind} excitation needs axis '1' or '2', got {self.axis!r}")
         if self.kind == "base" and self.axis not in BASE_AXES:
             raise ValueError(f"a base excitation needs axis roll, pitch or yaw, got {self.axis!r}")
-        if self.kind not in ("voltage", "base"):
-            raise ValueError(f"excitation kind must be 'voltage' or 'base', got {self.kind!r}")
 
     @property
     def input_signal(self) -> str:
-        return f"u_R{self.axis}" if self.kind == "voltage" else BASE_AXES[self.axis]
+        """The signal the gains are referred to: for an injection the injected sine D itself."""
+        if self.kind == "voltage":
+            return f"u_R{self.axis}"
+        return BASE_AXES[self.axis] if self.kind == "base" else injection_signal(self.axis)
 
     def default_outputs(self) -> list[str]:
         if self.kind == "voltage":
             return ["alpha_dot", "los.omega[3]"] if self.axis == "1" else ["beta_dot", "los.omega[1]"]
+        if self.kind == "injection":
+            return list(INJECTION_OUTPUTS[self.axis])
         return list(LOS_OUTPUTS)
+
+
+def injection_signal(axis: str) -> str:
+    """The name of the injected sine D on motor `axis` (rows' input of the responses to it)."""
+    return f"injection_R{axis}"
+
+
+def command_signal(axis: str) -> str:
+    """The recorded computed voltage of motor `axis`: A = U + D during an injection."""
+    return f"u_R{axis}_cmd"
+
+
+class InjectingController:
+    """The scene's controller with `amplitude sin(2 pi f t_k)` added to motor `axis`'s computed voltage.
+
+    The sine is added to what the controller returns at t_k (after its own clamp and anti-windup, which
+    see only its own output U), so the master records A = U + D as the command and delays and holds A
+    like any command. Everything else (prepare, start, the references it records) is the wrapped
+    controller's: it behaves as in the scene. Being no built-in class, it runs in the Python loop."""
+
+    kind = "injection"
+
+    def __init__(self, controller, axis: str, amplitude: float, frequency_hz: float):
+        if axis not in MOTOR_AXES:
+            raise SceneError(f"injection axis must be '1' or '2', got {axis!r}")
+        self.controller = controller
+        self.index = int(axis) - 1
+        self.amplitude = float(amplitude)
+        self.w = 2 * math.pi * float(frequency_hz)
+
+    def injection(self, t):
+        """D at the time(s) t: the same expression the loop adds, for the analysis to subtract."""
+        return self.amplitude * np.sin(self.w * np.asarray(t, float))
+
+    @property
+    def reference(self):
+        return self.controller.reference
+
+    @property
+    def u_limit(self):
+        return self.controller.u_limit
+
+    def prepare(self, times, h, attitude, rates) -> None:
+        self.controller.prepare(times, h, attitude, rates)
+
+    def start(self, step_size: float, scene_name: str) -> None:
+        self.controller.start(step_size, scene_name)
+
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
+        u = list(self.controller(t, h, alpha, beta, gyro, base_attitude, base_rates, step=step))
+        u[self.index] += self.amplitude * math.sin(self.w * t)
+        return tuple(u)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -109,6 +181,8 @@ def _scene_for(scene, excitation: Excitation, f: float, stop_time: float, fideli
         merged = dict(scene.fidelity)
         merged.update(fidelity)
         changes["fidelity"] = merged
+    if excitation.kind == "injection":   # the loop gain at the operating point of a carrier at rest
+        changes["base_motion_spec"] = {"type": "fixed"}
     if excitation.kind == "base":
         changes["base_motion_spec"] = {
             "type": "sinusoids",
@@ -119,23 +193,20 @@ def _scene_for(scene, excitation: Excitation, f: float, stop_time: float, fideli
 
 def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: Dwell = Dwell(),
                   outputs: list[str] | None = None, fidelity: dict | None = None, slave=None, log=None) -> list[dict]:
-    """One sine dwell at `frequency`: one row per output (and 'los' for a base excitation)."""
-    from .controllers import Replay
+    """One sine dwell at `frequency`: one row per output (and 'los' for a base excitation; for an
+    injection first 'loop_gain' = -U / A, input u_R<axis>_cmd, coherence that of U, and 'sensitivity' =
+    A / D, then the outputs per D, input injection_R<axis>)."""
     from .master import run
 
     h = scene.step_size
     f, n_settle, n_measure = snapped_grid(frequency, h, dwell)
     n = n_settle + n_measure
     run_scene = _scene_for(scene, excitation, f, n * h, fidelity)
-    controller = None
-    if excitation.kind == "voltage":
-        t = np.arange(n + 1) * h
-        voltages = np.zeros((n + 1, 2))
-        # the command at t_k is applied delay steps later: its phase does not matter, u_R<j> is measured
-        voltages[:, int(excitation.axis) - 1] = excitation.offset + excitation.amplitude * np.sin(2 * math.pi * f * t)
-        controller = Replay(voltages)
+    controller = _controller_for(run_scene, fmu, excitation, f, n)
     result = run(run_scene, fmu, controller=controller, slave=slave, log=log)
-    sig = result.signals
+    sig = dict(result.signals)
+    if excitation.kind == "injection":
+        sig[excitation.input_signal] = controller.injection(sig["time"])
     window = slice(n_settle, n_settle + n_measure)
     t = sig["time"][window]
     u = np.asarray(sig[excitation.input_signal])[window]
@@ -149,15 +220,13 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
     common = dict(frequency_hz=f, requested_hz=frequency, input=excitation.input_signal,
                   input_amplitude=abs(U), samples_per_period=1.0 / (f * h), settle_s=n_settle * h,
                   measure_periods=dwell.measure_periods, current_limited_fraction=float(limited.mean()))
-    rows, gains = [], {}
+    rows = _injection_rows(common, sig, window, t, f, excitation.axis, U) if excitation.kind == "injection" else []
+    gains = {}
     for name in outputs or excitation.default_outputs():
         y = np.asarray(sig[name])[window]
         Y = fundamental(y, t, f)
-        G = Y / U
-        gains[name] = G
-        rows.append(dict(common, output=name, gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
-                         phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=power_fraction(y, Y),
-                         output_amplitude=abs(Y), output_mean=float(np.mean(y)), output_variance=float(np.var(y))))
+        gains[name] = Y / U
+        rows.append(_gain_row(common, name, Y / U, y, Y))
     if excitation.kind == "base" and all(name in gains for name in LOS_OUTPUTS):
         g = math.sqrt(sum(abs(gains[name]) ** 2 for name in LOS_OUTPUTS))
         parts = [r for r in rows if r["output"] in LOS_OUTPUTS]
@@ -167,6 +236,43 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
                          coherence=sum(r["output_amplitude"] ** 2 / 2 for r in parts) / total_var if total_var > 0 else math.nan,
                          output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var))
     return rows
+
+
+def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
+    """The controller of the run: None (the scene's own), Replay of the sine (voltage), or the scene's
+    own wrapped by InjectingController (injection)."""
+    from .controllers import Replay
+    from .scene import parameter_value
+
+    h = run_scene.step_size
+    if excitation.kind == "voltage":
+        t = np.arange(n + 1) * h
+        voltages = np.zeros((n + 1, 2))
+        # the command at t_k is applied delay steps later: its phase does not matter, u_R<j> is measured
+        voltages[:, int(excitation.axis) - 1] = excitation.offset + excitation.amplitude * np.sin(2 * math.pi * f * t)
+        return Replay(voltages)
+    if excitation.kind == "injection":
+        u_limit = tuple(float(parameter_value(run_scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+        return InjectingController(run_scene.controller(u_limit), excitation.axis, excitation.amplitude, f)
+    return None
+
+
+def _gain_row(common: dict, output: str, G: complex, y: np.ndarray, Y: complex, **extra) -> dict:
+    """A row of gain G for `output` whose samples over the window are y, fundamental Y."""
+    return dict(common, output=output, gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=power_fraction(y, Y),
+                output_amplitude=abs(Y), output_mean=float(np.mean(y)), output_variance=float(np.var(y)), **extra)
+
+
+def _injection_rows(common: dict, sig: dict, window: slice, t: np.ndarray, f: float, axis: str, D: complex) -> list:
+    """'loop_gain' = -U / A (A = the recorded command, U = A - D the controller's own output; all samples
+    at t_k, so no hold correction: the prediction is of samples too) and 'sensitivity' = A / D."""
+    a = np.asarray(sig[command_signal(axis)])[window]
+    d = np.asarray(sig[injection_signal(axis)])[window]
+    u = a - d
+    A, U = fundamental(a, t, f), fundamental(u, t, f)
+    loop_gain = _gain_row(dict(common, input=command_signal(axis), input_amplitude=abs(A)), LOOP_GAIN, -U / A, u, U)
+    return [loop_gain, _gain_row(common, SENSITIVITY, A / D, a, A)]
 
 
 # -- the linear model's prediction ------------------------------------------------------------------

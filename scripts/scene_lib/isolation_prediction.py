@@ -291,13 +291,22 @@ def controller_matrices(loop: IsolationLoop, axis: str, z: complex, w: float):
     """u = feedback @ y + feedforward * G: y the LOOP_OUTPUTS samples, G the carrier angle phasor."""
     azimuth, elevation = loop.axes
     c_az, c_el = azimuth.error_transfer(z, loop.h), elevation.error_transfer(z, loop.h)
-    # rows u_R1, u_R2; columns alpha, beta, los.omega[1], los.omega[3]; gyro_axis_rates: (w3 / cos beta, w1)
-    feedback = np.array([[-c_az, 0.0, 0.0, -azimuth.k_gyro / loop.cos_beta],
-                         [0.0, -c_el, -elevation.k_gyro, 0.0]], complex)
+    feedback = feedback_matrix(loop, z)
     sensitivity = loop.reference_jacobian[:, CARRIER_ANGLE_INDEX[axis]]
     feedforward = np.array([(c_az + azimuth.k_ff * 1j * w) * sensitivity[0],
                             (c_el + elevation.k_ff * 1j * w) * sensitivity[1]])
     return feedback, feedforward
+
+
+def feedback_matrix(loop: IsolationLoop, z: complex) -> np.ndarray:
+    """K(z), 2 x 4: the controllers' outputs (u_R1, u_R2 computed at t_k) per LOOP_OUTPUTS samples at t_k
+    (references at rest). The PID acts on e = reference - angle and on -k_gyro times gyro_axis_rates
+    (w3 / cos beta, w1), linearized at the operating beta."""
+    azimuth, elevation = loop.axes
+    c_az, c_el = azimuth.error_transfer(z, loop.h), elevation.error_transfer(z, loop.h)
+    # rows u_R1, u_R2; columns alpha, beta, los.omega[1], los.omega[3]
+    return np.array([[-c_az, 0.0, 0.0, -azimuth.k_gyro / loop.cos_beta],
+                     [0.0, -c_el, -elevation.k_gyro, 0.0]], complex)
 
 
 def isolation_gains(loop: IsolationLoop, axis: str, frequencies) -> dict:
@@ -343,3 +352,155 @@ def isolation_lines(loop: IsolationLoop, axis: str, f_min: float, f_max: float, 
     f = np.logspace(math.log10(f_min), math.log10(f_max), points)
     gains = isolation_gains(loop, axis, f)
     return [(f"{LINEAR_CURVE}: {name}", f, gains[name], name != "los") for name in LOS_OUTPUTS + ["los"]]
+
+
+# -- the loop gain broken at one motor's computed voltage (voltage injection) -------------------------
+
+MOTOR_AXES = ("1", "2")
+
+
+def _check_motor_axis(axis: str) -> int:
+    if axis not in MOTOR_AXES:
+        raise SceneError(f"injection axis must be motor '1' or '2', got {axis!r}")
+    return int(axis) - 1
+
+
+def return_matrix(loop: IsolationLoop, z: complex) -> np.ndarray:
+    """G(z) = K(z) P(z), 2 x 2: the controllers' outputs U per computed voltages A (both at t_k), with
+    P = voltage_transfer (A -> LOOP_OUTPUTS: hold, delay, plant) and K = feedback_matrix. The loop closed
+    on both axes is A = U = G A; with an injection D on axis j, A = G A + e_j D."""
+    return feedback_matrix(loop, z) @ voltage_transfer(loop, z)
+
+
+def loop_gain(loop: IsolationLoop, axis: str, z: complex) -> complex:
+    """L_j(z): the loop gain broken at motor `axis`'s computed voltage, the other axis's loop closed.
+
+    With G = K P (return_matrix), j the broken axis and i the other: the other loop closed means
+    A_i = U_i = G_ii A_i + G_ij A_j, so A_i = G_ij A_j / (1 - G_ii), and the broken axis's controller
+    answers A_j with U_j = G_jj A_j + G_ji A_i. Hence
+        L_j = -U_j / A_j = -(G_jj + G_ji G_ij / (1 - G_ii)).
+    The sign: the loop is U = -L A, a negative feedback loop of gain L, as the textbook's 1 + L = 0.
+    The injection closes A_j = U_j + D: A_j / D = 1 / (1 + L_j) = [(I - G)^-1]_jj (the Schur
+    complement of the 2 x 2 return difference; injection_sensitivity computes it that way)."""
+    j = _check_motor_axis(axis)
+    i = 1 - j
+    G = return_matrix(loop, z)
+    return complex(-(G[j, j] + G[j, i] * G[i, j] / (1.0 - G[i, i])))
+
+
+def injection_sensitivity(loop: IsolationLoop, axis: str, z: complex) -> complex:
+    """A_j / D with both loops closed: [(I - G)^-1]_jj, computed directly (not through loop_gain)."""
+    j = _check_motor_axis(axis)
+    G = return_matrix(loop, z)
+    return complex(np.linalg.solve(np.eye(2) - G, np.eye(2)[:, j])[j])
+
+
+def injection_response(loop: IsolationLoop, axis: str, z: complex) -> np.ndarray:
+    """LOOP_OUTPUTS samples per injected D on motor `axis`, both loops closed: P (I - G)^-1 e_j."""
+    j = _check_motor_axis(axis)
+    G = return_matrix(loop, z)
+    return voltage_transfer(loop, z) @ np.linalg.solve(np.eye(2) - G, np.eye(2)[:, j])
+
+
+def loop_gain_gains(loop: IsolationLoop, axis: str, frequencies) -> dict:
+    """{output: complex gains per frequency}: 'loop_gain' (L_j), 'sensitivity' (A_j / D) and the LOS rate
+    that motor moves (los.omega[3] for 1, los.omega[1] for 2) per D: the rows measure_point gives for
+    Excitation('injection', axis, ...)."""
+    from .frequency_response import INJECTION_OUTPUTS, LOOP_GAIN, SENSITIVITY
+
+    outputs = INJECTION_OUTPUTS[axis]
+    gains = {name: [] for name in [LOOP_GAIN, SENSITIVITY] + outputs}
+    for f in np.atleast_1d(np.asarray(frequencies, float)):
+        z = _unit_circle(f, loop.h)
+        gains[LOOP_GAIN].append(loop_gain(loop, axis, z))
+        gains[SENSITIVITY].append(injection_sensitivity(loop, axis, z))
+        response = injection_response(loop, axis, z)
+        for name in outputs:
+            gains[name].append(response[LOOP_OUTPUTS.index(name)])
+    return {name: np.array(values, complex) for name, values in gains.items()}
+
+
+def loop_gain_rows(loop: IsolationLoop, axis: str, frequencies) -> list[dict]:
+    """Rows in frequency_response's CSV format (curve LINEAR_CURVE, coherence 1), inputs as measure_point's
+    for an injection: loop_gain per u_R<axis>_cmd, the others per injection_R<axis>."""
+    from .frequency_response import LOOP_GAIN, command_signal, injection_signal
+
+    gains = loop_gain_gains(loop, axis, frequencies)
+    rows = []
+    for index, f in enumerate(np.atleast_1d(np.asarray(frequencies, float))):
+        for name, values in gains.items():
+            G = complex(values[index])
+            rows.append(dict(curve=LINEAR_CURVE, output=name, requested_hz=float(f), frequency_hz=float(f),
+                             input=command_signal(axis) if name == LOOP_GAIN else injection_signal(axis),
+                             gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                             phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=1.0))
+    return rows
+
+
+def loop_gain_lines(loop: IsolationLoop, axis: str, f_min: float, f_max: float, points: int = 400) -> list:
+    """Dense lines for plot_bode: [(label, frequencies, G), ...] of loop_gain_gains."""
+    f = np.logspace(math.log10(f_min), math.log10(f_max), points)
+    return [(f"{LINEAR_CURVE}: {name}", f, G) for name, G in loop_gain_gains(loop, axis, f).items()]
+
+
+@dataclasses.dataclass(frozen=True)
+class StabilityMargins:
+    """Classical margins of a negative-feedback loop gain L (NaN where there is no such crossing)."""
+    crossover_hz: float        # |L| = 1
+    phase_margin_deg: float    # 180 deg + the phase of L there, in (-180, 180]
+    phase_crossover_hz: float  # phase of L = -180 deg (L crosses the negative real axis)
+    gain_margin_db: float      # -20 log10 |L| there: how much more gain makes the loop marginal
+
+    def describe(self) -> str:
+        return (f"crossover {self.crossover_hz:.4g} Hz, phase margin {self.phase_margin_deg:.3g} deg; "
+                f"-180 deg at {self.phase_crossover_hz:.4g} Hz, gain margin {self.gain_margin_db:.3g} dB")
+
+
+def stability_margins(frequencies, L) -> StabilityMargins:
+    """Margins of the loop gain L sampled on an increasing, dense `frequencies` grid (Hz).
+
+    Crossings are located between grid points by linear interpolation in log frequency (of log |L| for
+    the gain crossover, of the phase of -L for the phase crossover; the phase at the gain crossover is
+    interpolated on the unwrapped phase). Of several crossings the worst is reported: the gain crossover
+    with the smallest |phase margin| and the phase crossover with the smallest |gain margin| in dB (a
+    resonance may cross twice). A -180 deg crossing is one where the phase of -L passes 0 (L on the
+    negative real axis), not a jump of the wrapped phase at +-180 deg of -L."""
+    f = np.asarray(frequencies, float)
+    L = np.asarray(L, complex)
+    if f.ndim != 1 or f.shape != L.shape or len(f) < 2 or np.any(np.diff(f) <= 0) or np.any(f <= 0):
+        raise SceneError("stability_margins needs increasing positive frequencies and one L value each")
+    x = np.log(f)
+    magnitude = np.log(np.maximum(np.abs(L), 1e-300))
+    phase = np.unwrap(np.angle(L))
+    crossings = []
+    for k in np.flatnonzero(np.sign(magnitude[:-1]) * np.sign(magnitude[1:]) <= 0):
+        if magnitude[k] == magnitude[k + 1]:
+            continue
+        s = magnitude[k] / (magnitude[k] - magnitude[k + 1])
+        angle = phase[k] + s * (phase[k + 1] - phase[k])
+        margin = (math.degrees(angle) + 180.0 + 180.0) % 360.0 - 180.0   # (-180, 180]: wrapped 180 + phase
+        crossings.append((abs(margin), math.exp(x[k] + s * (x[k + 1] - x[k])), margin))
+    negative_phase = np.angle(-L)           # 0 where L is on the negative real axis
+    phase_crossings = []
+    for k in np.flatnonzero(np.sign(negative_phase[:-1]) * np.sign(negative_phase[1:]) <= 0):
+        a, b = negative_phase[k], negative_phase[k + 1]
+        if abs(a - b) > math.pi or a == b:   # a wrap at +-180 deg of -L: L crossing the positive real axis
+            continue
+        s = a / (a - b)
+        gain_db = -20.0 / math.log(10.0) * (magnitude[k] + s * (magnitude[k + 1] - magnitude[k]))
+        phase_crossings.append((abs(gain_db), math.exp(x[k] + s * (x[k + 1] - x[k])), gain_db))
+    crossover_hz, phase_margin = min(crossings)[1:] if crossings else (math.nan, math.nan)
+    phase_crossover_hz, gain_margin = min(phase_crossings)[1:] if phase_crossings else (math.nan, math.nan)
+    return StabilityMargins(float(crossover_hz), float(phase_margin), float(phase_crossover_hz), float(gain_margin))
+
+
+def predicted_margins(loop: IsolationLoop, axis: str, f_min: float = 0.01, f_max: float | None = None,
+                      points: int = 20000) -> StabilityMargins:
+    """stability_margins of loop_gain on a dense log grid up to Nyquist (default)."""
+    f_max = f_max or 0.5 / loop.h * 0.999
+    f = np.logspace(math.log10(f_min), math.log10(f_max), points)
+    return stability_margins(f, [loop_gain(loop, axis, _unit_circle(each, loop.h)) for each in f])
+
+
+def _unit_circle(frequency_hz: float, h: float) -> complex:
+    return complex(math.cos(2 * math.pi * frequency_hz * h), math.sin(2 * math.pi * frequency_hz * h))
