@@ -166,6 +166,9 @@ def test_the_injecting_controller_is_the_scenes_controller_plus_the_sine(scene, 
         u, v = inner(*args, step=k), wrapped(*args, step=k)
         assert v[0] == u[0] and v[1] == pytest.approx(u[1] + 0.3 * math.sin(2 * math.pi * 5.0 * t), abs=1e-15)
         assert wrapped.reference == inner.reference
+    from scene_lib.master import choose_loop
+
+    assert choose_loop(wrapped, None) == "python"   # the compiled loop stays as it is
     with pytest.raises(SceneError, match="'3'"):
         InjectingController(inner, "3", 0.3, 5.0)
     with pytest.raises(ValueError, match="axis '1' or '2'"):

@@ -34,6 +34,10 @@ hold's aliases; this form has no such neglect.)
 
 Gains are referred to the carrier RATE sample phasor (j w G), as measure_point does (output
 fundamental / fundamental of the sampled base.<axis>_dot); "los" is sqrt(|G1|^2 + |G3|^2), no phase.
+
+The same loop broken at one motor's computed voltage gives the loop gain a voltage injection measures
+(Excitation("injection", ...)): loop_gain, injection_sensitivity, injection_response, loop_gain_rows /
+loop_gain_lines, and the classical margins of a sampled L (stability_margins, predicted_margins).
 """
 from __future__ import annotations
 
