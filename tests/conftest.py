@@ -50,3 +50,23 @@ def client():
     yield client
     client.close()
     cluster.close()
+
+
+@pytest.fixture(scope="session")
+def ship_scene():
+    """scenes/ship_stabilization.toml: the PID loop the linear predictions (scene_lib.isolation_prediction)
+    are checked on; they assume ideal sensors."""
+    from scene_lib import load_scene
+
+    scene = load_scene(REPO_ROOT / "scenes" / "ship_stabilization.toml")
+    assert scene.sensors().ideal, "the prediction assumes ideal sensors"
+    return scene
+
+
+@pytest.fixture(scope="session")
+def ship_linear_loop(ship_scene, gimbal_fmu):
+    """The ship loop's linear sampled-data model without backlash and dry friction."""
+    from scene_lib import isolation_prediction
+    from scene_lib.frequency_response import LINEAR_FIDELITY
+
+    return isolation_prediction.build_loop(ship_scene, gimbal_fmu, LINEAR_FIDELITY)

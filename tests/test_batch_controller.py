@@ -2,7 +2,6 @@
 steps the cases of a task together, one step() call for all. Checked against the scalar form of
 the same controller case by case, with a failing case inside a batch, with a class returning the
 wrong shape, and serial against Dask."""
-import math
 import pathlib
 
 import numpy as np

@@ -3,17 +3,14 @@ sine dwell of the nonlinear FMU in the ship-stabilization scene's own PID loop (
 delay_steps = 1), without backlash and dry friction and at a small carrier rate (0.1 deg/s)."""
 import dataclasses
 import math
-import pathlib
 
 import numpy as np
 import pytest
 
-from scene_lib import load_scene
 from scene_lib.errors import SceneError
-from scene_lib.frequency_response import LINEAR_CURVE, LINEAR_FIDELITY, Dwell, Excitation, measure_point
+from scene_lib.frequency_response import LINEAR_CURVE, LINEAR_FIDELITY, Dwell, Excitation, prediction_errors, sweep
 from scene_lib import isolation_prediction
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
 FREQUENCIES_HZ = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0)
 RATE_AMPLITUDE = math.radians(0.1)     # rad/s: small enough to stay linear, large against the solver's tolerance
 DWELL = Dwell(settle_periods=3, settle_s=1.0, measure_periods=1)
@@ -21,38 +18,21 @@ OUTPUTS = ("los.omega[1]", "los.omega[3]", "los")
 
 
 @pytest.fixture(scope="module")
-def scene():
-    scene = load_scene(REPO / "scenes" / "ship_stabilization.toml")
-    assert scene.sensors().ideal, "the prediction assumes ideal sensors"
-    return scene
-
-
-@pytest.fixture(scope="module")
-def loop(scene, gimbal_fmu):
-    return isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+def loop(ship_linear_loop):
+    return ship_linear_loop
 
 
 @pytest.fixture(scope="module", params=["roll", "pitch"])
-def dwell_rows(request, scene, gimbal_fmu):
+def dwell_rows(request, ship_scene, fmu_path):
     """(axis, simulated rows) of a sweep over FREQUENCIES_HZ."""
     axis = request.param
-    rows = []
-    for f in FREQUENCIES_HZ:
-        rows += measure_point(scene, gimbal_fmu, f, Excitation("base", axis, RATE_AMPLITUDE), DWELL,
-                              fidelity=LINEAR_FIDELITY)
-    return axis, rows
+    return axis, sweep(ship_scene, fmu_path, FREQUENCIES_HZ, Excitation("base", axis, RATE_AMPLITUDE), DWELL,
+                       fidelity=LINEAR_FIDELITY)
 
 
 def relative_errors(loop, axis: str, rows: list[dict]) -> list[tuple]:
     """(row, gain ratio - 1, phase difference in deg (NaN for 'los')) of each simulated row against `loop`."""
-    out = []
-    for row in rows:
-        predicted = isolation_prediction.isolation_gains(loop, axis, [row["frequency_hz"]])[row["output"]][0]
-        gain_error = row["gain"] / abs(predicted) - 1
-        phase_error = math.nan if row["output"] == "los" else \
-            (row["phase_deg"] - math.degrees(np.angle(predicted)) + 180) % 360 - 180
-        out.append((row, gain_error, phase_error))
-    return out
+    return prediction_errors(rows, lambda output, f: isolation_prediction.isolation_gains(loop, axis, [f])[output][0])
 
 
 def test_prediction_matches_the_simulated_isolation_from_0p1_to_100_hz(loop, dwell_rows):
@@ -101,12 +81,12 @@ def test_a_wrong_loop_misses_the_simulation(loop, dwell_rows, mistake):
     assert worst > 0.05
 
 
-def test_rows_and_lines(scene, gimbal_fmu, tmp_path):
+def test_rows_and_lines(ship_scene, gimbal_fmu, tmp_path):
     """Rows in the CSV format of frequency_response (the 'los' row without phase) and dense lines that
     plot_bode draws."""
     from scene_lib.frequency_response import plot_bode, write_csv
 
-    loop = isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+    loop = isolation_prediction.build_loop(ship_scene, gimbal_fmu, LINEAR_FIDELITY)
     rows = isolation_prediction.isolation_rows(loop, "roll", [1.0, 10.0])
     assert [(r["output"], r["frequency_hz"]) for r in rows] == [(o, f) for f in (1.0, 10.0) for o in OUTPUTS]
     assert all(r["curve"] == LINEAR_CURVE and r["input"] == "base.gamma_dot" and r["coherence"] == 1.0 for r in rows)
@@ -124,11 +104,11 @@ def test_rows_and_lines(scene, gimbal_fmu, tmp_path):
     assert (tmp_path / "iso.png").stat().st_size > 0
 
 
-def test_other_controllers_are_refused(scene, gimbal_fmu):
-    none = scene.with_changes(controller_spec={"type": "none"})
+def test_other_controllers_are_refused(ship_scene, gimbal_fmu):
+    none = ship_scene.with_changes(controller_spec={"type": "none"})
     with pytest.raises(SceneError, match="PID controller only"):
         isolation_prediction.build_loop(none, gimbal_fmu, LINEAR_FIDELITY)
-    loop = isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+    loop = isolation_prediction.build_loop(ship_scene, gimbal_fmu, LINEAR_FIDELITY)
     with pytest.raises(SceneError, match="roll, pitch or yaw"):
         isolation_prediction.isolation_rows(loop, "heave", [1.0])
 
@@ -156,10 +136,10 @@ def test_the_closed_loop_poles_are_where_the_frequency_domain_loop_is_singular(l
     assert singular[-1] > 1e-3 * singular[0]
 
 
-def test_a_loop_that_does_not_settle_is_refused(scene, gimbal_fmu):
+def test_a_loop_that_does_not_settle_is_refused(ship_scene, gimbal_fmu):
     """k_gyro = 32 excites the azimuth gear's resonance: the simulated loop ends current-limited, and no
     isolation ratio is predicted for it."""
-    spec = dict(scene.controller_spec)
+    spec = dict(ship_scene.controller_spec)
     spec["azimuth"] = dict(spec["azimuth"], k_gyro=32.0)
     with pytest.raises(SceneError, match="does not come to rest"):
-        isolation_prediction.build_loop(scene.with_changes(controller_spec=spec), gimbal_fmu, LINEAR_FIDELITY)
+        isolation_prediction.build_loop(ship_scene.with_changes(controller_spec=spec), gimbal_fmu, LINEAR_FIDELITY)

@@ -1,6 +1,5 @@
 """The linear model A, B, C, D (scene_lib.linearization, through libgimbal_probe.so) against the FMU itself,
 and against the textbook transfer function of a single rigid axis with a quasi-static motor."""
-import cmath
 import math
 
 import numpy as np

@@ -6,53 +6,36 @@ import cmath
 import csv
 import dataclasses
 import math
-import pathlib
 
 import numpy as np
 import pytest
 
-from scene_lib import isolation_prediction, load_scene
+from scene_lib import isolation_prediction
 from scene_lib.errors import SceneError
 from scene_lib.frequency_response import (LINEAR_CURVE, LINEAR_FIDELITY, LOOP_GAIN, SENSITIVITY, Dwell, Excitation,
-                                          InjectingController, measure_point)
+                                          InjectingController, prediction_errors, sweep)
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
 FREQUENCIES_HZ = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0)
 INJECTION_V = 0.05       # small: the gimbal moves by micro-radians, the loop stays linear
 DWELL = Dwell(settle_periods=1, settle_s=1.0, measure_periods=1)
 
 
 @pytest.fixture(scope="module")
-def scene():
-    scene = load_scene(REPO / "scenes" / "ship_stabilization.toml")
-    assert scene.sensors().ideal, "the prediction assumes ideal sensors"
-    return scene
-
-
-@pytest.fixture(scope="module")
-def loop(scene, gimbal_fmu):
-    return isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+def loop(ship_linear_loop):
+    return ship_linear_loop
 
 
 @pytest.fixture(scope="module", params=["1", "2"])
-def dwell_rows(request, scene, gimbal_fmu):
+def dwell_rows(request, ship_scene, fmu_path):
     """(motor axis, simulated rows) of an injection sweep over FREQUENCIES_HZ."""
     axis = request.param
-    rows = []
-    for f in FREQUENCIES_HZ:
-        rows += measure_point(scene, gimbal_fmu, f, Excitation("injection", axis, INJECTION_V), DWELL,
-                              fidelity=LINEAR_FIDELITY)
-    return axis, rows
+    return axis, sweep(ship_scene, fmu_path, FREQUENCIES_HZ, Excitation("injection", axis, INJECTION_V), DWELL,
+                       fidelity=LINEAR_FIDELITY)
 
 
 def errors_against(loop, axis: str, rows: list[dict]) -> list[tuple]:
     """(row, gain ratio - 1, phase difference in deg) of each simulated row against `loop`'s prediction."""
-    out = []
-    for row in rows:
-        predicted = isolation_prediction.loop_gain_gains(loop, axis, [row["frequency_hz"]])[row["output"]][0]
-        phase_error = (row["phase_deg"] - math.degrees(cmath.phase(predicted)) + 180) % 360 - 180
-        out.append((row, row["gain"] / abs(predicted) - 1, phase_error))
-    return out
+    return prediction_errors(rows, lambda output, f: isolation_prediction.loop_gain_gains(loop, axis, [f])[output][0])
 
 
 def test_measured_loop_gain_matches_the_prediction_from_0p1_to_100_hz(loop, dwell_rows):
@@ -152,10 +135,10 @@ def test_margins_of_textbook_loops():
         isolation_prediction.stability_margins(f[::-1], K / s[::-1])
 
 
-def test_the_injecting_controller_is_the_scenes_controller_plus_the_sine(scene, gimbal_fmu):
+def test_the_injecting_controller_is_the_scenes_controller_plus_the_sine(ship_scene, gimbal_fmu):
     """Same references and outputs as the wrapped controller on the same inputs, plus D on one axis only;
     a bad axis named."""
-    inner, twin = scene.controller((24.0, 24.0)), scene.controller((24.0, 24.0))
+    inner, twin = ship_scene.controller((24.0, 24.0)), ship_scene.controller((24.0, 24.0))
     wrapped = InjectingController(twin, "2", 0.3, 5.0)
     times = np.arange(3) * 1e-3
     for c in (inner, wrapped):
@@ -175,12 +158,17 @@ def test_the_injecting_controller_is_the_scenes_controller_plus_the_sine(scene, 
         Excitation("injection", "roll", 0.1)
 
 
-def test_command_writes_rows_and_plot(tmp_path):
-    import frequency_response as command
+def test_command_writes_rows_and_plot(fmu_path, tmp_path):
+    import importlib.util
+    import pathlib
 
+    script = pathlib.Path(__file__).resolve().parents[1] / "scripts" / "frequency_response.py"
+    spec = importlib.util.spec_from_file_location("frequency_response_command", script)
+    command = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(command)
     assert command.main(["loop-gain", "--axis", "2", "--amplitude", "0.05", "--points", "2", "--fmin", "3",
                          "--fmax", "30", "--linear-only", "--serial", "--settle-s", "1", "--measure-periods", "1",
-                         "--out", str(tmp_path), "--name", "lg"]) == 0
+                         "--fmu", str(fmu_path), "--out", str(tmp_path), "--name", "lg"]) == 0
     with open(tmp_path / "lg.csv") as f:
         rows = list(csv.DictReader(f))
     curves = {(r["curve"], r["output"]) for r in rows}

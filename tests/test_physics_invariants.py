@@ -1,6 +1,5 @@
 """Physical invariants of the integrated FMU: energy, Galilean invariance, convergence."""
 import numpy as np
-import pytest
 
 from scene_lib.fmu import STATES, simulate
 

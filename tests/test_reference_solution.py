@@ -1,6 +1,5 @@
 """A closed-loop scene on a moving base against an independent high-accuracy solution."""
 import numpy as np
-import pytest
 
 from scene_lib.fmu import STATES, simulate
 from reference_model import ReferenceModel

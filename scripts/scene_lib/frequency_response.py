@@ -311,6 +311,19 @@ def linear_rows(model, rows: list[dict]) -> list[dict]:
     return out
 
 
+def prediction_errors(rows: list[dict], predicted) -> list[tuple]:
+    """(row, gain ratio - 1, phase difference in deg) of each measured row against `predicted(output,
+    frequency_hz)`, a complex gain; the phase difference is wrapped to +-180 and NaN where the row has no
+    phase (the combined 'los')."""
+    out = []
+    for row in rows:
+        G = complex(predicted(row["output"], row["frequency_hz"]))
+        phase = math.nan if math.isnan(row["phase_deg"]) else \
+            (row["phase_deg"] - math.degrees(math.atan2(G.imag, G.real)) + 180) % 360 - 180
+        out.append((row, row["gain"] / abs(G) - 1, phase))
+    return out
+
+
 def linear_lines(model, input_signal: str, outputs: list[str], f_min: float, f_max: float, points: int = 400) -> list:
     """Dense Bode lines of the linear model for plot_bode: [(label, frequencies, complex G), ...] (a 4th
     element False marks a line without phase)."""

@@ -12,7 +12,6 @@ With a fixed base the base inputs are never set (they stay 0).
 """
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
