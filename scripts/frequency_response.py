@@ -60,6 +60,17 @@ def with_overrides(scene, assignments: list[str]):
     return scene.with_changes(fidelity=fidelity, parameters=parameters)
 
 
+def check_arguments(args) -> None:
+    """What argparse cannot say: ranges."""
+    if not (args.fmin > 0 and args.fmax >= args.fmin):
+        raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
+    if args.points < 1:
+        raise SceneError(f"--points {args.points}: need at least 1")
+    for amplitude in args.amplitude or []:
+        if not (amplitude > 0 and math.isfinite(amplitude)):
+            raise SceneError(f"--amplitude {amplitude:g}: need a positive amplitude")
+
+
 def unit_of(mode: str) -> str:
     """The unit of --amplitude."""
     return "deg/s" if mode == "isolation" else "V"
@@ -146,6 +157,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     try:
+        check_arguments(args)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
             scene = load_scene(args.scene)
@@ -201,7 +213,7 @@ def main(argv=None) -> int:
                 client.close()
             if cluster is not None:
                 cluster.close()
-    except SceneError as exc:
+    except (SceneError, ValueError) as exc:   # ValueError: an Excitation refusing its axis
         print(f"frequency_response: {exc}", file=sys.stderr)
         return 1
     if predict_rows is not None:

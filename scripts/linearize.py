@@ -5,7 +5,8 @@
 The operating point is the FMU's start values, changed by a scene's parameters, fidelity and initial
 state (--scene) and by --set NAME=VALUE (parameters, fidelity switches, start values of states such as
 beta=0.3, inputs such as u_R1=2 or base.gamma=0.1). With --at-time T the scene is run with its
-controller up to T and the model is linearized where the simulation is then (state, modes, inputs).
+controller up to T and the model is linearized where the simulation is then: its state and modes, the
+voltages applied from T on and the carrier's motion at T (--set may change these inputs).
 
 Writes <out> (.npz or .mat: A, B, C, D, the names of states, inputs and outputs, the modes and the
 point) and prints the states, the modes and the poles. With --bode INPUT:OUTPUT (repeatable) it also
@@ -72,17 +73,39 @@ def scene_point(scene_path: str, fmu_path: str, at_time: float | None, overrides
         if bad:
             raise SceneError(f"--at-time: only inputs can be changed at a running simulation's point, not {bad} "
                              f"(change parameters in the scene)")
+        steps = at_time / scene.step_size
+        if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
+            raise SceneError(f"--at-time {at_time:g}: not a whole number of the scene's steps ({scene.step_size:g} s)")
         scene = scene.with_changes(stop_time=at_time)
         log: list = []
         slave = fmu.instantiate("linearize", log)
         try:
-            run(scene, fmu, slave=slave, log=log)
-            return linearization.linearize_instance(fmu, slave, overrides)
+            signals = run(scene, fmu, slave=slave, log=log).signals
+            return linearization.linearize_instance(fmu, slave, {**inputs_at_end(scene, signals), **overrides})
         finally:
             slave.freeInstance()
 
 
-def write_bode(model, pairs: list[str], stem: pathlib.Path, f_min: float, f_max: float) -> list[pathlib.Path]:
+def inputs_at_end(scene, signals: dict) -> dict:
+    """The inputs of the step that would start at the run's end: the voltages applied from there (the
+    controller's commands of `delay_steps` before) and the carrier's motion there. The instance itself
+    still holds those of the step that ended."""
+    from scene_lib.base_motion import INPUTS as BASE_INPUTS
+
+    inputs = {"u_R1": float(signals["u_R1"][-1]), "u_R2": float(signals["u_R2"][-1])}
+    if not (scene.fidelity.get("base.fixed", False) or scene.base_motion().fixed):
+        inputs.update({name: float(signals[name][-1]) for name in BASE_INPUTS})
+    return inputs
+
+
+def parse_pair(pair: str) -> tuple[str, str]:
+    source, sep, target = pair.partition(":")
+    if not sep or not source or not target:
+        raise SceneError(f"--bode {pair!r}: expected INPUT:OUTPUT, e.g. u_R1:alpha_dot")
+    return source, target
+
+
+def write_bode(model, pairs: list[tuple[str, str]], stem: pathlib.Path, f_min: float, f_max: float) -> list[pathlib.Path]:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -91,11 +114,7 @@ def write_bode(model, pairs: list[str], stem: pathlib.Path, f_min: float, f_max:
     frequencies = np.logspace(math.log10(f_min), math.log10(f_max), 400)
     fig, (ax_g, ax_p) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     rows = []
-    for pair in pairs:
-        source, sep, target = pair.partition(":")
-        if not sep or source not in model.inputs or target not in model.outputs:
-            raise SceneError(f"--bode {pair!r}: expected INPUT:OUTPUT with an input of {model.inputs} and an output "
-                             f"of {model.outputs}")
+    for source, target in pairs:
         G = model.frequency_response(frequencies, source, target)
         gain_db = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
         phase = np.degrees(np.unwrap(np.angle(G)))
@@ -146,18 +165,30 @@ def main(argv=None) -> int:
         overrides = parse_assignments(args.set)
         if args.at_time is not None and args.scene is None:
             raise SceneError("--at-time needs --scene: the run that reaches the operating point")
+        if args.at_time is not None and not (args.at_time > 0 and math.isfinite(args.at_time)):
+            raise SceneError(f"--at-time {args.at_time:g}: need a positive time (s)")
+        if args.bode and not (0 < args.fmin <= args.fmax):
+            raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
+        bode_pairs = [parse_pair(pair) for pair in args.bode]
         if args.scene is not None:
             model = scene_point(args.scene, args.fmu, args.at_time, overrides)
         else:
             model = linearization.linearize(overrides)
+        for source, target in bode_pairs:
+            if source not in model.inputs or target not in model.outputs:
+                raise SceneError(f"--bode '{source}:{target}': expected INPUT:OUTPUT with an input of {model.inputs} "
+                                 f"and an output of {model.outputs}")
         out = pathlib.Path(args.out)
+        if out.suffix not in (".npz", ".mat"):
+            raise SceneError(f"--out {out}: write .npz or .mat")
         out.parent.mkdir(parents=True, exist_ok=True)
         model.save(out)
         written = [out]
-        if args.bode:
-            written += write_bode(model, args.bode, out.with_suffix(""), args.fmin, args.fmax)
+        if bode_pairs:
+            written += write_bode(model, bode_pairs, out.with_suffix(""), args.fmin, args.fmax)
     except SceneError as exc:
-        print(f"linearize: {exc}", file=sys.stderr)
+        text = str(exc)
+        print(text if text.startswith("linearize: ") else f"linearize: {text}", file=sys.stderr)
         return 1
     print(model.summary())
     print("wrote " + ", ".join(str(p) for p in written))

@@ -273,3 +273,18 @@ def test_several_amplitudes_give_a_curve_each(fmu_path, tmp_path):
     # the continuous fundamental of the held sine: the amplitude times the hold's sinc (5 Hz, 1 ms: 0.99959)
     assert amplitude["full model, 2 V"] == pytest.approx(4 * amplitude["full model, 0.5 V"], rel=1e-9)
     assert amplitude["full model, 0.5 V"] == pytest.approx(0.5, rel=1e-3)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["isolation", "--axis", "sideways"], "roll, pitch or yaw"),
+    (["open-loop", "--fmin", "0"], "need 0 < fmin <= fmax"),
+    (["isolation", "--amplitude", "0"], "need a positive amplitude"),
+])
+def test_command_refusals_name_the_culprit_without_a_traceback(fmu_path, tmp_path, args, message):
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), *args, "--serial",
+                          "--fmu", str(fmu_path), "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 1
+    assert message in out.stderr and "Traceback" not in out.stderr, out.stderr

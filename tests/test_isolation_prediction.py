@@ -1,6 +1,7 @@
 """The linear prediction of the closed loop's isolation ratio (scene_lib.isolation_prediction) against the
 sine dwell of the nonlinear FMU in the ship-stabilization scene's own PID loop (ideal sensors, 1 ms step,
 delay_steps = 1), without backlash and dry friction and at a small carrier rate (0.1 deg/s)."""
+import copy
 import dataclasses
 import math
 
@@ -143,3 +144,41 @@ def test_a_loop_that_does_not_settle_is_refused(ship_scene, gimbal_fmu):
     spec["azimuth"] = dict(spec["azimuth"], k_gyro=32.0)
     with pytest.raises(SceneError, match="does not come to rest"):
         isolation_prediction.build_loop(ship_scene.with_changes(controller_spec=spec), gimbal_fmu, LINEAR_FIDELITY)
+
+
+def test_the_operating_point_is_that_of_ideal_sensors_and_decoupling_modes_are_named(ship_scene, ship_linear_loop,
+                                                                                       gimbal_fmu):
+    """Sensor noise and quantization would keep the settling run from ever resting: the operating point is
+    found with ideal sensors, as the prediction assumes, so a noisy scene gets the ideal one's prediction.
+    With the scene's own fidelity the gimbal rests in the backlash gap with the rotors stuck: the voltage
+    does not reach the load, the linear loop has a pole at 1, and the refusal says why."""
+    noisy = ship_scene.with_changes(sensors_spec={"encoder_resolution_deg": 0.01, "imu_attitude_noise_deg": 0.05})
+    loop = isolation_prediction.build_loop(noisy, gimbal_fmu, LINEAR_FIDELITY)
+    for axis in ("roll", "pitch"):
+        noisy_gains = isolation_prediction.isolation_gains(loop, axis, [1.0, 10.0])["los"]
+        ideal_gains = isolation_prediction.isolation_gains(ship_linear_loop, axis, [1.0, 10.0])["los"]
+        assert np.allclose(noisy_gains, ideal_gains, rtol=1e-12)
+    with pytest.raises(SceneError, match=r"gear1.contact = 0.*rotor1.friction = stuck.*without backlash and dry"):
+        isolation_prediction.build_loop(ship_scene, gimbal_fmu, None)
+
+
+@pytest.mark.parametrize("change", ["no delay", "two steps of delay", "filtered derivative"])
+def test_other_delays_and_a_derivative_term_are_predicted_too(ship_scene, gimbal_fmu, change):
+    """The ship loop's own configuration has delay_steps = 1 and kd = 0; the prediction's z^-d and its
+    filtered backward difference are checked on two points each (roll at 3 and 30 Hz), same bar."""
+    spec = copy.deepcopy(ship_scene.controller_spec)
+    if change == "no delay":
+        spec["delay_steps"] = 0
+    elif change == "two steps of delay":
+        spec["delay_steps"] = 2
+    else:
+        for axis in ("azimuth", "elevation"):
+            spec[axis].update(kd=1.0, d_filter_s=0.003)
+    scene = ship_scene.with_changes(controller_spec=spec)
+    loop = isolation_prediction.build_loop(scene, gimbal_fmu, LINEAR_FIDELITY)
+    rows = sweep(scene, gimbal_fmu.path, (3.0, 30.0), Excitation("base", "roll", RATE_AMPLITUDE), DWELL,
+                 fidelity=LINEAR_FIDELITY)
+    for row, gain_error, phase_error in relative_errors(loop, "roll", rows):
+        where = f"{change}: {row['output']} at {row['frequency_hz']:.3g} Hz"
+        assert abs(gain_error) < 0.01, where
+        assert math.isnan(phase_error) or abs(phase_error) < 1.0, where

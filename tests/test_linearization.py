@@ -245,9 +245,14 @@ def test_single_rigid_axis_has_the_textbook_transfer_function(gimbal_fmu):
     assert model.C[model.outputs.index("alpha_m_dot"), rate] == pytest.approx(N, rel=1e-12)
     # a voltage beyond the clamp does not reach the motor
     U_L = float(gimbal_fmu.start("motor1.U_L"))
-    clamped = linearization.linearize({**values, "u_R1": 1.5 * U_L})
-    assert np.all(clamped.B[:, clamped.inputs.index("u_R1")] == 0.0)
-    assert np.all(clamped.D[:, clamped.inputs.index("u_R1")] == 0.0)
+    for voltage, side in ((1.5 * U_L, 1), (U_L, 1), (-U_L, -1)):
+        clamped = linearization.linearize({**values, "u_R1": voltage})
+        assert np.all(clamped.B[:, u] == 0.0) and np.all(clamped.D[:, u] == 0.0), voltage
+        assert clamped.modes["motor1.voltage_clamped"] == side and clamped.modes["motor2.voltage_clamped"] == 0
+    # (the current limit raised: 0.999 U_L / R would be beyond the default i_L, where D is 0 for that reason)
+    just_inside = linearization.linearize({**values, "u_R1": 0.999 * U_L, "motor1.i_L": 10 * U_L / R})
+    assert just_inside.modes["motor1.voltage_clamped"] == 0 and just_inside.modes["motor1.limited"] == 0
+    assert just_inside.D[i, u] == pytest.approx(1 / R, rel=1e-9)
 
 
 def test_python_control_state_space_and_files(tmp_path):
@@ -279,6 +284,8 @@ def test_python_control_state_space_and_files(tmp_path):
     ({"no.such": 1.0}, "'no.such' is not a variable"),
     ({"motor1.R": -1.0}, "motor1.R"),
     ({"alpha": math.nan}, "not finite"),
+    ({"gear1.model": 1.5}, "'gear1.model' is an Integer: 1.5 is not a whole number"),
+    ({"energy.kinetic": 1.0}, "energy.kinetic is a computed output"),
 ])
 def test_bad_points_are_refused_with_the_culprit_named(values, message):
     with pytest.raises(SceneError, match=message):
@@ -286,22 +293,36 @@ def test_bad_points_are_refused_with_the_culprit_named(values, message):
 
 
 def test_a_running_instance_is_linearized_where_it_is_and_left_undisturbed(gimbal_fmu):
+    """linearize_instance at t = 20 ms of a run: the matrices and modes of the same point set up directly,
+    and the run goes on exactly as without the call (the next step's outputs bit for bit, against a replay
+    from an FMU state taken at the same point)."""
     fmu = gimbal_fmu
+    outputs = [name for name in linearization.linearize({}).outputs]
     slave = fmu.instantiate("linearization")
     try:
-        values = {"u_R1": 2.0, "base.fixed": True}
+        values = {"u_R1": 2.0, "u_R2": -1.0, "base.fixed": True}
         start(fmu, slave, values)
         for k in range(20):
             slave.doStep(k * 1e-3, 1e-3)
-        before = fmu.get_values(slave, ["alpha", "alpha_dot", "i_R1"])
+        point = slave.getFMUstate()
+        here = dict(zip(["alpha", "alpha_m", "beta", "beta_m", "alpha_dot", "alpha_m_dot", "beta_dot", "beta_m_dot",
+                         "i_R1", "i_R2", "theta_b1", "theta_b2"],
+                        fmu.get_values(slave, ["alpha", "alpha_m", "beta", "beta_m", "alpha_dot", "alpha_m_dot",
+                                               "beta_dot", "beta_m_dot", "i_R1", "i_R2", "theta_b1", "theta_b2"])))
         model = linearization.linearize_instance(fmu, slave)
         assert model.time == pytest.approx(0.02, abs=1e-15)
         with pytest.raises(SceneError, match="not an input"):
             linearization.linearize_instance(fmu, slave, {"motor1.R": 3.0})
         slave.doStep(0.02, 1e-3)
-        assert fmu.get_values(slave, ["alpha"])[0] != before[0]
+        after_linearizing = fmu.get_values(slave, outputs)
+        slave.setFMUstate(point)
+        slave.doStep(0.02, 1e-3)
+        assert fmu.get_values(slave, outputs) == after_linearizing
+        slave.freeFMUstate(point)
     finally:
         slave.freeInstance()
-    # the same point set up directly: the same matrices
-    direct = linearization.linearize({**values, "alpha": before[0], "alpha_dot": before[1], "i_R1": before[2]})
-    assert np.allclose(direct.A[:4, :4], model.A[:4, :4], rtol=1e-6, atol=1e-9)
+    direct = linearization.linearize({**values, **here})
+    assert direct.modes == model.modes and direct.states == model.states
+    for name in "ABCD":
+        expected, got = getattr(direct, name), getattr(model, name)
+        assert np.allclose(got, expected, rtol=1e-7, atol=1e-9 * np.max(np.abs(expected))), name

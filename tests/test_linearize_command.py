@@ -50,8 +50,16 @@ def test_refusals_name_the_culprit_without_a_traceback(build_dir, fmu_path, tmp_
           "--set", "motor1.R=3"], "only inputs can be changed"),
         (["--out", str(tmp_path / "m.txt")], "write .npz or .mat"),
         (["--bode", "u_R1:nothing"], "--bode 'u_R1:nothing'"),
+        (["--bode", "u_R1"], "expected INPUT:OUTPUT"),
+        (["--bode", "u_R1:alpha_dot", "--fmin", "0"], "need 0 < fmin <= fmax"),
+        (["--scene", str(REPO / "scenes" / "ship_stabilization.toml"), "--at-time", "0.0005", "--fmu",
+          str(fmu_path)], "--at-time 0.0005: not a whole number"),
+        (["--scene", str(REPO / "scenes" / "ship_stabilization.toml"), "--at-time", "-1"], "need a positive time"),
+        (["--set", "gear1.model=1.5"], "is not a whole number"),
     ]
     for args, message in cases:
         out = linearize(build_dir, *args)
         assert out.returncode == 1, args
         assert message in out.stderr and "Traceback" not in out.stderr, (args, out.stderr)
+        assert "linearize: linearize:" not in out.stderr
+    assert not (tmp_path / "m.txt").exists()

@@ -69,11 +69,16 @@ void linearize(const ModelParameters& params, const StepInputs& given_inputs, co
     StepInputs inputs = given_inputs;
     inputs.step_start_time = time;
     inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;
-    // A held voltage beyond its clamp does not reach the motor: its column is 0.
+    // A held voltage at or beyond its clamp does not respond to a small change (at the limit itself,
+    // not to an increase: a saturated controller sits exactly there): its column is 0 and the mode
+    // says clamped, on the side of the limit.
     double voltage_passes[2];
     for (int axis = 0; axis < 2; ++axis) {
-        inputs.voltage[axis] = clamp_voltage(params.motor[axis], inputs.commanded_voltage[axis]);
-        voltage_passes[axis] = std::fabs(inputs.commanded_voltage[axis]) < params.motor[axis].voltage_limit ? 1.0 : 0.0;
+        const double commanded = inputs.commanded_voltage[axis], limit = params.motor[axis].voltage_limit;
+        inputs.voltage[axis] = clamp_voltage(params.motor[axis], commanded);
+        const bool clamped = std::fabs(commanded) >= limit;
+        voltage_passes[axis] = clamped ? 0.0 : 1.0;
+        if (clamped) out.modes.voltage_clamped[axis] = commanded > 0.0 ? 1 : -1;
     }
 
     const BaseKinematics base = base_kinematics_at(params, inputs, time);

@@ -1,5 +1,6 @@
 #include "gimbal/probe_api.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -77,6 +78,14 @@ extern "C" int gimbal_probe_linearize(const GimbalProbeSetting* settings, size_t
         if (setting.type < GIMBAL_REAL || setting.type > GIMBAL_BOOLEAN ||
             !gimbal_variable_info(static_cast<GimbalType>(setting.type), setting.vr, &info))
             return fail(message, message_size, "setting " + std::to_string(k) + " names no variable");
+        if (info.causality == GIMBAL_OUTPUT && info.initial != GIMBAL_INITIAL_EXACT)
+            return fail(message, message_size,
+                        std::string(info.name) + " is a computed output: it has no start value to set");
+        if (setting.type != GIMBAL_REAL &&
+            !(std::nearbyint(setting.value) == setting.value && std::fabs(setting.value) <= 2147483647.0))
+            return fail(message, message_size,
+                        std::string(info.name) + " is " + (setting.type == GIMBAL_INTEGER ? "an Integer" : "a Boolean") +
+                            ": " + std::to_string(setting.value) + " is not a whole number");
         if (snapshot != nullptr && info.causality != GIMBAL_INPUT)
             return fail(message, message_size,
                         std::string(info.name) + " is not an input: at a snapshot's operating point only inputs can change");

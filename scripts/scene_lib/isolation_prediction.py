@@ -41,6 +41,7 @@ loop_gain_lines, and the classical margins of a sampled L (stability_margins, pr
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 
@@ -140,9 +141,12 @@ def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_
 
     merged = dict(scene.fidelity)
     merged.update(fidelity or {})
+    # The prediction's assumptions for the settling run too: ideal sensors (noise and quantization keep a
+    # loop from ever resting) and set points held at their start (a ramp is never at rest).
+    held = scene.with_changes(sensors_spec={}, controller_spec=frozen_references(scene.controller_spec))
     # a slow but stable loop (a low gyro gain) gets a second, longer run before it is refused
     for attempt, duration in enumerate((settle_s, SETTLE_RETRY_FACTOR * settle_s)):
-        at_rest = scene.with_changes(stop_time=duration, fidelity=merged, base_motion_spec={"type": "fixed"})
+        at_rest = held.with_changes(stop_time=duration, fidelity=merged, base_motion_spec={"type": "fixed"})
         signals = run(at_rest, fmu).signals
         problems = rest_problems(signals)
         if not problems:
@@ -155,6 +159,22 @@ def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_
     values.update(merged)
     values.update({name: float(signals[name][-1]) for name in STATES + VOLTAGES if name in signals})
     return values
+
+
+def frozen_references(spec: dict) -> dict:
+    """The controller's spec with each set point given as a table (constant, step, ramp, sine) held at its
+    value at t = 0: they do not depend on the carrier, so they add nothing at its frequency, but a
+    moving one would keep the loop from resting at an operating point."""
+    from .controllers import AXES
+    from .references import Reference
+
+    frozen = copy.deepcopy(spec)
+    for axis in AXES:
+        reference = frozen.get(axis, {}).get("reference", frozen.get("reference"))
+        if isinstance(reference, dict):
+            start = Reference(f"controller.{axis}.reference", reference).at(0.0)
+            frozen.setdefault(axis, {})["reference"] = {"type": "constant", "value_deg": math.degrees(start)}
+    return frozen
 
 
 REST_RATE_RAD_S = 1e-4   # gimbal rates below this at the end of the settling run: the loop holds still
@@ -208,8 +228,14 @@ def build_loop(scene, fmu, fidelity: dict | None) -> IsolationLoop:
                          cos_beta=max(math.cos(beta0), 0.2), h=scene.step_size, delay=scene.delay_steps)
     radius = float(np.max(np.abs(closed_loop_poles(loop))))
     if radius >= 1.0:
+        # in the backlash gap or stuck by friction the voltage does not reach the load: a pole at 1
+        decoupled = [f"{name} = {value}" for name, value in model.modes.items()
+                     if (name.endswith(".contact") and value == 0 and values.get(f"{name.split('.')[0]}.model", 2) == 2)
+                     or (name.endswith(".friction") and value != "none" and not str(value).startswith("slipping"))]
+        why = (f"; at the operating point {', '.join(decoupled)}: linearize without backlash and dry friction "
+               f"(LINEAR_FIDELITY)" if decoupled else "")
         raise SceneError(f"{scene.name}: the linear closed loop is unstable (a pole at |z| = {radius:.6g} >= 1): "
-                         f"it has no steady-state response, hence no isolation ratio")
+                         f"it has no steady-state response, hence no isolation ratio{why}")
     return loop
 
 

@@ -25,6 +25,7 @@ import dataclasses
 import math
 import os
 import pathlib
+import struct
 
 import numpy as np
 
@@ -34,6 +35,7 @@ REAL, INTEGER, BOOLEAN = 0, 1, 2
 INPUT_CAUSALITY = 1
 MAX_STATES, INPUTS, OUTPUTS = 12, 17, 17
 SERIALIZED_HEADER_BYTES = 128   # fmu_src/fmu_state.h: the wrapper's header before the core's snapshot
+SERIALIZED_MAGIC = 0x46535441   # its first field, STATE_MAGIC ("FSTA"); then the format version and the size
 FRICTION_MODES = ["none", "slipping +", "slipping -", "stuck", "at break-away +", "at break-away -"]
 PROBE_NAME = "libgimbal_probe.so"
 
@@ -107,11 +109,12 @@ class Probe:
             if snapshot is not None and causality != INPUT_CAUSALITY:
                 raise SceneError(f"linearize: '{name}' is not an input: at a running instance's operating point "
                                  f"only inputs can be changed")
-            if isinstance(value, bool) or type_ != REAL:
-                value = float(int(value))
             value = float(value)
             if not math.isfinite(value):
                 raise SceneError(f"linearize: '{name}' = {value} is not finite")
+            if type_ != REAL and not value.is_integer():
+                raise SceneError(f"linearize: '{name}' is {'an Integer' if type_ == INTEGER else 'a Boolean'}: "
+                                 f"{value:g} is not a whole number")
             settings[k] = _Setting(type_, vr, value)
         buffer = None
         if snapshot is not None:
@@ -295,6 +298,10 @@ def linearize_instance(fmu, slave, inputs: dict | None = None, build_dir: str | 
         serialized = bytes(slave.serializeFMUstate(state))
     finally:
         slave.freeFMUstate(state)
+    magic, _version, recorded_size = struct.unpack_from("<IIQ", serialized)
+    if magic != SERIALIZED_MAGIC or recorded_size != len(serialized):
+        raise SceneError(f"linearize: {fmu.path} handed out an FMU state that does not start like one of this "
+                         f"project's FMUs (magic {magic:#x}, recorded size {recorded_size})")
     if len(serialized) != SERIALIZED_HEADER_BYTES + probe.snapshot_size:
         raise SceneError(f"linearize: {fmu.path} serializes {len(serialized)} bytes where {probe.path} expects "
                          f"{SERIALIZED_HEADER_BYTES + probe.snapshot_size}: they come from different builds")

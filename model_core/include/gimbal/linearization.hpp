@@ -28,7 +28,9 @@ struct LinearModel {
     double B[kStateSize][kLinearInputCount] = {};
     double C[kLinearOutputCount][kStateSize] = {};
     double D[kLinearOutputCount][kLinearInputCount] = {};
-    Modes modes;  // in force at the point: the model holds until one of them switches
+    // In force at the point: the model holds until one of them switches. voltage_clamped also marks a
+    // held voltage at or beyond +-U_L (the core's own mode covers ramps only).
+    Modes modes;
 };
 
 // `inputs` as a step starting at `time` would hold them (voltage ramps are ignored: they last one
