@@ -412,6 +412,8 @@ class DaskRun:
                 self.client.cancel(self.futures + self.scattered)
             except Exception:
                 pass
+        if self.cluster is not None and self.options.processes:
+            _quiet_workers_for_shutdown(self.client)
         if self.cluster is not None and interrupted:
             # Our own cluster, dropped with cases still running: its scheduler's complaints about
             # the work and the scattered FMU it loses are no news to the user who stopped it.
@@ -426,6 +428,26 @@ class DaskRun:
         if self.cluster is not None and not interrupted:
             self.cluster.close()
         return False
+
+
+def _silence_logging() -> None:
+    logging.disable(logging.CRITICAL)
+
+
+def _quiet_workers_for_shutdown(client) -> None:
+    """Silences the logging of our own cluster's workers before it closes: a worker whose
+    heartbeat is in flight when the scheduler goes logs the failed connection with a traceback,
+    which is the cluster closing, not news to the user (the cases' own errors are in the table)."""
+    def silence():
+        try:
+            client.run(_silence_logging, on_error="ignore")
+        except Exception:
+            pass
+
+    # a worker that does not answer must not hold up the shutdown that follows
+    asking = threading.Thread(target=silence, daemon=True)
+    asking.start()
+    asking.join(timeout=5.0)
 
 
 def _task_results(future, chunk: list) -> list[dict]:
