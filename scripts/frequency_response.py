@@ -210,9 +210,8 @@ def main(argv=None) -> int:
                     rows += fr.sweep(scene, args.fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
         finally:
             if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
+                from sweep_lib import close_client
+                close_client(client, cluster)
     except (SceneError, ValueError) as exc:   # ValueError: an Excitation refusing its axis
         print(f"frequency_response: {exc}", file=sys.stderr)
         return 1

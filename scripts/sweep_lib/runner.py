@@ -412,7 +412,7 @@ class DaskRun:
                 self.client.cancel(self.futures + self.scattered)
             except Exception:
                 pass
-        if self.cluster is not None and self.options.processes:
+        if self.cluster is not None and getattr(self.cluster, "processes", True):
             _quiet_workers_for_shutdown(self.client)
         if self.cluster is not None and interrupted:
             # Our own cluster, dropped with cases still running: its scheduler's complaints about
@@ -428,6 +428,17 @@ class DaskRun:
         if self.cluster is not None and not interrupted:
             self.cluster.close()
         return False
+
+
+def close_client(client, cluster) -> None:
+    """Closes a client and the local cluster make_client made with it (None: nothing to close);
+    the cluster's workers are silenced first, see _quiet_workers_for_shutdown."""
+    if client is not None and cluster is not None and getattr(cluster, "processes", True):
+        _quiet_workers_for_shutdown(client)
+    if client is not None:
+        client.close()
+    if cluster is not None:
+        cluster.close()
 
 
 def _silence_logging() -> None:
