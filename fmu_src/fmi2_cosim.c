@@ -668,6 +668,25 @@ static fmi2Status impl_DeSerializeFMUstate(fmi2Component c, const fmi2Byte seria
     return fmi2OK;
 }
 
+/* The `index`-th unknown or known (`role`) of fmi2GetDirectionalDerivative: a Real variable of the
+ * given causality, whose description it writes to `info`; else logged, 0. */
+static int directional_variable(Instance* instance, const char* role, size_t index, fmi2ValueReference vr,
+                                GimbalCausality causality, GimbalVariableInfo* info) {
+    const char* function = "fmi2GetDirectionalDerivative";
+    const char* kind = causality == GIMBAL_OUTPUT ? "output" : "input";
+    if (!gimbal_variable_info(GIMBAL_REAL, vr, info)) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: %s %zu: value reference %u is not a Real variable",
+                    function, role, index, (unsigned)vr);
+        return 0;
+    }
+    if (info->causality != causality) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: %s %s is not an %s: in Co-Simulation the %ss are the %ss",
+                    function, role, info->name, kind, role, kind);
+        return 0;
+    }
+    return 1;
+}
+
 /* Directional derivatives at a communication point (FMI 2.0, section 4.2.1 with 3.2.1): dvUnknown =
  * (d h / d vKnown) dvKnown, where the unknowns are outputs (ModelStructure <Outputs>) and the knowns
  * inputs; a Co-Simulation FMU exposes no states, so no <Derivatives> are unknowns or knowns here.
@@ -689,32 +708,11 @@ static fmi2Status impl_GetDirectionalDerivative(fmi2Component c, const fmi2Value
     if (nKnown > 0 && (!not_null(instance, function, vKnown_ref, "vKnown_ref") ||
                        !not_null(instance, function, dvKnown, "dvKnown")))
         return fmi2Error;
-    for (size_t i = 0; i < nUnknown; ++i) {
-        GimbalVariableInfo info;
-        if (!gimbal_variable_info(GIMBAL_REAL, vUnknown_ref[i], &info)) {
-            log_message(instance, fmi2Error, "logStatusError", "%s: unknown %zu: value reference %u is not a Real variable",
-                        function, i, (unsigned)vUnknown_ref[i]);
-            return fmi2Error;
-        }
-        if (info.causality != GIMBAL_OUTPUT) {
-            log_message(instance, fmi2Error, "logStatusError",
-                        "%s: unknown %s is not an output: in Co-Simulation the unknowns are the outputs", function,
-                        info.name);
-            return fmi2Error;
-        }
-    }
+    GimbalVariableInfo info;
+    for (size_t i = 0; i < nUnknown; ++i)
+        if (!directional_variable(instance, "unknown", i, vUnknown_ref[i], GIMBAL_OUTPUT, &info)) return fmi2Error;
     for (size_t j = 0; j < nKnown; ++j) {
-        GimbalVariableInfo info;
-        if (!gimbal_variable_info(GIMBAL_REAL, vKnown_ref[j], &info)) {
-            log_message(instance, fmi2Error, "logStatusError", "%s: known %zu: value reference %u is not a Real variable",
-                        function, j, (unsigned)vKnown_ref[j]);
-            return fmi2Error;
-        }
-        if (info.causality != GIMBAL_INPUT) {
-            log_message(instance, fmi2Error, "logStatusError",
-                        "%s: known %s is not an input: in Co-Simulation the knowns are the inputs", function, info.name);
-            return fmi2Error;
-        }
+        if (!directional_variable(instance, "known", j, vKnown_ref[j], GIMBAL_INPUT, &info)) return fmi2Error;
         if (!isfinite(dvKnown[j])) {
             log_message(instance, fmi2Error, "logStatusError", "%s: the seed of %s must be finite", function, info.name);
             return fmi2Error;
@@ -723,6 +721,7 @@ static fmi2Status impl_GetDirectionalDerivative(fmi2Component c, const fmi2Value
     for (size_t i = 0; i < nUnknown; ++i) dvUnknown[i] = 0.0;
     return fmi2OK;
 }
+
 static fmi2Status impl_SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     Instance* instance = (Instance*)c;
