@@ -10,36 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2Functions.h"
-#include "fmu_state.h"
+#include "fmu_instance.h"
 #include "gimbal_guid.h"
-#include "gimbal/gimbal_c_api.h"
-#include "host_fp_environment.h"
-
-typedef enum {
-    STATE_INSTANTIATED = 1 << 0,
-    STATE_INITIALIZATION = 1 << 1,
-    STATE_STEP_COMPLETE = 1 << 2,
-    STATE_STEP_FAILED = 1 << 3,
-    STATE_TERMINATED = 1 << 4,
-    STATE_ERROR = 1 << 5,
-} InstanceState;
-
-#define ANY_STATE (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED | STATE_ERROR)
-#define GET_STATES (STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED | STATE_ERROR)
-#define SET_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE)
-#define FMU_STATE_STATES (STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
-#define STATUS_STATES (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)
-
-/* The states in which each function may be called (FMI 2.0, section 4.2.4), in one table. */
-typedef enum {
-    FN_SetDebugLogging, FN_SetupExperiment, FN_EnterInitializationMode, FN_ExitInitializationMode, FN_Terminate,
-    FN_Reset, FN_GetReal, FN_GetInteger, FN_GetBoolean, FN_GetString, FN_SetReal, FN_SetInteger, FN_SetBoolean,
-    FN_SetString, FN_GetFMUstate, FN_SetFMUstate, FN_FreeFMUstate, FN_SerializedFMUstateSize, FN_SerializeFMUstate,
-    FN_DeSerializeFMUstate, FN_GetDirectionalDerivative, FN_SetRealInputDerivatives, FN_GetRealOutputDerivatives,
-    FN_DoStep, FN_CancelStep, FN_GetStatus, FN_GetRealStatus, FN_GetIntegerStatus, FN_GetBooleanStatus,
-    FN_GetStringStatus, FUNCTION_COUNT
-} Function;
 
 static const struct {
     const char* name;
@@ -49,7 +21,7 @@ static const struct {
     [FN_SetupExperiment] = {"fmi2SetupExperiment", STATE_INSTANTIATED},
     [FN_EnterInitializationMode] = {"fmi2EnterInitializationMode", STATE_INSTANTIATED},
     [FN_ExitInitializationMode] = {"fmi2ExitInitializationMode", STATE_INITIALIZATION},
-    [FN_Terminate] = {"fmi2Terminate", STATE_STEP_COMPLETE | STATE_STEP_FAILED},
+    [FN_Terminate] = {"fmi2Terminate", STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_EVENT_MODE | STATE_CONTINUOUS_TIME},
     [FN_Reset] = {"fmi2Reset", ANY_STATE},
     [FN_GetReal] = {"fmi2GetReal", GET_STATES},
     [FN_GetInteger] = {"fmi2GetInteger", GET_STATES},
@@ -76,27 +48,24 @@ static const struct {
     [FN_GetIntegerStatus] = {"fmi2GetIntegerStatus", STATUS_STATES},
     [FN_GetBooleanStatus] = {"fmi2GetBooleanStatus", STATUS_STATES},
     [FN_GetStringStatus] = {"fmi2GetStringStatus", STATUS_STATES},
+    /* Model Exchange (FMI 2.0, section 3.2.3) */
+    [FN_EnterEventMode] = {"fmi2EnterEventMode", STATE_CONTINUOUS_TIME},
+    [FN_NewDiscreteStates] = {"fmi2NewDiscreteStates", STATE_EVENT_MODE},
+    [FN_EnterContinuousTimeMode] = {"fmi2EnterContinuousTimeMode", STATE_EVENT_MODE},
+    [FN_CompletedIntegratorStep] = {"fmi2CompletedIntegratorStep", STATE_CONTINUOUS_TIME},
+    [FN_SetTime] = {"fmi2SetTime", STATE_EVENT_MODE | STATE_CONTINUOUS_TIME},
+    [FN_SetContinuousStates] = {"fmi2SetContinuousStates", STATE_CONTINUOUS_TIME},
+    [FN_GetDerivatives] = {"fmi2GetDerivatives", EVALUATION_STATES},
+    [FN_GetEventIndicators] = {"fmi2GetEventIndicators", EVALUATION_STATES},
+    [FN_GetContinuousStates] = {"fmi2GetContinuousStates", EVALUATION_STATES},
+    [FN_GetNominalsOfContinuousStates] = {"fmi2GetNominalsOfContinuousStates", STATE_INSTANTIATED | EVALUATION_STATES},
 };
 
-/* Log categories of modelDescription.xml, in the order of its <LogCategories>. */
-static const char* const kLogCategories[] = {"logEvents", "logSolver", "logStatusWarning", "logStatusDiscard",
-                                             "logStatusError", "logAll"};
-enum { LOG_CATEGORY_COUNT = sizeof kLogCategories / sizeof kLogCategories[0] };
+const char* function_name(Function function) { return kFunctions[function].name; }
 
-typedef struct {
-    fmi2CallbackLogger logger;
-    fmi2ComponentEnvironment environment;
-    char* instance_name;
-    GimbalCore* core;
-    InstanceState state;
-    int category_enabled[LOG_CATEGORY_COUNT];
-    double time;
-    double stop_time;
-    int stop_time_defined;
-    double last_successful_time;
-    fmi2Status last_step_status;
-    FmuStateRegistry states; /* the FMU states this instance handed out */
-} Instance;
+/* Log categories of modelDescription.xml, in the order of its <LogCategories>. */
+static const char* const kLogCategories[LOG_CATEGORY_COUNT] = {"logEvents", "logSolver", "logStatusWarning", "logStatusDiscard",
+                                                             "logStatusError", "logAll"};
 
 static int category_index(const char* category) {
     for (int k = 0; k < LOG_CATEGORY_COUNT; ++k)
@@ -105,7 +74,7 @@ static int category_index(const char* category) {
 }
 
 /* Refusals and failures are always reported; other categories only when the host enabled them. */
-static void log_message(const Instance* instance, fmi2Status status, const char* category, const char* format, ...) {
+void log_message(const Instance* instance, fmi2Status status, const char* category, const char* format, ...) {
     if (instance == NULL || instance->logger == NULL) return;
     const int index = category_index(category);
     const int always = status == fmi2Error || status == fmi2Discard || status == fmi2Fatal;
@@ -130,7 +99,11 @@ static void log_message(const Instance* instance, fmi2Status status, const char*
 
 static void core_log(void* context, GimbalStatus status, const char* category, const char* message) {
     static const fmi2Status kStatus[] = {fmi2OK, fmi2Warning, fmi2Discard, fmi2Error};
-    log_message((const Instance*)context, kStatus[status], category, "%s", message);
+    const Instance* instance = (const Instance*)context;
+    if (instance->calling != NULL)
+        log_message(instance, kStatus[status], category, "%s: %s", instance->calling, message);
+    else
+        log_message(instance, kStatus[status], category, "%s", message);
 }
 
 static int core_log_enabled(void* context, const char* category) {
@@ -140,7 +113,7 @@ static int core_log_enabled(void* context, const char* category) {
            ((index >= 0 && instance->category_enabled[index]) || instance->category_enabled[LOG_CATEGORY_COUNT - 1]);
 }
 
-static fmi2Status from_core(GimbalStatus status) {
+fmi2Status from_core(GimbalStatus status) {
     switch (status) {
         case GIMBAL_OK: return fmi2OK;
         case GIMBAL_WARNING: return fmi2Warning;
@@ -149,19 +122,21 @@ static fmi2Status from_core(GimbalStatus status) {
     }
 }
 
-static const char* state_name(InstanceState state) {
+const char* state_name(InstanceState state) {
     switch (state) {
         case STATE_INSTANTIATED: return "instantiated";
         case STATE_INITIALIZATION: return "initialization mode";
         case STATE_STEP_COMPLETE: return "step complete";
         case STATE_STEP_FAILED: return "step failed";
         case STATE_TERMINATED: return "terminated";
+        case STATE_EVENT_MODE: return "event mode";
+        case STATE_CONTINUOUS_TIME: return "continuous-time mode";
         default: return "error";
     }
 }
 
 /* NULL-safe check that a call is allowed in the instance's current state. */
-static int allowed(Instance* instance, Function function) {
+int allowed(Instance* instance, Function function) {
     if (instance == NULL) return 0;
     if (instance->state & kFunctions[function].states) return 1;
     log_message(instance, fmi2Error, "logStatusError", "%s is not allowed in state '%s'", kFunctions[function].name,
@@ -169,7 +144,7 @@ static int allowed(Instance* instance, Function function) {
     return 0;
 }
 
-static int not_null(Instance* instance, const char* function, const void* pointer, const char* argument) {
+int not_null(Instance* instance, const char* function, const void* pointer, const char* argument) {
     if (pointer != NULL) return 1;
     log_message(instance, fmi2Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
     return 0;
@@ -215,9 +190,9 @@ static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType,
         log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: instanceName must be a non-empty string");
         return NULL;
     }
-    if (fmuType != fmi2CoSimulation) {
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
         log_message(&probe, fmi2Error, "logStatusError",
-                    "fmi2Instantiate: this FMU supports Co-Simulation only (fmuType = %d)", (int)fmuType);
+                    "fmi2Instantiate: fmuType = %d is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)", (int)fmuType);
         return NULL;
     }
     if (fmuGUID == NULL || strcmp(fmuGUID, GIMBAL_GUID) != 0) {
@@ -238,7 +213,13 @@ static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType,
     instance->environment = functions->componentEnvironment;
     instance->instance_name = name;
     for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
+    instance->type = fmuType;
     instance->core = gimbal_core_create(core_log, core_log_enabled, instance);
+    if (instance->core != NULL && fmuType == fmi2ModelExchange &&
+        gimbal_core_use_continuous_time(instance->core) != GIMBAL_OK) {
+        gimbal_core_destroy(instance->core);
+        instance->core = NULL;
+    }
     if (instance->core == NULL) {
         log_message(instance, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
         free(name);
@@ -295,7 +276,8 @@ static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
         return fmi2Error; /* still in initialization mode: the master may correct and retry */
     }
     instance->last_successful_time = instance->time;
-    instance->state = STATE_STEP_COMPLETE;
+    /* Model Exchange starts in event mode: the host settles the modes with fmi2NewDiscreteStates. */
+    instance->state = instance->type == fmi2ModelExchange ? STATE_EVENT_MODE : STATE_STEP_COMPLETE;
     return status;
 }
 
@@ -330,6 +312,8 @@ static int settable(Instance* instance, const GimbalVariableInfo* info) {
         case STATE_INITIALIZATION:
             return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT;
         case STATE_STEP_COMPLETE:
+        case STATE_EVENT_MODE:
+        case STATE_CONTINUOUS_TIME:
             return info->causality == GIMBAL_INPUT ||
                    (info->causality == GIMBAL_PARAMETER && info->variability == GIMBAL_TUNABLE);
         default:
@@ -519,7 +503,7 @@ static int valid_state_content(Instance* instance, Function function, const unsi
     if (from_core(gimbal_core_check_snapshot(instance->core, kFunctions[function].name, record + sizeof header,
                                              &initialized)) > fmi2Warning)
         return 0;
-    const int running = (header.state & (STATE_STEP_COMPLETE | STATE_STEP_FAILED | STATE_TERMINATED)) != 0;
+    const int running = (header.state & (RUNNING_STATES | STATE_TERMINATED)) != 0;
     if (running != initialized) {
         log_message(instance, fmi2Error, "logStatusError",
                     "%s: the FMU state is refused: its instance state '%s' contradicts its %s model", kFunctions[function].name,
@@ -855,14 +839,6 @@ static fmi2Status impl_GetStringStatus(fmi2Component c, const fmi2StatusKind s, 
 }
 
 /* ---------------------------------------------------------------- the exported functions */
-
-/* Runs an implementation in the FMU's floating-point environment and gives the host its own back. */
-#define IN_FMU_FP_ENVIRONMENT(type, call)   \
-    HostFpEnvironment host_environment;     \
-    enter_fmu_fp(&host_environment);        \
-    const type result = call;               \
-    leave_fmu_fp(&host_environment);        \
-    return result
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
     IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetDebugLogging(c, loggingOn, nCategories, categories));

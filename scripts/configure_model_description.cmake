@@ -4,6 +4,12 @@ file(READ ${FRAGMENTS}/types.xml GIMBAL_TYPE_DEFINITIONS)
 file(READ ${FRAGMENTS}/variables.xml GIMBAL_MODEL_VARIABLES)
 file(READ ${FRAGMENTS}/structure.xml GIMBAL_MODEL_STRUCTURE)
 file(READ ${FRAGMENTS}/default_tolerance.txt GIMBAL_DEFAULT_TOLERANCE)
+# numberOfEventIndicators: the core's count (gimbal_c_api.h), the one place it is written.
+file(STRINGS ${SOURCE_DIR}/model_core/include/gimbal/gimbal_c_api.h _indicators REGEX "^#define GIMBAL_EVENT_INDICATORS ")
+string(REGEX REPLACE "^#define GIMBAL_EVENT_INDICATORS ([0-9]+).*" "\\1" GIMBAL_EVENT_INDICATORS "${_indicators}")
+if(NOT GIMBAL_EVENT_INDICATORS MATCHES "^[0-9]+$")
+  message(FATAL_ERROR "GIMBAL_EVENT_INDICATORS not found in gimbal_c_api.h")
+endif()
 
 # generationDateAndTime, in UTC. Reproducible: the same sources give the same modelDescription.xml.
 # - SOURCE_DATE_EPOCH when set (the reproducible-builds convention; string(TIMESTAMP) honours it);

@@ -784,8 +784,11 @@ void do_instantiate(Sequence& s, bool valid) {
             case 1: name = "", expect_valid = false, may_succeed = false; break;
             case 2: name = "%s%n%d%%" + std::to_string(inst->id); break;  // valid, but printf-hostile
             case 3: name = std::string(5000, 'n') + std::to_string(inst->id); break;
-            case 4: type = fmi2ModelExchange, expect_valid = false, may_succeed = false; break;
-            case 5: type = static_cast<int>(r.integer(-5, 9)); if (type != fmi2CoSimulation) expect_valid = may_succeed = false; break;
+            case 4: type = 2, expect_valid = false, may_succeed = false; break;  // neither interface
+            case 5:
+                type = static_cast<int>(r.integer(-5, 9));
+                if (type != fmi2CoSimulation && type != fmi2ModelExchange) expect_valid = may_succeed = false;
+                break;
             case 6: guid = "{00000000-0000-0000-0000-000000000000}", expect_valid = may_succeed = false; break;
             case 7: guid_pointer = nullptr, guid = "(NULL)", expect_valid = may_succeed = false; break;
             case 8: guid = "", expect_valid = may_succeed = false; break;
@@ -834,6 +837,17 @@ void do_instantiate(Sequence& s, bool valid) {
     }
     ++stats.instances;
     inst->component = component;
+    if (type == fmi2ModelExchange) {
+        // These sequences drive the Co-Simulation interface; a Model Exchange instance is only made
+        // and freed here.
+        CallScope free_scope;
+        begin_call(inst.get(), format("fmi2FreeInstance(c%d)", inst->id));
+        free_scope.captured_before = capture_size();
+        free_scope.start = std::chrono::steady_clock::now();
+        api.freeInstance(component);
+        end_call(free_scope, "void");
+        return;
+    }
     s.live.push_back(std::move(inst));
 }
 

@@ -542,7 +542,8 @@ void check_round_trip_by_name() {
     std::map<std::string, int> integers;
     for (unsigned v = 0; v < kRealVariableCount; ++v) {
         const VariableInfo& info = kRealVariables[v];
-        if (info.causality == Causality::output && info.initial != Initial::exact) continue;
+        if ((info.causality == Causality::output || info.causality == Causality::local) && info.initial != Initial::exact)
+            continue;
         reals[info.name] = 0.5 + 0.25 * static_cast<double>(reals.size());
     }
     for (unsigned v = 0; v < kIntegerVariableCount; ++v)

@@ -45,6 +45,19 @@ GimbalStatus guarded(GimbalCore* core, const char* function, Body&& body) noexce
     }
     return GIMBAL_ERROR;
 }
+// The continuous-time entries need an initialized instance of that interface.
+template <class Body>
+GimbalStatus continuous(GimbalCore* core, const char* function, Body&& body) noexcept {
+    return guarded(core, function, [&] {
+        if (!core->instance.continuous_time_interface() || !core->instance.initialized()) {
+            core->log(core->log_context, GIMBAL_ERROR, "logStatusError",
+                      "the instance is not an initialized instance of the continuous-time interface");
+            return GIMBAL_ERROR;
+        }
+        return body();
+    });
+}
+
 
 }  // namespace
 
@@ -187,6 +200,67 @@ GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
         for (int body = 0; body < 4; ++body) model->friction[body] = static_cast<int>(linear.modes.friction[body]);
         model->time = core->instance.time();
         return GIMBAL_OK;
+    });
+}
+
+GimbalStatus gimbal_core_use_continuous_time(GimbalCore* core) {
+    return guarded(core, "use_continuous_time", [&] {
+        core->instance.use_continuous_time_interface();
+        return GIMBAL_OK;
+    });
+}
+
+unsigned gimbal_continuous_state_vr(int k) {
+    static_assert(GIMBAL_CONTINUOUS_STATES == gimbal::kContinuousStateCount &&
+                      GIMBAL_EVENT_INDICATORS == gimbal::GimbalHybridSystem::kIndicatorCount,
+                  "the C view of the continuous-time interface has the core's sizes");
+    return k >= 0 && k < GIMBAL_CONTINUOUS_STATES ? gimbal::kContinuousStates[k] : ~0u;
+}
+
+unsigned gimbal_state_derivative_vr(int k) {
+    return k >= 0 && k < GIMBAL_CONTINUOUS_STATES ? gimbal::kStateDerivatives[k] : ~0u;
+}
+
+
+GimbalStatus gimbal_core_set_time(GimbalCore* core, double time) {
+    return continuous(core, "set_time", [&] { return core->instance.set_time(time); });
+}
+
+GimbalStatus gimbal_core_set_continuous_states(GimbalCore* core, const double* states) {
+    return continuous(core, "set_continuous_states", [&] { return core->instance.set_continuous_states(states); });
+}
+
+GimbalStatus gimbal_core_get_continuous_states(GimbalCore* core, double* states) {
+    return continuous(core, "get_continuous_states", [&] {
+        core->instance.get_continuous_states(states);
+        return GIMBAL_OK;
+    });
+}
+
+GimbalStatus gimbal_core_get_nominal_states(GimbalCore* core, double* nominals) {
+    return guarded(core, "get_nominal_states", [&] {
+        core->instance.get_nominal_states(nominals);
+        return GIMBAL_OK;
+    });
+}
+
+GimbalStatus gimbal_core_get_derivatives(GimbalCore* core, double* derivatives) {
+    return continuous(core, "get_derivatives", [&] { return core->instance.get_derivatives(derivatives); });
+}
+
+GimbalStatus gimbal_core_get_event_indicators(GimbalCore* core, double* indicators) {
+    return continuous(core, "get_event_indicators", [&] { return core->instance.get_event_indicators(indicators); });
+}
+
+GimbalStatus gimbal_core_update_discrete_states(GimbalCore* core, GimbalDiscreteUpdate* update) {
+    return continuous(core, "update_discrete_states", [&] {
+        gimbal::GimbalInstance::DiscreteUpdate result;
+        const GimbalStatus status = core->instance.update_discrete_states(result);
+        update->states_changed = result.states_changed ? 1 : 0;
+        update->next_time_defined = result.next_time_defined ? 1 : 0;
+        update->next_time = result.next_time;
+        update->mode_changes = result.mode_changes;
+        return status;
     });
 }
 

@@ -20,23 +20,28 @@ bool same_modes(const Modes& a, const Modes& b) {
 GimbalHybridSystem::GimbalHybridSystem(const ModelParameters& params) : params_(params) {
     // One element per switching part present, each with its own slice of the event vector.
     int guards = 0;
+    // Each element's guards also get their fixed place among the indicators (kIndicatorCount).
+    const auto place = [this, &guards](int count, int first_indicator) {
+        for (int k = 0; k < count; ++k) guard_indicator_.push_back(first_indicator + k);
+        guards += count;
+    };
     for (int axis = 0; axis < 2; ++axis) {
         if (params.layout.backlash_slot[axis] < 0) continue;
         backlash_.emplace_back(axis, guards);
-        guards += backlash_.back().guard_count();
+        place(backlash_.back().guard_count(), 2 * axis);
     }
     for (int axis = 0; axis < 2; ++axis) {
         clamps_.emplace_back(axis, guards);
-        guards += clamps_.back().guard_count();
+        place(clamps_.back().guard_count(), 4 + 2 * axis);
     }
     for (int axis = 0; axis < 2; ++axis) {
         limiters_.emplace_back(axis, guards);
-        guards += limiters_.back().guard_count();
+        place(limiters_.back().guard_count(), 8 + 2 * axis);
     }
     for (int body = 0; body < 4; ++body) {
         if (!params.coordinate_friction[body].present()) continue;
         friction_.emplace_back(body, guards);
-        guards += friction_.back().guard_count();
+        place(friction_.back().guard_count(), 12 + 6 * body);
     }
     event_count_ = guards;
     for (const auto& e : backlash_) elements_.push_back(&e);
@@ -63,6 +68,8 @@ const BaseKinematics& GimbalHybridSystem::base_at(double time) {
     if (!base_cached_ || (time != base_time_ && !base_constant_)) {
         if (params_.fidelity.fixed_base) {
             base_ = base_kinematics_at(params_, inputs_, time);
+        } else if (inputs_held_) {
+            base_ = evaluate_base_kinematics(inputs_.base, arc_start_trig_, params_.multibody.gravity);
         } else {
             const BaseMotion motion = inputs_.base.advanced(time - inputs_.step_start_time);
             const AttitudeTrig trig = attitude_trig_near(arc_start_trig_, inputs_.base.attitude, motion.attitude);
@@ -80,7 +87,8 @@ void GimbalHybridSystem::set_inputs(const StepInputs& inputs) {
     cache_valid_ = false;
     const BaseMotion& b = inputs.base;
     arc_start_trig_ = attitude_trig(b.attitude);
-    base_constant_ = params_.fidelity.fixed_base ||
+    // Held inputs do not move with time either: evaluated once per set.
+    base_constant_ = params_.fidelity.fixed_base || inputs_held_ ||
                      (b.attitude_rate.isZero(0.0) && b.attitude_accel.isZero(0.0) && b.acceleration_a.isZero(0.0));
 }
 
@@ -127,6 +135,13 @@ bool GimbalHybridSystem::jacobian(double time, const double* state, double* colu
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     const SwitchingContext context{params_, inputs_, dynamics_at(time, state), time};
     for (const SwitchingElement* element : elements_) element->guards(context, modes_, values);
+}
+
+void GimbalHybridSystem::event_indicators(double time, const double* state, double* values) {
+    std::fill(values, values + kIndicatorCount, 1.0);
+    double guards[kIndicatorCount];
+    event_functions(time, state, guards);
+    for (int k = 0; k < event_count_; ++k) values[guard_indicator_[k]] = guards[k];
 }
 
 int GimbalHybridSystem::update_modes(double time, double* state, const int* directions) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <type_traits>
 
@@ -34,7 +35,7 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 4;
+constexpr std::uint32_t kSnapshotVersion = 5;
 
 // Plain integers and doubles only, flags as bytes: any byte pattern decodes without undefined
 // behaviour, and check_snapshot() decides whether it is a state this model can be in.
@@ -63,6 +64,15 @@ struct Snapshot {
     double arc_start_time;  // model time
     double epoch;
     IntegratorMemory integrator_memory;
+    // The continuous-time interface's event memory.
+    std::uint8_t continuous_time;
+    std::uint8_t decided_here;
+    std::int8_t decided_side[GimbalHybridSystem::kIndicatorCount];
+    double reference_guards[GimbalHybridSystem::kIndicatorCount];
+    double last_event_time;
+    double dwell_until;
+    std::int32_t rapid_events;
+    std::int64_t zeno_holds;
 };
 static_assert(std::is_trivially_copyable<Snapshot>::value, "snapshots are copied as bytes");
 static_assert(sizeof(int) == sizeof(std::int32_t), "Integer variables are stored as int");
@@ -149,6 +159,14 @@ void GimbalInstance::reset() {
     master_tolerance_ = 0.0;
     rtol_set_ = false;
     steps_over_budget_ = 0;
+    inputs_stale_ = outputs_stale_ = true;
+    decided_here_ = false;
+    std::fill(reference_guards_, reference_guards_ + kIndicatorCount, 0.0);
+    std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
+    last_event_time_ = -1e300;
+    rapid_events_ = 0;
+    dwell_until_ = -1e300;
+    zeno_holds_ = 0;
 }
 
 GimbalStatus GimbalInstance::refuse(GimbalStatus status, const std::string& message) const {
@@ -167,6 +185,10 @@ GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
     }
     reals_[vr] = value;
     preview_current_ = false;
+    if (kRealVariables[vr].causality == Causality::input) {
+        inputs_stale_ = outputs_stale_ = true;
+        decided_here_ = false;
+    }
     if (vr == vr_solver_rtol) rtol_set_ = true;
     // A new voltage starts a new ramp: its derivative must be given again.
     if (vr == vr_u_R1) voltage_rate_[0] = 0.0;
@@ -202,6 +224,7 @@ GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
         const GimbalStatus status = preview_outputs("fmi2GetReal", kRealVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
+    if (system_ && continuous_time_ && outputs_stale_) publish_continuous_time_outputs();
     value = reals_[vr];
     return GIMBAL_OK;
 }
@@ -223,6 +246,7 @@ GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) {
         const GimbalStatus status = preview_outputs("fmi2GetInteger", kIntegerVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
+    if (system_ && continuous_time_ && outputs_stale_) publish_continuous_time_outputs();
     value = integers_[vr];
     return GIMBAL_OK;
 }
@@ -288,6 +312,14 @@ void GimbalInstance::publish_outputs() {
     reals_[vr_energy_viscous] = accounting ? flows[kViscous] : 0.0;
     reals_[vr_energy_shaft_damping] = accounting ? flows[kShaftDamping] : 0.0;
     reals_[vr_energy_dry_friction] = accounting ? flows[kDryFriction] : 0.0;
+    double integrated[kMaxStateSize], derivative[kContinuousStateCount];
+    if (state_derivative(params_, dynamics, integrated)) {
+        full_state_derivative(dynamics, integrated, derivative);
+        for (int k = 0; k < kContinuousStateCount; ++k) reals_[kStateDerivatives[k]] = derivative[k];
+    } else {
+        for (int k = 0; k < kContinuousStateCount; ++k)
+            reals_[kStateDerivatives[k]] = std::numeric_limits<double>::quiet_NaN();
+    }
 
     integers_[vi_gear1_contact] = modes.gear_contact[0];
     integers_[vi_gear2_contact] = modes.gear_contact[1];
@@ -304,7 +336,7 @@ void GimbalInstance::publish_outputs() {
     integers_[vi_events_current_limit1] = static_cast<int>(events.current_limit[0]);
     integers_[vi_events_current_limit2] = static_cast<int>(events.current_limit[1]);
     integers_[vi_events_stick_slip] = static_cast<int>(events.stick_slip);
-    integers_[vi_events_zeno_guard] = static_cast<int>(stats.zeno_holds);
+    integers_[vi_events_zeno_guard] = static_cast<int>(std::min<std::int64_t>(stats.zeno_holds + zeno_holds_, 2147483647));
     integers_[vi_solver_states] = params_.layout.size;
     integers_[vi_solver_steps] = static_cast<int>(std::min<std::int64_t>(stats.steps, 2147483647));
     integers_[vi_solver_rhs_evaluations] = static_cast<int>(std::min<std::int64_t>(stats.rhs_evaluations, 2147483647));
@@ -460,6 +492,7 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     load_start_state();
     time_ = start_time;
     epoch_ = start_time;
+    system->hold_inputs_at_any_time(continuous_time_);
     system->set_inputs(read_step_inputs(0.0));
     system->update_modes(0.0, state_, nullptr);
     EventCounters none;
@@ -469,7 +502,15 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     integrator_ = std::move(integrator);
     integrator_running_ = false;
     steps_over_budget_ = 0;
+    // The continuous-time interface measures the first crossings against the guards of the start.
+    system_->event_functions(0.0, state_, reference_guards_);
+    std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
+    inputs_stale_ = decided_here_ = false;
+    last_event_time_ = dwell_until_ = -1e300;
+    rapid_events_ = 0;
+    zeno_holds_ = 0;
     publish_outputs();
+    outputs_stale_ = false;
     return GIMBAL_OK;
 }
 
@@ -493,6 +534,14 @@ void GimbalInstance::save(void* buffer) {
     snap.pending_voltage_rate[1] = voltage_rate_[1];
     snap.epoch = epoch_;
     snap.integrator_memory = IntegratorMemory{};
+    snap.continuous_time = continuous_time_;
+    snap.decided_here = decided_here_;
+    std::copy(decided_side_, decided_side_ + kIndicatorCount, snap.decided_side);
+    std::copy(reference_guards_, reference_guards_ + kIndicatorCount, snap.reference_guards);
+    snap.last_event_time = last_event_time_;
+    snap.dwell_until = dwell_until_;
+    snap.rapid_events = rapid_events_;
+    snap.zeno_holds = zeno_holds_;
     if (snap.initialized) {
         snap.modes = system_->modes();
         snap.counters = system_->counters();
@@ -545,6 +594,17 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
     check.finite("epoch", &snap.epoch, 1);
     check.finite("state", snap.state, kMaxStateSize);
     check.finite("pending voltage rate", snap.pending_voltage_rate, 2);
+    check.flag("continuous_time", snap.continuous_time);
+    check.flag("decided_here", snap.decided_here);
+    if (check.ok() && (snap.continuous_time != 0) != continuous_time_)
+        check.fail(std::string("it was saved by an instance of the ") +
+                   (snap.continuous_time ? "continuous-time (Model Exchange)" : "Co-Simulation") + " interface");
+    for (int k = 0; k < kIndicatorCount; ++k) check.within("decided side", snap.decided_side[k], -1, 1);
+    check.finite("reference guards", snap.reference_guards, kIndicatorCount);
+    check.finite("last event time", &snap.last_event_time, 1);
+    check.finite("end of the chattering hold", &snap.dwell_until, 1);
+    check.count("rapid events", snap.rapid_events);
+    check.count("chattering holds", snap.zeno_holds);
     const IntegerVariable mode_outputs[] = {vi_gear1_contact, vi_gear2_contact, vi_motor1_limited, vi_motor2_limited};
     for (IntegerVariable vi : mode_outputs) check.within(kIntegerVariables[vi].name, snap.integers[vi], -1, 1);
     const IntegerVariable friction_outputs[] = {vi_body1_stick_slip, vi_rotor1_stick_slip, vi_body2_stick_slip,
@@ -630,6 +690,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
         if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
         params_ = params;
         system = std::make_unique<GimbalHybridSystem>(params_);
+        system->hold_inputs_at_any_time(continuous_time_);
         StepInputs in;
         for (int axis = 0; axis < 2; ++axis) {
             in.voltage[axis] = snap.voltage[axis];
@@ -664,6 +725,14 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     std::copy(snap.state, snap.state + kMaxStateSize, state_);
     voltage_rate_[0] = snap.pending_voltage_rate[0];
     voltage_rate_[1] = snap.pending_voltage_rate[1];
+    decided_here_ = snap.decided_here != 0;
+    std::copy(snap.decided_side, snap.decided_side + kIndicatorCount, decided_side_);
+    std::copy(snap.reference_guards, snap.reference_guards + kIndicatorCount, reference_guards_);
+    last_event_time_ = snap.last_event_time;
+    dwell_until_ = snap.dwell_until;
+    rapid_events_ = snap.rapid_events;
+    zeno_holds_ = snap.zeno_holds;
+    inputs_stale_ = outputs_stale_ = true;
     integrator_running_ = initialized && snap.integrator_running && integrator->resumable();
     at_rest_ = integrator_running_ && snap.at_rest;
     swap.commit();
@@ -674,6 +743,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
 
 GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     if (!integrator_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance is not initialized");
+    if (continuous_time_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance serves the continuous-time interface");
     StepStart start;
     std::copy(state_, state_ + kMaxStateSize, start.state);
     start.modes = system_->modes();

@@ -13,7 +13,10 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <algorithm>
+#include <vector>
 
+#include "gimbal/variable_groups.hpp"
 #include "gimbal/variables.hpp"
 
 namespace {
@@ -40,6 +43,8 @@ const UnitDefinition kUnits[] = {
     {"kg.m2", "kg=\"1\" m=\"2\"", ""},
     {"V", "kg=\"1\" m=\"2\" s=\"-3\" A=\"-1\"", ""},
     {"A", "A=\"1\"", ""},
+    {"A/s", "A=\"1\" s=\"-1\"", ""},
+    {"W", "kg=\"1\" m=\"2\" s=\"-3\"", ""},
     {"Ohm", "kg=\"1\" m=\"2\" s=\"-3\" A=\"-2\"", ""},
     {"H", "kg=\"1\" m=\"2\" s=\"-2\" A=\"-2\"", ""},
     {"N.m", "kg=\"1\" m=\"2\" s=\"-2\"", ""},
@@ -55,6 +60,7 @@ const char* to_string(gimbal::Causality c) {
         case gimbal::Causality::parameter: return "parameter";
         case gimbal::Causality::input: return "input";
         case gimbal::Causality::output: return "output";
+        case gimbal::Causality::local: return "local";
     }
     return "";
 }
@@ -147,6 +153,55 @@ std::string broken_rule(const gimbal::VariableInfo& v, Type type) {
     return "";
 }
 
+// 1-based indices of <ModelVariables>: the Real table comes first.
+unsigned real_index(gimbal::RealVariable vr) { return vr + 1; }
+
+std::string index_list(const std::vector<unsigned>& indices) {
+    std::string list;
+    for (unsigned index : indices) list += (list.empty() ? "" : " ") + std::to_string(index);
+    return list;
+}
+
+// What each continuous output depends on in the continuous-time (Model Exchange) view: the states,
+// and the inputs that reach it without passing through a state. (In Co-Simulation the outputs are
+// held from step to step; these dependencies are then a superset of the true ones.)
+std::vector<unsigned> output_dependencies(gimbal::RealVariable vr) {
+    using namespace gimbal;
+    std::vector<unsigned> indices;
+    for (RealVariable state : kContinuousStates) indices.push_back(real_index(state));
+    const auto add = [&indices](const RealVector& vector) {
+        for (RealVariable input : vector) indices.push_back(real_index(input));
+    };
+    switch (vr) {
+        case vr_i_R1: indices.push_back(real_index(vr_u_R1)); break;  // a quasi-static motor's current
+        case vr_i_R2: indices.push_back(real_index(vr_u_R2)); break;
+        case vr_los_omega_1:
+        case vr_los_omega_2:
+        case vr_los_omega_3: add(kBaseMotion.attitude), add(kBaseMotion.attitude_rate); break;
+        case vr_energy_kinetic: add(kBaseMotion.attitude), add(kBaseMotion.attitude_rate), add(kBaseMotion.velocity_a); break;
+        case vr_energy_potential: add(kBaseMotion.attitude); break;
+        default: break;
+    }
+    std::sort(indices.begin(), indices.end());
+    return indices;
+}
+
+// A derivative of an angle is a rate (of its own body, or N times the load's for a rigid gear); the
+// others depend on the whole state and every input.
+std::vector<unsigned> derivative_dependencies(int state) {
+    using namespace gimbal;
+    std::vector<unsigned> indices;
+    if (state < 4) {
+        for (RealVariable rate : kBodyRate) indices.push_back(real_index(rate));
+    } else {
+        for (RealVariable s : kContinuousStates) indices.push_back(real_index(s));
+        for (unsigned vr = 0; vr < kRealVariableCount; ++vr)
+            if (kRealVariables[vr].causality == Causality::input) indices.push_back(real_index(static_cast<RealVariable>(vr)));
+    }
+    std::sort(indices.begin(), indices.end());
+    return indices;
+}
+
 std::string bound(double value, Type type) {
     return type == Type::integer ? std::to_string(static_cast<long>(value)) : number(value);
 }
@@ -195,18 +250,27 @@ int main(int argc, char** argv) {
             if (v.display_unit[0] != '\0') variables << " displayUnit=\"" << v.display_unit << "\"";
             if (v.min != gimbal::kNoMin) variables << " min=\"" << bound(v.min, table.type) << "\"";
             if (v.max != gimbal::kNoMax) variables << " max=\"" << bound(v.max, table.type) << "\"";
+            for (int k = 0; k < gimbal::kContinuousStateCount; ++k)
+                if (table.type == Type::real && vr == gimbal::kStateDerivatives[k])
+                    variables << " derivative=\"" << real_index(gimbal::kContinuousStates[k]) << "\"";
             if (v.initial != gimbal::Initial::calculated) {
                 if (table.type == Type::boolean) variables << " start=\"" << (v.start != 0.0 ? "true" : "false") << "\"";
                 else if (table.type == Type::real) variables << " start=\"" << number(v.start) << "\"";
                 else variables << " start=\"" << static_cast<long>(v.start) << "\"";
             }
             variables << "/>\n    </ScalarVariable>\n";
-            if (v.causality == gimbal::Causality::output) {
-                // Outputs are computed in fmi2DoStep: setting an input changes none before the next step.
+            const bool continuous_output = table.type == Type::real && v.causality == gimbal::Causality::output &&
+                                           vr != gimbal::vr_events_last_time;
+            if (continuous_output) {
+                outputs << "      <Unknown index=\"" << index << "\" dependencies=\""
+                        << index_list(output_dependencies(static_cast<gimbal::RealVariable>(vr))) << "\"/>\n";
+            } else if (v.causality == gimbal::Causality::output) {
+                // Event counters, modes and the last event's time change at events only.
                 outputs << "      <Unknown index=\"" << index << "\" dependencies=\"\"/>\n";
-                if (v.initial == gimbal::Initial::calculated)
-                    initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
             }
+            if ((v.causality == gimbal::Causality::output || v.causality == gimbal::Causality::local) &&
+                v.initial == gimbal::Initial::calculated)
+                initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
         }
     }
 
@@ -235,7 +299,12 @@ int main(int argc, char** argv) {
     types << "  </TypeDefinitions>\n";
 
     std::ostringstream structure;
+    std::ostringstream derivatives;
+    for (int k = 0; k < gimbal::kContinuousStateCount; ++k)
+        derivatives << "      <Unknown index=\"" << real_index(gimbal::kStateDerivatives[k]) << "\" dependencies=\""
+                    << index_list(derivative_dependencies(k)) << "\"/>\n";
     structure << "    <Outputs>\n" << outputs.str() << "    </Outputs>\n"
+              << "    <Derivatives>\n" << derivatives.str() << "    </Derivatives>\n"
               << "    <InitialUnknowns>\n" << initial_unknowns.str() << "    </InitialUnknowns>\n";
     const std::string tolerance = number(gimbal::kRealVariables[gimbal::vr_solver_rtol].start);
     return write(argv[1], units.str()) && write(argv[2], variables.str()) && write(argv[3], structure.str()) &&

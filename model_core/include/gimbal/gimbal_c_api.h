@@ -14,7 +14,7 @@ extern "C" {
 typedef struct GimbalCore GimbalCore;
 
 typedef enum { GIMBAL_OK = 0, GIMBAL_WARNING = 1, GIMBAL_DISCARD = 2, GIMBAL_ERROR = 3 } GimbalStatus;
-typedef enum { GIMBAL_PARAMETER = 0, GIMBAL_INPUT = 1, GIMBAL_OUTPUT = 2 } GimbalCausality;
+typedef enum { GIMBAL_PARAMETER = 0, GIMBAL_INPUT = 1, GIMBAL_OUTPUT = 2, GIMBAL_LOCAL = 3 } GimbalCausality;
 typedef enum { GIMBAL_FIXED = 0, GIMBAL_TUNABLE = 1, GIMBAL_CONTINUOUS = 2 } GimbalVariability;
 typedef enum { GIMBAL_INITIAL_NONE = 0, GIMBAL_INITIAL_EXACT = 1, GIMBAL_INITIAL_CALCULATED = 2 } GimbalInitial;
 
@@ -66,6 +66,35 @@ GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer);
 GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, const void* buffer, int* initialized);
 /* Checks the snapshot as above; a refused one leaves the instance as it was. */
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
+
+/* ---- The continuous-time interface (FMI Model Exchange): the host integrates.
+ * Chosen once per instance, right after creation. The states are always GIMBAL_CONTINUOUS_STATES
+ * values in the order of gimbal_continuous_state_vr (a state the chosen fidelity does not integrate is
+ * computed from the others, and what the host sets for it is not used); the indicators are
+ * GIMBAL_EVENT_INDICATORS guards in a fixed order (an element the fidelity lacks gives constants).
+ * Messages of these functions name no interface function: the caller prefixes its own. */
+#define GIMBAL_CONTINUOUS_STATES 17
+#define GIMBAL_EVENT_INDICATORS 36
+GimbalStatus gimbal_core_use_continuous_time(GimbalCore* core);
+/* The Real value references of state k and of its derivative; k in [0, GIMBAL_CONTINUOUS_STATES). */
+unsigned gimbal_continuous_state_vr(int k);
+unsigned gimbal_state_derivative_vr(int k);
+/* After initialization only (GIMBAL_ERROR before). */
+GimbalStatus gimbal_core_set_time(GimbalCore* core, double time);
+GimbalStatus gimbal_core_set_continuous_states(GimbalCore* core, const double* states);
+GimbalStatus gimbal_core_get_continuous_states(GimbalCore* core, double* states);
+GimbalStatus gimbal_core_get_nominal_states(GimbalCore* core, double* nominals);
+GimbalStatus gimbal_core_get_derivatives(GimbalCore* core, double* derivatives);
+GimbalStatus gimbal_core_get_event_indicators(GimbalCore* core, double* indicators);
+typedef struct GimbalDiscreteUpdate {
+    int states_changed;    /* a transition moved the continuous states (projection onto a stop or limit) */
+    int next_time_defined; /* the chattering guard holds the modes until next_time */
+    double next_time;
+    int mode_changes;
+} GimbalDiscreteUpdate;
+/* Decides the modes at the current point: where an indicator crossed zero since the last decision,
+ * or an input jumped. A repeated call at the same point changes nothing. */
+GimbalStatus gimbal_core_update_discrete_states(GimbalCore* core, GimbalDiscreteUpdate* update);
 
 /* The continuous model linearized at the instance's current time and state, with its inputs as last
  * set, within the modes in force there (docs/linearization.md). Not exported by the FMU (it exports

@@ -38,6 +38,22 @@ public:
     std::string describe_last_changes() const override;
 
     void set_inputs(const StepInputs& inputs);
+    // Model Exchange: the host sets the inputs at every instant it evaluates, so the carrier's motion is
+    // taken as set, not extrapolated from where it was set (the Co-Simulation step's arc).
+    void hold_inputs_at_any_time(bool held) {
+        inputs_held_ = held;
+        base_cached_ = false;
+        cache_valid_ = false;
+    }
+
+    // The guards of every switching element the model can have, in one fixed order whatever the
+    // fidelity (Model Exchange's event indicators): gear 1 and 2 backlash (2 each), motor 1 and 2
+    // voltage clamp (2 each), current limiter (2 each), then dry friction of body1, rotor1, body2,
+    // rotor2 (6 each). An element this fidelity lacks contributes constants 1 (never crossing).
+    static constexpr int kIndicatorCount = 36;
+    void event_indicators(double time, const double* state, double* values);
+    // Where guard k of event_functions() sits among the indicators.
+    int indicator_of_guard(int guard) const { return guard_indicator_[guard]; }
     // The dynamics at (time, state) under the current modes: those of the last right-hand side when it
     // was evaluated there (the usual case at the end of a step), else evaluated now.
     const Dynamics& dynamics_at(double time, const double* state);
@@ -65,6 +81,8 @@ private:
     std::vector<DryFrictionElement> friction_;
     std::vector<const SwitchingElement*> elements_;
     int event_count_ = 0;
+    std::vector<int> guard_indicator_;
+    bool inputs_held_ = false;
     StepInputs inputs_;
     BaseKinematics base_;
     double base_time_ = 0.0;

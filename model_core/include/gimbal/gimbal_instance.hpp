@@ -12,6 +12,7 @@
 #include "gimbal/gimbal_hybrid_system.hpp"
 #include "gimbal/integrator.hpp"
 #include "gimbal/linearization.hpp"
+#include "gimbal/variable_groups.hpp"
 #include "gimbal/variables.hpp"
 
 namespace gimbal {
@@ -53,8 +54,31 @@ public:
     // (about 25 ms of CPU at the measured 230 ns per evaluation: 5,000 times the default scene's).
     static constexpr long kStepWorkBudget = 100000;
     double time() const { return time_; }
+    bool initialized() const { return system_ != nullptr && integrator_ != nullptr; }
     // The continuous model linearized at the current time and state, with the inputs as last set.
     GimbalStatus linearize(LinearModel& model);
+
+    // ---- The continuous-time interface (Model Exchange; gimbal_instance_continuous.cpp) ----
+    // The host integrates: it sets the time, the states and the inputs, reads derivatives and event
+    // indicators, and calls update_discrete_states() where an indicator crossed zero (or an input
+    // jumped, or the time event it was given came). Chosen once, before initialization.
+    void use_continuous_time_interface() { continuous_time_ = true; }
+    bool continuous_time_interface() const { return continuous_time_; }
+    static constexpr int kStateCount = kContinuousStateCount;
+    static constexpr int kIndicatorCount = GimbalHybridSystem::kIndicatorCount;
+    struct DiscreteUpdate {
+        bool states_changed = false;      // a transition moved the state (onto a stop, a limit)
+        bool next_time_defined = false;   // the chattering guard holds the modes until next_time
+        double next_time = 0.0;
+        int mode_changes = 0;
+    };
+    GimbalStatus set_time(double time);
+    GimbalStatus set_continuous_states(const double* states);
+    void get_continuous_states(double* states);
+    void get_nominal_states(double* nominals) const;
+    GimbalStatus get_derivatives(double* derivatives);
+    GimbalStatus get_event_indicators(double* indicators);
+    GimbalStatus update_discrete_states(DiscreteUpdate& update);
 
 private:
     StepInputs read_step_inputs(double step_start) const;
@@ -82,6 +106,22 @@ private:
     GimbalStatus preview_outputs(const char* function, const char* name);
     void publish_outputs();
     GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
+    // Continuous-time interface: the 17 states and their derivatives from the integrated ones (a state a
+    // reduced fidelity does not integrate is computed from the others).
+    void full_state_vector(const Dynamics& dynamics, double* states) const;
+    void full_state_derivative(const Dynamics& dynamics, const double* derivative, double* out) const;
+    // Pushes inputs set since the last evaluation into the hybrid system.
+    void refresh_held_inputs();
+    // Guards at the current point with those that sit exactly on zero settled as a located event would
+    // settle them; returns the mode changes this made.
+    int settle_guards(const int* decided);
+    void clamp_published_to_bounds();
+    void publish_continuous_time_outputs() {
+        refresh_held_inputs();
+        publish_outputs();
+        clamp_published_to_bounds();
+        outputs_stale_ = false;
+    }
 
     Logger logger_;
     LogFilter log_filter_;
@@ -106,6 +146,19 @@ private:
     double master_tolerance_ = 0.0;
     bool rtol_set_ = false;            // solver.rtol set by the user: the master's tolerance does not apply
     std::int64_t steps_over_budget_ = 0;
+
+    // Continuous-time interface state (saved with an FMU state).
+    bool continuous_time_ = false;
+    bool inputs_stale_ = true;     // an input was set since the hybrid system last took them
+    bool outputs_stale_ = true;    // time, state or inputs changed since outputs were published
+    bool decided_here_ = false;    // update_discrete_states ran at this very point: a repeat changes nothing
+    double reference_guards_[kIndicatorCount] = {};  // guards as decided at the last update (crossings are
+                                                     // measured against them)
+    std::int8_t decided_side_[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
+    double last_event_time_ = -1e300;  // chattering guard, as the integrators' (IntegratorSettings)
+    int rapid_events_ = 0;
+    double dwell_until_ = -1e300;      // model time until which the modes are held
+    std::int64_t zeno_holds_ = 0;
 };
 
 }  // namespace gimbal

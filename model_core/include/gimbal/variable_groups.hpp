@@ -95,6 +95,23 @@ inline constexpr IntegerVariable kEventCounters[7] = {
     vi_events_current_limit2, vi_events_stick_slip, vi_events_zeno_guard,
 };
 
+// The continuous states of the Model Exchange interface, in the order of its state vector (and of
+// <Derivatives>): the full state of section "State" in docs/physics.md and the energy accumulators,
+// whatever the fidelity; kStateDerivatives[k] is der(kContinuousStates[k]).
+inline constexpr int kContinuousStateCount = 17;
+inline constexpr RealVariable kContinuousStates[kContinuousStateCount] = {
+    vr_alpha,     vr_alpha_m,     vr_beta,     vr_beta_m,     vr_alpha_dot, vr_alpha_m_dot,
+    vr_beta_dot,  vr_beta_m_dot,  vr_i_R1,     vr_i_R2,       vr_theta_b1,  vr_theta_b2,
+    vr_energy_electrical_in, vr_energy_resistive, vr_energy_viscous, vr_energy_shaft_damping,
+    vr_energy_dry_friction,
+};
+inline constexpr RealVariable kStateDerivatives[kContinuousStateCount] = {
+    vr_der_alpha,     vr_der_alpha_m,     vr_der_beta,     vr_der_beta_m,     vr_der_alpha_dot, vr_der_alpha_m_dot,
+    vr_der_beta_dot,  vr_der_beta_m_dot,  vr_der_i_R1,     vr_der_i_R2,       vr_der_theta_b1,  vr_der_theta_b2,
+    vr_der_energy_electrical_in, vr_der_energy_resistive, vr_der_energy_viscous, vr_der_energy_shaft_damping,
+    vr_der_energy_dry_friction,
+};
+
 // ---------------------------------------------------------------------------------------------------
 // Compile-time checks of the groups against the tables themselves (names, causality, initial), read
 // here from the same .def lines as kRealVariables.
@@ -268,6 +285,21 @@ static_assert(variable_table::holds_exactly(kStartState, variable_table::kReal,
                                                 return v.causality == Causality::output && v.initial == Initial::exact;
                                             }),
               "kStartState is every output whose start value is used (initial = exact): the start state");
+static_assert([] {
+    for (int k = 0; k < kContinuousStateCount; ++k) {
+        const char* state = variable_table::name(kContinuousStates[k]);
+        const char* derivative = variable_table::name(kStateDerivatives[k]);
+        if (!variable_table::starts_with(derivative, "der(") || !variable_table::starts_with(derivative + 4, state) ||
+            variable_table::length(derivative) != variable_table::length(state) + 5 ||
+            derivative[variable_table::length(derivative) - 1] != ')')
+            return false;
+        if (k < 12 && kContinuousStates[k] != kStartState[k]) return false;
+    }
+    return true;
+}(), "kStateDerivatives[k] is der(kContinuousStates[k]), and the first 12 states are the start state in its order");
+static_assert(variable_table::holds_exactly(kStateDerivatives, variable_table::kReal,
+                                            [](const VariableInfo& v) { return v.causality == Causality::local; }),
+              "kStateDerivatives is every local variable: the derivatives are the only ones");
 static_assert(variable_table::holds_exactly(kEventCounters, variable_table::kInteger,
                                             [](const VariableInfo& v) {
                                                 return variable_table::starts_with(v.name, "events.");

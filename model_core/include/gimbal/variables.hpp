@@ -7,7 +7,7 @@
 
 namespace gimbal {
 
-enum class Causality { parameter, input, output };
+enum class Causality { parameter, input, output, local };
 enum class Variability { fixed, tunable, discrete, continuous };
 enum class Initial { none, exact, calculated };
 

@@ -1,0 +1,299 @@
+// The continuous-time face of an instance (what FMI calls Model Exchange): the host owns time, the
+// continuous states and the integration; the instance evaluates derivatives, event indicators and
+// outputs at the point the host sets, and decides the modes where the host reports an event.
+//
+// The modes are decided by the same switching elements, with the same crossing directions and the
+// same settling of guards that sit exactly on zero as the integrators of the Co-Simulation step use,
+// so that a host that locates events accurately meets the same mode sequence. A host that locates
+// them late (a fixed-step method) gets the state projected back onto the constraint of the new mode
+// (a gear at its stop, a current at its limit): no state leaves its bounds after an event update.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "gimbal/gimbal_instance.hpp"
+
+namespace gimbal {
+namespace {
+
+bool crossed(double before, double after) {
+    return before != 0.0 && (after == 0.0 || (before > 0.0) != (after > 0.0));
+}
+
+// Chattering guard settings: those of the integrators (IntegratorSettings), so that a chattering
+// sequence is cut the same way in either interface.
+const IntegratorSettings kGuardSettings{};
+
+// How far ahead a guard sitting exactly on zero is looked at to see where it goes: short against the
+// fastest time constant the parameters allow (L/R and c_s/k_s down to 1e-8 s in the hard cases).
+constexpr double kDepartureLookahead = 1e-12;
+
+}  // namespace
+
+void GimbalInstance::full_state_vector(const Dynamics& d, double* states) const {
+    const StateLayout& layout = params_.layout;
+    for (int body = 0; body < 4; ++body) {
+        states[body] = d.full.angle[body];
+        states[kRates + body] = d.full.rate[body];
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        states[kCurrents + axis] = d.full.current[axis];
+        states[kBacklash + axis] = d.full.backlash[axis];
+    }
+    for (int k = 0; k < kEnergyFlowCount; ++k)
+        states[kStateSize + k] = layout.energy_slot >= 0 ? state_[layout.energy_slot + k] : 0.0;
+}
+
+void GimbalInstance::full_state_derivative(const Dynamics& d, const double* derivative, double* out) const {
+    const StateLayout& layout = params_.layout;
+    for (int body = 0; body < 4; ++body) {
+        out[body] = d.full.rate[body];
+        out[kRates + body] = d.full_acceleration[body];
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        const int slot = layout.current_slot[axis];
+        if (slot >= 0) {
+            out[kCurrents + axis] = derivative[slot];
+        } else if (system_->modes().motor_limited[axis] != 0) {
+            out[kCurrents + axis] = 0.0;
+        } else {
+            // A quasi-static motor's current (u - k_e w) / R moves with its rotor's speed (u is held).
+            const MotorParameters& motor = params_.motor[axis];
+            out[kCurrents + axis] = -motor.back_emf_constant * d.full_acceleration[rotor_index(axis)] / motor.resistance;
+        }
+        out[kBacklash + axis] = layout.backlash_slot[axis] >= 0 ? derivative[layout.backlash_slot[axis]] : 0.0;
+    }
+    for (int k = 0; k < kEnergyFlowCount; ++k)
+        out[kStateSize + k] = layout.energy_slot >= 0 ? derivative[layout.energy_slot + k] : 0.0;
+}
+
+void GimbalInstance::refresh_held_inputs() {
+    if (!inputs_stale_) return;
+    StepInputs inputs = read_step_inputs(model_time(time_));
+    inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;  // no input derivatives in this interface
+    system_->set_inputs(inputs);
+    inputs_stale_ = false;
+}
+
+GimbalStatus GimbalInstance::set_time(double time) {
+    if (!std::isfinite(time)) return refuse(GIMBAL_ERROR, "the time must be finite");
+    if (time != time_) {
+        time_ = time;
+        outputs_stale_ = true;
+        decided_here_ = false;
+    }
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::set_continuous_states(const double* states) {
+    for (int k = 0; k < kStateCount; ++k) {
+        if (std::isfinite(states[k])) continue;
+        std::ostringstream s;
+        s << "continuous state " << k << " (" << kRealVariables[kContinuousStates[k]].name << ") = " << states[k]
+          << " refused: states must be finite";
+        return refuse(GIMBAL_ERROR, s.str());
+    }
+    const StateLayout& layout = params_.layout;
+    // The states this fidelity integrates take the host's values; the others follow from them.
+    for (int body = 0; body < 4; ++body) {
+        if (!layout.independent(body)) continue;
+        state_[layout.angle_slot[body]] = states[body];
+        state_[layout.rate_slot[body]] = states[kRates + body];
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        if (layout.current_slot[axis] >= 0) state_[layout.current_slot[axis]] = states[kCurrents + axis];
+        if (layout.backlash_slot[axis] >= 0) state_[layout.backlash_slot[axis]] = states[kBacklash + axis];
+    }
+    if (layout.energy_slot >= 0)
+        for (int k = 0; k < kEnergyFlowCount; ++k) state_[layout.energy_slot + k] = states[kStateSize + k];
+    outputs_stale_ = true;
+    decided_here_ = false;
+    return GIMBAL_OK;
+}
+
+void GimbalInstance::get_continuous_states(double* states) {
+    refresh_held_inputs();
+    full_state_vector(system_->dynamics_at(model_time(time_), state_), states);
+}
+
+void GimbalInstance::get_nominal_states(double* nominals) const {
+    std::fill(nominals, nominals + kStateCount, 1.0);
+    // The play is small against a radian: its own size is the scale its error is measured on.
+    // From the values as set: the host may ask before initialization.
+    const RealVariable half_backlash[2] = {vr_gear1_eta, vr_gear2_eta};
+    for (int axis = 0; axis < 2; ++axis)
+        if (reals_[half_backlash[axis]] > 0.0) nominals[kBacklash + axis] = reals_[half_backlash[axis]];
+}
+
+GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
+    refresh_held_inputs();
+    const double now = model_time(time_);
+    const Dynamics& dynamics = system_->dynamics_at(now, state_);
+    double integrated[kMaxStateSize];
+    if (!state_derivative(params_, dynamics, integrated)) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "the derivatives are not finite at t = " << time_
+          << ": the states or inputs set lie beyond what the model can represent";
+        return refuse(GIMBAL_ERROR, s.str());
+    }
+    full_state_derivative(dynamics, integrated, derivatives);
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
+    refresh_held_inputs();
+    const double now = model_time(time_);
+    if (now < dwell_until_) {
+        // The chattering guard holds the modes: the indicators keep the values of its start, so that
+        // the host sees no crossing before the time event that ends the hold.
+        std::fill(indicators, indicators + kIndicatorCount, 1.0);
+        for (int k = 0; k < system_->event_count(); ++k)
+            indicators[system_->indicator_of_guard(k)] = reference_guards_[k];
+        return GIMBAL_OK;
+    }
+    double guards[kIndicatorCount];
+    system_->event_functions(now, state_, guards);
+    std::fill(indicators, indicators + kIndicatorCount, 1.0);
+    for (int k = 0; k < system_->event_count(); ++k) {
+        double value = guards[k];
+        if (!std::isfinite(value)) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "event indicator " << system_->indicator_of_guard(k) << " is not finite at t = " << time_
+              << ": the states or inputs set lie beyond what the model can represent";
+            return refuse(GIMBAL_ERROR, s.str());
+        }
+        // A guard exactly on zero where the modes were decided has the side it was decided for.
+        if (value == 0.0 && decided_side_[k] != 0) value = decided_side_[k] * std::numeric_limits<double>::min();
+        indicators[system_->indicator_of_guard(k)] = value;
+    }
+    return GIMBAL_OK;
+}
+
+int GimbalInstance::settle_guards(const int* decided) {
+    // As a one-step integrator restarts at an event (OneStepIntegrator::refresh_at_current_point): a
+    // guard exactly at zero has no sign to change; the side it departs to, looked at an instant ahead
+    // along the dynamics, decides the modes again (once) where they were chosen blind to it.
+    const int n = system_->event_count();
+    const double now = model_time(time_);
+    int changes = 0;
+    int decided_side[kIndicatorCount];
+    for (int k = 0; k < n; ++k) decided_side[k] = decided != nullptr ? decided[k] : 0;
+    for (int round = 0;; ++round) {
+        double derivative[kMaxStateSize];
+        if (!system_->derivative(now, state_, derivative)) break;  // reported by get_derivatives
+        system_->event_functions(now, state_, reference_guards_);
+        bool on_surface = false;
+        for (int k = 0; k < n; ++k) on_surface = on_surface || reference_guards_[k] == 0.0;
+        if (!on_surface) break;
+        const double delta = kDepartureLookahead * std::max(1.0, std::fabs(now));
+        double ahead_state[kMaxStateSize], ahead[kIndicatorCount];
+        for (int i = 0; i < params_.layout.size; ++i) ahead_state[i] = state_[i] + delta * derivative[i];
+        system_->event_functions(now + delta, ahead_state, ahead);
+        if (round == 0) {
+            int directions[kIndicatorCount] = {};
+            bool departs = false;
+            for (int k = 0; k < n; ++k) {
+                if (reference_guards_[k] != 0.0 || ahead[k] == 0.0) continue;
+                const int departure = ahead[k] > 0.0 ? 1 : -1;
+                if (decided_side[k] == departure) continue;
+                directions[k] = departure;
+                decided_side[k] = departure;
+                departs = true;
+            }
+            if (departs) {
+                const int more = system_->update_modes(now, state_, directions);
+                changes += more;
+                if (more > 0) continue;
+            }
+        }
+        for (int k = 0; k < n; ++k) {
+            if (reference_guards_[k] != 0.0) continue;
+            const int side = decided_side[k] != 0 ? decided_side[k] : (ahead[k] > 0.0 ? 1 : (ahead[k] < 0.0 ? -1 : 0));
+            decided_side_[k] = static_cast<std::int8_t>(side);
+        }
+        break;
+    }
+    for (int k = 0; k < n; ++k)
+        if (reference_guards_[k] == 0.0 && decided_side_[k] != 0)
+            reference_guards_[k] = decided_side_[k] * std::numeric_limits<double>::min();
+    return changes;
+}
+
+GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
+    update = DiscreteUpdate{};
+    refresh_held_inputs();
+    const double now = model_time(time_);
+    const bool holding = dwell_until_ > -1e300;
+    if (holding && now < dwell_until_) {
+        update.next_time_defined = true;
+        update.next_time = epoch_ + dwell_until_;
+        return GIMBAL_OK;
+    }
+    // A repeated call at the point just decided (a host that iterates once more) changes nothing: a
+    // second decision without the crossing directions could undo what they decided.
+    if (decided_here_ && !holding) return GIMBAL_OK;
+
+    const int n = system_->event_count();
+    double guards[kIndicatorCount];
+    system_->event_functions(now, state_, guards);
+    int directions[kIndicatorCount] = {};
+    if (holding) {
+        // The hold ends here: the modes are chosen again from the signs, as after an input change.
+        dwell_until_ = -1e300;
+    } else {
+        for (int k = 0; k < n; ++k)
+            if (crossed(reference_guards_[k], guards[k])) directions[k] = guards[k] > reference_guards_[k] ? 1 : -1;
+    }
+    double before[kMaxStateSize];
+    std::copy(state_, state_ + kMaxStateSize, before);
+    std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
+    int changes = system_->update_modes(now, state_, directions);
+    if (changes > 0 && log_filter_("logEvents")) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "t = " << time_ << ": " << changes << " mode change(s)";
+        const std::string what = system_->describe_last_changes();
+        if (!what.empty()) s << ": " << what;
+        logger_(GIMBAL_OK, "logEvents", s.str());
+    }
+    changes += settle_guards(directions);
+
+    if (changes > 0) {
+        const double window = kGuardSettings.zeno_window;
+        rapid_events_ = now - last_event_time_ <= window ? rapid_events_ + 1 : 0;
+        last_event_time_ = now;
+        if (rapid_events_ >= kGuardSettings.zeno_event_limit) {
+            dwell_until_ = now + kGuardSettings.zeno_dwell;
+            rapid_events_ = 0;
+            ++zeno_holds_;
+            std::ostringstream s;
+            s.precision(17);
+            s << "t = " << time_ << ": " << kGuardSettings.zeno_event_limit
+              << " events without progress in time (chattering); modes held until t = " << epoch_ + dwell_until_;
+            logger_(GIMBAL_OK, "logEvents", s.str());
+        }
+    }
+    update.mode_changes = changes;
+    update.states_changed = !std::equal(state_, state_ + params_.layout.size, before);
+    update.next_time_defined = dwell_until_ > -1e300;
+    update.next_time = epoch_ + dwell_until_;
+    decided_here_ = true;
+    outputs_stale_ = true;
+    return GIMBAL_OK;
+}
+
+void GimbalInstance::clamp_published_to_bounds() {
+    // Between a host's step that overshoots a stop or a limit and the event update that projects the
+    // state back, the outputs already show the physical values.
+    const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
+    for (int axis = 0; axis < 2; ++axis) {
+        const double limit = params_.motor[axis].current_limit, eta = params_.gear[axis].half_backlash;
+        reals_[currents[axis]] = std::clamp(reals_[currents[axis]], -limit, limit);
+        reals_[backlash[axis]] = std::clamp(reals_[backlash[axis]], -eta, eta);
+    }
+}
+
+}  // namespace gimbal

@@ -1,0 +1,324 @@
+"""FMI 2.0 Model Exchange: the same FMU integrated by the host.
+
+- CVode at a tight tolerance against the Co-Simulation FMU at a tight tolerance: fixed base with
+  piecewise-constant voltages, and a moving base (the same carrier motion in both);
+- a smooth carrier motion, which Co-Simulation approximates by constant accelerations over each step:
+  its results converge to Model Exchange's as the step shrinks;
+- a coarse forward-Euler host: outputs stay physical (limits, play, finite) and converge;
+- the event iteration ends after one fmi2NewDiscreteStates, and a naive host that repeats it changes
+  nothing, on every scene's parameters;
+- FMU states, refusals and the model description's Model Exchange parts.
+"""
+from __future__ import annotations
+
+import ctypes
+import math
+import pathlib
+import tomllib
+
+import numpy as np
+import pytest
+from fmpy.fmi1 import FMICallException
+
+from model_exchange_host import ModelExchangeInstance, simulate_model_exchange
+from scene_lib.fmu import simulate
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+ANGLES = ["alpha", "alpha_m", "beta", "beta_m"]
+COUNTERS = ["events.total", "events.backlash1", "events.backlash2", "events.current_limit1",
+            "events.current_limit2", "events.stick_slip"]
+TIGHT = 1e-10
+
+
+def angle_errors(fmu, a: dict, b: dict) -> dict:
+    """Largest differences of the angles, the rotors' referred to the load side (divided by the gear
+    ratio): a rotor turns N times the load's angle, and so does its share of the tolerance."""
+    ratio = {"alpha": 1.0, "beta": 1.0, "alpha_m": fmu.start("gear1.N"), "beta_m": fmu.start("gear2.N")}
+    return {name: float(np.max(np.abs(a[name] - b[name]))) / ratio[name] for name in ANGLES}
+
+
+def square_wave(amplitude: float, half_period: float):
+    """Voltages switching every half_period (which is not a power of two of the 1 ms step)."""
+    def voltages(t: float) -> dict:
+        # Right-continuous, and not early: a switch a few ulp before its time would be a state event.
+        k = int(math.floor(t / half_period * (1.0 + 1e-14)))
+        sign = 1.0 if k % 2 == 0 else -1.0
+        return {"u_R1": amplitude * sign, "u_R2": -0.6 * amplitude * sign}
+    return voltages
+
+
+def test_cvode_matches_co_simulation_on_a_fixed_base_with_switching_voltages(gimbal_fmu):
+    # Voltages that reverse every 30 ms: the limiter, the backlash and stick-slip all switch.
+    voltages = square_wave(12.0, 0.03)
+    start = {"base.fixed": True, "beta": 0.3}
+    # Ends between two switches: at a switch the two interfaces report before and after it.
+    me = simulate_model_exchange(gimbal_fmu, 0.31, start, voltages, input_events=np.arange(1, 11) * 0.03,
+                                 outputs=ANGLES + COUNTERS, rtol=TIGHT)
+    cs = simulate(gimbal_fmu, 0.31, 1e-3, dict(start, **{"solver.rtol": TIGHT}), lambda t, _: voltages(t),
+                  outputs=ANGLES + COUNTERS)
+    errors = angle_errors(gimbal_fmu, me, cs)
+    assert max(errors.values()) < 1e-7, errors
+    assert me["events.current_limit1"][-1] > 0 and me["events.backlash2"][-1] > 0
+    for name in COUNTERS:
+        assert me[name][-1] == cs[name][-1], name
+
+
+def carrier(t: float) -> dict:
+    amplitude = {"delta": 0.05, "psi": 0.03, "gamma": 0.04}
+    omega = {"delta": 2 * math.pi * 0.7, "psi": 2 * math.pi * 0.5, "gamma": 2 * math.pi * 0.9}
+    values = {}
+    for axis, a in amplitude.items():
+        w = omega[axis]
+        values[f"base.{axis}"] = a * math.sin(w * t)
+        values[f"base.{axis}_dot"] = a * w * math.cos(w * t)
+        values[f"base.{axis}_ddot"] = -a * w * w * math.sin(w * t)
+    values.update({"base.v_a[1]": 0.3 * math.cos(2 * t), "base.a_a[1]": -0.6 * math.sin(2 * t),
+                   "base.v_a[3]": 0.2 * math.sin(3 * t), "base.a_a[3]": 0.6 * math.cos(3 * t)})
+    return values
+
+
+def held_carrier(step: float):
+    """The carrier motion a Co-Simulation step sees: from each step start, constant accelerations."""
+    def motion(t: float) -> dict:
+        k = math.floor(t / step + 1e-9)
+        t0 = k * step
+        tau = t - t0
+        start = carrier(t0)
+        values = dict(start)
+        for axis in ("delta", "psi", "gamma"):
+            a, r, acc = start[f"base.{axis}"], start[f"base.{axis}_dot"], start[f"base.{axis}_ddot"]
+            values[f"base.{axis}"] = a + r * tau + 0.5 * acc * tau * tau
+            values[f"base.{axis}_dot"] = r + acc * tau
+        for j in (1, 3):
+            values[f"base.v_a[{j}]"] = start[f"base.v_a[{j}]"] + start[f"base.a_a[{j}]"] * tau
+        values.update({"u_R1": 2.0, "u_R2": -1.0})
+        return values
+    return motion
+
+
+def test_cvode_matches_co_simulation_on_a_moving_base(gimbal_fmu):
+    step = 1e-3
+    motion = held_carrier(step)
+    start = {"beta": 0.1}
+    me = simulate_model_exchange(gimbal_fmu, 0.5, start, motion, input_events=np.arange(1, 500) * step,
+                                 outputs=ANGLES + COUNTERS, rtol=TIGHT)
+    cs = simulate(gimbal_fmu, 0.5, step, dict(start, **{"solver.rtol": TIGHT}),
+                  lambda t, _: dict(carrier(t), u_R1=2.0, u_R2=-1.0), outputs=ANGLES + COUNTERS)
+    errors = angle_errors(gimbal_fmu, me, cs)
+    assert max(errors.values()) < 1e-7, errors
+    assert me["events.total"][-1] > 10
+    for name in COUNTERS:
+        assert me[name][-1] == cs[name][-1], name
+
+
+def test_co_simulation_of_a_smooth_carrier_converges_to_model_exchange(gimbal_fmu):
+    """Model Exchange takes the carrier's motion as set at every instant; a Co-Simulation step holds
+    its accelerations from the step start, an error of first order in the step."""
+    start = {"beta": 0.1}
+    inputs = lambda t: dict(carrier(t), u_R1=2.0, u_R2=-1.0)  # noqa: E731
+    me = simulate_model_exchange(gimbal_fmu, 0.5, start, inputs, outputs=["alpha", "beta"], rtol=TIGHT)
+    errors = []
+    for step in (1e-3, 5e-4, 2.5e-4):
+        cs = simulate(gimbal_fmu, 0.5, step, dict(start, **{"solver.rtol": TIGHT}), lambda t, _: inputs(t),
+                      outputs=["alpha", "beta"])
+        k = int(round(1e-3 / step))
+        errors.append(max(np.max(np.abs(me[n] - cs[n][::k])) for n in ("alpha", "beta")))
+    assert errors[0] > 1e-7  # the held accelerations make a visible difference ...
+    for coarse, fine in zip(errors, errors[1:]):
+        assert 1.6 < coarse / fine < 2.5  # ... of first order in the step
+
+
+BOUNDS = {"motor1.i_L": "i_R1", "motor2.i_L": "i_R2", "gear1.eta": "theta_b1", "gear2.eta": "theta_b2"}
+
+
+def test_a_coarse_euler_host_gets_physical_outputs_and_converges(gimbal_fmu):
+    voltages = square_wave(12.0, 0.03)
+    start = {"base.fixed": True, "beta": 0.3}
+    names = ANGLES + list(BOUNDS.values())
+    reference = simulate(gimbal_fmu, 0.12, 1e-3, dict(start, **{"solver.rtol": TIGHT}), lambda t, _: voltages(t),
+                         outputs=names)
+    limits = {output: gimbal_fmu.start(parameter) for parameter, output in BOUNDS.items()}
+    errors = []
+    for euler_step in (4e-5, 2e-5, 1e-5):
+        me = simulate_model_exchange(gimbal_fmu, 0.12, start, voltages, input_events=np.arange(1, 4) * 0.03,
+                                     outputs=names, solver="Euler", euler_step=euler_step)
+        for name in names:
+            assert np.all(np.isfinite(me[name])), name
+        for output, limit in limits.items():
+            assert np.max(np.abs(me[output])) <= limit, output
+        errors.append(max(np.max(np.abs(me[n] - reference[n])) for n in ANGLES))
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[2] < 0.6 * errors[0]
+
+
+def scene_model(path: pathlib.Path) -> dict:
+    """The FMU values a scene file sets (fidelity, parameters, initial state)."""
+    scene = tomllib.loads(path.read_text())
+    values = {}
+    for table in ("fidelity", "parameters", "initial"):
+        values.update(scene.get(table, {}))
+    return values
+
+
+@pytest.mark.parametrize("scene", sorted(p.name for p in (REPO / "scenes").glob("*.toml")))
+def test_the_event_iteration_ends_at_once_and_a_repeat_changes_nothing(gimbal_fmu, scene):
+    start = scene_model(REPO / "scenes" / scene)
+    fixed = bool(start.get("base.fixed", False))
+    voltages = square_wave(8.0, 0.02)
+    inputs = voltages if fixed else (lambda t: dict(carrier(t), **voltages(t)))
+    me = simulate_model_exchange(gimbal_fmu, 0.1, start, inputs, input_events=np.arange(1, 5) * 0.02,
+                                 outputs=ANGLES + ["events.total"], rtol=1e-8, repeats=3)
+    assert me["events.total"][-1] > 0
+    assert set(me["event_calls"]) == {1}
+
+
+def test_backlash_chatter_of_a_stiff_undamped_gear_ends_every_event_iteration(gimbal_fmu):
+    """Backlash chatter of a very stiff, nearly undamped gear (a hard case of docs/hard_cases.md): about
+    2,000 events in 20 ms, each iteration settled by one call; a chattering hold (50 events within 1 ns
+    each; none occurs here) would be said in the log as often as events.zeno_guard counts."""
+    log = []
+    start = {"base.fixed": True, "gear2.k_s": 1e8, "gear2.c_s": 1e-6, "beta": 0.3, "dry_friction": False}
+    me = simulate_model_exchange(gimbal_fmu, 0.02, start, square_wave(12.0, 0.005),
+                                 input_events=np.arange(1, 4) * 0.005, outputs=["beta", "events.zeno_guard",
+                                                                                "events.total"],
+                                 rtol=1e-6, log=log)
+    assert np.all(np.isfinite(me["beta"]))
+    assert me["events.total"][-1] > 1000 and set(me["event_calls"]) == {1}
+    holds = me["events.zeno_guard"][-1]
+    said = [entry for entry in log if "chattering" in entry.text]
+    assert len(said) == holds
+
+
+def me_instance(gimbal_fmu, start=None, log=None, name="me"):
+    return ModelExchangeInstance(gimbal_fmu, start or {"beta": 0.4}, lambda t: {"u_R1": 3.0}, log=log, name=name)
+
+
+def derivatives(instance):
+    dx = np.zeros(instance.nx)
+    instance.model.getDerivatives(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), instance.nx)
+    return dx
+
+
+def indicators(instance):
+    z = np.zeros(instance.nz)
+    instance.model.getEventIndicators(z.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), instance.nz)
+    return z
+
+
+def set_states(instance, x):
+    x = np.ascontiguousarray(x, dtype=float)
+    instance.model.setContinuousStates(x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), instance.nx)
+
+
+def states(instance):
+    x = np.zeros(instance.nx)
+    instance.model.getContinuousStates(x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), instance.nx)
+    return x
+
+
+def test_states_derivatives_and_variables_agree(gimbal_fmu):
+    md = gimbal_fmu.model_description
+    instance = me_instance(gimbal_fmu)
+    try:
+        x = states(instance)
+        state_names = [d.variable.derivative.name for d in md.derivatives]
+        derivative_names = [d.variable.name for d in md.derivatives]
+        assert state_names[:4] == ANGLES and derivative_names[0] == "der(alpha)"
+        assert np.array_equal(x, instance.values(state_names))
+        dx = derivatives(instance)
+        assert np.array_equal(dx, instance.values(derivative_names))
+        # der(angle) is the rate state, and the model is not at rest (the payload hangs at 0.4 rad).
+        assert np.array_equal(dx[:4], x[4:8])
+        assert np.any(dx[4:8] != 0.0)
+        nominals = np.zeros(instance.nx)
+        instance.model.getNominalsOfContinuousStates(nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                                                     instance.nx)
+        assert nominals[10] == gimbal_fmu.start("gear1.eta") and np.all(nominals > 0)
+    finally:
+        instance.free()
+
+
+def test_fmu_states_restore_the_point_and_refuse_the_other_interface(gimbal_fmu):
+    instance = me_instance(gimbal_fmu)
+    other = me_instance(gimbal_fmu, name="other")
+    try:
+        instance.set_time(0.01)
+        x = states(instance) + 1e-3
+        set_states(instance, x)
+        saved = instance.model.getFMUstate()
+        dx, z = derivatives(instance), indicators(instance)
+        set_states(instance, x + 0.1)
+        instance.set_time(0.02)
+        instance.model.setFMUstate(saved)
+        assert np.array_equal(derivatives(instance), dx) and np.array_equal(indicators(instance), z)
+        blob = instance.model.serializeFMUstate(saved)
+        copy = other.model.deSerializeFMUstate(blob)
+        other.model.setFMUstate(copy)
+        assert np.array_equal(derivatives(other), dx) and np.array_equal(indicators(other), z)
+        instance.model.freeFMUstate(saved)
+        other.model.freeFMUstate(copy)
+    finally:
+        instance.free()
+        other.free()
+    log = []
+    slave = gimbal_fmu.instantiate("cs", log=log)
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        with pytest.raises(FMICallException):
+            slave.setFMUstate(slave.deSerializeFMUstate(blob))
+        assert any("continuous-time (Model Exchange)" in e.text for e in log)
+    finally:
+        slave.freeInstance()
+
+
+def test_refusals_name_the_function_and_the_culprit(gimbal_fmu):
+    log = []
+    instance = me_instance(gimbal_fmu, log=log)
+    model = instance.model
+    try:
+        def refused(call, *fragments):
+            del log[:]
+            with pytest.raises(FMICallException):
+                call()
+            text = " ".join(e.text for e in log)
+            for fragment in fragments:
+                assert fragment in text, (fragment, text)
+
+        small = np.zeros(3)
+        refused(lambda: model.getDerivatives(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
+                "fmi2GetDerivatives", "nx = 3", "17")
+        refused(lambda: model.getEventIndicators(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
+                "fmi2GetEventIndicators", "ni = 3", "36")
+        refused(lambda: model.getDerivatives(None, 17), "fmi2GetDerivatives", "derivatives", "null")
+        bad = states(instance)
+        bad[9] = float("nan")
+        refused(lambda: set_states(instance, bad), "fmi2SetContinuousStates", "i_R2", "finite")
+        refused(lambda: model.setTime(float("inf")), "fmi2SetTime", "finite")
+        refused(lambda: model.newDiscreteStates(), "fmi2NewDiscreteStates", "continuous-time mode")
+        del log[:]
+        do_step = model.dll.fmi2DoStep
+        do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+        assert do_step(model.component, 0.0, 1e-3, 1) == 3  # fmi2Error
+        assert any("fmi2DoStep is not allowed in state 'continuous-time mode'" in e.text for e in log)
+        model.enterEventMode()
+        refused(lambda: set_states(instance, states(instance)), "fmi2SetContinuousStates", "event mode")
+        model.enterContinuousTimeMode()
+    finally:
+        instance.free()
+
+
+def test_the_model_description_declares_model_exchange(gimbal_fmu):
+    md = gimbal_fmu.model_description
+    assert md.modelExchange is not None and md.coSimulation is not None
+    assert md.modelExchange.modelIdentifier == md.coSimulation.modelIdentifier
+    assert md.numberOfContinuousStates == 17 and md.numberOfEventIndicators == 36
+    header = (REPO / "model_core" / "include" / "gimbal" / "gimbal_c_api.h").read_text()
+    assert "#define GIMBAL_EVENT_INDICATORS 36" in header and "#define GIMBAL_CONTINUOUS_STATES 17" in header
+    states = [d.variable.derivative.name for d in md.derivatives]
+    assert states == ANGLES + ["alpha_dot", "alpha_m_dot", "beta_dot", "beta_m_dot", "i_R1", "i_R2", "theta_b1",
+                               "theta_b2", "energy.electrical_in", "energy.resistive", "energy.viscous",
+                               "energy.shaft_damping", "energy.dry_friction"]
+    initial_unknowns = {u.variable.name for u in md.initialUnknowns}
+    assert {d.variable.name for d in md.derivatives} <= initial_unknowns
