@@ -100,6 +100,7 @@ void log_message(const Instance* instance, fmi2Status status, const char* catego
 static void core_log(void* context, GimbalStatus status, const char* category, const char* message) {
     static const fmi2Status kStatus[] = {fmi2OK, fmi2Warning, fmi2Discard, fmi2Error};
     const Instance* instance = (const Instance*)context;
+    /* The core names no interface function: say which one the message comes from. */
     if (instance->calling != NULL)
         log_message(instance, kStatus[status], category, "%s: %s", instance->calling, message);
     else
@@ -138,7 +139,10 @@ const char* state_name(InstanceState state) {
 /* NULL-safe check that a call is allowed in the instance's current state. */
 int allowed(Instance* instance, Function function) {
     if (instance == NULL) return 0;
-    if (instance->state & kFunctions[function].states) return 1;
+    if (instance->state & kFunctions[function].states) {
+        instance->calling = kFunctions[function].name; /* the prefix of the core's messages in this call */
+        return 1;
+    }
     log_message(instance, fmi2Error, "logStatusError", "%s is not allowed in state '%s'", kFunctions[function].name,
                 state_name(instance->state));
     return 0;
@@ -214,6 +218,7 @@ static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType,
     instance->instance_name = name;
     for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
     instance->type = fmuType;
+    instance->calling = "fmi2Instantiate";
     instance->core = gimbal_core_create(core_log, core_log_enabled, instance);
     if (instance->core != NULL && fmuType == fmi2ModelExchange &&
         gimbal_core_use_continuous_time(instance->core) != GIMBAL_OK) {
@@ -500,7 +505,7 @@ static int valid_state_content(Instance* instance, Function function, const unsi
         return 0;
     }
     int initialized = 0;
-    if (from_core(gimbal_core_check_snapshot(instance->core, kFunctions[function].name, record + sizeof header,
+    if (from_core(gimbal_core_check_snapshot(instance->core, record + sizeof header,
                                              &initialized)) > fmi2Warning)
         return 0;
     const int running = (header.state & (RUNNING_STATES | STATE_TERMINATED)) != 0;

@@ -7,13 +7,6 @@
 
 #include "fmu_instance.h"
 
-/* The core's messages of these functions name no FMI function: the wrapper's logger prefixes it. */
-static fmi2Status call_core(Instance* instance, Function function, GimbalStatus status) {
-    (void)function;
-    instance->calling = NULL;
-    return from_core(status);
-}
-
 static int count_is(Instance* instance, Function function, size_t given, size_t expected, const char* argument) {
     if (given == expected) return 1;
     log_message(instance, fmi2Error, "logStatusError", "%s: %s = %zu, but the model has %zu (modelDescription.xml)",
@@ -26,9 +19,7 @@ static int check_vector(Instance* instance, Function function, const void* value
                         const char* argument, const char* count_name) {
     if (!allowed(instance, function)) return 0;
     if (!count_is(instance, function, given, expected, count_name)) return 0;
-    if (!not_null(instance, function_name(function), values, argument)) return 0;
-    instance->calling = function_name(function);
-    return 1;
+    return not_null(instance, function_name(function), values, argument);
 }
 
 static fmi2Status impl_EnterEventMode(fmi2Component c) {
@@ -42,10 +33,9 @@ static fmi2Status impl_NewDiscreteStates(fmi2Component c, fmi2EventInfo* eventIn
     Instance* instance = (Instance*)c;
     if (!allowed(instance, FN_NewDiscreteStates)) return fmi2Error;
     if (!not_null(instance, "fmi2NewDiscreteStates", eventInfo, "fmi2eventInfo")) return fmi2Error;
-    instance->calling = "fmi2NewDiscreteStates";
     GimbalDiscreteUpdate update;
     const fmi2Status status =
-        call_core(instance, FN_NewDiscreteStates, gimbal_core_update_discrete_states(instance->core, &update));
+        from_core(gimbal_core_update_discrete_states(instance->core, &update));
     if (status > fmi2Warning) return status;
     /* The modes are decided whole in one call: the iteration ends here. */
     eventInfo->newDiscreteStatesNeeded = fmi2False;
@@ -85,8 +75,7 @@ static fmi2Status impl_SetTime(fmi2Component c, fmi2Real time) {
         log_message(instance, fmi2Error, "logStatusError", "fmi2SetTime: time = %g must be finite", time);
         return fmi2Error;
     }
-    instance->calling = "fmi2SetTime";
-    const fmi2Status status = call_core(instance, FN_SetTime, gimbal_core_set_time(instance->core, time));
+    const fmi2Status status = from_core(gimbal_core_set_time(instance->core, time));
     if (status <= fmi2Warning) instance->time = time;
     return status;
 }
@@ -94,14 +83,14 @@ static fmi2Status impl_SetTime(fmi2Component c, fmi2Real time) {
 static fmi2Status impl_SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     Instance* instance = (Instance*)c;
     if (!check_vector(instance, FN_SetContinuousStates, x, nx, GIMBAL_CONTINUOUS_STATES, "x", "nx")) return fmi2Error;
-    return call_core(instance, FN_SetContinuousStates, gimbal_core_set_continuous_states(instance->core, x));
+    return from_core(gimbal_core_set_continuous_states(instance->core, x));
 }
 
 static fmi2Status impl_GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
     Instance* instance = (Instance*)c;
     if (!check_vector(instance, FN_GetDerivatives, derivatives, nx, GIMBAL_CONTINUOUS_STATES, "derivatives", "nx"))
         return fmi2Error;
-    return call_core(instance, FN_GetDerivatives, gimbal_core_get_derivatives(instance->core, derivatives));
+    return from_core(gimbal_core_get_derivatives(instance->core, derivatives));
 }
 
 static fmi2Status impl_GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
@@ -109,13 +98,13 @@ static fmi2Status impl_GetEventIndicators(fmi2Component c, fmi2Real eventIndicat
     if (!check_vector(instance, FN_GetEventIndicators, eventIndicators, ni, GIMBAL_EVENT_INDICATORS, "eventIndicators",
                       "ni"))
         return fmi2Error;
-    return call_core(instance, FN_GetEventIndicators, gimbal_core_get_event_indicators(instance->core, eventIndicators));
+    return from_core(gimbal_core_get_event_indicators(instance->core, eventIndicators));
 }
 
 static fmi2Status impl_GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
     Instance* instance = (Instance*)c;
     if (!check_vector(instance, FN_GetContinuousStates, x, nx, GIMBAL_CONTINUOUS_STATES, "x", "nx")) return fmi2Error;
-    return call_core(instance, FN_GetContinuousStates, gimbal_core_get_continuous_states(instance->core, x));
+    return from_core(gimbal_core_get_continuous_states(instance->core, x));
 }
 
 static fmi2Status impl_GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
@@ -123,7 +112,7 @@ static fmi2Status impl_GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x
     if (!check_vector(instance, FN_GetNominalsOfContinuousStates, x_nominal, nx, GIMBAL_CONTINUOUS_STATES, "x_nominal",
                       "nx"))
         return fmi2Error;
-    return call_core(instance, FN_GetNominalsOfContinuousStates, gimbal_core_get_nominal_states(instance->core, x_nominal));
+    return from_core(gimbal_core_get_nominal_states(instance->core, x_nominal));
 }
 
 /* ---------------------------------------------------------------- the exported functions */

@@ -31,7 +31,7 @@ def test_master_tolerance_becomes_solver_rtol_when_left_at_its_start(gimbal_fmu)
     slave = initialized(gimbal_fmu, log, tolerance=1e-9)
     try:
         assert gimbal_fmu.get_values(slave, ["solver.rtol"]) == [1e-9]
-        assert any("solver.rtol = 1.0000000000000001e-09, the tolerance of fmi2SetupExperiment" in text
+        assert any("solver.rtol = 1.0000000000000001e-09, the tolerance the master gave" in text
                    for _, _, text in log), log
         with_master_tolerance = trajectory(gimbal_fmu, slave)
     finally:

@@ -16,12 +16,9 @@ struct GimbalCore {
                gimbal::GimbalInstance::LogFilter filter)
         : log(log_function), log_context(context), instance(std::move(logger), std::move(filter)) {}
 
-    // Straight to the host's callback, through a stack buffer: usable when memory has run out.
-    void report(const char* function, const char* what) const noexcept {
-        if (log == nullptr) return;
-        char message[512];
-        std::snprintf(message, sizeof message, "%s: %s", function, what);
-        log(log_context, GIMBAL_ERROR, "logStatusError", message);
+    // Straight to the host's callback, no allocation: usable when memory has run out.
+    void report(const char* what) const noexcept {
+        if (log != nullptr) log(log_context, GIMBAL_ERROR, "logStatusError", what);
     }
 
     GimbalLogFunction log;
@@ -31,24 +28,25 @@ struct GimbalCore {
 
 namespace {
 
+// Messages name no interface function: the caller (fmu_src/) prefixes the one it serves.
 template <class Body>
-GimbalStatus guarded(GimbalCore* core, const char* function, Body&& body) noexcept {
+GimbalStatus guarded(GimbalCore* core, Body&& body) noexcept {
     if (core == nullptr) return GIMBAL_ERROR;
     try {
         return body();
     } catch (const std::bad_alloc&) {
-        core->report(function, "out of memory; the instance is left as it was before the call");
+        core->report("out of memory; the instance is left as it was before the call");
     } catch (const std::exception& error) {
-        core->report(function, error.what());
+        core->report(error.what());
     } catch (...) {
-        core->report(function, "internal error (an unknown C++ exception)");
+        core->report("internal error (an unknown C++ exception)");
     }
     return GIMBAL_ERROR;
 }
 // The continuous-time entries need an initialized instance of that interface.
 template <class Body>
-GimbalStatus continuous(GimbalCore* core, const char* function, Body&& body) noexcept {
-    return guarded(core, function, [&] {
+GimbalStatus continuous(GimbalCore* core, Body&& body) noexcept {
+    return guarded(core, [&] {
         if (!core->instance.continuous_time_interface() || !core->instance.initialized()) {
             core->log(core->log_context, GIMBAL_ERROR, "logStatusError",
                       "the instance is not an initialized instance of the continuous-time interface");
@@ -87,7 +85,7 @@ GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction e
         };
         return new GimbalCore{log, log_context, logger, wants};
     } catch (...) {
-        if (log != nullptr) log(log_context, GIMBAL_ERROR, "logStatusError", "fmi2Instantiate: out of memory");
+        if (log != nullptr) log(log_context, GIMBAL_ERROR, "logStatusError", "out of memory");
         return nullptr;
     }
 }
@@ -95,39 +93,38 @@ GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction e
 void gimbal_core_destroy(GimbalCore* core) { delete core; }
 
 GimbalStatus gimbal_core_reset(GimbalCore* core) {
-    return guarded(core, "fmi2Reset", [&] {
+    return guarded(core, [&] {
         core->instance.reset();
         return GIMBAL_OK;
     });
 }
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value) {
-    return guarded(core, "fmi2SetReal", [&] { return core->instance.set_real(vr, value); });
+    return guarded(core, [&] { return core->instance.set_real(vr, value); });
 }
 
 GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value) {
-    return guarded(core, "fmi2GetReal", [&] { return core->instance.get_real(vr, *value); });
+    return guarded(core, [&] { return core->instance.get_real(vr, *value); });
 }
 
 GimbalStatus gimbal_core_set_input_derivative(GimbalCore* core, unsigned vr, int order, double value) {
-    return guarded(core, "fmi2SetRealInputDerivatives",
-                   [&] { return core->instance.set_input_derivative(vr, order, value); });
+    return guarded(core, [&] { return core->instance.set_input_derivative(vr, order, value); });
 }
 
 GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value) {
-    return guarded(core, "fmi2SetInteger", [&] { return core->instance.set_integer(vr, value); });
+    return guarded(core, [&] { return core->instance.set_integer(vr, value); });
 }
 
 GimbalStatus gimbal_core_get_integer(GimbalCore* core, unsigned vr, int* value) {
-    return guarded(core, "fmi2GetInteger", [&] { return core->instance.get_integer(vr, *value); });
+    return guarded(core, [&] { return core->instance.get_integer(vr, *value); });
 }
 
 GimbalStatus gimbal_core_set_boolean(GimbalCore* core, unsigned vr, int value) {
-    return guarded(core, "fmi2SetBoolean", [&] { return core->instance.set_boolean(vr, value != 0); });
+    return guarded(core, [&] { return core->instance.set_boolean(vr, value != 0); });
 }
 
 GimbalStatus gimbal_core_get_boolean(GimbalCore* core, unsigned vr, int* value) {
-    return guarded(core, "fmi2GetBoolean", [&] {
+    return guarded(core, [&] {
         bool flag = false;
         const GimbalStatus status = core->instance.get_boolean(vr, flag);
         *value = flag ? 1 : 0;
@@ -136,18 +133,18 @@ GimbalStatus gimbal_core_get_boolean(GimbalCore* core, unsigned vr, int* value) 
 }
 
 GimbalStatus gimbal_core_set_master_tolerance(GimbalCore* core, int defined, double tolerance) {
-    return guarded(core, "fmi2SetupExperiment", [&] {
+    return guarded(core, [&] {
         core->instance.set_master_tolerance(defined != 0, tolerance);
         return GIMBAL_OK;
     });
 }
 
 GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time) {
-    return guarded(core, "fmi2ExitInitializationMode", [&] { return core->instance.initialize(start_time); });
+    return guarded(core, [&] { return core->instance.initialize(start_time); });
 }
 
 GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double step_size) {
-    return guarded(core, "fmi2DoStep", [&] { return core->instance.do_step(current_time, step_size); });
+    return guarded(core, [&] { return core->instance.do_step(current_time, step_size); });
 }
 
 double gimbal_core_time(const GimbalCore* core) { return core != nullptr ? core->instance.time() : 0.0; }
@@ -155,27 +152,27 @@ double gimbal_core_time(const GimbalCore* core) { return core != nullptr ? core-
 size_t gimbal_core_snapshot_size(void) { return gimbal::GimbalInstance::snapshot_size(); }
 
 GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer) {
-    return guarded(core, "fmi2GetFMUstate", [&] {
+    return guarded(core, [&] {
         core->instance.save(buffer);
         return GIMBAL_OK;
     });
 }
 
-GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, const void* buffer, int* initialized) {
-    return guarded(core, function, [&] {
+GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const void* buffer, int* initialized) {
+    return guarded(core, [&] {
         bool flag = false;
-        const GimbalStatus status = core->instance.check_snapshot(function, buffer, flag);
+        const GimbalStatus status = core->instance.check_snapshot(buffer, flag);
         *initialized = flag ? 1 : 0;
         return status;
     });
 }
 
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer) {
-    return guarded(core, "fmi2SetFMUstate", [&] { return core->instance.restore(buffer); });
+    return guarded(core, [&] { return core->instance.restore(buffer); });
 }
 
 GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
-    return guarded(core, "gimbal_core_linearize", [&] {
+    return guarded(core, [&] {
         if (model == nullptr) return GIMBAL_ERROR;
         static_assert(GIMBAL_LINEAR_MAX_STATES == gimbal::kStateSize && GIMBAL_LINEAR_INPUTS == gimbal::kLinearInputCount &&
                           GIMBAL_LINEAR_OUTPUTS == gimbal::kLinearOutputCount,
@@ -204,7 +201,7 @@ GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
 }
 
 GimbalStatus gimbal_core_use_continuous_time(GimbalCore* core) {
-    return guarded(core, "use_continuous_time", [&] {
+    return guarded(core, [&] {
         core->instance.use_continuous_time_interface();
         return GIMBAL_OK;
     });
@@ -223,37 +220,37 @@ unsigned gimbal_state_derivative_vr(int k) {
 
 
 GimbalStatus gimbal_core_set_time(GimbalCore* core, double time) {
-    return continuous(core, "set_time", [&] { return core->instance.set_time(time); });
+    return continuous(core, [&] { return core->instance.set_time(time); });
 }
 
 GimbalStatus gimbal_core_set_continuous_states(GimbalCore* core, const double* states) {
-    return continuous(core, "set_continuous_states", [&] { return core->instance.set_continuous_states(states); });
+    return continuous(core, [&] { return core->instance.set_continuous_states(states); });
 }
 
 GimbalStatus gimbal_core_get_continuous_states(GimbalCore* core, double* states) {
-    return continuous(core, "get_continuous_states", [&] {
+    return continuous(core, [&] {
         core->instance.get_continuous_states(states);
         return GIMBAL_OK;
     });
 }
 
 GimbalStatus gimbal_core_get_nominal_states(GimbalCore* core, double* nominals) {
-    return guarded(core, "get_nominal_states", [&] {
+    return guarded(core, [&] {
         core->instance.get_nominal_states(nominals);
         return GIMBAL_OK;
     });
 }
 
 GimbalStatus gimbal_core_get_derivatives(GimbalCore* core, double* derivatives) {
-    return continuous(core, "get_derivatives", [&] { return core->instance.get_derivatives(derivatives); });
+    return continuous(core, [&] { return core->instance.get_derivatives(derivatives); });
 }
 
 GimbalStatus gimbal_core_get_event_indicators(GimbalCore* core, double* indicators) {
-    return continuous(core, "get_event_indicators", [&] { return core->instance.get_event_indicators(indicators); });
+    return continuous(core, [&] { return core->instance.get_event_indicators(indicators); });
 }
 
 GimbalStatus gimbal_core_update_discrete_states(GimbalCore* core, GimbalDiscreteUpdate* update) {
-    return continuous(core, "update_discrete_states", [&] {
+    return continuous(core, [&] {
         gimbal::GimbalInstance::DiscreteUpdate result;
         const GimbalStatus status = core->instance.update_discrete_states(result);
         update->states_changed = result.states_changed ? 1 : 0;

@@ -139,6 +139,7 @@ private:
 
 GimbalInstance::GimbalInstance(Logger logger, LogFilter filter)
     : logger_(std::move(logger)), log_filter_(std::move(filter)) {
+    event_settings_.events_logged = [this] { return log_filter_("logEvents"); };
     reset();
 }
 
@@ -163,9 +164,7 @@ void GimbalInstance::reset() {
     decided_here_ = false;
     std::fill(reference_guards_, reference_guards_ + kIndicatorCount, 0.0);
     std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
-    last_event_time_ = -1e300;
-    rapid_events_ = 0;
-    dwell_until_ = -1e300;
+    chattering_ = ChatteringMemory{};
     zeno_holds_ = 0;
 }
 
@@ -176,11 +175,11 @@ GimbalStatus GimbalInstance::refuse(GimbalStatus status, const std::string& mess
 
 GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
     if (vr >= kRealVariableCount) {
-        return refuse(GIMBAL_ERROR, "fmi2SetReal: value reference " + std::to_string(vr) + " is not a Real variable");
+        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Real variable");
     }
     if (!std::isfinite(value)) {
         std::ostringstream s;
-        s << "fmi2SetReal: " << kRealVariables[vr].name << " = " << value << " refused: values must be finite";
+        s << "" << kRealVariables[vr].name << " = " << value << " refused: values must be finite";
         return refuse(GIMBAL_ERROR, s.str());
     }
     reals_[vr] = value;
@@ -200,16 +199,16 @@ GimbalStatus GimbalInstance::set_input_derivative(unsigned vr, int order, double
     const int axis = vr == vr_u_R1 ? 0 : (vr == vr_u_R2 ? 1 : -1);
     if (axis < 0) {
         const char* name = vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)";
-        return refuse(GIMBAL_ERROR, std::string("fmi2SetRealInputDerivatives: ") + name +
+        return refuse(GIMBAL_ERROR, std::string("") + name +
                                         " takes no derivative: only u_R1 and u_R2 do (the base inputs carry their own "
                                         "rates and accelerations)");
     }
     if (order != 1) {
-        return refuse(GIMBAL_ERROR, "fmi2SetRealInputDerivatives: order " + std::to_string(order) + " for " +
+        return refuse(GIMBAL_ERROR, "order " + std::to_string(order) + " for " +
                                         kRealVariables[vr].name + " refused: only first derivatives are used");
     }
     if (!std::isfinite(value)) {
-        return refuse(GIMBAL_ERROR, std::string("fmi2SetRealInputDerivatives: the derivative of ") +
+        return refuse(GIMBAL_ERROR, std::string("the derivative of ") +
                                         kRealVariables[vr].name + " must be finite");
     }
     voltage_rate_[axis] = value;
@@ -218,10 +217,10 @@ GimbalStatus GimbalInstance::set_input_derivative(unsigned vr, int order, double
 
 GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
     if (vr >= kRealVariableCount) {
-        return refuse(GIMBAL_ERROR, "fmi2GetReal: value reference " + std::to_string(vr) + " is not a Real variable");
+        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Real variable");
     }
     if (!system_ && kRealVariables[vr].initial == Initial::calculated) {
-        const GimbalStatus status = preview_outputs("fmi2GetReal", kRealVariables[vr].name);
+        const GimbalStatus status = preview_outputs(kRealVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
     if (system_ && continuous_time_ && outputs_stale_) publish_continuous_time_outputs();
@@ -231,7 +230,7 @@ GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
 
 GimbalStatus GimbalInstance::set_integer(unsigned vr, int value) {
     if (vr >= kIntegerVariableCount) {
-        return refuse(GIMBAL_ERROR, "fmi2SetInteger: value reference " + std::to_string(vr) + " is not an Integer variable");
+        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not an Integer variable");
     }
     integers_[vr] = value;
     preview_current_ = false;
@@ -240,10 +239,10 @@ GimbalStatus GimbalInstance::set_integer(unsigned vr, int value) {
 
 GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) {
     if (vr >= kIntegerVariableCount) {
-        return refuse(GIMBAL_ERROR, "fmi2GetInteger: value reference " + std::to_string(vr) + " is not an Integer variable");
+        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not an Integer variable");
     }
     if (!system_ && kIntegerVariables[vr].initial == Initial::calculated) {
-        const GimbalStatus status = preview_outputs("fmi2GetInteger", kIntegerVariables[vr].name);
+        const GimbalStatus status = preview_outputs(kIntegerVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
     if (system_ && continuous_time_ && outputs_stale_) publish_continuous_time_outputs();
@@ -253,7 +252,7 @@ GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) {
 
 GimbalStatus GimbalInstance::set_boolean(unsigned vr, bool value) {
     if (vr >= kBooleanVariableCount) {
-        return refuse(GIMBAL_ERROR, "fmi2SetBoolean: value reference " + std::to_string(vr) + " is not a Boolean variable");
+        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Boolean variable");
     }
     booleans_[vr] = value;
     preview_current_ = false;
@@ -262,7 +261,7 @@ GimbalStatus GimbalInstance::set_boolean(unsigned vr, bool value) {
 
 GimbalStatus GimbalInstance::get_boolean(unsigned vr, bool& value) const {
     if (vr >= kBooleanVariableCount) {
-        return refuse(GIMBAL_ERROR, "fmi2GetBoolean: value reference " + std::to_string(vr) + " is not a Boolean variable");
+        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Boolean variable");
     }
     value = booleans_[vr];
     return GIMBAL_OK;
@@ -367,12 +366,12 @@ void GimbalInstance::load_start_state() {
     }
 }
 
-GimbalStatus GimbalInstance::check_fixed_base(const char* function) const {
+GimbalStatus GimbalInstance::check_fixed_base() const {
     if (!params_.fidelity.fixed_base) return GIMBAL_OK;
     for (RealVariable vr : kBaseInputs) {
         if (reals_[vr] != 0.0) {
             std::ostringstream s;
-            s << function << ": " << kRealVariables[vr].name << " = " << reals_[vr]
+            s << kRealVariables[vr].name << " = " << reals_[vr]
               << " refused: base.fixed = true, so every base input must be 0";
             return refuse(GIMBAL_ERROR, s.str());
         }
@@ -420,29 +419,29 @@ void GimbalInstance::apply_master_tolerance() {
     s.precision(17);
     if (rtol_set_) {
         if (master_tolerance_ != reals_[vr_solver_rtol]) {
-            s << "fmi2SetupExperiment: tolerance = " << master_tolerance_ << " is not used: solver.rtol = "
+            s << "the master's tolerance = " << master_tolerance_ << " is not used: solver.rtol = "
               << reals_[vr_solver_rtol] << " was set explicitly";
             logger_(GIMBAL_OK, "logSolver", s.str());
         }
         return;
     }
     if (!(master_tolerance_ > 0.0 && master_tolerance_ < 1.0)) {
-        s << "fmi2SetupExperiment: tolerance = " << master_tolerance_ << " is ignored (a relative tolerance lies in "
+        s << "the master's tolerance = " << master_tolerance_ << " is ignored (a relative tolerance lies in "
           << "(0, 1)); solver.rtol keeps " << reals_[vr_solver_rtol];
         logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
         return;
     }
     reals_[vr_solver_rtol] = master_tolerance_;
-    s << "solver.rtol = " << master_tolerance_ << ", the tolerance of fmi2SetupExperiment (set solver.rtol to override)";
+    s << "solver.rtol = " << master_tolerance_ << ", the tolerance the master gave (set solver.rtol to override)";
     logger_(GIMBAL_OK, "logSolver", s.str());
 }
 
-GimbalStatus GimbalInstance::preview_outputs(const char* function, const char* name) {
+GimbalStatus GimbalInstance::preview_outputs(const char* name) {
     if (preview_current_) return GIMBAL_OK;
     std::string error;
     ModelParameters params;
     if (!build_parameters(params, error)) {
-        return refuse(GIMBAL_ERROR, std::string(function) + ": " + name +
+        return refuse(GIMBAL_ERROR, std::string(name) +
                                         " cannot be computed from the current values: " + error);
     }
     // Built aside and committed only at the end: a failure (out of memory) leaves nothing half-made.
@@ -483,7 +482,7 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
         reals_[vr_solver_rtol] = rtol_before;
         throw;
     }
-    const GimbalStatus base_status = check_fixed_base("fmi2ExitInitializationMode");
+    const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) {
         reals_[vr_solver_rtol] = rtol_before;
         return base_status;
@@ -506,8 +505,7 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     system_->event_functions(0.0, state_, reference_guards_);
     std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
     inputs_stale_ = decided_here_ = false;
-    last_event_time_ = dwell_until_ = -1e300;
-    rapid_events_ = 0;
+    chattering_ = ChatteringMemory{};
     zeno_holds_ = 0;
     publish_outputs();
     outputs_stale_ = false;
@@ -538,9 +536,9 @@ void GimbalInstance::save(void* buffer) {
     snap.decided_here = decided_here_;
     std::copy(decided_side_, decided_side_ + kIndicatorCount, snap.decided_side);
     std::copy(reference_guards_, reference_guards_ + kIndicatorCount, snap.reference_guards);
-    snap.last_event_time = last_event_time_;
-    snap.dwell_until = dwell_until_;
-    snap.rapid_events = rapid_events_;
+    snap.last_event_time = chattering_.last_event_time;
+    snap.dwell_until = chattering_.dwell_until;
+    snap.rapid_events = chattering_.rapid_events;
     snap.zeno_holds = zeno_holds_;
     if (snap.initialized) {
         snap.modes = system_->modes();
@@ -575,7 +573,7 @@ void GimbalInstance::save(void* buffer) {
     std::memcpy(buffer, &snap, sizeof snap);
 }
 
-GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* buffer, bool& initialized) const {
+GimbalStatus GimbalInstance::check_snapshot(const void* buffer, bool& initialized) const {
     Snapshot snap;
     std::memcpy(&snap, buffer, sizeof snap);
     SnapshotCheck check;
@@ -640,7 +638,8 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
                                    st.method_switches, st.rejected_steps};
         for (std::int64_t value : statistics) check.count("integrator statistic", value);
         const IntegratorMemory& m = snap.integrator_memory;
-        const double memory_reals[] = {m.step_size, m.previous_error, m.last_event_time, m.dwell_until};
+        const double memory_reals[] = {m.step_size, m.previous_error, m.chattering.last_event_time,
+                                       m.chattering.dwell_until};
         check.finite("integrator memory", memory_reals, 4);
         if (!(m.step_size >= 0.0)) check.fail("the saved step size is negative");
         if (!(m.previous_error > 0.0)) check.fail("the saved error estimate is not positive");
@@ -649,7 +648,7 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
                    static_cast<std::uint8_t>(m.last_step_rejected < 0 || m.last_step_rejected > 1 ? 2 : m.last_step_rejected));
         check.count("stiff votes", m.stiff_votes);
         check.count("non-stiff votes", m.nonstiff_votes);
-        check.count("rapid events", m.rapid_events);
+        check.count("rapid events", m.chattering.rapid_events);
     }
     if (check.ok() && snap.initialized) {
         // The parameters must be valid, and the modes possible for the elements they define.
@@ -668,14 +667,14 @@ GimbalStatus GimbalInstance::check_snapshot(const char* function, const void* bu
             if (snap.state[k] != 0.0) check.fail("the state has values beyond the model's " +
                                                  std::to_string(params.layout.size) + " states");
     }
-    if (!check.ok()) return refuse(GIMBAL_ERROR, std::string(function) + ": the FMU state is refused: " + check.reason);
+    if (!check.ok()) return refuse(GIMBAL_ERROR, "the FMU state is refused: " + check.reason);
     initialized = snap.initialized != 0;
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::restore(const void* buffer) {
     bool initialized = false;
-    const GimbalStatus checked = check_snapshot("fmi2SetFMUstate", buffer, initialized);
+    const GimbalStatus checked = check_snapshot(buffer, initialized);
     if (checked != GIMBAL_OK) return checked;
     Snapshot snap;
     std::memcpy(&snap, buffer, sizeof snap);
@@ -687,7 +686,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     ParameterSwap swap(params_, params_);
     if (initialized) {
         std::string error;
-        if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: " + error);
+        if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, "" + error);
         params_ = params;
         system = std::make_unique<GimbalHybridSystem>(params_);
         system->hold_inputs_at_any_time(continuous_time_);
@@ -707,7 +706,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
         integrator = make_integrator(*system, params_);
         if (snap.integrator_running && integrator->resumable() &&
             !integrator->resume(snap.time - snap.epoch, snap.state, snap.integrator_memory)) {
-            return refuse(GIMBAL_ERROR, "fmi2SetFMUstate: the integrator cannot continue from the saved state (" +
+            return refuse(GIMBAL_ERROR, "the integrator cannot continue from the saved state (" +
                                             last_integrator_error_ + ")");
         }
         integrator->set_statistics(snap.statistics);
@@ -728,9 +727,9 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     decided_here_ = snap.decided_here != 0;
     std::copy(snap.decided_side, snap.decided_side + kIndicatorCount, decided_side_);
     std::copy(snap.reference_guards, snap.reference_guards + kIndicatorCount, reference_guards_);
-    last_event_time_ = snap.last_event_time;
-    dwell_until_ = snap.dwell_until;
-    rapid_events_ = snap.rapid_events;
+    chattering_.last_event_time = snap.last_event_time;
+    chattering_.dwell_until = snap.dwell_until;
+    chattering_.rapid_events = snap.rapid_events;
     zeno_holds_ = snap.zeno_holds;
     inputs_stale_ = outputs_stale_ = true;
     integrator_running_ = initialized && snap.integrator_running && integrator->resumable();
@@ -742,8 +741,8 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
 }
 
 GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
-    if (!integrator_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance is not initialized");
-    if (continuous_time_) return refuse(GIMBAL_ERROR, "fmi2DoStep: the instance serves the continuous-time interface");
+    if (!integrator_) return refuse(GIMBAL_ERROR, "the instance is not initialized");
+    if (continuous_time_) return refuse(GIMBAL_ERROR, "the instance serves the continuous-time interface");
     StepStart start;
     std::copy(state_, state_ + kMaxStateSize, start.state);
     start.modes = system_->modes();
@@ -788,7 +787,7 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
     const auto method = static_cast<IntegrationMethod>(params_.method);
     std::ostringstream s;
     s.precision(6);
-    s << "fmi2DoStep: the step to t = " << time_ << " (h = " << step_size << ") took " << rhs
+    s << "the step to t = " << time_ << " (h = " << step_size << ") took " << rhs
       << " right-hand-side evaluations (budget " << kStepWorkBudget << "), " << steps << " steps, " << rejected
       << " rejected, " << events << " mode changes";
     if (events > steps / 4) {
@@ -811,7 +810,7 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
 
 GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, StepStart& start) {
 
-    const GimbalStatus base_status = check_fixed_base("fmi2DoStep");
+    const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) return base_status;
     const double step_start = model_time(current_time);
     const double step_end = model_time(current_time + step_size);
@@ -834,7 +833,7 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
             inputs.base = running.base.advanced(step_start - running.step_start_time);
             system_->set_inputs(inputs);
             if (!integrator_->inputs_changed(step_start, state_)) {
-                return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not take the new inputs (" +
+                return refuse(GIMBAL_ERROR, "the integrator could not take the new inputs (" +
                                                 last_integrator_error_ + ")");
             }
         }
@@ -843,7 +842,7 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         // New inputs may cross a switching surface at once (e.g. the voltage reverses while limited).
         system_->update_modes(step_start, state_, nullptr);
         if (!integrator_->restart(step_start, state_)) {
-            return refuse(GIMBAL_ERROR, "fmi2DoStep: the integrator could not be restarted");
+            return refuse(GIMBAL_ERROR, "the integrator could not be restarted");
         }
     }
     last_integrator_error_.clear();
@@ -851,7 +850,7 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         roll_back(start);
         std::ostringstream s;
         s.precision(17);
-        s << "fmi2DoStep: integration from t = " << current_time << " over h = " << step_size << " failed ("
+        s << "integration from t = " << current_time << " over h = " << step_size << " failed ("
           << last_integrator_error_ << "); state rolled back to t = " << current_time;
         return refuse(GIMBAL_DISCARD, s.str());
     }
@@ -870,7 +869,7 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         if (kRealVariables[vr].causality != Causality::output || std::isfinite(reals_[vr])) continue;
         std::ostringstream s;
         s.precision(17);
-        s << "fmi2DoStep: " << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
+        s << "" << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
           << ": an input or parameter lies beyond what the model can represent; state rolled back to t = "
           << current_time;
         roll_back(start);

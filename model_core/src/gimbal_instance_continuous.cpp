@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "gimbal/event_handling.hpp"
 #include "gimbal/gimbal_instance.hpp"
 
 namespace gimbal {
@@ -20,10 +21,6 @@ namespace {
 bool crossed(double before, double after) {
     return before != 0.0 && (after == 0.0 || (before > 0.0) != (after > 0.0));
 }
-
-// Chattering guard settings: those of the integrators (IntegratorSettings), so that a chattering
-// sequence is cut the same way in either interface.
-const IntegratorSettings kGuardSettings{};
 
 // How far ahead a guard sitting exactly on zero is looked at to see where it goes: short against the
 // fastest time constant the parameters allow (L/R and c_s/k_s down to 1e-8 s in the hard cases).
@@ -145,7 +142,7 @@ GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
 GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
     refresh_held_inputs();
     const double now = model_time(time_);
-    if (now < dwell_until_) {
+    if (now < chattering_.dwell_until) {
         // The chattering guard holds the modes: the indicators keep the values of its start, so that
         // the host sees no crossing before the time event that ends the hold.
         std::fill(indicators, indicators + kIndicatorCount, 1.0);
@@ -172,64 +169,14 @@ GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
     return GIMBAL_OK;
 }
 
-int GimbalInstance::settle_guards(const int* decided) {
-    // As a one-step integrator restarts at an event (OneStepIntegrator::refresh_at_current_point): a
-    // guard exactly at zero has no sign to change; the side it departs to, looked at an instant ahead
-    // along the dynamics, decides the modes again (once) where they were chosen blind to it.
-    const int n = system_->event_count();
-    const double now = model_time(time_);
-    int changes = 0;
-    int decided_side[kIndicatorCount];
-    for (int k = 0; k < n; ++k) decided_side[k] = decided != nullptr ? decided[k] : 0;
-    for (int round = 0;; ++round) {
-        double derivative[kMaxStateSize];
-        if (!system_->derivative(now, state_, derivative)) break;  // reported by get_derivatives
-        system_->event_functions(now, state_, reference_guards_);
-        bool on_surface = false;
-        for (int k = 0; k < n; ++k) on_surface = on_surface || reference_guards_[k] == 0.0;
-        if (!on_surface) break;
-        const double delta = kDepartureLookahead * std::max(1.0, std::fabs(now));
-        double ahead_state[kMaxStateSize], ahead[kIndicatorCount];
-        for (int i = 0; i < params_.layout.size; ++i) ahead_state[i] = state_[i] + delta * derivative[i];
-        system_->event_functions(now + delta, ahead_state, ahead);
-        if (round == 0) {
-            int directions[kIndicatorCount] = {};
-            bool departs = false;
-            for (int k = 0; k < n; ++k) {
-                if (reference_guards_[k] != 0.0 || ahead[k] == 0.0) continue;
-                const int departure = ahead[k] > 0.0 ? 1 : -1;
-                if (decided_side[k] == departure) continue;
-                directions[k] = departure;
-                decided_side[k] = departure;
-                departs = true;
-            }
-            if (departs) {
-                const int more = system_->update_modes(now, state_, directions);
-                changes += more;
-                if (more > 0) continue;
-            }
-        }
-        for (int k = 0; k < n; ++k) {
-            if (reference_guards_[k] != 0.0) continue;
-            const int side = decided_side[k] != 0 ? decided_side[k] : (ahead[k] > 0.0 ? 1 : (ahead[k] < 0.0 ? -1 : 0));
-            decided_side_[k] = static_cast<std::int8_t>(side);
-        }
-        break;
-    }
-    for (int k = 0; k < n; ++k)
-        if (reference_guards_[k] == 0.0 && decided_side_[k] != 0)
-            reference_guards_[k] = decided_side_[k] * std::numeric_limits<double>::min();
-    return changes;
-}
-
 GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     update = DiscreteUpdate{};
     refresh_held_inputs();
     const double now = model_time(time_);
-    const bool holding = dwell_until_ > -1e300;
-    if (holding && now < dwell_until_) {
+    const bool holding = chattering_.holding();
+    if (holding && now < chattering_.dwell_until) {
         update.next_time_defined = true;
-        update.next_time = epoch_ + dwell_until_;
+        update.next_time = epoch_ + chattering_.dwell_until;
         return GIMBAL_OK;
     }
     // A repeated call at the point just decided (a host that iterates once more) changes nothing: a
@@ -242,44 +189,43 @@ GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     int directions[kIndicatorCount] = {};
     if (holding) {
         // The hold ends here: the modes are chosen again from the signs, as after an input change.
-        dwell_until_ = -1e300;
+        chattering_.dwell_until = -1e300;
     } else {
         for (int k = 0; k < n; ++k)
             if (crossed(reference_guards_[k], guards[k])) directions[k] = guards[k] > reference_guards_[k] ? 1 : -1;
     }
     double before[kMaxStateSize];
     std::copy(state_, state_ + kMaxStateSize, before);
-    std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
-    int changes = system_->update_modes(now, state_, directions);
-    if (changes > 0 && log_filter_("logEvents")) {
-        std::ostringstream s;
-        s.precision(17);
-        s << "t = " << time_ << ": " << changes << " mode change(s)";
-        const std::string what = system_->describe_last_changes();
-        if (!what.empty()) s << ": " << what;
-        logger_(GIMBAL_OK, "logEvents", s.str());
-    }
-    changes += settle_guards(directions);
+    const HybridIntegrator::MessageSink sink = [this](const std::string& message) { log_event(message); };
+    int changes = switch_modes(*system_, now, state_, directions, event_settings_, sink, time_);
 
-    if (changes > 0) {
-        const double window = kGuardSettings.zeno_window;
-        rapid_events_ = now - last_event_time_ <= window ? rapid_events_ + 1 : 0;
-        last_event_time_ = now;
-        if (rapid_events_ >= kGuardSettings.zeno_event_limit) {
-            dwell_until_ = now + kGuardSettings.zeno_dwell;
-            rapid_events_ = 0;
-            ++zeno_holds_;
-            std::ostringstream s;
-            s.precision(17);
-            s << "t = " << time_ << ": " << kGuardSettings.zeno_event_limit
-              << " events without progress in time (chattering); modes held until t = " << epoch_ + dwell_until_;
-            logger_(GIMBAL_OK, "logEvents", s.str());
-        }
-    }
+    // The guards left exactly on zero, settled as the integrators settle them after a located event;
+    // what they settle to is where the next crossing is measured from.
+    double derivative[kMaxStateSize];
+    double raw[kIndicatorCount];
+    int settled_changes = 0;
+    const double lookahead = kDepartureLookahead * std::max(1.0, std::fabs(now));
+    const bool evaluated = guard_settling_.settle(
+        now, state_, params_.layout.size, n, lookahead, directions, derivative, reference_guards_, settled_changes,
+        [this](double t, const double* x, double* dx) { return system_->derivative(t, x, dx); },
+        [this, n, &raw](double t, const double* x, double* g) {
+            system_->event_functions(t, x, g);
+            if (g == reference_guards_) std::copy(g, g + n, raw);
+            return true;
+        },
+        [this, now, &sink](const int* settle_directions) {
+            return switch_modes(*system_, now, state_, settle_directions, event_settings_, sink, time_);
+        });
+    changes += settled_changes;
+    for (int k = 0; k < n; ++k)
+        decided_side_[k] = static_cast<std::int8_t>(evaluated && raw[k] == 0.0 ? (reference_guards_[k] > 0.0) - (reference_guards_[k] < 0.0) : 0);
+    // A failed evaluation (non-finite derivatives) is reported by the next fmi2GetDerivatives.
+
+    if (changes > 0 && record_mode_change(chattering_, event_settings_, now, 0.0, sink, epoch_)) ++zeno_holds_;
     update.mode_changes = changes;
     update.states_changed = !std::equal(state_, state_ + params_.layout.size, before);
-    update.next_time_defined = dwell_until_ > -1e300;
-    update.next_time = epoch_ + dwell_until_;
+    update.next_time_defined = chattering_.holding();
+    update.next_time = epoch_ + chattering_.dwell_until;
     decided_here_ = true;
     outputs_stale_ = true;
     return GIMBAL_OK;

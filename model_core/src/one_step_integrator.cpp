@@ -1,6 +1,8 @@
 #include <cstdint>
 #include "one_step_integrator.hpp"
 
+#include "gimbal/event_handling.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -57,8 +59,12 @@ bool OneStepIntegrator::rhs(double time, const Vector& y, Vector& dy) {
 }
 
 bool OneStepIntegrator::event_values(double time, const Vector& y, std::vector<double>& values) {
+    return guards_at(time, y.data(), values.data());
+}
+
+bool OneStepIntegrator::guards_at(double time, const double* state, double* values) {
     if (event_count_ == 0) return true;
-    system_.event_functions(time, y.data(), values.data());
+    system_.event_functions(time, state, values);
     for (int k = 0; k < event_count_; ++k) {
         if (std::isfinite(values[k])) continue;
         std::ostringstream s;
@@ -72,61 +78,23 @@ bool OneStepIntegrator::event_values(double time, const Vector& y, std::vector<d
 
 bool OneStepIntegrator::refresh_at_current_point(const int* decided) {
     jacobian_current_ = false;
-    // Scratch: the side each guard's mode was decided for: by the event that reported its crossing,
-    // or by the first round below from where the guard goes next.
-    std::vector<double>& decided_side = g_low_;
-    for (int k = 0; k < event_count_; ++k) decided_side[k] = decided != nullptr ? decided[k] : 0;
-    for (int round = 0;; ++round) {
-        if (!rhs(t_, y_, f_)) {
+    const double lookahead = 1e-6 * (memory_.step_size > 0.0 ? memory_.step_size : 1e-6);
+    int changes = 0;
+    const bool settled = guard_settling_.settle(
+        t_, y_.data(), size_, event_count_, lookahead, decided, f_.data(), g_.data(), changes,
+        [this](double time, const double* state, double* derivative) {
+            ++totals_.rhs_evaluations;
+            if (system_.derivative(time, state, derivative)) return true;
             std::ostringstream s;
             s.precision(17);
-            s << "the right-hand side is not finite at t = " << t_;
+            s << "the right-hand side is not finite at t = " << time;
             error_sink_(s.str());
             return false;
-        }
-        if (!event_values(t_, y_, g_)) return false;
-        // A guard exactly at zero here (a state projected onto a switching surface, a ramp starting on
-        // the clamp) has no sign to change: take the sign it has just after, or a return to zero within
-        // the next step goes unseen. The modes were chosen blind to that direction where the guard sat
-        // on zero: decide them again with it, once.
-        bool on_surface = false;
-        for (int k = 0; k < event_count_; ++k) on_surface = on_surface || g_[k] == 0.0;
-        if (!on_surface) return true;
-        const double delta = 1e-6 * (memory_.step_size > 0.0 ? memory_.step_size : 1e-6);
-        for (int i = 0; i < size_; ++i) stage_state_[i] = y_[i] + delta * f_[i];
-        if (!event_values(t_ + delta, stage_state_, g_mid_)) return false;
-        if (round == 0) {
-            bool departs = false;
-            for (int k = 0; k < event_count_; ++k) {
-                // A guard whose crossing the event just reported has been decided with its direction.
-                // (`decided` may be directions_ itself: read it before overwriting.)
-                directions_[k] = 0;
-                if (g_[k] != 0.0 || g_mid_[k] == 0.0) continue;
-                const int departure = g_mid_[k] > 0.0 ? 1 : -1;
-                // Decided for the side it now leaves to (a bounce's reset, a ramp leaving the clamp):
-                // nothing to do. Undecided, or decided for the other side: decide again with it.
-                if (decided_side[k] == departure) continue;
-                directions_[k] = departure;
-                decided_side[k] = departure;
-                departs = true;
-            }
-            if (departs) {
-                const int changes = system_.update_modes(t_, y_.data(), directions_.data());
-                totals_.events += changes;
-                log_events(t_, changes);
-                if (changes > 0) continue;  // new modes: evaluate again under them
-            }
-        }
-        // The baseline is the side the modes were decided for: if the modes push the guard back across
-        // (a sliding surface), the next step sees that crossing and the chattering guard deals with it,
-        // instead of the guard leaving on the wrong side unseen.
-        for (int k = 0; k < event_count_; ++k) {
-            if (g_[k] != 0.0) continue;
-            const double size = g_mid_[k] != 0.0 ? std::fabs(g_mid_[k]) : std::numeric_limits<double>::min();
-            g_[k] = decided_side[k] != 0.0 ? std::copysign(size, decided_side[k]) : g_mid_[k];
-        }
-        return true;
-    }
+        },
+        [this](double time, const double* state, double* values) { return guards_at(time, state, values); },
+        [this](const int* directions) { return switch_modes(system_, t_, y_.data(), directions, settings_, event_sink_, t_); });
+    totals_.events += changes;
+    return settled;
 }
 
 bool OneStepIntegrator::restart(double time, const double* state) {
@@ -451,21 +419,11 @@ bool OneStepIntegrator::any_crossing(const std::vector<double>& before, const st
     return false;
 }
 
-void OneStepIntegrator::log_events(double time, int changes) {
-    if (changes <= 0 || !settings_.events_logged()) return;
-    std::ostringstream s;
-    s.precision(17);
-    s << "t = " << time << ": " << changes << " mode change(s)";
-    const std::string what = system_.describe_last_changes();
-    if (!what.empty()) s << ": " << what;
-    event_sink_(s.str());
-}
-
 bool OneStepIntegrator::handle_events(bool& event_found) {
     event_found = false;
-    if (event_count_ == 0 || t_new_ <= memory_.dwell_until) return true;
+    if (event_count_ == 0 || t_new_ <= memory_.chattering.dwell_until) return true;
     if (!event_values(t_new_, y_new_, g_new_)) return false;
-    if (t_ < memory_.dwell_until) {
+    if (t_ < memory_.chattering.dwell_until) {
         // The chattering guard held the modes until inside this step: re-select them here.
         return true;
     }
@@ -510,28 +468,13 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
         directions_[k] = crossed(g_[k], g_high_[k]) ? (g_high_[k] > g_[k] ? 1 : -1) : 0;
     t_ = root;
     y_ = y_new_;
-    const int changes = system_.update_modes(root, y_.data(), directions_.data());
+    const int changes = switch_modes(system_, root, y_.data(), directions_.data(), settings_, event_sink_, root);
     totals_.events += changes;
-    log_events(root, changes);
     const bool stiffness_may_change = changes > 0;
 
     // Roots closer than a few location tolerances cannot be told apart: at large times (1e5 s and more)
     // that spacing exceeds the window itself.
-    const double window = std::max(settings_.zeno_window, 4.0 * tolerance);
-    memory_.rapid_events = root - memory_.last_event_time <= window ? memory_.rapid_events + 1 : 0;
-    memory_.last_event_time = root;
-    if (memory_.rapid_events >= settings_.zeno_event_limit) {
-        memory_.dwell_until = root + settings_.zeno_dwell;
-        memory_.rapid_events = 0;
-        ++totals_.zeno_holds;
-        if (settings_.events_logged()) {
-            std::ostringstream s;
-            s.precision(17);
-            s << "t = " << root << ": " << settings_.zeno_event_limit
-              << " events without progress in time (chattering); modes held until t = " << memory_.dwell_until;
-            event_sink_(s.str());
-        }
-    }
+    if (record_mode_change(memory_.chattering, settings_, root, 4.0 * tolerance, event_sink_)) ++totals_.zeno_holds;
     // New modes (or a projection onto a stop) change the right-hand side: one evaluation restarts.
     if (!refresh_at_current_point(directions_.data())) return false;
     if (stiffness_may_change) check_stiffness_after_switch();
@@ -565,10 +508,8 @@ bool OneStepIntegrator::time_derivative_at_current_point() {
 }
 
 bool OneStepIntegrator::reselect_after_dwell() {
-    memory_.dwell_until = -1e300;
-    const int changes = system_.update_modes(t_, y_.data(), nullptr);
-    totals_.events += changes;
-    log_events(t_, changes);
+    memory_.chattering.dwell_until = -1e300;
+    totals_.events += switch_modes(system_, t_, y_.data(), nullptr, settings_, event_sink_, t_);
     return refresh_at_current_point();
 }
 
@@ -589,7 +530,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
     long attempts = 0;
     std::int64_t events_here = 0;
     while (t_ < end_time) {
-        if (memory_.dwell_until > -1e300 && t_ >= memory_.dwell_until && !reselect_after_dwell()) return false;
+        if (memory_.chattering.dwell_until > -1e300 && t_ >= memory_.chattering.dwell_until && !reselect_after_dwell()) return false;
         if (++attempts > settings_.max_steps) {
             std::ostringstream s;
             s.precision(17);
@@ -633,8 +574,8 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         t_new_ = last ? end_time : t_ + h;
         // The chattering guard's hold ends at a step end, so that the modes are re-selected on time.
         bool cut_short = last;
-        if (t_ < memory_.dwell_until && memory_.dwell_until < t_new_ && memory_.dwell_until - t_ > smallest)
-            t_new_ = memory_.dwell_until, last = false, cut_short = true;
+        if (t_ < memory_.chattering.dwell_until && memory_.chattering.dwell_until < t_new_ && memory_.chattering.dwell_until - t_ > smallest)
+            t_new_ = memory_.chattering.dwell_until, last = false, cut_short = true;
         h = t_new_ - t_;
 
         StepResult result;
@@ -674,7 +615,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         std::swap(y_, y_new_);
         std::swap(f_, f_new_);
         std::swap(g_, g_new_);
-        if (event_count_ > 0 && t_ >= memory_.dwell_until && memory_.dwell_until > -1e300 && !reselect_after_dwell())
+        if (event_count_ > 0 && t_ >= memory_.chattering.dwell_until && memory_.chattering.dwell_until > -1e300 && !reselect_after_dwell())
             return false;
         // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
         // input jump it takes a few short steps, at which any method would be stable.

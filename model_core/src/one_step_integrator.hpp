@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "gimbal/event_handling.hpp"
 #include "gimbal/integrator.hpp"
 #include "small_lu.hpp"
 
@@ -46,6 +47,7 @@ private:
     bool advance_steps(double end_time, double* state);
     bool rhs(double time, const Vector& y, Vector& dy);
     bool event_values(double time, const Vector& y, std::vector<double>& values);
+    bool guards_at(double time, const double* state, double* values);
     double initial_step(double end_time);
     double error_norm(const Vector& error, const Vector& y_old, const Vector& y_new) const;
     // One attempt from (t_, y_, f_) to t_new; fills y_new_, f_new_ (explicit: the FSAL stage) and the
@@ -68,7 +70,6 @@ private:
     bool reselect_after_dwell();
     // f_ and g_ at (t_, y_); `decided`: guards whose crossing update_modes has just been told.
     bool refresh_at_current_point(const int* decided = nullptr);
-    void log_events(double time, int changes);
 
     HybridSystem& system_;
     IntegratorSettings settings_;
@@ -88,6 +89,7 @@ private:
     Vector y_new_, f_new_, stage_[7], stage_state_, error_;
     std::vector<double> g_new_, g_low_, g_high_, g_mid_;
     std::vector<int> directions_;
+    GuardSettling guard_settling_;
     // Continuous extension of the last accepted step over [dense_t0_, dense_t0_ + dense_h_].
     bool dense_rosenbrock_ = false;
     double dense_t0_ = 0.0, dense_h_ = 0.0;

@@ -67,7 +67,7 @@ extern "C" int gimbal_probe_linearize(const GimbalProbeSetting* settings, size_t
                         "the snapshot has " + std::to_string(snapshot_size) + " bytes where this build's have " +
                             std::to_string(gimbal_core_snapshot_size()) + ": it comes from another version");
         int initialized = 0;
-        if (gimbal_core_check_snapshot(core.get(), "snapshot", snapshot, &initialized) != GIMBAL_OK)
+        if (gimbal_core_check_snapshot(core.get(), snapshot, &initialized) != GIMBAL_OK)
             return fail(message, message_size, errors.first_error);
         if (!initialized) return fail(message, message_size, "the snapshot is of an instance not yet initialized");
         if (gimbal_core_restore(core.get(), snapshot) != GIMBAL_OK) return fail(message, message_size, errors.first_error);

@@ -1,6 +1,8 @@
 #include <cstdint>
 #include "sundials_integrator.hpp"
 
+#include "gimbal/event_handling.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -179,7 +181,7 @@ int SundialsIntegrator::right_hand_side(sunrealtype time, N_Vector y, N_Vector y
 int SundialsIntegrator::event_functions(sunrealtype time, N_Vector y, sunrealtype* values, void* user_data) {
     auto* self = static_cast<SundialsIntegrator*>(user_data);
     return without_exceptions(-1, [&] {
-        if (time < self->dwell_until_) {
+        if (time < self->chattering_.dwell_until) {
             std::fill(values, values + self->root_directions_.size(), 1.0);
             return 0;
         }
@@ -230,32 +232,13 @@ bool SundialsIntegrator::advance(double end_time, double* state) {
         double before[64];
         const bool tracked = size_ <= 64;
         if (tracked) std::copy(state, state + size_, before);
-        const int changes = system_.update_modes(reached, state, root_directions_.data());
+        const int changes = switch_modes(system_, reached, state, root_directions_.data(), settings_, event_sink_, reached);
         // A projection without a mode change (e.g. theta_b clamped back onto a stop) must not be lost.
         const bool projected = tracked && !std::equal(state, state + size_, before);
         totals_.events += changes;
         events_here += changes;
-        if (changes > 0 && settings_.events_logged()) {
-            std::ostringstream s;
-            s.precision(17);
-            s << "t = " << reached << ": " << changes << " mode change(s)";
-            event_sink_(s.str());
-        }
-        const double window = settings_.zeno_window;
-        rapid_events_ = reached - last_event_time_ <= window ? rapid_events_ + 1 : 0;
-        last_event_time_ = reached;
-        if (rapid_events_ >= settings_.zeno_event_limit) {
-            dwell_until_ = reached + settings_.zeno_dwell;
-            rapid_events_ = 0;
-            ++totals_.zeno_holds;
-            if (settings_.events_logged()) {
-                std::ostringstream s;
-                s.precision(17);
-                s << "t = " << reached << ": " << settings_.zeno_event_limit
-                  << " events without progress in time (chattering); modes held until t = " << dwell_until_;
-                event_sink_(s.str());
-            }
-        }
+        // CVODE and ARKODE locate roots to about 100 ulp of the time: the window itself resolves them.
+        if (record_mode_change(chattering_, settings_, reached, 0.0, event_sink_)) ++totals_.zeno_holds;
         // New modes change the right-hand side: restart there, from the (possibly projected) state. A
         // root that changed nothing (a grazing touch) needs no restart: the integrator carries on.
         if ((changes > 0 || projected) && !restart(reached, state)) return false;

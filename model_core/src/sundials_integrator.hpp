@@ -90,9 +90,7 @@ private:
     SUNMatrix spare_matrix_ = nullptr;
 
     IntegratorStatistics totals_;  // of finished backend runs (their counters reset at each restart)
-    double last_event_time_ = -1e300;
-    int rapid_events_ = 0;
-    double dwell_until_ = -1e300;
+    ChatteringMemory chattering_;
 };
 
 std::unique_ptr<HybridIntegrator> make_cvode_backend(HybridSystem&, const IntegratorSettings&,

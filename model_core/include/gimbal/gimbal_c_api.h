@@ -1,6 +1,8 @@
 /* C interface of the dynamics core, used by the FMI wrapper in fmu_src/.
  * The core knows variables, physics and integration; the wrapper knows the FMI state machine.
  * No function lets a C++ exception out: each returns GIMBAL_ERROR (with a logged reason) instead.
+ * The core speaks no interface's language: its messages name no FMI function, and the wrapper that
+ * calls it prefixes the function it serves (fmu_src/fmi2_cosim.c, core_log).
  * Every GimbalCore* argument must come from gimbal_core_create; NULL is refused. */
 #ifndef GIMBAL_C_API_H
 #define GIMBAL_C_API_H
@@ -61,9 +63,9 @@ double gimbal_core_time(const GimbalCore* core);
 size_t gimbal_core_snapshot_size(void);
 /* Saving ends the current integration segment, so that restoring it later replays bit for bit. */
 GimbalStatus gimbal_core_save(GimbalCore* core, void* buffer);
-/* Range-checks every field of a snapshot from an untrusted source; logs the reason of a refusal under
- * the name of the calling FMI function. *initialized tells whether it holds an initialized instance. */
-GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const char* function, const void* buffer, int* initialized);
+/* Range-checks every field of a snapshot from an untrusted source; logs the reason of a refusal.
+ * *initialized tells whether it holds an initialized instance. */
+GimbalStatus gimbal_core_check_snapshot(GimbalCore* core, const void* buffer, int* initialized);
 /* Checks the snapshot as above; a refused one leaves the instance as it was. */
 GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
 
@@ -72,7 +74,7 @@ GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
  * values in the order of gimbal_continuous_state_vr (a state the chosen fidelity does not integrate is
  * computed from the others, and what the host sets for it is not used); the indicators are
  * GIMBAL_EVENT_INDICATORS guards in a fixed order (an element the fidelity lacks gives constants).
- * Messages of these functions name no interface function: the caller prefixes its own. */
+ */
 #define GIMBAL_CONTINUOUS_STATES 17
 #define GIMBAL_EVENT_INDICATORS 36
 GimbalStatus gimbal_core_use_continuous_time(GimbalCore* core);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "gimbal/gimbal_c_api.h"
+#include "gimbal/event_handling.hpp"
 #include "gimbal/gimbal_hybrid_system.hpp"
 #include "gimbal/integrator.hpp"
 #include "gimbal/linearization.hpp"
@@ -47,7 +48,7 @@ public:
     // refuses a bad one with the reason and leaves the instance as it was.
     static std::size_t snapshot_size();
     void save(void* buffer);
-    GimbalStatus check_snapshot(const char* function, const void* buffer, bool& initialized) const;
+    GimbalStatus check_snapshot(const void* buffer, bool& initialized) const;
     GimbalStatus restore(const void* buffer);
     GimbalStatus do_step(double current_time, double step_size);
     // Work of one fmi2DoStep, in right-hand-side evaluations, beyond which the step is reported
@@ -84,7 +85,7 @@ private:
     StepInputs read_step_inputs(double step_start) const;
     bool build_parameters(ModelParameters& params, std::string& error) const;
     void load_start_state();
-    GimbalStatus check_fixed_base(const char* function) const;
+    GimbalStatus check_fixed_base() const;
     std::unique_ptr<HybridIntegrator> make_integrator(GimbalHybridSystem& system, const ModelParameters& params);
     void create_integrator();
     // What a failed or interrupted step returns to.
@@ -103,7 +104,7 @@ private:
     GimbalStatus report_step_work(double step_size, const IntegratorStatistics& before, const EventCounters& events_before);
     void apply_master_tolerance();
     // Before initialization ends, calculated outputs follow from the start values on request.
-    GimbalStatus preview_outputs(const char* function, const char* name);
+    GimbalStatus preview_outputs(const char* name);
     void publish_outputs();
     GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
     // Continuous-time interface: the 17 states and their derivatives from the integrated ones (a state a
@@ -112,9 +113,7 @@ private:
     void full_state_derivative(const Dynamics& dynamics, const double* derivative, double* out) const;
     // Pushes inputs set since the last evaluation into the hybrid system.
     void refresh_held_inputs();
-    // Guards at the current point with those that sit exactly on zero settled as a located event would
-    // settle them; returns the mode changes this made.
-    int settle_guards(const int* decided);
+    void log_event(const std::string& message) const { logger_(GIMBAL_OK, "logEvents", message); }
     void clamp_published_to_bounds();
     void publish_continuous_time_outputs() {
         refresh_held_inputs();
@@ -155,9 +154,9 @@ private:
     double reference_guards_[kIndicatorCount] = {};  // guards as decided at the last update (crossings are
                                                      // measured against them)
     std::int8_t decided_side_[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
-    double last_event_time_ = -1e300;  // chattering guard, as the integrators' (IntegratorSettings)
-    int rapid_events_ = 0;
-    double dwell_until_ = -1e300;      // model time until which the modes are held
+    ChatteringMemory chattering_;      // model times
+    GuardSettling guard_settling_;
+    IntegratorSettings event_settings_;  // the chattering guard's limits, and whether events are logged
     std::int64_t zeno_holds_ = 0;
 };
 

@@ -69,6 +69,14 @@ struct IntegratorSettings {
     std::function<bool()> events_logged = [] { return true; };
 };
 
+// The chattering guard's memory (event_handling.hpp, record_mode_change).
+struct ChatteringMemory {
+    double last_event_time = -1e300;
+    int rapid_events = 0;
+    double dwell_until = -1e300;  // the modes are held before this time
+    bool holding() const { return dwell_until > -1e300; }
+};
+
 // Everything a one-step integrator carries from one communication step to the next besides the state:
 // saved with an FMU state, so that a restored copy continues bit for bit.
 struct IntegratorMemory {
@@ -78,9 +86,7 @@ struct IntegratorMemory {
     int stiff_votes = 0;          // consecutive explicit steps at the stability boundary
     int nonstiff_votes = 0;       // consecutive steps that voted the other way
     int last_step_rejected = 0;
-    double last_event_time = -1e300;
-    int rapid_events = 0;
-    double dwell_until = -1e300;
+    ChatteringMemory chattering;
 };
 
 class HybridIntegrator {
