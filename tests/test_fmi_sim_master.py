@@ -269,3 +269,49 @@ def test_fmi_sim_holds_a_jump_from_the_next_step_on(fmi_sim, fmu_path, gimbal_fm
     # Over [0.2, 0.201] fmi-sim still applies -1.5 V: the reversal shows in i_R2 (~0.8 A) one step later.
     i_R2 = OUTPUTS.index("i_R2")
     assert abs(got[at_jump + 1, i_R2] - right_continuous[at_jump + 1, i_R2]) > 0.5
+
+
+# ----------------------------------------------------------------------------------------------------
+# Model Exchange: fmi-sim's forward Euler, a second host independent of fmpy's
+
+def run_fmi_sim_model_exchange(fmi_sim: pathlib.Path, fmu_path: pathlib.Path, workdir: pathlib.Path,
+                               start_values: dict, table: dict, stop_time: float, step: float) -> dict:
+    """fmi-sim's `model-exchange` (forward Euler whose step is the output interval, events seen at the
+    end of a step, left limits not printed): {name: array} of the values after each event handling."""
+    output = workdir / f"me_{step!r}.csv"
+    write_input_csv(workdir / "me_in.csv", table)
+    command = [str(fmi_sim), "--model", str(fmu_path), "--output-file", str(output), "--input-file",
+               str(workdir / "me_in.csv"), "model-exchange", "-s", "0.0", "-f", repr(stop_time),
+               "--step", repr(step), "--output-interval", repr(step), "-n", "0"]
+    for name, value in start_values.items():
+        command += ["--init-values", f"{name}={value!r}"]
+    done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=300)
+    assert done.returncode == 0, f"fmi-sim failed ({done.returncode}):\n{done.stderr[-4000:]}"
+    with output.open(newline="") as file:
+        rows = list(csv.DictReader(file))
+    return {name: np.array([float(row[name]) for row in rows]) for name in rows[0]}
+
+
+def test_fmi_sim_model_exchange_stays_physical_and_converges(fmi_sim, fmu_path, gimbal_fmu, tmp_path):
+    """The same FMU as Model Exchange under a second host: outputs finite and within their bounds at
+    every point, and the Euler solution converging to the Co-Simulation reference at first order."""
+    start = {"base.fixed": True, "beta": 0.3, "beta_m": 18.0}
+    table = {"time": [0.0, 0.2], "u_R1": [6.0, 6.0], "u_R2": [-4.0, -4.0]}
+    stop = 0.04
+    reference = simulate(gimbal_fmu, stop, 1e-3, dict(start, **{"solver.rtol": 1e-10}),
+                         lambda t, _: {"u_R1": 6.0, "u_R2": -4.0}, outputs=["alpha", "beta"])
+    limits = {"i_R1": gimbal_fmu.start("motor1.i_L"), "i_R2": gimbal_fmu.start("motor2.i_L"),
+              "theta_b1": gimbal_fmu.start("gear1.eta"), "theta_b2": gimbal_fmu.start("gear2.eta")}
+    errors = []
+    for step in (2e-5, 1e-5):
+        me = run_fmi_sim_model_exchange(fmi_sim, fmu_path, tmp_path, start, table, stop, step)
+        for name, values in me.items():
+            assert np.all(np.isfinite(values)), name
+        for name, limit in limits.items():
+            assert np.max(np.abs(me[name])) <= limit, name
+        assert me["events.total"][-1] > 0
+        # The last row at each millisecond (after any event handling there).
+        at_ms = {round(t * 1000): k for k, t in enumerate(me["time"]) if abs(t * 1000 - round(t * 1000)) < 1e-6}
+        rows = [at_ms[k] for k in range(len(reference["time"]))]
+        errors.append(max(np.max(np.abs(me[n][rows] - reference[n])) for n in ("alpha", "beta")))
+    assert 1.5 < errors[0] / errors[1] < 2.6, errors
