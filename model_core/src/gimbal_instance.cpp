@@ -488,6 +488,7 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
         return base_status;
     }
     swap.commit();
+    map_integrated_states();
     load_start_state();
     time_ = start_time;
     epoch_ = start_time;
@@ -735,6 +736,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     integrator_running_ = initialized && snap.integrator_running && integrator->resumable();
     at_rest_ = integrator_running_ && snap.at_rest;
     swap.commit();
+    if (initialized) map_integrated_states();
     system_ = std::move(system);
     integrator_ = std::move(integrator);
     return GIMBAL_OK;

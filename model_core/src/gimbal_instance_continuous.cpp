@@ -65,6 +65,26 @@ void GimbalInstance::full_state_derivative(const Dynamics& d, const double* deri
         out[kStateSize + k] = layout.energy_slot >= 0 ? derivative[layout.energy_slot + k] : 0.0;
 }
 
+void GimbalInstance::map_integrated_states() {
+    const StateLayout& layout = params_.layout;
+    int slot_of[kStateCount];
+    for (int body = 0; body < 4; ++body) {
+        slot_of[body] = layout.angle_slot[body];
+        slot_of[kRates + body] = layout.rate_slot[body];
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+        slot_of[kCurrents + axis] = layout.current_slot[axis];
+        slot_of[kBacklash + axis] = layout.backlash_slot[axis];
+    }
+    for (int k = 0; k < kEnergyFlowCount; ++k) slot_of[kStateSize + k] = layout.energy_slot >= 0 ? layout.energy_slot + k : -1;
+    integrated_count_ = 0;
+    for (int k = 0; k < kStateCount; ++k) {
+        if (slot_of[k] < 0) continue;
+        integrated_state_[integrated_count_] = k;
+        integrated_slot_[integrated_count_++] = slot_of[k];
+    }
+}
+
 void GimbalInstance::refresh_held_inputs() {
     if (!inputs_stale_) return;
     StepInputs inputs = read_step_inputs(model_time(time_));
@@ -84,26 +104,20 @@ GimbalStatus GimbalInstance::set_time(double time) {
 }
 
 GimbalStatus GimbalInstance::set_continuous_states(const double* states) {
-    for (int k = 0; k < kStateCount; ++k) {
-        if (std::isfinite(states[k])) continue;
-        std::ostringstream s;
-        s << "continuous state " << k << " (" << kRealVariables[kContinuousStates[k]].name << ") = " << states[k]
-          << " refused: states must be finite";
-        return refuse(GIMBAL_ERROR, s.str());
+    // One pass over the host's values, branch-free: this runs at every right-hand side of the host.
+    bool finite = true;
+    for (int k = 0; k < kStateCount; ++k) finite &= std::isfinite(states[k]);
+    if (!finite) {
+        for (int k = 0; k < kStateCount; ++k) {
+            if (std::isfinite(states[k])) continue;
+            std::ostringstream s;
+            s << "continuous state " << k << " (" << kRealVariables[kContinuousStates[k]].name << ") = " << states[k]
+              << " refused: states must be finite";
+            return refuse(GIMBAL_ERROR, s.str());
+        }
     }
-    const StateLayout& layout = params_.layout;
     // The states this fidelity integrates take the host's values; the others follow from them.
-    for (int body = 0; body < 4; ++body) {
-        if (!layout.independent(body)) continue;
-        state_[layout.angle_slot[body]] = states[body];
-        state_[layout.rate_slot[body]] = states[kRates + body];
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-        if (layout.current_slot[axis] >= 0) state_[layout.current_slot[axis]] = states[kCurrents + axis];
-        if (layout.backlash_slot[axis] >= 0) state_[layout.backlash_slot[axis]] = states[kBacklash + axis];
-    }
-    if (layout.energy_slot >= 0)
-        for (int k = 0; k < kEnergyFlowCount; ++k) state_[layout.energy_slot + k] = states[kStateSize + k];
+    for (int k = 0; k < integrated_count_; ++k) state_[integrated_slot_[k]] = states[integrated_state_[k]];
     outputs_stale_ = true;
     decided_here_ = false;
     return GIMBAL_OK;

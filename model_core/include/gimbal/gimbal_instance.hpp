@@ -111,6 +111,8 @@ private:
     // reduced fidelity does not integrate is computed from the others).
     void full_state_vector(const Dynamics& dynamics, double* states) const;
     void full_state_derivative(const Dynamics& dynamics, const double* derivative, double* out) const;
+    // Which of the 17 states this fidelity integrates, and where (set with the parameters).
+    void map_integrated_states();
     // Pushes inputs set since the last evaluation into the hybrid system.
     void refresh_held_inputs();
     void log_event(const std::string& message) const { logger_(GIMBAL_OK, "logEvents", message); }
@@ -156,6 +158,9 @@ private:
     std::int8_t decided_side_[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
     ChatteringMemory chattering_;      // model times
     GuardSettling guard_settling_;
+    int integrated_count_ = 0;
+    int integrated_state_[kContinuousStateCount] = {};  // index among the 17 states
+    int integrated_slot_[kContinuousStateCount] = {};   // its slot in state_
     IntegratorSettings event_settings_;  // the chattering guard's limits, and whether events are logged
     std::int64_t zeno_holds_ = 0;
 };
