@@ -38,7 +38,7 @@ static const struct {
     [FN_SerializeFMUstate] = {"fmi2SerializeFMUstate", ANY_STATE},
     [FN_DeSerializeFMUstate] = {"fmi2DeSerializeFMUstate", ANY_STATE},
     /* After initialization only: the derivatives of the InitialUnknowns are not provided. */
-    [FN_GetDirectionalDerivative] = {"fmi2GetDirectionalDerivative", STATUS_STATES | STATE_ERROR},
+    [FN_GetDirectionalDerivative] = {"fmi2GetDirectionalDerivative", STATUS_STATES | EVALUATION_STATES},
     [FN_SetRealInputDerivatives] = {"fmi2SetRealInputDerivatives", STATE_INITIALIZATION | STATE_STEP_COMPLETE},
     [FN_GetRealOutputDerivatives] = {"fmi2GetRealOutputDerivatives", ANY_STATE},
     [FN_DoStep] = {"fmi2DoStep", STATE_STEP_COMPLETE},
@@ -690,6 +690,9 @@ static fmi2Status impl_GetDirectionalDerivative(fmi2Component c, const fmi2Value
                                         fmi2Real dvUnknown[]) {
     Instance* instance = (Instance*)c;
     if (!allowed(instance, FN_GetDirectionalDerivative)) return fmi2Error;
+    if (instance->type == fmi2ModelExchange)
+        return model_exchange_directional_derivative(instance, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown,
+                                                     dvUnknown);
     const char* function = "fmi2GetDirectionalDerivative";
     if (nUnknown > 0 && (!not_null(instance, function, vUnknown_ref, "vUnknown_ref") ||
                          !not_null(instance, function, dvUnknown, "dvUnknown")))

@@ -115,6 +115,27 @@ static fmi2Status impl_GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x
     return from_core(gimbal_core_get_nominal_states(instance->core, x_nominal));
 }
 
+/* Unknowns are state derivatives or outputs, knowns states or inputs (FMI 2.0, section 3.2.1): the core
+ * checks which, and names a variable that is neither. */
+fmi2Status model_exchange_directional_derivative(Instance* instance, const fmi2ValueReference unknowns[],
+                                                 size_t unknown_count, const fmi2ValueReference knowns[],
+                                                 size_t known_count, const fmi2Real seed[], fmi2Real result[]) {
+    const char* function = "fmi2GetDirectionalDerivative";
+    if (unknown_count > 0 && (!not_null(instance, function, unknowns, "vUnknown_ref") ||
+                              !not_null(instance, function, result, "dvUnknown")))
+        return fmi2Error;
+    if (known_count > 0 && (!not_null(instance, function, knowns, "vKnown_ref") ||
+                            !not_null(instance, function, seed, "dvKnown")))
+        return fmi2Error;
+    for (size_t j = 0; j < known_count; ++j) {
+        if (isfinite(seed[j])) continue;
+        log_message(instance, fmi2Error, "logStatusError", "%s: the seed of known %zu must be finite", function, j);
+        return fmi2Error;
+    }
+    return from_core(gimbal_core_directional_derivative(instance->core, unknowns, unknown_count, knowns, known_count,
+                                                        seed, result));
+}
+
 /* ---------------------------------------------------------------- the exported functions */
 
 fmi2Status fmi2EnterEventMode(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_EnterEventMode(c)); }

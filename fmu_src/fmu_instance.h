@@ -73,6 +73,12 @@ const char* state_name(InstanceState state);
 int allowed(Instance* instance, Function function);
 int not_null(Instance* instance, const char* function, const void* pointer, const char* argument);
 
+/* fmi2GetDirectionalDerivative of a Model Exchange instance (fmi2_model_exchange.c), once its state
+ * is checked. */
+fmi2Status model_exchange_directional_derivative(Instance* instance, const fmi2ValueReference unknowns[],
+                                                 size_t unknown_count, const fmi2ValueReference knowns[],
+                                                 size_t known_count, const fmi2Real seed[], fmi2Real result[]);
+
 /* Runs an implementation in the FMU's floating-point environment and gives the host its own back. */
 #define IN_FMU_FP_ENVIRONMENT(type, call)   \
     HostFpEnvironment host_environment;     \

@@ -261,4 +261,12 @@ GimbalStatus gimbal_core_update_discrete_states(GimbalCore* core, GimbalDiscrete
     });
 }
 
+GimbalStatus gimbal_core_directional_derivative(GimbalCore* core, const unsigned* unknowns, size_t unknown_count,
+                                                const unsigned* knowns, size_t known_count, const double* seed,
+                                                double* result) {
+    return continuous(core, [&] {
+        return core->instance.directional_derivative(unknowns, unknown_count, knowns, known_count, seed, result);
+    });
+}
+
 }  // extern "C"

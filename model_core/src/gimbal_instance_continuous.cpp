@@ -11,6 +11,8 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "gimbal/event_handling.hpp"
 #include "gimbal/gimbal_instance.hpp"
@@ -242,6 +244,84 @@ GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     update.next_time = epoch_ + chattering_.dwell_until;
     decided_here_ = true;
     outputs_stale_ = true;
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, std::size_t unknown_count,
+                                                    const unsigned* knowns, std::size_t known_count, const double* seed,
+                                                    double* result) {
+    // What each known and unknown is: a state (its index among the 17) or an input; a derivative (its
+    // index) or an output.
+    double state_seed[kStateCount] = {};
+    std::vector<std::pair<unsigned, double>> input_seed;
+    for (std::size_t j = 0; j < known_count; ++j) {
+        const unsigned vr = knowns[j];
+        const auto state = std::find(kContinuousStates, kContinuousStates + kStateCount, vr);
+        if (state != kContinuousStates + kStateCount) {
+            state_seed[state - kContinuousStates] += seed[j];
+        } else if (vr < kRealVariableCount && kRealVariables[vr].causality == Causality::input) {
+            input_seed.emplace_back(vr, seed[j]);
+        } else {
+            return refuse(GIMBAL_ERROR, std::string("known ") + std::to_string(j) + ": " +
+                                            (vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)") +
+                                            " is neither a continuous state nor an input");
+        }
+    }
+    for (std::size_t i = 0; i < unknown_count; ++i) {
+        const unsigned vr = unknowns[i];
+        const bool derivative = std::find(kStateDerivatives, kStateDerivatives + kStateCount, vr) !=
+                                kStateDerivatives + kStateCount;
+        if (!derivative && !(vr < kRealVariableCount && kRealVariables[vr].causality == Causality::output))
+            return refuse(GIMBAL_ERROR, std::string("unknown ") + std::to_string(i) + ": " +
+                                            (vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)") +
+                                            " is neither a state derivative nor an output");
+    }
+    std::fill(result, result + unknown_count, 0.0);
+    // A central difference along the seed, within the modes in force: two evaluations whatever the
+    // number of knowns and unknowns. The step is the cube root of the rounding error relative to the
+    // values moved, the balance of truncation and rounding of a central difference.
+    refresh_held_inputs();
+    double states[kStateCount];
+    get_continuous_states(states);
+    double size = 0.0, scale = 1.0;
+    for (int k = 0; k < kStateCount; ++k)
+        if (state_seed[k] != 0.0) size = std::max(size, std::fabs(state_seed[k])), scale = std::max(scale, std::fabs(states[k]));
+    for (const auto& [vr, value] : input_seed)
+        if (value != 0.0) size = std::max(size, std::fabs(value)), scale = std::max(scale, std::fabs(reals_[vr]));
+    if (size == 0.0) return GIMBAL_OK;
+    const double step = 6e-6 * scale / size;
+
+    double saved_state[kMaxStateSize];
+    std::copy(state_, state_ + kMaxStateSize, saved_state);
+    std::vector<double> saved_reals(reals_, reals_ + kRealVariableCount);
+    std::vector<int> saved_integers(integers_, integers_ + kIntegerVariableCount);
+    const bool saved_outputs_stale = outputs_stale_, saved_decided = decided_here_;
+    double values[2][kRealVariableCount];
+    GimbalStatus status = GIMBAL_OK;
+    for (int side = 0; side < 2 && status == GIMBAL_OK; ++side) {
+        const double h = side == 0 ? step : -step;
+        std::copy(saved_state, saved_state + kMaxStateSize, state_);
+        for (int k = 0; k < integrated_count_; ++k)
+            state_[integrated_slot_[k]] += h * state_seed[integrated_state_[k]];
+        std::copy(saved_reals.begin(), saved_reals.end(), reals_);
+        for (const auto& [vr, value] : input_seed) reals_[vr] += h * value;
+        inputs_stale_ = true;
+        double derivatives[kStateCount];
+        status = get_derivatives(derivatives);
+        publish_continuous_time_outputs();
+        for (std::size_t i = 0; i < unknown_count; ++i) {
+            const auto d = std::find(kStateDerivatives, kStateDerivatives + kStateCount, unknowns[i]);
+            values[side][i] = d != kStateDerivatives + kStateCount ? derivatives[d - kStateDerivatives] : reals_[unknowns[i]];
+        }
+    }
+    std::copy(saved_state, saved_state + kMaxStateSize, state_);
+    std::copy(saved_reals.begin(), saved_reals.end(), reals_);
+    std::copy(saved_integers.begin(), saved_integers.end(), integers_);
+    inputs_stale_ = true;
+    outputs_stale_ = saved_outputs_stale;
+    decided_here_ = saved_decided;
+    if (status != GIMBAL_OK) return status;
+    for (std::size_t i = 0; i < unknown_count; ++i) result[i] = (values[0][i] - values[1][i]) / (2.0 * step);
     return GIMBAL_OK;
 }
 

@@ -97,6 +97,12 @@ typedef struct GimbalDiscreteUpdate {
 /* Decides the modes at the current point: where an indicator crossed zero since the last decision,
  * or an input jumped. A repeated call at the same point changes nothing. */
 GimbalStatus gimbal_core_update_discrete_states(GimbalCore* core, GimbalDiscreteUpdate* update);
+/* result = d(unknowns)/d(knowns) . seed at the current point, within the modes in force (a central
+ * difference along the seed). Unknowns: state derivatives or outputs; knowns: states or inputs (Real
+ * value references; anything else is refused with the reason). */
+GimbalStatus gimbal_core_directional_derivative(GimbalCore* core, const unsigned* unknowns, size_t unknown_count,
+                                                const unsigned* knowns, size_t known_count, const double* seed,
+                                                double* result);
 
 /* The continuous model linearized at the instance's current time and state, with its inputs as last
  * set, within the modes in force there (docs/linearization.md). Not exported by the FMU (it exports

@@ -80,6 +80,10 @@ public:
     GimbalStatus get_derivatives(double* derivatives);
     GimbalStatus get_event_indicators(double* indicators);
     GimbalStatus update_discrete_states(DiscreteUpdate& update);
+    // d(unknowns)/d(knowns) . seed at the current point, within the modes in force: unknowns are state
+    // derivatives or outputs, knowns continuous states or inputs (Real value references).
+    GimbalStatus directional_derivative(const unsigned* unknowns, std::size_t unknown_count, const unsigned* knowns,
+                                        std::size_t known_count, const double* seed, double* result);
 
 private:
     StepInputs read_step_inputs(double step_start) const;
