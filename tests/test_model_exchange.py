@@ -353,3 +353,26 @@ def test_directional_derivatives_match_the_linear_model_of_the_core(gimbal_fmu, 
         assert np.allclose(both, 2.0 * linear.A[:, 0] - linear.B[:, 0], rtol=1e-5, atol=1e-5 * np.max(np.abs(both)))
     finally:
         instance.free()
+
+
+# The hard cases' stiff and switching extremes (tests/test_hard_cases.py, docs/hard_cases.md).
+HARD_CASES = {
+    "gear k_s 1e8, small rotors": {"gear1.k_s": 1e8, "gear2.k_s": 1e8, "rotor1.I_zz": 1e-6, "rotor2.I_xx": 1e-6},
+    "inductance 1e-7 H": {"motor1.L": 1e-7, "motor2.L": 1e-7},
+    "shaft damping 1e-6": {"gear1.c_s": 1e-6, "gear2.c_s": 1e-6},
+    "pure dead zone (c_s = 0)": {"gear1.c_s": 0.0, "gear2.c_s": 0.0},
+    "wide backlash, free load": {"gear1.eta": 0.05, "gear2.eta": 0.05, "g": 0.0},
+    "rotor friction near w_min": {"rotor1.T_max": 0.02, "rotor1.T_din": 0.015, "rotor2.T_max": 0.02,
+                                  "rotor2.T_din": 0.015},
+}
+
+
+@pytest.mark.parametrize("case", sorted(HARD_CASES))
+def test_the_event_iteration_ends_at_once_on_the_hard_cases(gimbal_fmu, case):
+    start = dict(HARD_CASES[case], **{"base.fixed": True, "beta": 0.2, "beta_m": 12.0})
+    me = simulate_model_exchange(gimbal_fmu, 0.05, start, square_wave(10.0, 0.01),
+                                 input_events=np.arange(1, 5) * 0.01, outputs=["alpha", "beta", "events.total"],
+                                 rtol=1e-7, repeats=2)
+    assert np.all(np.isfinite(me["alpha"])) and np.all(np.isfinite(me["beta"]))
+    assert me["events.total"][-1] > 0
+    assert set(me["event_calls"]) == {1}
