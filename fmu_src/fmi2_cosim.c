@@ -56,8 +56,8 @@ static const struct {
     [FN_SetTime] = {"fmi2SetTime", STATE_EVENT_MODE | STATE_CONTINUOUS_TIME},
     [FN_SetContinuousStates] = {"fmi2SetContinuousStates", STATE_CONTINUOUS_TIME},
     [FN_GetDerivatives] = {"fmi2GetDerivatives", EVALUATION_STATES},
-    [FN_GetEventIndicators] = {"fmi2GetEventIndicators", EVALUATION_STATES},
-    [FN_GetContinuousStates] = {"fmi2GetContinuousStates", EVALUATION_STATES},
+    [FN_GetEventIndicators] = {"fmi2GetEventIndicators", STATE_INITIALIZATION | EVALUATION_STATES},
+    [FN_GetContinuousStates] = {"fmi2GetContinuousStates", STATE_INITIALIZATION | EVALUATION_STATES},
     [FN_GetNominalsOfContinuousStates] = {"fmi2GetNominalsOfContinuousStates", STATE_INSTANTIATED | EVALUATION_STATES},
 };
 

@@ -7,6 +7,16 @@
 
 #include "fmu_instance.h"
 
+/* The state masks let a Co-Simulation instance through in the states both interfaces share
+ * (instantiated, initialization mode): these functions are Model Exchange's alone. */
+static int model_exchange_instance(Instance* instance, Function function) {
+    if (instance->type == fmi2ModelExchange) return 1;
+    log_message(instance, fmi2Error, "logStatusError",
+                "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation", function_name(function),
+                instance->instance_name);
+    return 0;
+}
+
 static int count_is(Instance* instance, Function function, size_t given, size_t expected, const char* argument) {
     if (given == expected) return 1;
     log_message(instance, fmi2Error, "logStatusError", "%s: %s = %zu, but the model has %zu (modelDescription.xml)",
@@ -17,7 +27,7 @@ static int count_is(Instance* instance, Function function, size_t given, size_t 
 /* State, pointer and size checks of the vector getters and setters; names the culprit. */
 static int check_vector(Instance* instance, Function function, const void* values, size_t given, size_t expected,
                         const char* argument, const char* count_name) {
-    if (!allowed(instance, function)) return 0;
+    if (!allowed(instance, function) || !model_exchange_instance(instance, function)) return 0;
     if (!count_is(instance, function, given, expected, count_name)) return 0;
     return not_null(instance, function_name(function), values, argument);
 }

@@ -376,3 +376,48 @@ def test_the_event_iteration_ends_at_once_on_the_hard_cases(gimbal_fmu, case):
     assert np.all(np.isfinite(me["alpha"])) and np.all(np.isfinite(me["beta"]))
     assert me["events.total"][-1] > 0
     assert set(me["event_calls"]) == {1}
+
+
+def test_states_and_indicators_in_initialization_mode_are_those_of_the_start(gimbal_fmu):
+    """FMI 2.0 lets a host read the continuous states and event indicators in initialization mode:
+    they are those of the start values, and equal what the instance has right after initialization
+    (a rigid gear's rotor angle already N times its load's)."""
+    from fmpy.fmi2 import FMU2Model
+
+    md = gimbal_fmu.model_description
+    model = FMU2Model(guid=md.guid, unzipDirectory=gimbal_fmu.unzipdir, modelIdentifier="Gimbal2Axis",
+                      instanceName="init")
+    model.instantiate()
+    try:
+        model.setupExperiment(startTime=0.0)
+        gimbal_fmu.set_values(model, {"gear1.model": 0, "alpha": 0.2, "alpha_m": 5.0, "beta": 0.3, "i_R2": 0.5})
+        model.enterInitializationMode()
+        gimbal_fmu.set_values(model, {"u_R1": 30.0})
+        x0, z0 = np.zeros(17), np.zeros(36)
+        pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))  # noqa: E731
+        model.getContinuousStates(pointer(x0), 17)
+        model.getEventIndicators(pointer(z0), 36)
+        model.exitInitializationMode()
+        x1, z1 = np.zeros(17), np.zeros(36)
+        model.getContinuousStates(pointer(x1), 17)
+        model.getEventIndicators(pointer(z1), 36)
+        assert np.array_equal(x0, x1) and np.array_equal(z0, z1)
+        assert x0[0] == 0.2 and x0[1] == 0.2 * gimbal_fmu.start("gear1.N") and x0[9] == 0.5
+        assert z0[0] == 1.0 and z0[1] == 1.0  # gear 1 is rigid: no backlash guards
+        assert z0[4] == 1.0  # no voltage ramp: the clamp's guards are constant
+    finally:
+        model.terminate()
+        model.freeInstance()
+
+
+def test_model_exchange_functions_refuse_a_co_simulation_instance(gimbal_fmu):
+    log = []
+    slave = gimbal_fmu.instantiate("cs", log=log)
+    try:
+        get_nominals = slave.dll.fmi2GetNominalsOfContinuousStates
+        get_nominals.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t]
+        nominals = np.zeros(17)
+        assert get_nominals(slave.component, nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 17) == 3
+        assert any("fmi2GetNominalsOfContinuousStates is a Model Exchange function" in e.text for e in log)
+    finally:
+        slave.freeInstance()

@@ -228,6 +228,8 @@ GimbalStatus gimbal_core_set_continuous_states(GimbalCore* core, const double* s
 }
 
 GimbalStatus gimbal_core_get_continuous_states(GimbalCore* core, double* states) {
+    if (core != nullptr && !core->instance.initialized())
+        return guarded(core, [&] { return core->instance.preview_continuous(states, nullptr); });
     return continuous(core, [&] {
         core->instance.get_continuous_states(states);
         return GIMBAL_OK;
@@ -246,6 +248,8 @@ GimbalStatus gimbal_core_get_derivatives(GimbalCore* core, double* derivatives) 
 }
 
 GimbalStatus gimbal_core_get_event_indicators(GimbalCore* core, double* indicators) {
+    if (core != nullptr && !core->instance.initialized())
+        return guarded(core, [&] { return core->instance.preview_continuous(nullptr, indicators); });
     return continuous(core, [&] { return core->instance.get_event_indicators(indicators); });
 }
 

@@ -449,13 +449,18 @@ GimbalStatus GimbalInstance::preview_outputs(const char* name) {
     auto system = std::make_unique<GimbalHybridSystem>(params_);
     auto integrator = make_integrator(*system, params_);
     swap.commit();
+    map_integrated_states();
     load_start_state();
     epoch_ = time_;
+    system->hold_inputs_at_any_time(continuous_time_);
     system->set_inputs(read_step_inputs(0.0));
     system->update_modes(0.0, state_, nullptr);
     system_ = std::move(system);
     integrator_ = std::move(integrator);
     publish_outputs();
+    // The continuous-time interface may ask for the states and indicators during initialization.
+    full_state_vector(system_->dynamics_at(0.0, state_), preview_states_);
+    system_->event_indicators(0.0, state_, preview_indicators_);
     // The preview must not count as initialization: forget the integrator again.
     integrator_.reset();
     system_.reset();

@@ -139,6 +139,15 @@ void GimbalInstance::get_nominal_states(double* nominals) const {
         if (reals_[half_backlash[axis]] > 0.0) nominals[kBacklash + axis] = reals_[half_backlash[axis]];
 }
 
+GimbalStatus GimbalInstance::preview_continuous(double* states, double* indicators) {
+    if (system_) return refuse(GIMBAL_ERROR, "the instance is initialized: ask for the current point instead");
+    const GimbalStatus status = preview_outputs(states != nullptr ? "the continuous states" : "the event indicators");
+    if (status != GIMBAL_OK) return status;
+    if (states != nullptr) std::copy(preview_states_, preview_states_ + kStateCount, states);
+    if (indicators != nullptr) std::copy(preview_indicators_, preview_indicators_ + kIndicatorCount, indicators);
+    return GIMBAL_OK;
+}
+
 GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
     refresh_held_inputs();
     const double now = model_time(time_);

@@ -81,7 +81,8 @@ GimbalStatus gimbal_core_use_continuous_time(GimbalCore* core);
 /* The Real value references of state k and of its derivative; k in [0, GIMBAL_CONTINUOUS_STATES). */
 unsigned gimbal_continuous_state_vr(int k);
 unsigned gimbal_state_derivative_vr(int k);
-/* After initialization only (GIMBAL_ERROR before). */
+/* After initialization only (GIMBAL_ERROR before), except the continuous states and the event
+ * indicators: before, they are those of the start values (FMI's initialization mode). */
 GimbalStatus gimbal_core_set_time(GimbalCore* core, double time);
 GimbalStatus gimbal_core_set_continuous_states(GimbalCore* core, const double* states);
 GimbalStatus gimbal_core_get_continuous_states(GimbalCore* core, double* states);

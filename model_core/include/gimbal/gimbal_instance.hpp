@@ -79,6 +79,9 @@ public:
     void get_nominal_states(double* nominals) const;
     GimbalStatus get_derivatives(double* derivatives);
     GimbalStatus get_event_indicators(double* indicators);
+    // Before initialization ends: the states and indicators at the start values (the FMU's part of
+    // initialization mode), computed as the outputs are previewed then.
+    GimbalStatus preview_continuous(double* states, double* indicators);
     GimbalStatus update_discrete_states(DiscreteUpdate& update);
     // d(unknowns)/d(knowns) . seed at the current point, within the modes in force: unknowns are state
     // derivatives or outputs, knowns continuous states or inputs (Real value references).
@@ -162,6 +165,8 @@ private:
     std::int8_t decided_side_[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
     ChatteringMemory chattering_;      // model times
     GuardSettling guard_settling_;
+    double preview_states_[kContinuousStateCount] = {};      // at the start values, before initialization
+    double preview_indicators_[GimbalHybridSystem::kIndicatorCount] = {};
     int integrated_count_ = 0;
     int integrated_state_[kContinuousStateCount] = {};  // index among the 17 states
     int integrated_slot_[kContinuousStateCount] = {};   // its slot in state_
