@@ -22,6 +22,8 @@ if [ "$setup_for" = test ]; then
   # fmi-sim, another master of the test suite, is built by cargo; its FMI bindings are generated with
   # bindgen, which loads libclang.
   dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
+  # xmllint checks the model description against the FMI schemas (fmpy ships them).
+  command -v xmllint >/dev/null 2>&1 || need_apt+=(libxml2-utils)
   # The FMU's win64 binary is cross-compiled with mingw-w64 (the win32 thread model: no winpthread
   # DLL) and tested under Wine; without recommends, which would bring a desktop's worth of libraries.
   command -v x86_64-w64-mingw32-g++ >/dev/null 2>&1 || need_apt_bare+=(g++-mingw-w64-x86-64-win32)

@@ -213,3 +213,17 @@ def test_the_native_benchmark_driver_sets_the_enumerations(build_dir):
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "fidelity reduced, method 5" in done.stdout and "(4 states)" in done.stdout, done.stdout
+
+
+def test_the_model_description_is_valid_against_the_fmi_2_schema(build_dir):
+    """xmllint against FMI 2.0's XSD (as fmpy ships it), and fmpy's own checks: both clean."""
+    import fmpy
+    from fmpy.validation import validate_fmu
+
+    xmllint = shutil.which("xmllint")
+    assert xmllint, "xmllint is missing: scripts/setup.sh installs libxml2-utils"
+    schema = pathlib.Path(fmpy.__file__).parent / "schema" / "fmi2" / "fmi2ModelDescription.xsd"
+    description = build_dir / "fmu_staging" / "modelDescription.xml"
+    done = subprocess.run([xmllint, "--noout", "--schema", str(schema), str(description)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert validate_fmu(str(build_dir / "Gimbal2Axis.fmu")) == []
