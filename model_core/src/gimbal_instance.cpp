@@ -179,7 +179,7 @@ GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
     }
     if (!std::isfinite(value)) {
         std::ostringstream s;
-        s << "" << kRealVariables[vr].name << " = " << value << " refused: values must be finite";
+        s << kRealVariables[vr].name << " = " << value << " refused: values must be finite";
         return refuse(GIMBAL_ERROR, s.str());
     }
     reals_[vr] = value;
@@ -199,7 +199,7 @@ GimbalStatus GimbalInstance::set_input_derivative(unsigned vr, int order, double
     const int axis = vr == vr_u_R1 ? 0 : (vr == vr_u_R2 ? 1 : -1);
     if (axis < 0) {
         const char* name = vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)";
-        return refuse(GIMBAL_ERROR, std::string("") + name +
+        return refuse(GIMBAL_ERROR, std::string(name) +
                                         " takes no derivative: only u_R1 and u_R2 do (the base inputs carry their own "
                                         "rates and accelerations)");
     }
@@ -692,7 +692,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     ParameterSwap swap(params_, params_);
     if (initialized) {
         std::string error;
-        if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, "" + error);
+        if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, error);
         params_ = params;
         system = std::make_unique<GimbalHybridSystem>(params_);
         system->hold_inputs_at_any_time(continuous_time_);
@@ -876,7 +876,7 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         if (kRealVariables[vr].causality != Causality::output || std::isfinite(reals_[vr])) continue;
         std::ostringstream s;
         s.precision(17);
-        s << "" << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
+        s << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
           << ": an input or parameter lies beyond what the model can represent; state rolled back to t = "
           << current_time;
         roll_back(start);
