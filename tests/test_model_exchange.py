@@ -296,6 +296,16 @@ def test_refusals_name_the_function_and_the_culprit(gimbal_fmu):
         bad[9] = float("nan")
         refused(lambda: set_states(instance, bad), "fmi2SetContinuousStates", "i_R2", "finite")
         refused(lambda: model.setTime(float("inf")), "fmi2SetTime", "finite")
+        refused(lambda: model.setTime(-1e-3), "fmi2SetTime", "before the start time 0")
+        # States the model cannot represent: the outputs are refused, not handed out as inf, and an FMU
+        # state taken there can still be serialized and read back (found by fuzz_model_exchange).
+        huge = states(instance)
+        huge[4] = 1e300
+        set_states(instance, huge)
+        refused(lambda: instance.values(["energy.kinetic"]), "fmi2GetReal", "not finite", "beyond what the model can represent")
+        saved = model.getFMUstate()
+        model.freeFMUstate(model.deSerializeFMUstate(model.serializeFMUstate(saved)))
+        model.freeFMUstate(saved)
         refused(lambda: model.newDiscreteStates(), "fmi2NewDiscreteStates", "continuous-time mode")
         del log[:]
         do_step = model.dll.fmi2DoStep

@@ -223,7 +223,10 @@ GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
         const GimbalStatus status = preview_outputs(kRealVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
-    if (system_ && continuous_time_ && outputs_stale_) publish_continuous_time_outputs();
+    if (system_ && continuous_time_ && outputs_stale_) {
+        const GimbalStatus status = publish_continuous_time_outputs();
+        if (status != GIMBAL_OK) return status;
+    }
     value = reals_[vr];
     return GIMBAL_OK;
 }
@@ -245,7 +248,10 @@ GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) {
         const GimbalStatus status = preview_outputs(kIntegerVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
-    if (system_ && continuous_time_ && outputs_stale_) publish_continuous_time_outputs();
+    if (system_ && continuous_time_ && outputs_stale_) {
+        const GimbalStatus status = publish_continuous_time_outputs();
+        if (status != GIMBAL_OK) return status;
+    }
     value = integers_[vr];
     return GIMBAL_OK;
 }

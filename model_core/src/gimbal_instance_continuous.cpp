@@ -97,6 +97,12 @@ void GimbalInstance::refresh_held_inputs() {
 
 GimbalStatus GimbalInstance::set_time(double time) {
     if (!std::isfinite(time)) return refuse(GIMBAL_ERROR, "the time must be finite");
+    if (time < epoch_) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "time = " << time << " lies before the start time " << epoch_;
+        return refuse(GIMBAL_ERROR, s.str());
+    }
     if (time != time_) {
         time_ = time;
         outputs_stale_ = true;
@@ -317,7 +323,7 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
         inputs_stale_ = true;
         double derivatives[kStateCount];
         status = get_derivatives(derivatives);
-        publish_continuous_time_outputs();
+        if (status == GIMBAL_OK) status = publish_continuous_time_outputs();
         for (std::size_t i = 0; i < unknown_count; ++i) {
             const auto d = std::find(kStateDerivatives, kStateDerivatives + kStateCount, unknowns[i]);
             values[side][i] = d != kStateDerivatives + kStateCount ? derivatives[d - kStateDerivatives] : reals_[unknowns[i]];
@@ -331,6 +337,28 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
     decided_here_ = saved_decided;
     if (status != GIMBAL_OK) return status;
     for (std::size_t i = 0; i < unknown_count; ++i) result[i] = (values[0][i] - values[1][i]) / (2.0 * step);
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::publish_continuous_time_outputs() {
+    refresh_held_inputs();
+    double reals[kRealVariableCount];
+    int integers[kIntegerVariableCount];
+    std::copy(reals_, reals_ + kRealVariableCount, reals);
+    std::copy(integers_, integers_ + kIntegerVariableCount, integers);
+    publish_outputs();
+    clamp_published_to_bounds();
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
+        if (std::isfinite(reals_[vr])) continue;
+        std::ostringstream s;
+        s.precision(17);
+        s << kRealVariables[vr].name << " is not finite at t = " << time_
+          << ": the states or inputs set lie beyond what the model can represent";
+        std::copy(reals, reals + kRealVariableCount, reals_);
+        std::copy(integers, integers + kIntegerVariableCount, integers_);
+        return refuse(GIMBAL_ERROR, s.str());
+    }
+    outputs_stale_ = false;
     return GIMBAL_OK;
 }
 

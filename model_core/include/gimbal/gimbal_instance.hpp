@@ -124,12 +124,9 @@ private:
     void refresh_held_inputs();
     void log_event(const std::string& message) const { logger_(GIMBAL_OK, "logEvents", message); }
     void clamp_published_to_bounds();
-    void publish_continuous_time_outputs() {
-        refresh_held_inputs();
-        publish_outputs();
-        clamp_published_to_bounds();
-        outputs_stale_ = false;
-    }
+    // The outputs at the point the host set; refused (and the last good ones kept) where the states or
+    // inputs set make one of them non-finite.
+    GimbalStatus publish_continuous_time_outputs();
 
     Logger logger_;
     LogFilter log_filter_;
