@@ -39,6 +39,15 @@ struct Api {
     fmi2SerializedFMUstateSizeTYPE* serializedFMUstateSize;
     fmi2SerializeFMUstateTYPE* serializeFMUstate;
     fmi2DeSerializeFMUstateTYPE* deSerializeFMUstate;
+    // Model Exchange
+    fmi2EnterEventModeTYPE* enterEventMode;
+    fmi2NewDiscreteStatesTYPE* newDiscreteStates;
+    fmi2EnterContinuousTimeModeTYPE* enterContinuousTimeMode;
+    fmi2SetTimeTYPE* setTime;
+    fmi2SetContinuousStatesTYPE* setContinuousStates;
+    fmi2GetDerivativesTYPE* getDerivatives;
+    fmi2GetEventIndicatorsTYPE* getEventIndicators;
+    fmi2GetContinuousStatesTYPE* getContinuousStates;
 
     bool load(const char* path) {
         void* opened = dlopen(path, RTLD_NOW | RTLD_LOCAL);
@@ -79,6 +88,14 @@ struct Api {
         find(serializedFMUstateSize, "fmi2SerializedFMUstateSize");
         find(serializeFMUstate, "fmi2SerializeFMUstate");
         find(deSerializeFMUstate, "fmi2DeSerializeFMUstate");
+        find(enterEventMode, "fmi2EnterEventMode");
+        find(newDiscreteStates, "fmi2NewDiscreteStates");
+        find(enterContinuousTimeMode, "fmi2EnterContinuousTimeMode");
+        find(setTime, "fmi2SetTime");
+        find(setContinuousStates, "fmi2SetContinuousStates");
+        find(getDerivatives, "fmi2GetDerivatives");
+        find(getEventIndicators, "fmi2GetEventIndicators");
+        find(getContinuousStates, "fmi2GetContinuousStates");
         return ok;
     }
 };
