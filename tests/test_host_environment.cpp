@@ -121,12 +121,73 @@ std::vector<double> run_scene(const SceneInputs& scene, long& calls_changing_env
     return trajectory;
 }
 
+// The same for a Model Exchange host: forward-Euler steps over 0.1 s (the FMU's derivatives,
+// indicators, event iterations), every call checked.
+std::vector<double> run_model_exchange(long& calls_changing_environment) {
+    Log log;
+    fmi2CallbackFunctions callbacks = fmu_loader::callbacks_for(log);
+    // The host computes between the calls (its Euler step raises its own flags): each call is
+    // compared with the environment right before it.
+    auto checked = [&](auto&& call) {
+        const HostEnvironment before = host_environment();
+        const fmi2Status status = call();
+        if (!same(host_environment(), before)) ++calls_changing_environment;
+        return status;
+    };
+    fmi2Component c =
+        api.instantiate("host", fmi2ModelExchange, model.guid.c_str(), "file:///tmp", &callbacks, fmi2False, fmi2False);
+    CHECK(c != nullptr);
+    const fmi2ValueReference inputs[] = {model.vr("u_R1"), model.vr("u_R2"), model.vr("base.gamma_dot")};
+    const double values[] = {12.0, -8.0, 0.2};
+    CHECK(checked([&] { return api.setupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0); }) == fmi2OK);
+    CHECK(checked([&] { return api.enterInitializationMode(c); }) == fmi2OK);
+    CHECK(checked([&] { return api.setReal(c, inputs, 3, values); }) == fmi2OK);
+    CHECK(checked([&] { return api.exitInitializationMode(c); }) == fmi2OK);
+    fmi2EventInfo info{};
+    CHECK(checked([&] { return api.newDiscreteStates(c, &info); }) == fmi2OK);
+    CHECK(checked([&] { return api.enterContinuousTimeMode(c); }) == fmi2OK);
+    double x[17], dx[17], z[36], z_before[36];
+    std::vector<double> trajectory;
+    long events = 0;
+    for (int k = 1; k <= 4000; ++k) {
+        CHECK(checked([&] { return api.getEventIndicators(c, z_before, 36); }) == fmi2OK);
+        CHECK(checked([&] { return api.getContinuousStates(c, x, 17); }) == fmi2OK);
+        CHECK(checked([&] { return api.getDerivatives(c, dx, 17); }) == fmi2OK);
+        // The first derivatives come before any arithmetic of the host's: the same bits in any host.
+        if (k == 1) trajectory.insert(trajectory.end(), dx, dx + 17);
+        for (int i = 0; i < 17; ++i) x[i] += 2.5e-5 * dx[i];
+        CHECK(checked([&] { return api.setTime(c, k * 2.5e-5); }) == fmi2OK);
+        CHECK(checked([&] { return api.setContinuousStates(c, x, 17); }) == fmi2OK);
+        CHECK(checked([&] { return api.getEventIndicators(c, z, 36); }) == fmi2OK);
+        bool crossed = false;
+        for (int i = 0; i < 36; ++i) crossed = crossed || ((z[i] > 0.0) != (z_before[i] > 0.0));
+        if (crossed) {
+            ++events;
+            CHECK(checked([&] { return api.enterEventMode(c); }) == fmi2OK);
+            CHECK(checked([&] { return api.newDiscreteStates(c, &info); }) == fmi2OK);
+            CHECK(checked([&] { return api.enterContinuousTimeMode(c); }) == fmi2OK);
+        }
+        if (k % 40 == 0) trajectory.insert(trajectory.end(), x, x + 17);
+    }
+    CHECK(events > 0);
+    // A non-finite state is refused, not trapped.
+    x[0] = NAN;
+    CHECK(checked([&] { return api.setContinuousStates(c, x, 17); }) == fmi2Error);
+    const HostEnvironment before_free = host_environment();
+    api.freeInstance(c);
+    if (!same(host_environment(), before_free)) ++calls_changing_environment;
+    return trajectory;
+}
+
 void test_host_floating_point_environment_is_held() {
     const SceneInputs scene = scene_inputs();
     long changed = 0;
     feclearexcept(FE_ALL_EXCEPT);
     const std::vector<double> reference = run_scene(scene, changed);
     CHECK(changed == 0);
+    long changed_me = 0;
+    const std::vector<double> me_reference = run_model_exchange(changed_me);
+    CHECK(changed_me == 0);
 
     // Rounding upward, FTZ and DAZ, trapping exceptions, sticky flags raised before the calls.
     fesetround(FE_UPWARD);
@@ -137,6 +198,8 @@ void test_host_floating_point_environment_is_held() {
     feenableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW);
     long changed_in_hostile_host = 0;
     const std::vector<double> hostile_host = run_scene(scene, changed_in_hostile_host);
+    long changed_in_hostile_me_host = 0;
+    const std::vector<double> hostile_me_host = run_model_exchange(changed_in_hostile_me_host);
     fedisableexcept(FE_ALL_EXCEPT);
     fesetenv(FE_DFL_ENV);
     CHECK(changed_in_hostile_host == 0);
@@ -145,6 +208,17 @@ void test_host_floating_point_environment_is_held() {
     for (size_t k = 0; k < reference.size() && k < hostile_host.size(); ++k)
         differing += std::memcmp(&reference[k], &hostile_host[k], sizeof(double)) != 0;
     CHECK(differing == 0);
+    CHECK(changed_in_hostile_me_host == 0);
+    CHECK(hostile_me_host.size() == me_reference.size());
+    long differing_me = 0;
+    for (size_t k = 0; k < me_reference.size() && k < hostile_me_host.size(); ++k)
+        differing_me += std::memcmp(&me_reference[k], &hostile_me_host[k], sizeof(double)) != 0;
+    CHECK(hostile_me_host.size() >= 17 &&
+          std::memcmp(me_reference.data(), hostile_me_host.data(), 17 * sizeof(double)) == 0);
+    // The host's own Euler arithmetic runs in its environment here: only the FMU's part is the same.
+    std::printf("  Model Exchange host: %zu states recorded, %ld differ (the host's own arithmetic rounds upward); "
+                "calls that changed the host's environment: %ld and %ld\n",
+                me_reference.size(), differing_me, changed_me, changed_in_hostile_me_host);
     std::printf("  %zu outputs in a host rounding upward with FTZ/DAZ and traps: %ld differ from the default host's; "
                 "calls that changed the host's environment: %ld and %ld\n",
                 reference.size(), differing, changed, changed_in_hostile_host);
