@@ -2,8 +2,9 @@
 // value references, types, units, bounds and start values the FMU serves can never drift from what it
 // declares; refuses a table that breaks the rules below (undefined unit, rad-based variable without its
 // display unit, start outside its bounds, unknown enumeration type, ...).
-// Usage: gimbal_model_description_generator <units.xml> <variables.xml> <structure.xml> <types.xml>
+// Usage: gimbal_model_description_generator [--fmi3] <units.xml> <variables.xml> <structure.xml> <types.xml>
 //                                           <default_tolerance.txt>
+// (--fmi3: the parts of the FMI 3.0 model description, modelDescription3.xml.in)
 // The last is the DefaultExperiment's tolerance: the start value of solver.rtol.
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "gimbal/gimbal_c_api.h"
 #include "gimbal/variable_groups.hpp"
 #include "gimbal/variables.hpp"
 
@@ -206,9 +208,122 @@ std::string bound(double value, Type type) {
     return type == Type::integer ? std::to_string(static_cast<long>(value)) : number(value);
 }
 
+
+// ------------------------------------------------------------------------------------------ FMI 3.0
+// The same tables as FMI 3.0 model-description parts. FMI 3 has one value-reference space for all
+// types: a Real keeps its value reference, an Integer (Int32 or Enumeration) gets kFmi3IntegerBase +
+// its own, a Boolean kFmi3BooleanBase + its own (docs/fmi_interfaces.md). The 36 event indicators
+// are one Float64 array variable, `event_indicators`, the <EventIndicator> of <ModelStructure>.
+// The independent variable, which FMI 3.0 requires, is `time` (3001).
+constexpr unsigned kFmi3IntegerBase = 1000, kFmi3BooleanBase = 2000, kFmi3EventIndicators = 3000, kFmi3Time = 3001;
+
+std::string vr_list(const std::vector<unsigned>& references) {
+    std::string list;
+    for (unsigned vr : references) list += (list.empty() ? "" : " ") + std::to_string(vr);
+    return list;
+}
+
+int write_fmi3(char** paths) {
+    using namespace gimbal;
+    std::ostringstream variables, outputs, derivatives, initial_unknowns;
+    struct Table {
+        const VariableInfo* variables;
+        unsigned count;
+        Type type;
+        unsigned base;
+    };
+    const Table tables[] = {{kRealVariables, kRealVariableCount, Type::real, 0},
+                            {kIntegerVariables, kIntegerVariableCount, Type::integer, kFmi3IntegerBase},
+                            {kBooleanVariables, kBooleanVariableCount, Type::boolean, kFmi3BooleanBase}};
+    std::set<std::string> used_units{"s"};
+    variables << "    <Float64 name=\"time\" valueReference=\"" << kFmi3Time
+              << "\" causality=\"independent\" variability=\"continuous\" description=\"simulation time\" unit=\"s\"/>\n";
+    for (const Table& table : tables) {
+        for (unsigned index = 0; index < table.count; ++index) {
+            const VariableInfo& v = table.variables[index];
+            const unsigned vr = table.base + index;
+            const bool enumeration = v.declared_type[0] != '\0';
+            const char* element = table.type == Type::real ? "Float64"
+                                  : table.type == Type::boolean ? "Boolean"
+                                  : enumeration ? "Enumeration" : "Int32";
+            if (table.type == Type::real) used_units.insert(v.unit);
+            variables << "    <" << element << " name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
+                      << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
+            if (v.initial == Initial::exact) variables << " initial=\"exact\"";
+            if (v.initial == Initial::calculated) variables << " initial=\"calculated\"";
+            variables << "\n      description=\"" << xml_escape(v.description) << "\"";
+            if (enumeration) variables << " declaredType=\"" << v.declared_type << "\"";
+            if (table.type == Type::real) variables << " unit=\"" << v.unit << "\"";
+            if (v.display_unit[0] != '\0') variables << " displayUnit=\"" << v.display_unit << "\"";
+            if (v.min != kNoMin) variables << " min=\"" << bound(v.min, table.type) << "\"";
+            if (v.max != kNoMax) variables << " max=\"" << bound(v.max, table.type) << "\"";
+            for (int k = 0; k < kContinuousStateCount; ++k)
+                if (table.type == Type::real && index == kStateDerivatives[k])
+                    variables << " derivative=\"" << kContinuousStates[k] << "\"";
+            if (v.initial != Initial::calculated) {
+                if (table.type == Type::boolean) variables << " start=\"" << (v.start != 0.0 ? "true" : "false") << "\"";
+                else if (table.type == Type::real) variables << " start=\"" << number(v.start) << "\"";
+                else variables << " start=\"" << static_cast<long>(v.start) << "\"";
+            }
+            variables << "/>\n";
+            if (v.causality == Causality::output) {
+                std::vector<unsigned> dependencies;
+                if (table.type == Type::real && index != vr_events_last_time)
+                    for (unsigned i : output_dependencies(static_cast<RealVariable>(index))) dependencies.push_back(i - 1);
+                outputs << "    <Output valueReference=\"" << vr << "\" dependencies=\"" << vr_list(dependencies) << "\"/>\n";
+            }
+            if ((v.causality == Causality::output || v.causality == Causality::local) && v.initial == Initial::calculated)
+                initial_unknowns << "    <InitialUnknown valueReference=\"" << vr << "\"/>\n";
+        }
+    }
+    variables << "    <Float64 name=\"event_indicators\" valueReference=\"" << kFmi3EventIndicators
+              << "\" causality=\"local\" variability=\"continuous\" initial=\"calculated\"\n"
+              << "      description=\"the guards of the switching elements, in the order of docs/model_exchange.md: gear 1 and 2 "
+                 "backlash (2 each), motor 1 and 2 voltage clamp, current limiter (2 each), dry friction of body1, rotor1, "
+                 "body2, rotor2 (6 each); constant 1 where the fidelity has no such element\">\n"
+              << "      <Dimension start=\"" << GIMBAL_EVENT_INDICATORS << "\"/>\n    </Float64>\n";
+    for (int k = 0; k < kContinuousStateCount; ++k) {
+        std::vector<unsigned> dependencies;
+        for (unsigned i : derivative_dependencies(k)) dependencies.push_back(i - 1);
+        derivatives << "    <ContinuousStateDerivative valueReference=\"" << kStateDerivatives[k] << "\" dependencies=\""
+                    << vr_list(dependencies) << "\"/>\n";
+    }
+    std::ostringstream units;
+    for (const auto& u : kUnits) {
+        if (used_units.count(u.name) == 0) continue;
+        units << "    <Unit name=\"" << u.name << "\">";
+        if (u.base_unit[0] != '\0') units << "<BaseUnit " << u.base_unit << "/>";
+        if (u.display_unit[0] != '\0')
+            units << "<DisplayUnit name=\"" << u.display_unit << "\" factor=\"" << kDegreesPerRadian << "\"/>";
+        units << "</Unit>\n";
+    }
+    std::ostringstream types;
+    types << "  <TypeDefinitions>\n";
+    for (const auto& type : kEnumerationTypes) {
+        types << "    <EnumerationType name=\"" << type.name << "\" description=\"" << xml_escape(type.description) << "\">\n";
+        for (const auto& item : kEnumerationItems) {
+            if (std::string(item.type) != type.name) continue;
+            types << "      <Item name=\"" << item.name << "\" value=\"" << item.value << "\" description=\""
+                  << xml_escape(item.description) << "\"/>\n";
+        }
+        types << "    </EnumerationType>\n";
+    }
+    types << "  </TypeDefinitions>\n";
+    std::ostringstream structure;
+    structure << outputs.str() << derivatives.str() << initial_unknowns.str()
+              << "    <InitialUnknown valueReference=\"" << kFmi3EventIndicators << "\"/>\n"
+              << "    <EventIndicator valueReference=\"" << kFmi3EventIndicators << "\"/>\n";
+    const std::string tolerance = number(kRealVariables[vr_solver_rtol].start);
+    return write(paths[0], units.str()) && write(paths[1], variables.str()) && write(paths[2], structure.str()) &&
+                   write(paths[3], types.str()) && write(paths[4], tolerance)
+               ? 0
+               : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+    if (argc == 7 && std::string(argv[1]) == "--fmi3") return write_fmi3(argv + 2);
     if (argc != 6) {
         std::cerr << "usage: " << argv[0]
                   << " <units.xml> <variables.xml> <structure.xml> <types.xml> <default_tolerance.txt>\n";
