@@ -637,7 +637,7 @@ static fmi2Status impl_DeSerializeFMUstate(fmi2Component c, const fmi2Byte seria
         !not_null(instance, "fmi2DeSerializeFMUstate", FMUstate, "FMUstate"))
         return fmi2Error;
     const char* problem = fmu_state_integrity_problem((const unsigned char*)serializedState, size, state_record_size(),
-                                                      GIMBAL_GUID);
+                                                      GIMBAL_GUID, STATE_MAGIC);
     if (problem != NULL) {
         log_message(instance, fmi2Error, "logStatusError",
                     "fmi2DeSerializeFMUstate: the %zu bytes are refused: %s (an FMU state of this FMU, GUID %s, has %zu "

@@ -32,11 +32,13 @@ uint64_t fmu_state_checksum(const unsigned char* record, size_t size) {
 }
 
 const char* fmu_state_integrity_problem(const unsigned char* bytes, size_t size, size_t expected_size,
-                                        const char* guid) {
+                                        const char* guid, uint32_t magic) {
     if (size != expected_size) return "its size is not that of this FMU's states";
     StateHeader header;
     memcpy(&header, bytes, sizeof header);
-    if (header.magic != STATE_MAGIC) return "it does not start like an FMU state of this FMU";
+    if (header.magic == (magic == STATE_MAGIC ? STATE_MAGIC_FMI3 : STATE_MAGIC))
+        return "it is a state of this FMU's other FMI version";
+    if (header.magic != magic) return "it does not start like an FMU state of this FMU";
     if (header.format_version != STATE_FORMAT_VERSION) return "it was saved by another version of this FMU";
     if (header.size != expected_size) return "its recorded size does not match";
     if (memchr(header.guid, '\0', sizeof header.guid) == NULL || strcmp(header.guid, guid) != 0)

@@ -25,7 +25,8 @@ typedef struct {
     double last_successful_time;
 } StateHeader;
 
-#define STATE_MAGIC 0x46535441u /* "FSTA" */
+#define STATE_MAGIC 0x46535441u      /* "FSTA": a state of the FMI 2.0 binary */
+#define STATE_MAGIC_FMI3 0x33535441u /* "ATS3": a state of the FMI 3.0 binary */
 #define STATE_FORMAT_VERSION 2u
 
 /* Checksum of a serialized record: every 8-byte word goes through a bijective mix (MurmurHash3's
@@ -35,7 +36,7 @@ uint64_t fmu_state_checksum(const unsigned char* record, size_t size);
 /* NULL when the bytes are a record of this FMU (size, magic, format, GUID and checksum), otherwise
  * what is wrong with them. */
 const char* fmu_state_integrity_problem(const unsigned char* bytes, size_t size, size_t expected_size,
-                                        const char* guid);
+                                        const char* guid, uint32_t magic);
 
 typedef struct {
     void** records;

@@ -72,6 +72,7 @@ int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info)
     info->causality = static_cast<GimbalCausality>(v.causality);
     info->variability = static_cast<GimbalVariability>(v.variability);
     info->initial = static_cast<GimbalInitial>(v.initial);
+    info->declared_type = v.declared_type;
     return 1;
 }
 

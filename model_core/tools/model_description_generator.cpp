@@ -311,7 +311,6 @@ int write_fmi3(char** paths) {
     types << "  </TypeDefinitions>\n";
     std::ostringstream structure;
     structure << outputs.str() << derivatives.str() << initial_unknowns.str()
-              << "    <InitialUnknown valueReference=\"" << kFmi3EventIndicators << "\"/>\n"
               << "    <EventIndicator valueReference=\"" << kFmi3EventIndicators << "\"/>\n";
     const std::string tolerance = number(kRealVariables[vr_solver_rtol].start);
     return write(paths[0], units.str()) && write(paths[1], variables.str()) && write(paths[2], structure.str()) &&

@@ -30,6 +30,7 @@ typedef struct GimbalVariableInfo {
     GimbalCausality causality;
     GimbalVariability variability;
     GimbalInitial initial;
+    const char* declared_type; /* an Integer's enumeration type (enumeration_types.def), or "" */
 } GimbalVariableInfo;
 
 typedef enum { GIMBAL_REAL = 0, GIMBAL_INTEGER = 1, GIMBAL_BOOLEAN = 2 } GimbalType;

@@ -1,0 +1,1068 @@
+/* FMI 3.0 face of the core (Model Exchange and Co-Simulation), beside the FMI 2.0 one: the same core C
+ * API (gimbal_c_api.h), the same checks and wording, FMI 3.0's state machine and types.
+ *
+ * Value references (docs/fmi_interfaces.md): a Float64 is the core's Real of the same reference, an
+ * Int32 or Enumeration the core's Integer at FMI3_INTEGER_BASE + its reference, a Boolean the core's
+ * Boolean at FMI3_BOOLEAN_BASE + its reference; FMI3_EVENT_INDICATORS is the Float64 array of the 36
+ * event indicators and FMI3_TIME the independent variable. Enumerations are accessed with
+ * fmi3GetInt64/fmi3SetInt64, as FMI 3.0 says; the model has no other types.
+ *
+ * Co-Simulation handles every mode change inside fmi3DoStep (eventHandlingNeeded and earlyReturn stay
+ * false); Event Mode is accepted when the importer uses it, with no discrete state to update. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi3Functions.h"
+#include "fmu_state.h"
+#include "gimbal_guid.h"
+#include "gimbal/gimbal_c_api.h"
+#include "host_fp_environment.h"
+
+enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_EVENT_INDICATORS = 3000, FMI3_TIME = 3001 };
+
+typedef enum {
+    S_INSTANTIATED = 1 << 0,
+    S_INITIALIZATION = 1 << 1,
+    S_EVENT = 1 << 2,
+    S_CONTINUOUS_TIME = 1 << 3, /* Model Exchange */
+    S_STEP = 1 << 4,            /* Co-Simulation */
+    S_STEP_DISCARDED = 1 << 5,  /* Co-Simulation: a step failed; get, roll back, terminate or reset */
+    S_TERMINATED = 1 << 6,
+    S_ERROR = 1 << 7,
+} State3;
+
+#define S_ANY 0xFF
+#define S_RUNNING (S_EVENT | S_CONTINUOUS_TIME | S_STEP | S_STEP_DISCARDED)
+#define S_GET (S_INITIALIZATION | S_RUNNING | S_TERMINATED | S_ERROR)
+#define S_SET (S_INSTANTIATED | S_INITIALIZATION | S_EVENT | S_CONTINUOUS_TIME | S_STEP)
+#define S_FMU_STATE (S_INSTANTIATED | S_INITIALIZATION | S_RUNNING | S_TERMINATED)
+#define S_EVALUATE (S_EVENT | S_CONTINUOUS_TIME | S_TERMINATED | S_ERROR)
+
+enum { LOG_CATEGORIES = 6 };
+static const char* const kCategories[LOG_CATEGORIES] = {"logEvents", "logSolver", "logStatusWarning",
+                                                         "logStatusDiscard", "logStatusError", "logAll"};
+
+typedef struct {
+    fmi3LogMessageCallback log;
+    fmi3InstanceEnvironment environment;
+    char* name;
+    int model_exchange;
+    int event_mode_used;
+    GimbalCore* core;
+    State3 state;
+    int category_enabled[LOG_CATEGORIES];
+    double time;
+    double stop_time;
+    int stop_time_defined;
+    FmuStateRegistry states;
+    const char* calling; /* prefixes the core's messages */
+} Instance3;
+
+static int category_index(const char* category) {
+    for (int k = 0; k < LOG_CATEGORIES; ++k)
+        if (strcmp(category, kCategories[k]) == 0) return k;
+    return -1;
+}
+
+static int enabled(const Instance3* i, const char* category) {
+    const int index = category_index(category);
+    return (index >= 0 && i->category_enabled[index]) || i->category_enabled[LOG_CATEGORIES - 1];
+}
+
+static void say(const Instance3* i, fmi3Status status, const char* category, const char* format, ...) {
+    if (i == NULL || i->log == NULL) return;
+    if (status < fmi3Discard && !enabled(i, category)) return;
+    char text[1024];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(text, sizeof text, format, args);
+    va_end(args);
+    i->log(i->environment, status, category, text);
+}
+
+static void core_log(void* context, GimbalStatus status, const char* category, const char* message) {
+    static const fmi3Status kStatus[] = {fmi3OK, fmi3Warning, fmi3Discard, fmi3Error};
+    const Instance3* i = (const Instance3*)context;
+    if (i->calling != NULL) say(i, kStatus[status], category, "%s: %s", i->calling, message);
+    else say(i, kStatus[status], category, "%s", message);
+}
+
+static int core_log_enabled(void* context, const char* category) {
+    const Instance3* i = (const Instance3*)context;
+    return i->log != NULL && enabled(i, category);
+}
+
+static fmi3Status from_core(GimbalStatus status) {
+    switch (status) {
+        case GIMBAL_OK: return fmi3OK;
+        case GIMBAL_WARNING: return fmi3Warning;
+        case GIMBAL_DISCARD: return fmi3Discard;
+        default: return fmi3Error;
+    }
+}
+
+static const char* state_name(State3 s) {
+    switch (s) {
+        case S_INSTANTIATED: return "instantiated";
+        case S_INITIALIZATION: return "initialization mode";
+        case S_EVENT: return "event mode";
+        case S_CONTINUOUS_TIME: return "continuous-time mode";
+        case S_STEP: return "step mode";
+        case S_STEP_DISCARDED: return "step discarded";
+        case S_TERMINATED: return "terminated";
+        default: return "error";
+    }
+}
+
+/* The state check of every function; names the function for the core's messages. */
+static int allowed(Instance3* i, const char* function, int states) {
+    if (i == NULL) return 0;
+    if (i->state & states) {
+        i->calling = function;
+        return 1;
+    }
+    say(i, fmi3Error, "logStatusError", "%s is not allowed in state '%s'", function, state_name(i->state));
+    return 0;
+}
+
+static int not_null(Instance3* i, const char* function, const void* pointer, const char* argument) {
+    if (pointer != NULL) return 1;
+    say(i, fmi3Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
+    return 0;
+}
+
+static fmi3Status refuse(Instance3* i, const char* function, const char* why) {
+    if (i != NULL) say(i, fmi3Error, "logStatusError", "%s: %s", function, why);
+    return fmi3Error;
+}
+
+/* ---------------------------------------------------------------- lifetime */
+
+static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exchange, int event_mode_used,
+                                fmi3Boolean loggingOn, fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
+                                const char* function) {
+    if (log == NULL) return NULL; /* nowhere to say why */
+    Instance3 probe;
+    memset(&probe, 0, sizeof probe);
+    probe.log = log;
+    probe.environment = environment;
+    if (name == NULL || name[0] == '\0') {
+        say(&probe, fmi3Error, "logStatusError", "%s: instanceName must be a non-empty string", function);
+        return NULL;
+    }
+    if (token == NULL || strcmp(token, GIMBAL_GUID) != 0) {
+        say(&probe, fmi3Error, "logStatusError", "%s: instantiationToken '%s' does not match this FMU's '%s'", function,
+            token != NULL ? token : "(null)", GIMBAL_GUID);
+        return NULL;
+    }
+    Instance3* i = (Instance3*)calloc(1, sizeof(Instance3));
+    char* copy = (char*)malloc(strlen(name) + 1);
+    if (i == NULL || copy == NULL) {
+        free(i);
+        free(copy);
+        say(&probe, fmi3Error, "logStatusError", "%s: out of memory", function);
+        return NULL;
+    }
+    strcpy(copy, name);
+    i->log = log;
+    i->environment = environment;
+    i->name = copy;
+    i->model_exchange = model_exchange;
+    i->event_mode_used = event_mode_used;
+    for (int k = 0; k < LOG_CATEGORIES; ++k) i->category_enabled[k] = loggingOn ? 1 : 0;
+    i->calling = function;
+    i->core = gimbal_core_create(core_log, core_log_enabled, i);
+    if (i->core != NULL && model_exchange && gimbal_core_use_continuous_time(i->core) != GIMBAL_OK) {
+        gimbal_core_destroy(i->core);
+        i->core = NULL;
+    }
+    if (i->core == NULL) {
+        say(i, fmi3Error, "logStatusError", "%s: out of memory", function);
+        free(copy);
+        free(i);
+        return NULL;
+    }
+    i->state = S_INSTANTIATED;
+    return i;
+}
+
+static void free_instance(Instance3* i) {
+    if (i == NULL) return;
+    fmu_states_release_all(&i->states);
+    gimbal_core_destroy(i->core);
+    free(i->name);
+    free(i);
+}
+
+static fmi3Status set_debug_logging(Instance3* i, fmi3Boolean on, size_t n, const fmi3String categories[]) {
+    if (!allowed(i, "fmi3SetDebugLogging", S_ANY)) return fmi3Error;
+    if (n == 0) {
+        for (int k = 0; k < LOG_CATEGORIES; ++k) i->category_enabled[k] = on ? 1 : 0;
+        return fmi3OK;
+    }
+    if (!not_null(i, "fmi3SetDebugLogging", categories, "categories")) return fmi3Error;
+    for (size_t k = 0; k < n; ++k) {
+        const int index = categories[k] != NULL ? category_index(categories[k]) : -1;
+        if (index < 0) {
+            say(i, fmi3Error, "logStatusError", "fmi3SetDebugLogging: unknown log category '%s'",
+                categories[k] != NULL ? categories[k] : "(null)");
+            return fmi3Error;
+        }
+        i->category_enabled[index] = on ? 1 : 0;
+    }
+    return fmi3OK;
+}
+
+static fmi3Status enter_initialization(Instance3* i, fmi3Boolean tolerance_defined, fmi3Float64 tolerance,
+                                       fmi3Float64 start, fmi3Boolean stop_defined, fmi3Float64 stop) {
+    const char* f = "fmi3EnterInitializationMode";
+    if (!allowed(i, f, S_INSTANTIATED)) return fmi3Error;
+    if (!isfinite(start) || (stop_defined && (!isfinite(stop) || stop < start))) {
+        say(i, fmi3Error, "logStatusError", "%s: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
+            f, start, stop);
+        return fmi3Error;
+    }
+    const fmi3Status status = from_core(gimbal_core_set_master_tolerance(i->core, tolerance_defined ? 1 : 0, tolerance));
+    if (status > fmi3Warning) return status;
+    i->time = start;
+    i->stop_time = stop;
+    i->stop_time_defined = stop_defined ? 1 : 0;
+    i->state = S_INITIALIZATION;
+    return fmi3OK;
+}
+
+static fmi3Status exit_initialization(Instance3* i) {
+    if (!allowed(i, "fmi3ExitInitializationMode", S_INITIALIZATION)) return fmi3Error;
+    const fmi3Status status = from_core(gimbal_core_initialize(i->core, i->time));
+    if (status > fmi3Warning) {
+        say(i, fmi3Error, "logStatusError", "fmi3ExitInitializationMode: initialization refused; fix the values above and retry");
+        return fmi3Error;
+    }
+    /* Model Exchange, and Co-Simulation with Event Mode, start in event mode (FMI 3.0, 3.2 and 4.2). */
+    i->state = i->model_exchange || i->event_mode_used ? S_EVENT : S_STEP;
+    return status;
+}
+
+/* ---------------------------------------------------------------- values */
+
+typedef enum { KIND_FLOAT64, KIND_INT32, KIND_ENUMERATION, KIND_BOOLEAN } Kind;
+static const char* const kKindName[] = {"Float64", "Int32", "Enumeration (fmi3GetInt64/fmi3SetInt64)", "Boolean"};
+
+/* The core's type and reference of an FMI 3 value reference, or 0 (with *info unset). */
+static int core_variable(fmi3ValueReference vr, Kind* kind, unsigned* core_vr, GimbalVariableInfo* info) {
+    if (vr < FMI3_INTEGER_BASE && gimbal_variable_info(GIMBAL_REAL, vr, info)) {
+        *kind = KIND_FLOAT64, *core_vr = vr;
+        return 1;
+    }
+    if (vr >= FMI3_INTEGER_BASE && vr < FMI3_BOOLEAN_BASE &&
+        gimbal_variable_info(GIMBAL_INTEGER, vr - FMI3_INTEGER_BASE, info)) {
+        *kind = info->declared_type[0] != '\0' ? KIND_ENUMERATION : KIND_INT32, *core_vr = vr - FMI3_INTEGER_BASE;
+        return 1;
+    }
+    if (vr >= FMI3_BOOLEAN_BASE && vr < FMI3_EVENT_INDICATORS &&
+        gimbal_variable_info(GIMBAL_BOOLEAN, vr - FMI3_BOOLEAN_BASE, info)) {
+        *kind = KIND_BOOLEAN, *core_vr = vr - FMI3_BOOLEAN_BASE;
+        return 1;
+    }
+    return 0;
+}
+
+static int settable(const Instance3* i, const GimbalVariableInfo* info) {
+    if (i->state & (S_INSTANTIATED | S_INITIALIZATION))
+        return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT;
+    return info->causality == GIMBAL_INPUT || (info->causality == GIMBAL_PARAMETER && info->variability == GIMBAL_TUNABLE);
+}
+
+/* The common checks of a getter or setter; `values` and the count of values must match the variables. */
+static int check_access(Instance3* i, const char* f, int set, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+                        const void* values, size_t nvalues) {
+    if (!allowed(i, f, set ? S_SET : S_GET)) return 0;
+    if (nvr == 0) return 1;
+    if (!not_null(i, f, vr, "valueReferences") || !not_null(i, f, values, "values")) return 0;
+    size_t expected = 0;
+    for (size_t k = 0; k < nvr; ++k) {
+        Kind actual;
+        unsigned core_vr;
+        GimbalVariableInfo info;
+        if (kind == KIND_FLOAT64 && (vr[k] == FMI3_EVENT_INDICATORS || vr[k] == FMI3_TIME) && !set) {
+            expected += vr[k] == FMI3_EVENT_INDICATORS ? GIMBAL_EVENT_INDICATORS : 1;
+            continue;
+        }
+        if (!core_variable(vr[k], &actual, &core_vr, &info)) {
+            say(i, fmi3Error, "logStatusError", "%s: value reference %u is not a variable of this FMU%s", f, (unsigned)vr[k],
+                vr[k] == FMI3_EVENT_INDICATORS || vr[k] == FMI3_TIME ? " that can be set" : "");
+            return 0;
+        }
+        if (actual != kind) {
+            say(i, fmi3Error, "logStatusError", "%s: %s is a%s %s variable", f, info.name,
+                actual == KIND_INT32 || actual == KIND_ENUMERATION ? "n" : "", kKindName[actual]);
+            return 0;
+        }
+        if (set && !settable(i, &info)) {
+            say(i, fmi3Error, "logStatusError", "%s: %s cannot be set in state '%s'", f, info.name, state_name(i->state));
+            return 0;
+        }
+        ++expected;
+    }
+    if (nvalues != expected) {
+        say(i, fmi3Error, "logStatusError", "%s: nValues = %zu, but the variables hold %zu values", f, nvalues, expected);
+        return 0;
+    }
+    return 1;
+}
+
+static fmi3Status get_float64(Instance3* i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
+    if (!check_access(i, "fmi3GetFloat64", 0, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
+    size_t at = 0;
+    for (size_t k = 0; k < nvr; ++k) {
+        fmi3Status status = fmi3OK;
+        if (vr[k] == FMI3_TIME) {
+            values[at++] = i->time;
+            continue;
+        }
+        if (vr[k] == FMI3_EVENT_INDICATORS) {
+            if (!i->model_exchange) { /* Co-Simulation locates the events itself: no indicator is exposed */
+                for (int z = 0; z < GIMBAL_EVENT_INDICATORS; ++z) values[at + z] = 1.0;
+            } else {
+                status = from_core(gimbal_core_get_event_indicators(i->core, values + at));
+            }
+            at += GIMBAL_EVENT_INDICATORS;
+        } else {
+            status = from_core(gimbal_core_get_real(i->core, vr[k], &values[at++]));
+        }
+        if (status > fmi3Warning) return status;
+    }
+    return fmi3OK;
+}
+
+static fmi3Status set_float64(Instance3* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[], size_t n) {
+    if (!check_access(i, "fmi3SetFloat64", 1, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
+    for (size_t k = 0; k < nvr; ++k) { /* all or nothing */
+        if (isfinite(values[k])) continue;
+        GimbalVariableInfo info;
+        gimbal_variable_info(GIMBAL_REAL, vr[k], &info);
+        say(i, fmi3Error, "logStatusError", "fmi3SetFloat64: %s = %g refused: values must be finite", info.name, values[k]);
+        return fmi3Error;
+    }
+    for (size_t k = 0; k < nvr; ++k) {
+        const fmi3Status status = from_core(gimbal_core_set_real(i->core, vr[k], values[k]));
+        if (status > fmi3Warning) return status;
+    }
+    return fmi3OK;
+}
+
+static fmi3Status get_integers(Instance3* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+                               void* values, size_t n, int wide) {
+    if (!check_access(i, f, 0, kind, vr, nvr, values, n)) return fmi3Error;
+    for (size_t k = 0; k < nvr; ++k) {
+        int value = 0;
+        const fmi3Status status = from_core(gimbal_core_get_integer(i->core, vr[k] - FMI3_INTEGER_BASE, &value));
+        if (status > fmi3Warning) return status;
+        if (wide) ((fmi3Int64*)values)[k] = value;
+        else ((fmi3Int32*)values)[k] = value;
+    }
+    return fmi3OK;
+}
+
+static fmi3Status set_integers(Instance3* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+                               const void* values, size_t n, int wide) {
+    if (!check_access(i, f, 1, kind, vr, nvr, values, n)) return fmi3Error;
+    for (size_t k = 0; k < nvr; ++k) {
+        const long long value = wide ? ((const fmi3Int64*)values)[k] : ((const fmi3Int32*)values)[k];
+        if (value < INT32_MIN || value > INT32_MAX) {
+            GimbalVariableInfo info;
+            gimbal_variable_info(GIMBAL_INTEGER, vr[k] - FMI3_INTEGER_BASE, &info);
+            say(i, fmi3Error, "logStatusError", "%s: %s = %lld lies outside the Int32 range", f, info.name, value);
+            return fmi3Error;
+        }
+    }
+    for (size_t k = 0; k < nvr; ++k) {
+        const int value = (int)(wide ? ((const fmi3Int64*)values)[k] : ((const fmi3Int32*)values)[k]);
+        const fmi3Status status = from_core(gimbal_core_set_integer(i->core, vr[k] - FMI3_INTEGER_BASE, value));
+        if (status > fmi3Warning) return status;
+    }
+    return fmi3OK;
+}
+
+static fmi3Status get_boolean(Instance3* i, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
+    if (!check_access(i, "fmi3GetBoolean", 0, KIND_BOOLEAN, vr, nvr, values, n)) return fmi3Error;
+    for (size_t k = 0; k < nvr; ++k) {
+        int value = 0;
+        const fmi3Status status = from_core(gimbal_core_get_boolean(i->core, vr[k] - FMI3_BOOLEAN_BASE, &value));
+        if (status > fmi3Warning) return status;
+        values[k] = value != 0;
+    }
+    return fmi3OK;
+}
+
+static fmi3Status set_boolean(Instance3* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[], size_t n) {
+    if (!check_access(i, "fmi3SetBoolean", 1, KIND_BOOLEAN, vr, nvr, values, n)) return fmi3Error;
+    for (size_t k = 0; k < nvr; ++k) {
+        const fmi3Status status = from_core(gimbal_core_set_boolean(i->core, vr[k] - FMI3_BOOLEAN_BASE, values[k] ? 1 : 0));
+        if (status > fmi3Warning) return status;
+    }
+    return fmi3OK;
+}
+
+/* Types the model has no variables of: the state is checked, any value reference refused by name. */
+static fmi3Status no_such_type(Instance3* i, const char* f, int set, const fmi3ValueReference vr[], size_t nvr) {
+    if (!allowed(i, f, set ? S_SET : S_GET)) return fmi3Error;
+    if (nvr == 0) return fmi3OK;
+    if (!not_null(i, f, vr, "valueReferences")) return fmi3Error;
+    say(i, fmi3Error, "logStatusError", "%s: value reference %u: the model has no variable of this type", f, (unsigned)vr[0]);
+    return fmi3Error;
+}
+
+/* ---------------------------------------------------------------- FMU states */
+
+static size_t record_size(void) { return sizeof(StateHeader) + gimbal_core_snapshot_size(); }
+
+static unsigned char* own_state(Instance3* i, const char* f, const void* state) {
+    if (state == NULL) {
+        say(i, fmi3Error, "logStatusError", "%s: argument FMUState is a null pointer", f);
+        return NULL;
+    }
+    if (fmu_states_find(&i->states, state) < 0) {
+        say(i, fmi3Error, "logStatusError", "%s: FMUState %p is not an FMU state of instance '%s' (never handed out, or already freed)",
+            f, state, i->name);
+        return NULL;
+    }
+    return (unsigned char*)state;
+}
+
+static int valid_record(Instance3* i, const char* f, const unsigned char* record) {
+    StateHeader header;
+    memcpy(&header, record, sizeof header);
+    const int single = (header.state & S_FMU_STATE) != 0 && (header.state & (header.state - 1)) == 0;
+    const char* problem = NULL;
+    if (!single) problem = "its instance state is not one an FMU state can be taken in";
+    else if (header.stop_time_defined != 0 && header.stop_time_defined != 1) problem = "its stop-time flag is not a boolean";
+    else if (!isfinite(header.time) || !isfinite(header.stop_time)) problem = "its times are not finite";
+    else if ((header.state & S_CONTINUOUS_TIME) && !i->model_exchange) problem = "it was saved by a Model Exchange instance";
+    else if ((header.state & (S_STEP | S_STEP_DISCARDED)) && i->model_exchange) problem = "it was saved by a Co-Simulation instance";
+    if (problem != NULL) {
+        say(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: %s", f, problem);
+        return 0;
+    }
+    int initialized = 0;
+    if (from_core(gimbal_core_check_snapshot(i->core, record + sizeof header, &initialized)) > fmi3Warning) return 0;
+    if (((header.state & (S_RUNNING | S_TERMINATED)) != 0) != (initialized != 0)) {
+        say(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: its instance state '%s' contradicts its %s model", f,
+            state_name((State3)header.state), initialized ? "initialized" : "uninitialized");
+        return 0;
+    }
+    return 1;
+}
+
+static fmi3Status get_fmu_state(Instance3* i, fmi3FMUState* out) {
+    const char* f = "fmi3GetFMUState";
+    if (!allowed(i, f, S_FMU_STATE) || !not_null(i, f, out, "FMUState")) return fmi3Error;
+    unsigned char* record = fmu_states_find(&i->states, *out) >= 0 ? (unsigned char*)*out : NULL;
+    const int fresh = record == NULL;
+    if (fresh) {
+        record = (unsigned char*)calloc(1, record_size());
+        if (record == NULL || !fmu_states_add(&i->states, record)) {
+            free(record);
+            say(i, fmi3Error, "logStatusError", "%s: out of memory", f);
+            return fmi3Error;
+        }
+    }
+    StateHeader header;
+    memset(&header, 0, sizeof header);
+    header.magic = STATE_MAGIC_FMI3;
+    header.format_version = STATE_FORMAT_VERSION;
+    header.size = record_size();
+    strncpy(header.guid, GIMBAL_GUID, sizeof header.guid - 1);
+    header.state = (int32_t)i->state;
+    header.time = i->time;
+    header.stop_time = i->stop_time;
+    header.stop_time_defined = i->stop_time_defined;
+    if (from_core(gimbal_core_save(i->core, record + sizeof header)) > fmi3Warning) {
+        if (fresh) fmu_states_release(&i->states, fmu_states_find(&i->states, record));
+        return fmi3Error;
+    }
+    memcpy(record, &header, sizeof header);
+    *out = record;
+    return fmi3OK;
+}
+
+static fmi3Status set_fmu_state(Instance3* i, fmi3FMUState state) {
+    const char* f = "fmi3SetFMUState";
+    if (!allowed(i, f, S_FMU_STATE | S_STEP_DISCARDED)) return fmi3Error;
+    const unsigned char* record = own_state(i, f, state);
+    if (record == NULL || !valid_record(i, f, record)) return fmi3Error;
+    StateHeader header;
+    memcpy(&header, record, sizeof header);
+    const fmi3Status status = from_core(gimbal_core_restore(i->core, record + sizeof header));
+    if (status > fmi3Warning) return status;
+    i->state = (State3)header.state;
+    i->time = header.time;
+    i->stop_time = header.stop_time;
+    i->stop_time_defined = header.stop_time_defined;
+    return fmi3OK;
+}
+
+static fmi3Status free_fmu_state(Instance3* i, fmi3FMUState* state) {
+    const char* f = "fmi3FreeFMUState";
+    if (!allowed(i, f, S_ANY)) return fmi3Error;
+    if (state == NULL || *state == NULL) return fmi3OK;
+    const long index = fmu_states_find(&i->states, *state);
+    if (index < 0) {
+        say(i, fmi3Error, "logStatusError", "%s: *FMUState = %p is not an FMU state of instance '%s'; nothing was freed", f,
+            *state, i->name);
+        return fmi3Error;
+    }
+    fmu_states_release(&i->states, index);
+    *state = NULL;
+    return fmi3OK;
+}
+
+static fmi3Status serialized_size(Instance3* i, fmi3FMUState state, size_t* size) {
+    const char* f = "fmi3SerializedFMUStateSize";
+    if (!allowed(i, f, S_ANY) || own_state(i, f, state) == NULL || !not_null(i, f, size, "size")) return fmi3Error;
+    *size = record_size();
+    return fmi3OK;
+}
+
+static fmi3Status serialize(Instance3* i, fmi3FMUState state, fmi3Byte bytes[], size_t size) {
+    const char* f = "fmi3SerializeFMUState";
+    if (!allowed(i, f, S_ANY)) return fmi3Error;
+    const unsigned char* record = own_state(i, f, state);
+    if (record == NULL || !not_null(i, f, bytes, "serializedState")) return fmi3Error;
+    if (size < record_size()) {
+        say(i, fmi3Error, "logStatusError", "%s: size %zu is below the %zu bytes needed", f, size, record_size());
+        return fmi3Error;
+    }
+    memcpy(bytes, record, record_size());
+    const uint64_t checksum = fmu_state_checksum(bytes, record_size());
+    memcpy(bytes + offsetof(StateHeader, checksum), &checksum, sizeof checksum);
+    return fmi3OK;
+}
+
+static fmi3Status deserialize(Instance3* i, const fmi3Byte bytes[], size_t size, fmi3FMUState* out) {
+    const char* f = "fmi3DeserializeFMUState";
+    if (!allowed(i, f, S_ANY) || !not_null(i, f, bytes, "serializedState") || !not_null(i, f, out, "FMUState"))
+        return fmi3Error;
+    const char* problem = fmu_state_integrity_problem(bytes, size, record_size(), GIMBAL_GUID, STATE_MAGIC_FMI3);
+    if (problem != NULL) {
+        say(i, fmi3Error, "logStatusError", "%s: the %zu bytes are refused: %s", f, size, problem);
+        return fmi3Error;
+    }
+    if (!valid_record(i, f, bytes)) return fmi3Error;
+    void* record = malloc(size);
+    if (record == NULL || !fmu_states_add(&i->states, record)) {
+        free(record);
+        say(i, fmi3Error, "logStatusError", "%s: out of memory", f);
+        return fmi3Error;
+    }
+    memcpy(record, bytes, size);
+    *out = record;
+    return fmi3OK;
+}
+
+/* ---------------------------------------------------------------- derivatives */
+
+static fmi3Status directional_derivative(Instance3* i, const fmi3ValueReference unknowns[], size_t nu,
+                                         const fmi3ValueReference knowns[], size_t nk, const fmi3Float64 seed[],
+                                         size_t nseed, fmi3Float64 sensitivity[], size_t nsens) {
+    const char* f = "fmi3GetDirectionalDerivative";
+    if (!allowed(i, f, i->model_exchange ? (S_INITIALIZATION | S_EVALUATE) : (S_INITIALIZATION | S_RUNNING | S_TERMINATED)))
+        return fmi3Error;
+    if ((nu > 0 && (!not_null(i, f, unknowns, "unknowns") || !not_null(i, f, sensitivity, "sensitivity"))) ||
+        (nk > 0 && (!not_null(i, f, knowns, "knowns") || !not_null(i, f, seed, "seed"))))
+        return fmi3Error;
+    if (nseed != nk || nsens != nu) {
+        say(i, fmi3Error, "logStatusError", "%s: nSeed = %zu and nSensitivity = %zu must equal nKnowns = %zu and nUnknowns = %zu",
+            f, nseed, nsens, nk, nu);
+        return fmi3Error;
+    }
+    for (size_t k = 0; k < nk; ++k)
+        if (!isfinite(seed[k])) return refuse(i, f, "every seed must be finite");
+    if (i->state == S_INITIALIZATION) return refuse(i, f, "the derivatives are offered once initialization has ended");
+    unsigned* u = (unsigned*)malloc((nu + 1) * sizeof *u);
+    unsigned* kn = (unsigned*)malloc((nk + 1) * sizeof *kn);
+    if (u == NULL || kn == NULL) {
+        free(u), free(kn);
+        return refuse(i, f, "out of memory");
+    }
+    int ok = 1;
+    for (size_t k = 0; k < nu && ok; ++k) ok = unknowns[k] < FMI3_INTEGER_BASE, u[k] = unknowns[k];
+    for (size_t k = 0; k < nk && ok; ++k) ok = knowns[k] < FMI3_INTEGER_BASE, kn[k] = knowns[k];
+    fmi3Status status;
+    if (!ok) {
+        status = refuse(i, f, "unknowns and knowns are Float64 variables");
+    } else if (i->model_exchange) {
+        status = from_core(gimbal_core_directional_derivative(i->core, u, nu, kn, nk, seed, sensitivity));
+    } else {
+        /* Co-Simulation: the outputs are held between steps, so their derivatives with respect to the
+         * inputs are 0 (the FMI 2.0 wrapper explains); unknowns must be outputs, knowns inputs. */
+        status = fmi3OK;
+        GimbalVariableInfo info;
+        for (size_t k = 0; k < nu && status == fmi3OK; ++k)
+            if (!gimbal_variable_info(GIMBAL_REAL, u[k], &info) || info.causality != GIMBAL_OUTPUT)
+                status = refuse(i, f, "in Co-Simulation the unknowns are outputs");
+        for (size_t k = 0; k < nk && status == fmi3OK; ++k)
+            if (!gimbal_variable_info(GIMBAL_REAL, kn[k], &info) || info.causality != GIMBAL_INPUT)
+                status = refuse(i, f, "in Co-Simulation the knowns are inputs");
+        for (size_t k = 0; k < nu && status == fmi3OK; ++k) sensitivity[k] = 0.0;
+    }
+    free(u);
+    free(kn);
+    return status;
+}
+
+/* ---------------------------------------------------------------- Model Exchange */
+
+static int me_vector(Instance3* i, const char* f, int states, const void* values, size_t given, size_t expected,
+                     const char* argument) {
+    if (!allowed(i, f, states)) return 0;
+    if (!i->model_exchange) {
+        say(i, fmi3Error, "logStatusError", "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation",
+            f, i->name);
+        return 0;
+    }
+    if (given != expected) {
+        say(i, fmi3Error, "logStatusError", "%s: the count is %zu, but the model has %zu", f, given, expected);
+        return 0;
+    }
+    return not_null(i, f, values, argument);
+}
+
+static fmi3Status update_discrete_states(Instance3* i, fmi3Boolean* need, fmi3Boolean* terminate, fmi3Boolean* nominals,
+                                         fmi3Boolean* values, fmi3Boolean* next_defined, fmi3Float64* next) {
+    const char* f = "fmi3UpdateDiscreteStates";
+    if (!allowed(i, f, S_EVENT)) return fmi3Error;
+    if (!not_null(i, f, need, "discreteStatesNeedUpdate") || !not_null(i, f, terminate, "terminateSimulation") ||
+        !not_null(i, f, nominals, "nominalsOfContinuousStatesChanged") ||
+        !not_null(i, f, values, "valuesOfContinuousStatesChanged") || !not_null(i, f, next_defined, "nextEventTimeDefined") ||
+        !not_null(i, f, next, "nextEventTime"))
+        return fmi3Error;
+    *need = *terminate = *nominals = *values = *next_defined = fmi3False;
+    *next = 0.0;
+    if (!i->model_exchange) return fmi3OK; /* Co-Simulation has handled its mode changes in fmi3DoStep */
+    GimbalDiscreteUpdate update;
+    const fmi3Status status = from_core(gimbal_core_update_discrete_states(i->core, &update));
+    if (status > fmi3Warning) return status;
+    *values = update.states_changed != 0;
+    *next_defined = update.next_time_defined != 0;
+    *next = update.next_time_defined ? update.next_time : 0.0;
+    return status;
+}
+
+/* ---------------------------------------------------------------- Co-Simulation */
+
+static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean* event, fmi3Boolean* terminate,
+                          fmi3Boolean* early, fmi3Float64* last) {
+    const char* f = "fmi3DoStep";
+    if (!allowed(i, f, S_STEP)) return fmi3Error;
+    if (!not_null(i, f, event, "eventHandlingNeeded") || !not_null(i, f, terminate, "terminateSimulation") ||
+        !not_null(i, f, early, "earlyReturn") || !not_null(i, f, last, "lastSuccessfulTime"))
+        return fmi3Error;
+    *event = *terminate = *early = fmi3False;
+    *last = i->time;
+    if (!(h > 0.0) || !isfinite(h)) {
+        say(i, fmi3Error, "logStatusError", "%s: communicationStepSize = %g must be finite and > 0", f, h);
+        return fmi3Error;
+    }
+    const double tolerance = 1e-12 * fmax(1.0, fabs(i->time)) + 1e-6 * h;
+    if (!(fabs(t - i->time) <= tolerance)) {
+        say(i, fmi3Error, "logStatusError", "%s: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", f, t,
+            i->time);
+        return fmi3Error;
+    }
+    const double end = i->time + h;
+    if (i->stop_time_defined && end > i->stop_time + 1e-12 * fmax(1.0, fabs(i->stop_time)) + 1e-6 * h) {
+        say(i, fmi3Error, "logStatusError", "%s: step to t = %.17g passes the stopTime %.17g", f, end, i->stop_time);
+        return fmi3Error;
+    }
+    const fmi3Status status = from_core(gimbal_core_do_step(i->core, i->time, h));
+    if (status > fmi3Warning) {
+        i->state = status == fmi3Discard ? S_STEP_DISCARDED : S_ERROR;
+        return status;
+    }
+    i->time = end;
+    *last = end;
+    return status;
+}
+
+/* ---------------------------------------------------------------- the exported functions */
+
+#define HOLD(type, call)                 \
+    HostFpEnvironment host_environment; \
+    enter_fmu_fp(&host_environment);    \
+    const type result = call;           \
+    leave_fmu_fp(&host_environment);    \
+    return result
+#define I ((Instance3*)instance)
+
+const char* fmi3GetVersion(void) { return fmi3Version; }
+
+fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
+                               const fmi3String categories[]) {
+    HOLD(fmi3Status, set_debug_logging(I, loggingOn, nCategories, categories));
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath,
+                                          fmi3Boolean visible, fmi3Boolean loggingOn,
+                                          fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
+    (void)resourcePath, (void)visible;
+    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 1, 0, loggingOn, instanceEnvironment, logMessage,
+                                   "fmi3InstantiateModelExchange"));
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath,
+                                         fmi3Boolean visible, fmi3Boolean loggingOn, fmi3Boolean eventModeUsed,
+                                         fmi3Boolean earlyReturnAllowed, const fmi3ValueReference requiredIntermediateVariables[],
+                                         size_t nRequiredIntermediateVariables, fmi3InstanceEnvironment instanceEnvironment,
+                                         fmi3LogMessageCallback logMessage, fmi3IntermediateUpdateCallback intermediateUpdate) {
+    (void)resourcePath, (void)visible, (void)earlyReturnAllowed, (void)requiredIntermediateVariables,
+        (void)nRequiredIntermediateVariables, (void)intermediateUpdate;
+    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 0, eventModeUsed ? 1 : 0, loggingOn,
+                                   instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation"));
+}
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
+                                               fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                               fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage,
+                                               fmi3ClockUpdateCallback clockUpdate, fmi3LockPreemptionCallback lockPreemption,
+                                               fmi3UnlockPreemptionCallback unlockPreemption) {
+    (void)instanceName, (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn, (void)clockUpdate,
+        (void)lockPreemption, (void)unlockPreemption;
+    if (logMessage != NULL)
+        logMessage(instanceEnvironment, fmi3Error, "logStatusError",
+                   "fmi3InstantiateScheduledExecution: this FMU offers Model Exchange and Co-Simulation only");
+    return NULL;
+}
+
+void fmi3FreeInstance(fmi3Instance instance) {
+    HostFpEnvironment host_environment;
+    enter_fmu_fp(&host_environment);
+    free_instance(I);
+    leave_fmu_fp(&host_environment);
+}
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
+                                       fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    HOLD(fmi3Status, enter_initialization(I, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime));
+}
+
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { HOLD(fmi3Status, exit_initialization(I)); }
+
+static fmi3Status enter_event_mode(Instance3* i) {
+    if (!allowed(i, "fmi3EnterEventMode", i->model_exchange ? S_CONTINUOUS_TIME : S_STEP)) return fmi3Error;
+    if (!i->model_exchange && !i->event_mode_used)
+        return refuse(i, "fmi3EnterEventMode", "the instance was made with eventModeUsed = false");
+    i->state = S_EVENT;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) { HOLD(fmi3Status, enter_event_mode(I)); }
+
+static fmi3Status terminate(Instance3* i) {
+    if (!allowed(i, "fmi3Terminate", S_RUNNING)) return fmi3Error;
+    i->state = S_TERMINATED;
+    return fmi3OK;
+}
+fmi3Status fmi3Terminate(fmi3Instance instance) { HOLD(fmi3Status, terminate(I)); }
+
+static fmi3Status reset(Instance3* i) {
+    if (!allowed(i, "fmi3Reset", S_ANY)) return fmi3Error;
+    const fmi3Status status = from_core(gimbal_core_reset(i->core));
+    if (status > fmi3Warning) {
+        i->state = S_ERROR;
+        return status;
+    }
+    i->time = 0.0;
+    i->stop_time_defined = 0;
+    i->state = S_INSTANTIATED;
+    return fmi3OK;
+}
+fmi3Status fmi3Reset(fmi3Instance instance) { HOLD(fmi3Status, reset(I)); }
+
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
+    HOLD(fmi3Status, get_float64(I, vr, nvr, values, n));
+}
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
+                          size_t n) {
+    HOLD(fmi3Status, set_float64(I, vr, nvr, values, n));
+}
+fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[], size_t n) {
+    HOLD(fmi3Status, get_integers(I, "fmi3GetInt32", KIND_INT32, vr, nvr, values, n, 0));
+}
+fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[], size_t n) {
+    HOLD(fmi3Status, set_integers(I, "fmi3SetInt32", KIND_INT32, vr, nvr, values, n, 0));
+}
+fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int64 values[], size_t n) {
+    HOLD(fmi3Status, get_integers(I, "fmi3GetInt64", KIND_ENUMERATION, vr, nvr, values, n, 1));
+}
+fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int64 values[], size_t n) {
+    HOLD(fmi3Status, set_integers(I, "fmi3SetInt64", KIND_ENUMERATION, vr, nvr, values, n, 1));
+}
+fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
+    HOLD(fmi3Status, get_boolean(I, vr, nvr, values, n));
+}
+fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
+                          size_t n) {
+    HOLD(fmi3Status, set_boolean(I, vr, nvr, values, n));
+}
+
+#define NO_SUCH_GET(name, type)                                                                                 \
+    fmi3Status fmi3Get##name(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, type values[],   \
+                             size_t n) {                                                                        \
+        (void)values, (void)n;                                                                                  \
+        HOLD(fmi3Status, no_such_type(I, "fmi3Get" #name, 0, vr, nvr));                                         \
+    }
+#define NO_SUCH_SET(name, type)                                                                                 \
+    fmi3Status fmi3Set##name(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const type values[], \
+                             size_t n) {                                                                        \
+        (void)values, (void)n;                                                                                  \
+        HOLD(fmi3Status, no_such_type(I, "fmi3Set" #name, 1, vr, nvr));                                         \
+    }
+NO_SUCH_GET(Float32, fmi3Float32)
+NO_SUCH_SET(Float32, fmi3Float32)
+NO_SUCH_GET(Int8, fmi3Int8)
+NO_SUCH_SET(Int8, fmi3Int8)
+NO_SUCH_GET(UInt8, fmi3UInt8)
+NO_SUCH_SET(UInt8, fmi3UInt8)
+NO_SUCH_GET(Int16, fmi3Int16)
+NO_SUCH_SET(Int16, fmi3Int16)
+NO_SUCH_GET(UInt16, fmi3UInt16)
+NO_SUCH_SET(UInt16, fmi3UInt16)
+NO_SUCH_GET(UInt32, fmi3UInt32)
+NO_SUCH_SET(UInt32, fmi3UInt32)
+NO_SUCH_GET(UInt64, fmi3UInt64)
+NO_SUCH_SET(UInt64, fmi3UInt64)
+NO_SUCH_GET(String, fmi3String)
+NO_SUCH_SET(String, fmi3String)
+
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
+                         fmi3Binary values[], size_t n) {
+    (void)sizes, (void)values, (void)n;
+    HOLD(fmi3Status, no_such_type(I, "fmi3GetBinary", 0, vr, nvr));
+}
+fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const size_t sizes[],
+                         const fmi3Binary values[], size_t n) {
+    (void)sizes, (void)values, (void)n;
+    HOLD(fmi3Status, no_such_type(I, "fmi3SetBinary", 1, vr, nvr));
+}
+fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
+    (void)values;
+    HOLD(fmi3Status, no_such_type(I, "fmi3GetClock", 0, vr, nvr));
+}
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
+    (void)values;
+    HOLD(fmi3Status, no_such_type(I, "fmi3SetClock", 1, vr, nvr));
+}
+
+/* What this FMU does not offer, as its model description says: refused with the reason. */
+#define NOT_OFFERED(call, why) HOLD(fmi3Status, (I == NULL ? fmi3Error : refuse(I, call, why)))
+
+fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t* n) {
+    (void)vr, (void)n;
+    NOT_OFFERED("fmi3GetNumberOfVariableDependencies", "the dependencies are in <ModelStructure> (no per-element dependencies)");
+}
+fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent, size_t a[],
+                                       fmi3ValueReference b[], size_t c[], fmi3DependencyKind d[], size_t n) {
+    (void)dependent, (void)a, (void)b, (void)c, (void)d, (void)n;
+    NOT_OFFERED("fmi3GetVariableDependencies", "the dependencies are in <ModelStructure> (no per-element dependencies)");
+}
+
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { HOLD(fmi3Status, get_fmu_state(I, FMUState)); }
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) { HOLD(fmi3Status, set_fmu_state(I, FMUState)); }
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { HOLD(fmi3Status, free_fmu_state(I, FMUState)); }
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size) {
+    HOLD(fmi3Status, serialized_size(I, FMUState, size));
+}
+fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
+    HOLD(fmi3Status, serialize(I, FMUState, serializedState, size));
+}
+fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
+                                   fmi3FMUState* FMUState) {
+    HOLD(fmi3Status, deserialize(I, serializedState, size, FMUState));
+}
+
+fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                        const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                        size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
+    HOLD(fmi3Status, directional_derivative(I, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed, sensitivity, nSensitivity));
+}
+fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                    const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                    size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
+    (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed, (void)sensitivity, (void)nSensitivity;
+    NOT_OFFERED("fmi3GetAdjointDerivative", "providesAdjointDerivatives is false");
+}
+
+fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
+    NOT_OFFERED("fmi3EnterConfigurationMode", "the model has no structural parameters to configure after instantiation");
+}
+fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
+    NOT_OFFERED("fmi3ExitConfigurationMode", "the model has no structural parameters to configure after instantiation");
+}
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 a[],
+                                  fmi3IntervalQualifier q[]) {
+    (void)vr, (void)n, (void)a, (void)q;
+    NOT_OFFERED("fmi3GetIntervalDecimal", "the model has no clocks");
+}
+fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3UInt64 a[],
+                                   fmi3UInt64 b[], fmi3IntervalQualifier q[]) {
+    (void)vr, (void)n, (void)a, (void)b, (void)q;
+    NOT_OFFERED("fmi3GetIntervalFraction", "the model has no clocks");
+}
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 a[]) {
+    (void)vr, (void)n, (void)a;
+    NOT_OFFERED("fmi3GetShiftDecimal", "the model has no clocks");
+}
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3UInt64 a[],
+                                fmi3UInt64 b[]) {
+    (void)vr, (void)n, (void)a, (void)b;
+    NOT_OFFERED("fmi3GetShiftFraction", "the model has no clocks");
+}
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Float64 a[]) {
+    (void)vr, (void)n, (void)a;
+    NOT_OFFERED("fmi3SetIntervalDecimal", "the model has no clocks");
+}
+fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 a[],
+                                   const fmi3UInt64 b[]) {
+    (void)vr, (void)n, (void)a, (void)b;
+    NOT_OFFERED("fmi3SetIntervalFraction", "the model has no clocks");
+}
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Float64 a[]) {
+    (void)vr, (void)n, (void)a;
+    NOT_OFFERED("fmi3SetShiftDecimal", "the model has no clocks");
+}
+fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 a[],
+                                const fmi3UInt64 b[]) {
+    (void)vr, (void)n, (void)a, (void)b;
+    NOT_OFFERED("fmi3SetShiftFraction", "the model has no clocks");
+}
+fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance) {
+    NOT_OFFERED("fmi3EvaluateDiscreteStates", "providesEvaluateDiscreteStates is false");
+}
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discreteStatesNeedUpdate,
+                                    fmi3Boolean* terminateSimulation, fmi3Boolean* nominalsOfContinuousStatesChanged,
+                                    fmi3Boolean* valuesOfContinuousStatesChanged, fmi3Boolean* nextEventTimeDefined,
+                                    fmi3Float64* nextEventTime) {
+    HOLD(fmi3Status, update_discrete_states(I, discreteStatesNeedUpdate, terminateSimulation,
+                                            nominalsOfContinuousStatesChanged, valuesOfContinuousStatesChanged,
+                                            nextEventTimeDefined, nextEventTime));
+}
+
+static fmi3Status enter_continuous_time_mode(Instance3* i) {
+    if (!me_vector(i, "fmi3EnterContinuousTimeMode", S_EVENT, i, 0, 0, "instance")) return fmi3Error;
+    i->state = S_CONTINUOUS_TIME;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { HOLD(fmi3Status, enter_continuous_time_mode(I)); }
+
+static fmi3Status completed_integrator_step(Instance3* i, fmi3Boolean* enter, fmi3Boolean* terminate) {
+    const char* f = "fmi3CompletedIntegratorStep";
+    if (!me_vector(i, f, S_CONTINUOUS_TIME, i, 0, 0, "instance") || !not_null(i, f, enter, "enterEventMode") ||
+        !not_null(i, f, terminate, "terminateSimulation"))
+        return fmi3Error;
+    *enter = *terminate = fmi3False; /* every mode change shows in an event indicator */
+    return fmi3OK;
+}
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi3Boolean* enterEventMode, fmi3Boolean* terminateSimulation) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    HOLD(fmi3Status, completed_integrator_step(I, enterEventMode, terminateSimulation));
+}
+
+static fmi3Status set_time(Instance3* i, fmi3Float64 t) {
+    if (!me_vector(i, "fmi3SetTime", S_EVENT | S_CONTINUOUS_TIME, i, 0, 0, "instance")) return fmi3Error;
+    const fmi3Status status = from_core(gimbal_core_set_time(i->core, t));
+    if (status <= fmi3Warning) i->time = t;
+    return status;
+}
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) { HOLD(fmi3Status, set_time(I, time)); }
+
+static fmi3Status set_continuous_states(Instance3* i, const fmi3Float64 x[], size_t n) {
+    if (!me_vector(i, "fmi3SetContinuousStates", S_CONTINUOUS_TIME, x, n, GIMBAL_CONTINUOUS_STATES, "continuousStates"))
+        return fmi3Error;
+    return from_core(gimbal_core_set_continuous_states(i->core, x));
+}
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[], size_t n) {
+    HOLD(fmi3Status, set_continuous_states(I, continuousStates, n));
+}
+
+static fmi3Status get_derivatives(Instance3* i, fmi3Float64 dx[], size_t n) {
+    if (!me_vector(i, "fmi3GetContinuousStateDerivatives", S_EVALUATE, dx, n, GIMBAL_CONTINUOUS_STATES, "derivatives"))
+        return fmi3Error;
+    return from_core(gimbal_core_get_derivatives(i->core, dx));
+}
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t n) {
+    HOLD(fmi3Status, get_derivatives(I, derivatives, n));
+}
+
+static fmi3Status get_event_indicators(Instance3* i, fmi3Float64 z[], size_t n) {
+    if (!me_vector(i, "fmi3GetEventIndicators", S_INITIALIZATION | S_EVALUATE, z, n, GIMBAL_EVENT_INDICATORS,
+                   "eventIndicators"))
+        return fmi3Error;
+    return from_core(gimbal_core_get_event_indicators(i->core, z));
+}
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t n) {
+    HOLD(fmi3Status, get_event_indicators(I, eventIndicators, n));
+}
+
+static fmi3Status get_continuous_states(Instance3* i, fmi3Float64 x[], size_t n) {
+    if (!me_vector(i, "fmi3GetContinuousStates", S_INITIALIZATION | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
+                   "continuousStates"))
+        return fmi3Error;
+    return from_core(gimbal_core_get_continuous_states(i->core, x));
+}
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t n) {
+    HOLD(fmi3Status, get_continuous_states(I, continuousStates, n));
+}
+
+static fmi3Status get_nominals(Instance3* i, fmi3Float64 x[], size_t n) {
+    if (!me_vector(i, "fmi3GetNominalsOfContinuousStates", S_INSTANTIATED | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
+                   "nominals"))
+        return fmi3Error;
+    return from_core(gimbal_core_get_nominal_states(i->core, x));
+}
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t n) {
+    HOLD(fmi3Status, get_nominals(I, nominals, n));
+}
+
+static fmi3Status count(Instance3* i, const char* f, size_t* n, size_t value) {
+    if (!allowed(i, f, S_ANY) || !not_null(i, f, n, "count")) return fmi3Error;
+    *n = value;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t* n) {
+    HOLD(fmi3Status, count(I, "fmi3GetNumberOfEventIndicators", n, GIMBAL_EVENT_INDICATORS));
+}
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* n) {
+    HOLD(fmi3Status, count(I, "fmi3GetNumberOfContinuousStates", n, GIMBAL_CONTINUOUS_STATES));
+}
+
+static fmi3Status enter_step_mode(Instance3* i) {
+    if (!allowed(i, "fmi3EnterStepMode", S_EVENT)) return fmi3Error;
+    if (i->model_exchange) return refuse(i, "fmi3EnterStepMode", "a Model Exchange instance has no step mode");
+    i->state = S_STEP;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) { HOLD(fmi3Status, enter_step_mode(I)); }
+
+fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 orders[],
+                                    fmi3Float64 values[], size_t n) {
+    (void)vr, (void)nvr, (void)orders, (void)values, (void)n;
+    NOT_OFFERED("fmi3GetOutputDerivatives", "maxOutputDerivativeOrder is 0");
+}
+
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
+                      fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean* eventHandlingNeeded,
+                      fmi3Boolean* terminateSimulation, fmi3Boolean* earlyReturn, fmi3Float64* lastSuccessfulTime) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    HOLD(fmi3Status, do_step(I, currentCommunicationPoint, communicationStepSize, eventHandlingNeeded, terminateSimulation,
+                             earlyReturn, lastSuccessfulTime));
+}
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
+    (void)clockReference, (void)activationTime;
+    NOT_OFFERED("fmi3ActivateModelPartition", "this FMU offers Model Exchange and Co-Simulation only");
+}

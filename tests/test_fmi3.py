@@ -1,0 +1,234 @@
+"""The FMI 3.0 FMU (build/Gimbal2Axis-fmi3.fmu) under fmpy: Co-Simulation bit for bit the FMI 2.0
+FMU's for the same calls (with and without Event Mode, steps of 1 ms and 0.7 ms, fixed and moving
+base), Model Exchange agreeing with FMI 2.0's, Enumerations through fmi3GetInt64/fmi3SetInt64, FMU
+states, refusals, and the package: only fmi3* exported, the C++ runtime linked in."""
+from __future__ import annotations
+
+import math
+import pathlib
+import shutil
+import subprocess
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi3 import FMU3Model, FMU3Slave
+from fmpy.validation import validate_fmu
+
+from scene_lib.fmu import simulate
+
+OUTPUTS = ["alpha", "alpha_m", "beta", "beta_m", "i_R1", "i_R2", "theta_b2", "T_E2", "los.omega[1]"]
+
+
+@pytest.fixture(scope="module")
+def fmu3(build_dir, tmp_path_factory):
+    path = build_dir / "Gimbal2Axis-fmi3.fmu"
+    assert path.is_file(), f"{path} is missing: the build did not package it"
+    md = read_model_description(str(path))
+    unzipdir = extract(str(path), str(tmp_path_factory.mktemp("fmi3")))
+    return path, md, unzipdir
+
+
+def slave(fmu3, name="cs", log=None, event_mode=False):
+    path, md, unzipdir = fmu3
+    instance = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipdir, modelIdentifier="Gimbal2Axis",
+                         instanceName=name)
+    logger = None
+    if log is not None:
+        def logger(environment, status, category, message):
+            log.append((int(status), category.decode(), message.decode()))
+    instance.instantiate(eventModeUsed=event_mode, logMessage=logger, loggingOn=log is not None)
+    return instance
+
+
+def vr(fmu3, name):
+    return next(v.valueReference for v in fmu3[1].modelVariables if v.name == name)
+
+
+def carrier(t):
+    return {"base.gamma": 0.05 * math.sin(3.0 * t), "base.gamma_dot": 0.15 * math.cos(3.0 * t),
+            "base.gamma_ddot": -0.45 * math.sin(3.0 * t), "u_R1": 6.0 * math.copysign(1.0, math.sin(40 * t)),
+            "u_R2": -3.0}
+
+
+def run_fmi3(fmu3, start, step, stop, inputs, event_mode=False):
+    s = slave(fmu3, event_mode=event_mode)
+    try:
+        float_start = {k: v for k, v in start.items() if not isinstance(v, bool)}
+        s.setFloat64([vr(fmu3, k) for k in float_start], list(float_start.values()))
+        booleans = {k: v for k, v in start.items() if isinstance(v, bool)}
+        if booleans:
+            s.setBoolean([vr(fmu3, k) for k in booleans], list(booleans.values()))
+        s.enterInitializationMode(startTime=0.0)
+        s.exitInitializationMode()
+        if event_mode:
+            s.updateDiscreteStates()
+            s.enterStepMode()
+        out = [vr(fmu3, n) for n in OUTPUTS]
+        rows = [s.getFloat64(out)]
+        for k in range(int(round(stop / step))):
+            t = k * step
+            values = inputs(t)
+            s.setFloat64([vr(fmu3, n) for n in values], list(values.values()))
+            if event_mode and k % 7 == 3:  # an importer's event iteration in between: nothing to update
+                s.enterEventMode()
+                s.updateDiscreteStates()
+                s.enterStepMode()
+            event, terminate, early, last = s.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+            assert not event and not terminate and not early and last == pytest.approx(t + step, abs=1e-12)
+            rows.append(s.getFloat64(out))
+        s.terminate()
+        return np.array(rows)
+    finally:
+        s.freeInstance()
+
+
+@pytest.mark.parametrize("step", [1e-3, 7e-4])
+@pytest.mark.parametrize("base", ["fixed", "moving"])
+@pytest.mark.parametrize("event_mode", [False, True])
+def test_co_simulation_equals_fmi_2_bit_for_bit(gimbal_fmu, fmu3, step, base, event_mode):
+    start = {"beta": 0.3, "beta_m": 18.0}
+    if base == "fixed":
+        start["base.fixed"] = True
+        inputs = lambda t: {"u_R1": 6.0 * math.copysign(1.0, math.sin(40 * t)), "u_R2": -3.0}  # noqa: E731
+    else:
+        inputs = carrier
+    stop = 0.21
+    fmi3 = run_fmi3(fmu3, start, step, stop, inputs, event_mode)
+    fmi2 = simulate(gimbal_fmu, stop, step, start, lambda t, _: inputs(t), outputs=OUTPUTS)
+    matrix2 = np.column_stack([fmi2[n] for n in OUTPUTS])
+    assert fmi3.shape == matrix2.shape
+    assert np.array_equal(fmi3, matrix2)
+
+
+def test_model_exchange_agrees_with_fmi_2(gimbal_fmu, fmu3, build_dir):
+    start = {"beta": 0.3, "u_R1": 6.0, "u_R2": -3.0}
+    out = ["alpha", "beta", "events.total"]
+    me3 = simulate_fmu(str(fmu3[0]), fmi_type="ModelExchange", stop_time=0.3, output_interval=1e-3,
+                       relative_tolerance=1e-9, start_values=start, output=out)
+    me2 = simulate_fmu(str(build_dir / "Gimbal2Axis.fmu"), fmi_type="ModelExchange", stop_time=0.3, output_interval=1e-3,
+                       relative_tolerance=1e-9, start_values=start, output=out)
+    assert me3["events.total"][-1] == me2["events.total"][-1] > 0
+    assert abs(me3["alpha"][-1] - me2["alpha"][-1]) < 1e-9 and abs(me3["beta"][-1] - me2["beta"][-1]) < 1e-9
+
+
+def test_enumerations_are_int64_and_other_types_are_refused(fmu3):
+    log = []
+    s = slave(fmu3, log=log)
+    try:
+        gear = vr(fmu3, "gear1.model")
+        assert gear >= 1000  # an Integer's reference, 1000 + its FMI 2.0 one
+        s.setInt64([gear], [1])  # before initialization, as a structural parameter is
+        s.enterInitializationMode(startTime=0.0)
+        assert s.getInt64([gear]) == [1]
+        with pytest.raises(FMICallException):
+            s.getInt32([gear])
+        assert any("gear1.model is an Enumeration" in m for _, _, m in log)
+        with pytest.raises(FMICallException):
+            s.getFloat32([0])
+        assert any("fmi3GetFloat32: value reference 0: the model has no variable of this type" in m for _, _, m in log)
+        with pytest.raises(FMICallException):
+            s.setFloat64([vr(fmu3, "beta")], [float("nan")])
+        assert any("fmi3SetFloat64: beta = nan refused" in m for _, _, m in log)
+        with pytest.raises(FMICallException):
+            s.setFloat64([vr(fmu3, "event_indicators")], [0.0])
+        steps = vr(fmu3, "solver.steps")
+        assert steps >= 1000 and s.getInt32([steps]) == [0]
+        s.exitInitializationMode()
+        assert s.getFloat64([vr(fmu3, "time")]) == [0.0]
+        assert len(s.getFloat64([vr(fmu3, "event_indicators")], nValues=36)) == 36
+    finally:
+        s.freeInstance()
+
+
+def test_fmu_states_replay_and_refuse_the_other_fmi_version(gimbal_fmu, fmu3):
+    log = []
+    s = slave(fmu3, log=log)
+    try:
+        s.setFloat64([vr(fmu3, "beta")], [0.3])
+        s.enterInitializationMode(startTime=0.0)
+        s.exitInitializationMode()
+        u = vr(fmu3, "u_R1")
+        out = [vr(fmu3, n) for n in OUTPUTS]
+        for k in range(20):
+            s.setFloat64([u], [8.0 if k % 5 else -8.0])
+            s.doStep(k * 1e-3, 1e-3)
+        state = s.getFMUState()
+        blob = s.serializeFMUState(state)
+
+        def tail():
+            rows = []
+            for k in range(20, 40):
+                s.setFloat64([u], [8.0 if k % 5 else -8.0])
+                s.doStep(k * 1e-3, 1e-3)
+                rows.append(s.getFloat64(out))
+            return np.array(rows)
+
+        first = tail()
+        copy = s.deserializeFMUState(blob)
+        s.setFMUState(copy)
+        assert np.array_equal(tail(), first)
+        s.freeFMUState(state)
+        s.freeFMUState(copy)
+        # A state of the FMI 2.0 binary is refused by name.
+        fmi2 = gimbal_fmu.instantiate("fmi2")
+        try:
+            fmi2.setupExperiment(startTime=0.0)
+            fmi2.enterInitializationMode()
+            fmi2.exitInitializationMode()
+            fmi2_state = fmi2.getFMUstate()
+            fmi2_blob = bytes(fmi2.serializeFMUstate(fmi2_state))
+            fmi2.freeFMUstate(fmi2_state)
+        finally:
+            fmi2.freeInstance()
+        with pytest.raises(FMICallException):
+            s.deserializeFMUState(fmi2_blob)
+        assert any("this FMU's other FMI version" in m for _, _, m in log)
+    finally:
+        s.freeInstance()
+
+
+def test_state_machine_refusals_name_the_function(fmu3):
+    log = []
+    s = slave(fmu3, log=log)
+    try:
+        with pytest.raises(FMICallException):
+            s.doStep(0.0, 1e-3)
+        assert any("fmi3DoStep is not allowed in state 'instantiated'" in m for _, _, m in log)
+        s.enterInitializationMode(startTime=0.0)
+        s.exitInitializationMode()
+        with pytest.raises(FMICallException):
+            s.enterEventMode()
+        assert any("eventModeUsed = false" in m for _, _, m in log)
+        with pytest.raises(FMICallException):
+            s.doStep(0.5, 1e-3)
+        assert any("does not match the FMU's time" in m for _, _, m in log)
+    finally:
+        s.freeInstance()
+    path, md, unzipdir = fmu3
+    model = FMU3Model(guid=md.instantiationToken, unzipDirectory=unzipdir, modelIdentifier="Gimbal2Axis", instanceName="me")
+    model.instantiate()
+    try:
+        model.enterInitializationMode(startTime=0.0)
+        model.exitInitializationMode()
+        with pytest.raises(FMICallException):  # Model Exchange has no step mode
+            model.fmi3EnterStepMode(model.component)
+    finally:
+        model.freeInstance()
+
+
+def test_the_package(fmu3):
+    path = fmu3[0]
+    assert validate_fmu(str(path)) == []
+    names = zipfile.ZipFile(path).namelist()
+    assert "binaries/x86_64-linux/Gimbal2Axis.so" in names and "modelDescription.xml" in names
+    binary = str(pathlib.Path(fmu3[2]) / "binaries" / "x86_64-linux" / "Gimbal2Axis.so")
+    nm = shutil.which("nm")
+    exported = subprocess.run([nm, "-D", "--defined-only", binary], capture_output=True, text=True).stdout.split()
+    symbols = [s for s in exported[2::3]]
+    assert symbols and all(s.startswith("fmi3") for s in symbols), [s for s in symbols if not s.startswith("fmi3")][:5]
+    assert len(symbols) == 75  # every function of fmi3Functions.h
+    needed = subprocess.run(["ldd", binary], capture_output=True, text=True).stdout
+    assert "libstdc++" not in needed and "libgcc_s" not in needed and "sundials" not in needed
