@@ -232,3 +232,17 @@ def test_the_package(fmu3):
     assert len(symbols) == 75  # every function of fmi3Functions.h
     needed = subprocess.run(["ldd", binary], capture_output=True, text=True).stdout
     assert "libstdc++" not in needed and "libgcc_s" not in needed and "sundials" not in needed
+
+
+def test_the_windows_binary_exports_fmi3_only_and_imports_system_libraries(fmu3):
+    names = zipfile.ZipFile(fmu3[0]).namelist()
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    if "binaries/x86_64-windows/Gimbal2Axis.dll" not in names:
+        assert objdump is None, "mingw-w64 is installed but the FMU lacks binaries/x86_64-windows"
+        pytest.skip("built without mingw-w64: no x86_64-windows binary")
+    dll = pathlib.Path(fmu3[2]) / "binaries" / "x86_64-windows" / "Gimbal2Axis.dll"
+    table = subprocess.run([objdump, "-p", str(dll)], capture_output=True, text=True, check=True).stdout
+    exports = [line.split()[-1] for line in table.splitlines() if line.strip().startswith("[") and "fmi" in line]
+    assert len(exports) == 75 and all(name.startswith("fmi3") for name in exports)
+    imports = sorted(line.split(":")[1].strip() for line in table.splitlines() if "DLL Name" in line)
+    assert imports == ["KERNEL32.dll", "msvcrt.dll"]
