@@ -7,8 +7,9 @@
  * event indicators and FMI3_TIME the independent variable. Enumerations are accessed with
  * fmi3GetInt64/fmi3SetInt64, as FMI 3.0 says; the model has no other types.
  *
- * Co-Simulation handles every mode change inside fmi3DoStep (eventHandlingNeeded and earlyReturn stay
- * false); Event Mode is accepted when the importer uses it, with no discrete state to update. */
+ * Co-Simulation handles every mode change inside fmi3DoStep; an importer that allows an early return
+ * gets the step back right after the first one (earlyReturn, and eventHandlingNeeded if it uses Event
+ * Mode, where there is no discrete state left to update). */
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -52,6 +53,7 @@ typedef struct {
     char* name;
     int model_exchange;
     int event_mode_used;
+    int early_return_allowed;
     GimbalCore* core;
     State3 state;
     int category_enabled[LOG_CATEGORIES];
@@ -143,7 +145,7 @@ static fmi3Status refuse(Instance3* i, const char* function, const char* why) {
 /* ---------------------------------------------------------------- lifetime */
 
 static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exchange, int event_mode_used,
-                                fmi3Boolean loggingOn, fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
+                                int early_return_allowed, fmi3Boolean loggingOn, fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
                                 const char* function) {
     if (log == NULL) return NULL; /* nowhere to say why */
     Instance3 probe;
@@ -173,6 +175,7 @@ static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exc
     i->name = copy;
     i->model_exchange = model_exchange;
     i->event_mode_used = event_mode_used;
+    i->early_return_allowed = early_return_allowed;
     for (int k = 0; k < LOG_CATEGORIES; ++k) i->category_enabled[k] = loggingOn ? 1 : 0;
     i->calling = function;
     i->core = gimbal_core_create(core_log, core_log_enabled, i);
@@ -679,13 +682,21 @@ static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolea
         say(i, fmi3Error, "logStatusError", "%s: step to t = %.17g passes the stopTime %.17g", f, end, i->stop_time);
         return fmi3Error;
     }
-    const fmi3Status status = from_core(gimbal_core_do_step(i->core, i->time, h));
+    /* With early return allowed, the step ends right after the first mode change inside it: the
+     * importer sees the event where it happens (and handles it in Event Mode if it uses that). */
+    double reached = end;
+    const fmi3Status status = from_core(i->early_return_allowed
+                                            ? gimbal_core_do_step_until_mode_change(i->core, i->time, h, &reached)
+                                            : gimbal_core_do_step(i->core, i->time, h));
     if (status > fmi3Warning) {
         i->state = status == fmi3Discard ? S_STEP_DISCARDED : S_ERROR;
         return status;
     }
-    i->time = end;
-    *last = end;
+    const int ended_early = i->early_return_allowed && reached < end;
+    i->time = ended_early ? reached : end;
+    *last = i->time;
+    *early = ended_early ? fmi3True : fmi3False;
+    *event = ended_early && i->event_mode_used ? fmi3True : fmi3False;
     return status;
 }
 
@@ -710,7 +721,7 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3Boolean visible, fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
     (void)resourcePath, (void)visible;
-    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 1, 0, loggingOn, instanceEnvironment, logMessage,
+    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 1, 0, 0, loggingOn, instanceEnvironment, logMessage,
                                    "fmi3InstantiateModelExchange"));
 }
 
@@ -719,10 +730,10 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3Boolean earlyReturnAllowed, const fmi3ValueReference requiredIntermediateVariables[],
                                          size_t nRequiredIntermediateVariables, fmi3InstanceEnvironment instanceEnvironment,
                                          fmi3LogMessageCallback logMessage, fmi3IntermediateUpdateCallback intermediateUpdate) {
-    (void)resourcePath, (void)visible, (void)earlyReturnAllowed, (void)requiredIntermediateVariables,
-        (void)nRequiredIntermediateVariables, (void)intermediateUpdate;
-    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 0, eventModeUsed ? 1 : 0, loggingOn,
-                                   instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation"));
+    (void)resourcePath, (void)visible, (void)requiredIntermediateVariables, (void)nRequiredIntermediateVariables,
+        (void)intermediateUpdate;
+    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 0, eventModeUsed ? 1 : 0, earlyReturnAllowed ? 1 : 0,
+                                   loggingOn, instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation"));
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,

@@ -246,3 +246,54 @@ def test_the_windows_binary_exports_fmi3_only_and_imports_system_libraries(fmu3)
     assert len(exports) == 75 and all(name.startswith("fmi3") for name in exports)
     imports = sorted(line.split(":")[1].strip() for line in table.splitlines() if "DLL Name" in line)
     assert imports == ["KERNEL32.dll", "msvcrt.dll"]
+
+
+@pytest.mark.parametrize("event_mode", [False, True])
+def test_early_return_stops_at_each_mode_change_and_continues_the_same_solution(gimbal_fmu, fmu3, event_mode):
+    """With earlyReturnAllowed, fmi3DoStep ends right after the first mode change in the step (at the
+    event's time, which events.last_time confirms); the importer continues from there and, the inputs
+    left as the step carried them, gets the solution of steps without early return (to the
+    integrator's tolerance: the remaining steps end where the master's sums say) and the same events."""
+    path, md, unzipdir = fmu3
+    start = {"beta": 0.3, "beta_m": 18.0, "solver.rtol": 1e-10}
+    inputs = carrier
+    step, stop = 1e-3, 0.12
+    reference = run_fmi3(fmu3, start, step, stop, inputs)
+    s = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipdir, modelIdentifier="Gimbal2Axis", instanceName="early")
+    s.instantiate(eventModeUsed=event_mode, earlyReturnAllowed=True)
+    try:
+        s.setFloat64([vr(fmu3, k) for k in start], list(start.values()))
+        s.enterInitializationMode(startTime=0.0)
+        s.exitInitializationMode()
+        if event_mode:
+            s.updateDiscreteStates()
+            s.enterStepMode()
+        out = [vr(fmu3, n) for n in OUTPUTS]
+        last_event = vr(fmu3, "events.last_time")
+        rows, early_returns = [s.getFloat64(out)], 0
+        for k in range(int(round(stop / step))):
+            t, end = k * step, (k + 1) * step
+            values = inputs(t)
+            s.setFloat64([vr(fmu3, n) for n in values], list(values.values()))
+            now = t
+            while True:
+                event, terminate, early, reached = s.doStep(currentCommunicationPoint=now, communicationStepSize=end - now)
+                assert not terminate
+                if not early:
+                    break
+                early_returns += 1
+                assert now < reached < end and event == event_mode
+                assert s.getFloat64([last_event]) == [reached]  # it stopped at the mode change
+                if event_mode:
+                    s.enterEventMode()
+                    assert s.updateDiscreteStates()[0] is False
+                    s.enterStepMode()
+                now = reached
+            rows.append(s.getFloat64(out))
+        events = s.getInt32([vr(fmu3, "events.total")])[0]
+    finally:
+        s.freeInstance()
+    assert 10 < early_returns <= events  # several changes at one instant are one early return
+    result = np.array(rows)
+    scale = np.maximum(1.0, np.max(np.abs(reference), axis=0))
+    assert np.max(np.abs(result - reference) / scale) < 1e-7

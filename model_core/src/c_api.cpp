@@ -148,6 +148,16 @@ GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double s
     return guarded(core, [&] { return core->instance.do_step(current_time, step_size); });
 }
 
+GimbalStatus gimbal_core_do_step_until_mode_change(GimbalCore* core, double current_time, double step_size,
+                                                   double* reached) {
+    return guarded(core, [&] {
+        double end = current_time;
+        const GimbalStatus status = core->instance.do_step_until_mode_change(current_time, step_size, end);
+        if (reached != nullptr) *reached = end;
+        return status;
+    });
+}
+
 double gimbal_core_time(const GimbalCore* core) { return core != nullptr ? core->instance.time() : 0.0; }
 
 size_t gimbal_core_snapshot_size(void) { return gimbal::GimbalInstance::snapshot_size(); }

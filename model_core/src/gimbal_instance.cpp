@@ -754,6 +754,15 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
 }
 
 GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
+    double reached = 0.0;
+    return advance_step(current_time, step_size, nullptr, reached);
+}
+
+GimbalStatus GimbalInstance::do_step_until_mode_change(double current_time, double step_size, double& reached) {
+    return advance_step(current_time, step_size, &reached, reached);
+}
+
+GimbalStatus GimbalInstance::advance_step(double current_time, double step_size, double* early, double& reached) {
     if (!integrator_) return refuse(GIMBAL_ERROR, "the instance is not initialized");
     if (continuous_time_) return refuse(GIMBAL_ERROR, "the instance serves the continuous-time interface");
     StepStart start;
@@ -764,12 +773,13 @@ GimbalStatus GimbalInstance::do_step(double current_time, double step_size) {
     start.time = time_;
     GimbalStatus status;
     try {
-        status = integrate_step(current_time, step_size, start);
+        status = integrate_step(current_time, step_size, start, early);
     } catch (...) {
         // A C++ exception (out of memory while formatting a message, say) must not leave a half-taken step.
         roll_back(start);
         throw;
     }
+    reached = time_;
     if (status != GIMBAL_OK) return status;
     return report_step_work(step_size, start.work, start.counters);
 }
@@ -821,7 +831,7 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
     return GIMBAL_WARNING;
 }
 
-GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, StepStart& start) {
+GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, StepStart& start, double* early) {
 
     const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) return base_status;
@@ -859,7 +869,10 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         }
     }
     last_integrator_error_.clear();
-    if (!integrator_->advance(step_end, state_)) {
+    double reached_model_time = step_end;
+    const bool advanced = early != nullptr ? integrator_->advance_until_mode_change(step_end, state_, reached_model_time)
+                                           : integrator_->advance(step_end, state_);
+    if (!advanced) {
         roll_back(start);
         std::ostringstream s;
         s.precision(17);
@@ -868,13 +881,33 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         return refuse(GIMBAL_DISCARD, s.str());
     }
     integrator_running_ = true;
-    voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
-    at_rest_ = system_->at_rest(step_end, state_);
+    const bool ended_early = early != nullptr && reached_model_time < step_end;
     // Only now is there anything to undo in the published values (a step at rest publishes nothing).
     std::copy(reals_, reals_ + kRealVariableCount, start.reals);
     std::copy(integers_, integers_ + kIntegerVariableCount, start.integers);
     start.outputs_saved = true;
-    time_ = current_time + step_size;
+    if (ended_early) {
+        // The inputs as the step carried them to where it ended: a master that sets nothing new
+        // continues the same carrier arc and voltage ramps from here.
+        const StepInputs& running = system_->inputs();
+        const BaseMotion base = running.base.advanced(reached_model_time - running.step_start_time);
+        const Vec3* parts[5] = {&base.attitude, &base.attitude_rate, &base.attitude_accel, &base.velocity_a,
+                                &base.acceleration_a};
+        const RealVector* vectors[5] = {&kBaseMotion.attitude, &kBaseMotion.attitude_rate, &kBaseMotion.attitude_accel,
+                                        &kBaseMotion.velocity_a, &kBaseMotion.acceleration_a};
+        if (!params_.fidelity.fixed_base)
+            for (int p = 0; p < 5; ++p)
+                for (int k = 0; k < 3; ++k) reals_[(*vectors[p])[k]] = (*parts[p])[k];
+        const RealVariable voltages[2] = {vr_u_R1, vr_u_R2};
+        for (int axis = 0; axis < 2; ++axis)
+            if (running.voltage_rate[axis] != 0.0) reals_[voltages[axis]] = ramped_voltage(running, axis, reached_model_time);
+        time_ = epoch_ + reached_model_time;
+        at_rest_ = false;
+    } else {
+        voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
+        at_rest_ = system_->at_rest(step_end, state_);
+        time_ = current_time + step_size;
+    }
     publish_outputs();
     // Finite states can still give non-finite outputs from absurd inputs (a base velocity of 1e300
     // makes the kinetic energy overflow): refuse rather than hand out garbage.

@@ -526,6 +526,14 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
     return false;
 }
 
+bool OneStepIntegrator::advance_until_mode_change(double end_time, double* state, double& reached) {
+    stop_at_mode_change_ = true;
+    const bool advanced = advance(end_time, state);
+    stop_at_mode_change_ = false;
+    reached = t_;
+    return advanced;
+}
+
 bool OneStepIntegrator::advance_steps(double end_time, double* state) {
     long attempts = 0;
     std::int64_t events_here = 0;
@@ -610,7 +618,10 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         const std::int64_t events_before = totals_.events;
         if (!handle_events(event_found)) return false;
         events_here += totals_.events - events_before;
-        if (event_found) continue;
+        if (event_found) {
+            if (stop_at_mode_change_ && totals_.events > events_before && t_ < end_time) break;
+            continue;
+        }
         t_ = t_new_;
         std::swap(y_, y_new_);
         std::swap(f_, f_new_);

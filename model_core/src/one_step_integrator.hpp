@@ -31,6 +31,7 @@ public:
     bool restart(double time, const double* state) override;
     bool inputs_changed(double time, const double* state) override { return restart(time, state); }
     bool advance(double end_time, double* state) override;
+    bool advance_until_mode_change(double end_time, double* state, double& reached) override;
     IntegratorStatistics statistics() const override { return totals_; }
     void set_statistics(const IntegratorStatistics& totals) override { totals_ = totals; }
     bool resumable() const override { return true; }
@@ -101,6 +102,7 @@ private:
     double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
     bool jacobian_current_ = false;    // jacobian_ and time_derivative_ belong to (t_, y_) and the modes
     double proposal_ = 0.0;            // the controller's next step size after the last accepted step
+    bool stop_at_mode_change_ = false; // advance_until_mode_change: return after the first one
 };
 
 }  // namespace gimbal

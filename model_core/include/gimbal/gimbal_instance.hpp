@@ -51,6 +51,10 @@ public:
     GimbalStatus check_snapshot(const void* buffer, bool& initialized) const;
     GimbalStatus restore(const void* buffer);
     GimbalStatus do_step(double current_time, double step_size);
+    // A step that may end early, right after the first mode change (FMI 3.0's early return): *reached
+    // is the time it ended at. The inputs are then left as the step carried them there (the carrier's
+    // arc, a voltage ramp), so that the next step continues the same problem.
+    GimbalStatus do_step_until_mode_change(double current_time, double step_size, double& reached);
     // Work of one fmi2DoStep, in right-hand-side evaluations, beyond which the step is reported
     // (about 25 ms of CPU at the measured 230 ns per evaluation: 5,000 times the default scene's).
     static constexpr long kStepWorkBudget = 100000;
@@ -106,7 +110,8 @@ private:
         bool outputs_saved = false;
         double time;
     };
-    GimbalStatus integrate_step(double current_time, double step_size, StepStart& start);
+    GimbalStatus integrate_step(double current_time, double step_size, StepStart& start, double* early = nullptr);
+    GimbalStatus advance_step(double current_time, double step_size, double* early, double& reached);
     void roll_back(const StepStart& start);
     GimbalStatus report_step_work(double step_size, const IntegratorStatistics& before, const EventCounters& events_before);
     void apply_master_tolerance();

@@ -115,6 +115,14 @@ public:
     // the reason sent to the error sink; the state is then unspecified and the caller must roll back.
     virtual bool advance(double end_time, double* state) = 0;
 
+    // As advance(), but returns right after the first mode change before end_time (for a master that
+    // allows an early return); `reached` is where it stopped. Integrators that cannot stop there
+    // (the SUNDIALS ones) integrate to end_time.
+    virtual bool advance_until_mode_change(double end_time, double* state, double& reached) {
+        reached = end_time;
+        return advance(end_time, state);
+    }
+
     virtual IntegratorStatistics statistics() const = 0;
     // For restoring a saved instance: counts continue from these.
     virtual void set_statistics(const IntegratorStatistics& totals) = 0;
