@@ -42,9 +42,11 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "fmi2FunctionTypes.h"
+#include "fmi3FunctionTypes.h"
 #include "fmu_loader.hpp"
 
 namespace {
@@ -249,13 +251,20 @@ fmi2Integer integer_values[4096];
 // Instantiate, set up, initialize, step, get/serialize/deserialize/set FMU states, step, read the
 // outputs, reset, initialize again, step, terminate, free. A small backlash, a low current limit and
 // reversing voltages make mode changes (and so the integrators' restart paths) happen within a few steps.
-// In the place of a solver.method: the Model Exchange lifecycle, where the host integrates.
-constexpr int kModelExchange = 100;
+// In the place of a solver.method: the Model Exchange lifecycle, where the host integrates; and the
+// FMI 3.0 binary's lifecycle (Co-Simulation with Event Mode and early returns, then Model Exchange),
+// run on that binary (its value references are the FMI 2.0 Reals').
+constexpr int kModelExchange = 100, kFmi3 = 101;
 void model_exchange_lifecycle();
+void fmi3_lifecycle();
 
 void lifecycle(int method) {
     if (method == kModelExchange) {
         model_exchange_lifecycle();
+        return;
+    }
+    if (method == kFmi3) {
+        fmi3_lifecycle();
         return;
     }
     fmi2CallbackFunctions functions = {logger, allocate_memory, free_memory, nullptr, &environment_tag};
@@ -416,6 +425,180 @@ void model_exchange_lifecycle() {
     begin("fmi2FreeInstance");
     api.freeInstance(c);
     end("fmi2FreeInstance", false);
+}
+
+struct Api3 {
+    fmi3InstantiateCoSimulationTYPE* instantiateCoSimulation;
+    fmi3InstantiateModelExchangeTYPE* instantiateModelExchange;
+    fmi3FreeInstanceTYPE* freeInstance;
+    fmi3EnterInitializationModeTYPE* enterInitializationMode;
+    fmi3ExitInitializationModeTYPE* exitInitializationMode;
+    fmi3EnterEventModeTYPE* enterEventMode;
+    fmi3UpdateDiscreteStatesTYPE* updateDiscreteStates;
+    fmi3EnterStepModeTYPE* enterStepMode;
+    fmi3EnterContinuousTimeModeTYPE* enterContinuousTimeMode;
+    fmi3SetFloat64TYPE* setFloat64;
+    fmi3GetFloat64TYPE* getFloat64;
+    fmi3DoStepTYPE* doStep;
+    fmi3SetTimeTYPE* setTime;
+    fmi3SetContinuousStatesTYPE* setContinuousStates;
+    fmi3GetContinuousStatesTYPE* getContinuousStates;
+    fmi3GetContinuousStateDerivativesTYPE* getContinuousStateDerivatives;
+    fmi3GetEventIndicatorsTYPE* getEventIndicators;
+    fmi3GetFMUStateTYPE* getFMUState;
+    fmi3SetFMUStateTYPE* setFMUState;
+    fmi3FreeFMUStateTYPE* freeFMUState;
+    fmi3SerializedFMUStateSizeTYPE* serializedFMUStateSize;
+    fmi3SerializeFMUStateTYPE* serializeFMUState;
+    fmi3DeserializeFMUStateTYPE* deserializeFMUState;
+    fmi3TerminateTYPE* terminate;
+    fmi3ResetTYPE* reset;
+
+    bool bind(void* handle) {
+        bool ok = true;
+        auto find = [&](auto& pointer, const char* name) {
+            pointer = reinterpret_cast<std::remove_reference_t<decltype(pointer)>>(dlsym(handle, name));
+            if (pointer == nullptr) std::fprintf(stderr, "%s is not exported\n", name), ok = false;
+        };
+        find(instantiateCoSimulation, "fmi3InstantiateCoSimulation");
+        find(instantiateModelExchange, "fmi3InstantiateModelExchange");
+        find(freeInstance, "fmi3FreeInstance");
+        find(enterInitializationMode, "fmi3EnterInitializationMode");
+        find(exitInitializationMode, "fmi3ExitInitializationMode");
+        find(enterEventMode, "fmi3EnterEventMode");
+        find(updateDiscreteStates, "fmi3UpdateDiscreteStates");
+        find(enterStepMode, "fmi3EnterStepMode");
+        find(enterContinuousTimeMode, "fmi3EnterContinuousTimeMode");
+        find(setFloat64, "fmi3SetFloat64");
+        find(getFloat64, "fmi3GetFloat64");
+        find(doStep, "fmi3DoStep");
+        find(setTime, "fmi3SetTime");
+        find(setContinuousStates, "fmi3SetContinuousStates");
+        find(getContinuousStates, "fmi3GetContinuousStates");
+        find(getContinuousStateDerivatives, "fmi3GetContinuousStateDerivatives");
+        find(getEventIndicators, "fmi3GetEventIndicators");
+        find(getFMUState, "fmi3GetFMUState");
+        find(setFMUState, "fmi3SetFMUState");
+        find(freeFMUState, "fmi3FreeFMUState");
+        find(serializedFMUStateSize, "fmi3SerializedFMUStateSize");
+        find(serializeFMUState, "fmi3SerializeFMUState");
+        find(deserializeFMUState, "fmi3DeserializeFMUState");
+        find(terminate, "fmi3Terminate");
+        find(reset, "fmi3Reset");
+        return ok;
+    }
+};
+
+Api3 api3;
+
+void logger3(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category, fmi3String message) {
+    if (!call_log.active) {
+        ++messages_outside_calls;
+        return;
+    }
+    ++call_log.messages;
+    if (environment != &environment_tag || category == nullptr || message == nullptr || status < fmi3OK ||
+        status > fmi3Fatal)
+        ++call_log.bad_arguments;
+    if (status >= fmi3Discard && status <= fmi3Fatal) ++call_log.failure_messages;
+}
+
+template <class Call>
+fmi2Status checked3(const char* description, Call&& call) {
+    return checked(description, [&] { return static_cast<fmi2Status>(call()); });
+}
+
+void fmi3_lifecycle() {
+    for (const bool model_exchange : {false, true}) {
+        begin(model_exchange ? "fmi3InstantiateModelExchange" : "fmi3InstantiateCoSimulation");
+        const fmi3Instance c =
+            model_exchange
+                ? api3.instantiateModelExchange("oom", model.guid.c_str(), "", false, true, &environment_tag, logger3)
+                : api3.instantiateCoSimulation("oom", model.guid.c_str(), "", false, true, true, true, nullptr, 0,
+                                               &environment_tag, logger3, nullptr);
+        end("fmi3Instantiate", c == nullptr);
+        if (c == nullptr) return;
+        const fmi3ValueReference vr[] = {wiring.gear1_eta, wiring.motor1_i_L, wiring.u_R1, wiring.u_R2};
+        const fmi3Float64 values[] = {2e-5, 1.0, 24.0, 6.0};
+        fmi3Boolean need, terminate, nominals, changed, defined;
+        fmi3Float64 next;
+        auto initialize = [&] {
+            checked3("fmi3SetFloat64(parameters, inputs)", [&] { return api3.setFloat64(c, vr, 4, values, 4); });
+            checked3("fmi3EnterInitializationMode", [&] { return api3.enterInitializationMode(c, true, 1e-6, 0.0, false, 0.0); });
+            checked3("fmi3ExitInitializationMode", [&] { return api3.exitInitializationMode(c); });
+            checked3("fmi3UpdateDiscreteStates", [&] {
+                return api3.updateDiscreteStates(c, &need, &terminate, &nominals, &changed, &defined, &next);
+            });
+            if (model_exchange) checked3("fmi3EnterContinuousTimeMode", [&] { return api3.enterContinuousTimeMode(c); });
+            else checked3("fmi3EnterStepMode", [&] { return api3.enterStepMode(c); });
+        };
+        double time = 0.0;
+        auto steps = [&](int count, double voltage) {
+            checked3("fmi3SetFloat64(u_R1)", [&] { return api3.setFloat64(c, &wiring.u_R1, 1, &voltage, 1); });
+            for (int k = 0; k < count; ++k) {
+                if (model_exchange) {
+                    double x[17], dx[17], z[36];
+                    checked3("fmi3GetContinuousStates", [&] { return api3.getContinuousStates(c, x, 17); });
+                    checked3("fmi3GetContinuousStateDerivatives", [&] { return api3.getContinuousStateDerivatives(c, dx, 17); });
+                    for (int i = 0; i < 17; ++i) x[i] += 1e-5 * dx[i];
+                    time += 1e-5;
+                    checked3("fmi3SetTime", [&] { return api3.setTime(c, time); });
+                    checked3("fmi3SetContinuousStates", [&] { return api3.setContinuousStates(c, x, 17); });
+                    checked3("fmi3GetEventIndicators", [&] { return api3.getEventIndicators(c, z, 36); });
+                } else {
+                    fmi3Boolean event = false, stop = false, early = false;
+                    fmi3Float64 last = time;
+                    if (succeeded(checked3("fmi3DoStep", [&] {
+                            return api3.doStep(c, time, 1e-3, true, &event, &stop, &early, &last);
+                        })))
+                        time = last;
+                    if (event) {
+                        checked3("fmi3EnterEventMode", [&] { return api3.enterEventMode(c); });
+                        checked3("fmi3UpdateDiscreteStates", [&] {
+                            return api3.updateDiscreteStates(c, &need, &terminate, &nominals, &changed, &defined, &next);
+                        });
+                        checked3("fmi3EnterStepMode", [&] { return api3.enterStepMode(c); });
+                    }
+                }
+            }
+        };
+        initialize();
+        steps(6, -24.0);
+        fmi3FMUState saved = nullptr, restored = nullptr;
+        size_t size = 0;
+        checked3("fmi3GetFMUState", [&] { return api3.getFMUState(c, &saved); });
+        if (succeeded(checked3("fmi3SerializedFMUStateSize", [&] { return api3.serializedFMUStateSize(c, saved, &size); })) &&
+            size > sizeof serialized) {
+            violation("fmi3SerializedFMUStateSize", "the state is larger than the test's buffer");
+            size = sizeof serialized;
+        }
+        checked3("fmi3SerializeFMUState", [&] { return api3.serializeFMUState(c, saved, serialized, size); });
+        checked3("fmi3DeserializeFMUState", [&] { return api3.deserializeFMUState(c, serialized, size, &restored); });
+        checked3("fmi3SetFMUState", [&] { return api3.setFMUState(c, restored); });
+        checked3("fmi3FreeFMUState(saved)", [&] { return api3.freeFMUState(c, &saved); });
+        checked3("fmi3FreeFMUState(restored)", [&] { return api3.freeFMUState(c, &restored); });
+        steps(6, 24.0);
+        const fmi2Status reals_read = checked3("fmi3GetFloat64(outputs)", [&] {
+            return api3.getFloat64(c, model.real_outputs.data(), model.real_outputs.size(), real_values,
+                                   model.real_outputs.size());
+        });
+        if (succeeded(reals_read) && !model_exchange) {
+            unsigned long long fingerprint = 1469598103934665603ull;
+            const auto* bytes = reinterpret_cast<const unsigned char*>(real_values);
+            for (size_t k = 0; k < model.real_outputs.size() * sizeof(fmi3Float64); ++k)
+                fingerprint = (fingerprint ^ bytes[k]) * 1099511628211ull;
+            report->outputs_read = 1;
+            report->outputs_fingerprint = fingerprint;
+        }
+        checked3("fmi3Reset", [&] { return api3.reset(c); });
+        time = 0.0;
+        initialize();
+        steps(2, 0.0);
+        checked3("fmi3Terminate", [&] { return api3.terminate(c); });
+        begin("fmi3FreeInstance");
+        api3.freeInstance(c);
+        end("fmi3FreeInstance", false);
+    }
 }
 
 // One case, in the calling process: n = 0 counts without failing.
@@ -689,7 +872,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "test_out_of_memory: dlopen(%s) failed: %s\n", argv[1], dlerror());
         return 2;
     }
-    if (!api.bind(handle)) return 2;
+    // The FMI 3.0 lifecycle runs on the FMI 3.0 binary, which has no fmi2* functions.
+    if (methods.size() == 1 && methods[0] == kFmi3 ? !api3.bind(handle) : !api.bind(handle)) return 2;
     if (only_n >= 0) return run_single(methods[0], only_n, only_persistent);
 
     const char* jobs_text = std::getenv("OOM_JOBS");
