@@ -336,9 +336,10 @@ def test_the_model_description_declares_model_exchange(gimbal_fmu):
 
 @pytest.mark.parametrize("point", ["rich", "rigid"])
 def test_directional_derivatives_match_the_linear_model_of_the_core(gimbal_fmu, build_dir, point):
-    """d der(x) / d(x, u) and d y / d(x, u) by fmi2GetDirectionalDerivative (central differences along
-    the seed through the interface) against A, B, C, D of the core's linearization (A: the analytic
-    Jacobian the implicit integrators use) at the same point, column by column."""
+    """d der(x) / d(x, u) and d y / d(x, u) by fmi2GetDirectionalDerivative against A, B, C, D of the
+    core's linearization at the same point, column by column. d der(x) / dx is the analytic Jacobian
+    the implicit integrators use (equal to rounding); the rest are central differences along the seed,
+    and the analytic part is checked against a central difference of fmi2GetDerivatives."""
     from scene_lib.linearization import linearize
     from test_linearization import RICH_POINT, RIGID_POINT, split, with_contact
 
@@ -349,17 +350,37 @@ def test_directional_derivatives_match_the_linear_model_of_the_core(gimbal_fmu, 
     instance = ModelExchangeInstance(gimbal_fmu, start, lambda t: inputs)
     try:
         vr = gimbal_fmu.vr
-        derivatives = [vr(f"der({s})") for s in linear.states]
+        derivative_vrs = [vr(f"der({s})") for s in linear.states]
         outputs = [vr(o) for o in linear.outputs]
         for j, known in enumerate(linear.states + linear.inputs):
-            got = np.array(instance.model.getDirectionalDerivative(derivatives + outputs, [vr(known)], [1.0]))
+            got = np.array(instance.model.getDirectionalDerivative(derivative_vrs + outputs, [vr(known)], [1.0]))
             expected = np.concatenate([linear.A[:, j], linear.C[:, j]] if j < len(linear.states) else
                                       [linear.B[:, j - len(linear.states)], linear.D[:, j - len(linear.states)]])
             scale = max(1.0, float(np.max(np.abs(expected))))
             assert np.max(np.abs(got - expected)) <= 2e-6 * scale, (known, got - expected)  # measured 3e-7
+            if j < len(linear.states):
+                rows = len(linear.states)
+                assert np.max(np.abs(got[:rows] - expected[:rows])) <= 1e-12 * scale, (known, got[:rows] - expected[:rows])
+        # The analytic columns against differences of the derivatives themselves.
+        x0 = states(instance)
+        index = {d.variable.derivative.name: k for k, d in enumerate(gimbal_fmu.model_description.derivatives)}
+        for name in linear.states:
+            k = index[name]
+            column = np.array(instance.model.getDirectionalDerivative(derivative_vrs, [vr(name)], [1.0]))
+            h = 1e-6 * max(1.0, abs(x0[k]))
+            sides = []
+            for sign in (1.0, -1.0):
+                x = x0.copy()
+                x[k] += sign * h
+                set_states(instance, x)
+                sides.append(derivatives(instance)[[index[s] for s in linear.states]])
+            set_states(instance, x0)
+            difference = (sides[0] - sides[1]) / (2.0 * h)
+            scale = max(1.0, float(np.max(np.abs(column))))
+            assert np.max(np.abs(column - difference)) <= 1e-5 * scale, (name, column - difference)
         # A seed is linear: two knowns at once give the sum of their columns.
         pair = [vr(linear.states[0]), vr(linear.inputs[0])]
-        both = np.array(instance.model.getDirectionalDerivative(derivatives, pair, [2.0, -1.0]))
+        both = np.array(instance.model.getDirectionalDerivative(derivative_vrs, pair, [2.0, -1.0]))
         assert np.allclose(both, 2.0 * linear.A[:, 0] - linear.B[:, 0], rtol=1e-5, atol=1e-5 * np.max(np.abs(both)))
     finally:
         instance.free()

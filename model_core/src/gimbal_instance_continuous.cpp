@@ -275,27 +275,89 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
         if (state != kContinuousStates + kStateCount) {
             state_seed[state - kContinuousStates] += seed[j];
         } else if (vr < kRealVariableCount && kRealVariables[vr].causality == Causality::input) {
-            input_seed.emplace_back(vr, seed[j]);
+            if (seed[j] != 0.0) input_seed.emplace_back(vr, seed[j]);
         } else {
             return refuse(GIMBAL_ERROR, std::string("known ") + std::to_string(j) + ": " +
                                             (vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)") +
                                             " is neither a continuous state nor an input");
         }
     }
+    // The row of the analytic Jacobian that answers each unknown, or -1: the derivatives of the states
+    // this fidelity integrates, but for the energy accumulators (their rows are not in the Jacobian).
+    std::vector<int> jacobian_row(unknown_count, -1);
+    bool all_rows_analytic = true;
     for (std::size_t i = 0; i < unknown_count; ++i) {
         const unsigned vr = unknowns[i];
-        const bool derivative = std::find(kStateDerivatives, kStateDerivatives + kStateCount, vr) !=
-                                kStateDerivatives + kStateCount;
-        if (!derivative && !(vr < kRealVariableCount && kRealVariables[vr].causality == Causality::output))
+        const auto derivative = std::find(kStateDerivatives, kStateDerivatives + kStateCount, vr);
+        if (derivative == kStateDerivatives + kStateCount &&
+            !(vr < kRealVariableCount && kRealVariables[vr].causality == Causality::output))
             return refuse(GIMBAL_ERROR, std::string("unknown ") + std::to_string(i) + ": " +
                                             (vr < kRealVariableCount ? kRealVariables[vr].name : "(no Real variable)") +
                                             " is neither a state derivative nor an output");
+        if (derivative != kStateDerivatives + kStateCount) {
+            const int state = static_cast<int>(derivative - kStateDerivatives);
+            for (int k = 0; k < integrated_count_; ++k)
+                if (integrated_state_[k] == state && state < kStateSize) jacobian_row[i] = integrated_slot_[k];
+        }
+        all_rows_analytic &= jacobian_row[i] >= 0;
     }
     std::fill(result, result + unknown_count, 0.0);
-    // A central difference along the seed, within the modes in force: two evaluations whatever the
-    // number of knowns and unknowns. The step is the cube root of the rounding error relative to the
-    // values moved, the balance of truncation and rounding of a central difference.
     refresh_held_inputs();
+
+    // The state part of the derivatives' rows from the Jacobian the implicit integrators use (analytic
+    // where the model is stiff); everything else by a central difference within the modes in force.
+    const int n = params_.layout.size;
+    double jacobian[kMaxStateSize * kMaxStateSize];
+    double slot_seed[kMaxStateSize] = {};
+    bool any_state_seed = false;
+    for (int k = 0; k < integrated_count_; ++k) {
+        slot_seed[integrated_slot_[k]] = state_seed[integrated_state_[k]];
+        any_state_seed |= state_seed[integrated_state_[k]] != 0.0;
+    }
+    const bool use_jacobian = any_state_seed && std::any_of(jacobian_row.begin(), jacobian_row.end(), [](int r) { return r >= 0; });
+    if (use_jacobian) {
+        system_->jacobian(model_time(time_), state_, jacobian);
+        for (std::size_t i = 0; i < unknown_count; ++i) {
+            if (jacobian_row[i] < 0) continue;
+            double sum = 0.0;
+            for (int column = 0; column < n; ++column) sum += jacobian[jacobian_row[i] + column * n] * slot_seed[column];
+            if (!std::isfinite(sum)) {
+                std::ostringstream s;
+                s.precision(17);
+                s << "the Jacobian is not finite at t = " << time_
+                  << ": the states or inputs set lie beyond what the model can represent";
+                return refuse(GIMBAL_ERROR, s.str());
+            }
+            result[i] = sum;
+        }
+    }
+    // The rest: the input part of the analytic rows, and the whole of the other unknowns.
+    std::vector<double> difference[2] = {std::vector<double>(unknown_count), std::vector<double>(unknown_count)};
+    GimbalStatus status = GIMBAL_OK;
+    if (!all_rows_analytic || !use_jacobian) {
+        status = central_difference(unknowns, unknown_count, state_seed, input_seed, difference[0].data());
+        if (status != GIMBAL_OK) return status;
+        for (std::size_t i = 0; i < unknown_count; ++i)
+            if (jacobian_row[i] < 0 || !use_jacobian) result[i] = difference[0][i];
+    }
+    if (use_jacobian && !input_seed.empty()) {
+        const double no_state_seed[kStateCount] = {};
+        status = central_difference(unknowns, unknown_count, no_state_seed, input_seed, difference[1].data());
+        if (status != GIMBAL_OK) return status;
+        for (std::size_t i = 0; i < unknown_count; ++i)
+            if (jacobian_row[i] >= 0) result[i] += difference[1][i];
+    }
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::central_difference(const unsigned* unknowns, std::size_t unknown_count,
+                                                const double* state_seed,
+                                                const std::vector<std::pair<unsigned, double>>& input_seed,
+                                                double* result) {
+    std::fill(result, result + unknown_count, 0.0);
+    // Two evaluations whatever the number of knowns and unknowns. The step is the cube root of the
+    // rounding error relative to the values moved, the balance of truncation and rounding of a central
+    // difference.
     double states[kStateCount];
     get_continuous_states(states);
     double size = 0.0, scale = 1.0;
@@ -311,7 +373,7 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
     std::vector<double> saved_reals(reals_, reals_ + kRealVariableCount);
     std::vector<int> saved_integers(integers_, integers_ + kIntegerVariableCount);
     const bool saved_outputs_stale = outputs_stale_, saved_decided = decided_here_;
-    double values[2][kRealVariableCount];
+    std::vector<double> values[2] = {std::vector<double>(unknown_count), std::vector<double>(unknown_count)};
     GimbalStatus status = GIMBAL_OK;
     for (int side = 0; side < 2 && status == GIMBAL_OK; ++side) {
         const double h = side == 0 ? step : -step;

@@ -7,6 +7,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "gimbal/gimbal_c_api.h"
 #include "gimbal/event_handling.hpp"
@@ -88,7 +90,9 @@ public:
     GimbalStatus preview_continuous(double* states, double* indicators);
     GimbalStatus update_discrete_states(DiscreteUpdate& update);
     // d(unknowns)/d(knowns) . seed at the current point, within the modes in force: unknowns are state
-    // derivatives or outputs, knowns continuous states or inputs (Real value references).
+    // derivatives or outputs, knowns continuous states or inputs (Real value references). The
+    // derivatives' dependence on the integrated states comes from the analytic Jacobian, the rest from
+    // central differences.
     GimbalStatus directional_derivative(const unsigned* unknowns, std::size_t unknown_count, const unsigned* knowns,
                                         std::size_t known_count, const double* seed, double* result);
 
@@ -132,6 +136,9 @@ private:
     // The outputs at the point the host set; refused (and the last good ones kept) where the states or
     // inputs set make one of them non-finite.
     GimbalStatus publish_continuous_time_outputs();
+    // d(unknowns)/d(states, inputs) . seed by one central difference (two evaluations), the point restored.
+    GimbalStatus central_difference(const unsigned* unknowns, std::size_t unknown_count, const double* state_seed,
+                                    const std::vector<std::pair<unsigned, double>>& input_seed, double* result);
 
     Logger logger_;
     LogFilter log_filter_;
