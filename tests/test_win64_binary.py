@@ -1,8 +1,11 @@
 """The FMU's Windows binary (binaries/win64, cross-compiled with mingw-w64 by fmu_src/win64.cmake):
 a well-behaved guest by its import and export tables, the same scene under Wine as the linux64
-binary natively, and the SUNDIALS methods refused with a message that says why.
+binary natively, and the SUNDIALS methods refused with a message that says why. The FMI 3.0 FMU's
+x86_64-windows binary runs the same scene under Wine through the fmi3* functions and gives the FMI
+2.0 DLL's results bit for bit.
 
-tests/fmu_scene_driver.c, built natively and for Windows, runs the scene; Wine is started once."""
+tests/fmu_scene_driver.c, built natively and for Windows, runs the scene; Wine is started once per
+binary."""
 import os
 import pathlib
 import re
@@ -31,6 +34,14 @@ def built(path):
 @pytest.fixture(scope="module")
 def win64_dll(build_dir):
     return built(build_dir / "fmu_staging" / "binaries" / "win64" / "Gimbal2Axis.dll")
+
+
+@pytest.fixture(scope="module")
+def fmi3_dll(build_dir, fmu_path):
+    dll = build_dir / "win64" / "fmi3" / "binary" / "Gimbal2Axis.dll"
+    with zipfile.ZipFile(build_dir / "Gimbal2Axis-fmi3.fmu") as fmu:
+        assert fmu.read("binaries/x86_64-windows/Gimbal2Axis.dll") == built(dll).read_bytes()
+    return dll
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +90,7 @@ def windows_path(path: pathlib.Path) -> str:
 
 
 @pytest.fixture(scope="module")
-def scene_runs(build_dir, win64_dll, win64_driver, tmp_path_factory):
+def scene_runs(build_dir, win64_dll, fmi3_dll, win64_driver, tmp_path_factory):
     """Both drivers on the scene; the Windows one also tries every SUNDIALS method (one Wine start)."""
     wine = next((shutil.which(c) for c in ("wine64", "/usr/lib/wine/wine64", "wine") if shutil.which(c)), None)
     if wine is None:
@@ -98,7 +109,12 @@ def scene_runs(build_dir, win64_dll, win64_driver, tmp_path_factory):
     windows = subprocess.run([wine, str(win64_driver), windows_path(win64_dll), guid, windows_path(out / "win64.csv")] +
                              [str(m) for m in SUNDIALS_METHODS], capture_output=True, text=True, timeout=600, env=env)
     assert windows.returncode == 0, windows.stdout + windows.stderr
-    return out / "linux64.csv", out / "win64.csv", windows.stdout
+    token = fmpy.read_model_description(str(build_dir / "Gimbal2Axis-fmi3.fmu")).instantiationToken
+    fmi3 = subprocess.run([wine, str(win64_driver), "--fmi3", windows_path(fmi3_dll), token,
+                           windows_path(out / "win64_fmi3.csv")] + [str(m) for m in SUNDIALS_METHODS],
+                          capture_output=True, text=True, timeout=600, env=env)
+    assert fmi3.returncode == 0, fmi3.stdout + fmi3.stderr
+    return out / "linux64.csv", out / "win64.csv", windows.stdout, out / "win64_fmi3.csv", fmi3.stdout
 
 
 def read_csv(path):
@@ -106,7 +122,7 @@ def read_csv(path):
 
 
 def test_wine_runs_the_scene_like_linux(scene_runs):
-    linux_csv, windows_csv, _ = scene_runs
+    linux_csv, windows_csv = scene_runs[:2]
     linux, windows = read_csv(linux_csv), read_csv(windows_csv)
     assert linux.shape == windows.shape == (301,)
     np.testing.assert_array_equal(linux["time"], windows["time"])
@@ -124,8 +140,34 @@ def test_wine_runs_the_scene_like_linux(scene_runs):
     assert abs(int(windows["eventstotal"][-1]) - int(linux["eventstotal"][-1])) <= 2
 
 
-def test_dll_refuses_the_sundials_methods_by_name(scene_runs):
-    log = scene_runs[2]
+@pytest.mark.parametrize("version", ["fmi2", "fmi3"])
+def test_dll_refuses_the_sundials_methods_by_name(scene_runs, version):
+    log = scene_runs[2] if version == "fmi2" else scene_runs[4]
     for method in SUNDIALS_METHODS:
-        assert f"refusal: solver.method = {method} status = 3" in log, log  # fmi2Error
-        assert (f"solver.method = {method} is not available in this binary: it was built without SUNDIALS") in log, log
+        assert f"refusal: solver.method = {method} status = 3" in log, log  # fmi2Error, fmi3Error
+        assert (f"{version}ExitInitializationMode: solver.method = {method} is not available in this binary: "
+                "it was built without SUNDIALS") in log, log
+
+
+def test_the_fmi3_dll_under_wine_equals_the_fmi2_dll_bit_for_bit(scene_runs):
+    """The same core behind the other interface, the same calls in the same order: the same doubles."""
+    _, fmi2_csv, _, fmi3_csv, _ = scene_runs
+    fmi2, fmi3 = read_csv(fmi2_csv), read_csv(fmi3_csv)
+    assert fmi2.shape == fmi3.shape == (301,)
+    assert fmi3["eventstotal"][-1] > 10
+    for name in fmi2.dtype.names:
+        np.testing.assert_array_equal(fmi3[name], fmi2[name], err_msg=name)
+
+
+def test_the_fmi3_binaries_give_the_fmi2_binaries_results_natively(build_dir, tmp_path):
+    """The native driver on both linux binaries: the FMI 3.0 calls change no double."""
+    guid = fmpy.read_model_description(str(build_dir / "fmu_staging" / "modelDescription.xml")).guid
+    token = fmpy.read_model_description(str(build_dir / "Gimbal2Axis-fmi3.fmu")).instantiationToken
+    driver = str(build_dir / "fmu_scene_driver")
+    so2 = build_dir / "fmu_staging" / "binaries" / "linux64" / "Gimbal2Axis.so"
+    so3 = build_dir / "fmi3" / "binary" / "Gimbal2Axis.so"
+    for command in ([driver, str(so2), guid, str(tmp_path / "fmi2.csv")],
+                    [driver, "--fmi3", str(so3), token, str(tmp_path / "fmi3.csv")]):
+        done = subprocess.run(command, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stdout + done.stderr
+    assert (tmp_path / "fmi2.csv").read_bytes() == (tmp_path / "fmi3.csv").read_bytes()
