@@ -24,9 +24,10 @@ def ship_inputs(t, y):
             "base.delta_ddot": -0.0147 * np.sin(0.7 * t)}
 
 
-def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapshot=None):
+def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapshot=None, clock="product"):
     """Like scene_lib.fmu.simulate, with a start time and an optional FMU-state action at every step:
-    'get' (take and free a state), 'get-set' (take it, set it back, free it)."""
+    'get' (take and free a state), 'get-set' (take it, set it back, free it). The master's clock is
+    start + k h ('product') or a running sum t += h ('sum')."""
     slave = fmu.instantiate()
     try:
         slave.setupExperiment(startTime=start_time)
@@ -37,6 +38,7 @@ def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapsho
         record = np.empty((n + 1, len(RECORDED)))
         record[0] = fmu.get_values(slave, RECORDED)
         latest = dict(zip(RECORDED, record[0]))
+        master_time = start_time
         for k in range(n):
             t = k * step
             fmu.set_values(slave, inputs(t, latest))
@@ -45,7 +47,9 @@ def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapsho
                 if snapshot == "get-set":
                     slave.setFMUstate(state)
                 slave.freeFMUstate(state)
-            slave.doStep(currentCommunicationPoint=start_time + t, communicationStepSize=step)
+            slave.doStep(currentCommunicationPoint=start_time + t if clock == "product" else master_time,
+                         communicationStepSize=step)
+            master_time += step
             record[k + 1] = fmu.get_values(slave, RECORDED)
             latest = dict(zip(RECORDED, record[k + 1]))
         slave.terminate()
@@ -69,15 +73,23 @@ def square_wave(t, y):
     return {"u_R1": 12.0 if int(t / 0.05) % 2 == 0 else -12.0, "u_R2": -12.0 if int(t / 0.03) % 2 == 0 else 12.0}
 
 
-def test_results_do_not_depend_on_the_start_time(gimbal_fmu):
-    """Free swing under a +-12 V square wave: events 10-50 ms apart at any start time. The model runs on
-    time since initialization, so the same steps give the same trajectory bit for bit. The step is a
-    power of two, so that start + k h is exact at 1.7e9 (whose spacing of doubles is 2.4e-7 s): a step
-    of 1e-3 would itself be rounded there, and the comparison would measure the master's clock instead."""
+def motor1_square_wave(t, y):
+    """+-12 V on motor 1, 25 steps of 1 ms each way (the step index, not t / h, decides the sign)."""
+    return {"u_R1": 12.0 if int(round(t / 1e-3)) // 25 % 2 == 0 else -12.0}
+
+
+@pytest.mark.parametrize("clock", ["product", "sum"])
+@pytest.mark.parametrize("wave", ["motor 1", "both motors"])
+def test_results_do_not_depend_on_the_start_time(gimbal_fmu, clock, wave):
+    """Free swing under a +-12 V square wave, steps of 1 ms: at a start time of 1.7e9 the doubles lie
+    2.4e-7 s apart, so the master's times (start + k h, or a running sum) carry the step only to about
+    2e-4 of itself. The instance integrates each communicationStepSize on its own clock, the time since
+    the start: every start time gives the same trajectory bit for bit, whichever way the master counts."""
     start = {"beta": 0.5, "base.fixed": True}
-    step = 2.0 ** -10
-    runs = [run_loop(gimbal_fmu, 600 * step, step, start, square_wave, start_time=t0) for t0 in (0.0, 1e7, 1.7e9)]
-    assert runs[0]["events.total"][-1] > 20
+    inputs = motor1_square_wave if wave == "motor 1" else square_wave
+    runs = [run_loop(gimbal_fmu, 0.5, 1e-3, start, inputs, start_time=t0, clock=clock)
+            for t0 in (0.0, 123.456, 1e7, 1.7e9)]
+    assert runs[0]["events.total"][-1] > 10
     for other in runs[1:]:
         for name in RECORDED:
             assert np.array_equal(other[name], runs[0][name]), name

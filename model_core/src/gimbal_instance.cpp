@@ -35,7 +35,7 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 5;
+constexpr std::uint32_t kSnapshotVersion = 6;
 
 // Plain integers and doubles only, flags as bytes: any byte pattern decodes without undefined
 // behaviour, and check_snapshot() decides whether it is a state this model can be in.
@@ -52,6 +52,7 @@ struct Snapshot {
     std::uint8_t master_tolerance_defined;
     double master_tolerance;
     double time;
+    double clock;  // model time: the instance's own sum of steps since the start
     double state[kMaxStateSize];
     Modes modes;
     EventCounters counters;
@@ -156,6 +157,7 @@ void GimbalInstance::reset() {
     std::fill(state_, state_ + kMaxStateSize, 0.0);
     time_ = 0.0;
     epoch_ = 0.0;
+    clock_ = 0.0;
     master_tolerance_defined_ = false;
     master_tolerance_ = 0.0;
     rtol_set_ = false;
@@ -292,7 +294,7 @@ StepInputs GimbalInstance::read_step_inputs(double step_start) const {
 
 void GimbalInstance::publish_outputs() {
     const Modes& modes = system_->modes();
-    const double now = model_time(time_);
+    const double now = clock_;
     const Dynamics& dynamics = system_->dynamics_at(now, state_);
     const ModelOutputs out = outputs_from(params_, system_->inputs(), system_->base_kinematics_at_time(now), now, dynamics);
     for (int k = 0; k < 4; ++k) {
@@ -458,6 +460,7 @@ GimbalStatus GimbalInstance::preview_outputs(const char* name) {
     map_integrated_states();
     load_start_state();
     epoch_ = time_;
+    clock_ = 0.0;
     system->hold_inputs_at_any_time(continuous_time_);
     system->set_inputs(read_step_inputs(0.0));
     system->update_modes(0.0, state_, nullptr);
@@ -503,6 +506,7 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     load_start_state();
     time_ = start_time;
     epoch_ = start_time;
+    clock_ = 0.0;
     system->hold_inputs_at_any_time(continuous_time_);
     system->set_inputs(read_step_inputs(0.0));
     system->update_modes(0.0, state_, nullptr);
@@ -539,6 +543,7 @@ void GimbalInstance::save(void* buffer) {
     snap.master_tolerance_defined = master_tolerance_defined_;
     snap.master_tolerance = master_tolerance_;
     snap.time = time_;
+    snap.clock = clock_;
     std::copy(state_, state_ + kMaxStateSize, snap.state);
     snap.pending_voltage_rate[0] = voltage_rate_[0];
     snap.pending_voltage_rate[1] = voltage_rate_[1];
@@ -601,6 +606,7 @@ GimbalStatus GimbalInstance::check_snapshot(const void* buffer, bool& initialize
     check.flag("master_tolerance_defined", snap.master_tolerance_defined);
     check.finite("master tolerance", &snap.master_tolerance, 1);
     check.finite("time", &snap.time, 1);
+    check.finite("clock", &snap.clock, 1);
     check.finite("epoch", &snap.epoch, 1);
     check.finite("state", snap.state, kMaxStateSize);
     check.finite("pending voltage rate", snap.pending_voltage_rate, 2);
@@ -630,7 +636,7 @@ GimbalStatus GimbalInstance::check_snapshot(const void* buffer, bool& initialize
         check.finite("voltage rate", snap.voltage_rate, 2);
         check.finite("base motion", snap.base, 15);
         check.finite("arc start time", &snap.arc_start_time, 1);
-        if (!(snap.time >= snap.epoch)) check.fail("the time lies before the start of the run");
+        if (!(snap.time >= snap.epoch) || !(snap.clock >= 0.0)) check.fail("the time lies before the start of the run");
         const Modes& modes = snap.modes;
         for (int axis = 0; axis < 2; ++axis) {
             check.within("gear contact mode", modes.gear_contact[axis], -1, 1);
@@ -717,7 +723,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
         system->restore(snap.modes, snap.counters);
         integrator = make_integrator(*system, params_);
         if (snap.integrator_running && integrator->resumable() &&
-            !integrator->resume(snap.time - snap.epoch, snap.state, snap.integrator_memory)) {
+            !integrator->resume(snap.clock, snap.state, snap.integrator_memory)) {
             return refuse(GIMBAL_ERROR, "the integrator cannot continue from the saved state (" +
                                             last_integrator_error_ + ")");
         }
@@ -733,6 +739,7 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     master_tolerance_ = snap.master_tolerance;
     time_ = snap.time;
     epoch_ = snap.epoch;
+    clock_ = snap.clock;
     std::copy(snap.state, snap.state + kMaxStateSize, state_);
     voltage_rate_[0] = snap.pending_voltage_rate[0];
     voltage_rate_[1] = snap.pending_voltage_rate[1];
@@ -771,6 +778,7 @@ GimbalStatus GimbalInstance::advance_step(double current_time, double step_size,
     start.counters = system_->counters();
     start.work = integrator_->statistics();
     start.time = time_;
+    start.clock = clock_;
     GimbalStatus status;
     try {
         status = integrate_step(current_time, step_size, start, early);
@@ -792,6 +800,7 @@ void GimbalInstance::roll_back(const StepStart& start) {
         std::copy(start.integers, start.integers + kIntegerVariableCount, integers_);
     }
     time_ = start.time;
+    clock_ = start.clock;
     integrator_running_ = false;
     at_rest_ = false;
 }
@@ -835,8 +844,10 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
 
     const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) return base_status;
-    const double step_start = model_time(current_time);
-    const double step_end = model_time(current_time + step_size);
+    // From the instance's own clock (the host's current_time was checked against its time by the
+    // interface): any start time gives the same model times, bit for bit.
+    const double step_start = clock_;
+    const double step_end = clock_ + step_size;
     StepInputs inputs = read_step_inputs(step_start);
     const StepInputs& running = system_->inputs();
     // The right-hand side is continuous across the step boundary only if the held voltages are the same
@@ -844,7 +855,8 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
     const bool continuous = integrator_running_ && continues(running, inputs, step_start) &&
                             same_base_motion(inputs.base, running.base.advanced(step_start - running.step_start_time));
     if (continuous && at_rest_ && inputs.voltage_rate[0] == 0.0 && inputs.voltage_rate[1] == 0.0) {
-        time_ = current_time + step_size;  // outputs cannot change either
+        clock_ = step_end;
+        time_ = epoch_ + clock_;  // outputs cannot change either
         return GIMBAL_OK;
     }
     at_rest_ = false;
@@ -901,12 +913,14 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
         const RealVariable voltages[2] = {vr_u_R1, vr_u_R2};
         for (int axis = 0; axis < 2; ++axis)
             if (running.voltage_rate[axis] != 0.0) reals_[voltages[axis]] = ramped_voltage(running, axis, reached_model_time);
-        time_ = epoch_ + reached_model_time;
+        clock_ = reached_model_time;
+        time_ = epoch_ + clock_;
         at_rest_ = false;
     } else {
         voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
         at_rest_ = system_->at_rest(step_end, state_);
-        time_ = current_time + step_size;
+        clock_ = step_end;
+        time_ = epoch_ + clock_;
     }
     publish_outputs();
     // Finite states can still give non-finite outputs from absurd inputs (a base velocity of 1e300
@@ -926,7 +940,7 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
 
 GimbalStatus GimbalInstance::linearize(LinearModel& model) {
     if (!system_) return refuse(GIMBAL_ERROR, "linearize: the instance is not initialized (no operating point yet)");
-    const double now = model_time(time_);
+    const double now = clock_;
     StepInputs inputs = read_step_inputs(now);
     inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;
     // The modes the next step would start in: inputs set since the last step may have switched some.

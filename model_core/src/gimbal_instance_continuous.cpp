@@ -89,7 +89,7 @@ void GimbalInstance::map_integrated_states() {
 
 void GimbalInstance::refresh_held_inputs() {
     if (!inputs_stale_) return;
-    StepInputs inputs = read_step_inputs(model_time(time_));
+    StepInputs inputs = read_step_inputs(clock_);
     inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;  // no input derivatives in this interface
     system_->set_inputs(inputs);
     inputs_stale_ = false;
@@ -105,6 +105,7 @@ GimbalStatus GimbalInstance::set_time(double time) {
     }
     if (time != time_) {
         time_ = time;
+        clock_ = time - epoch_;
         outputs_stale_ = true;
         decided_here_ = false;
     }
@@ -133,7 +134,7 @@ GimbalStatus GimbalInstance::set_continuous_states(const double* states) {
 
 void GimbalInstance::get_continuous_states(double* states) {
     refresh_held_inputs();
-    full_state_vector(system_->dynamics_at(model_time(time_), state_), states);
+    full_state_vector(system_->dynamics_at(clock_, state_), states);
 }
 
 void GimbalInstance::get_nominal_states(double* nominals) const {
@@ -156,7 +157,7 @@ GimbalStatus GimbalInstance::preview_continuous(double* states, double* indicato
 
 GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
     refresh_held_inputs();
-    const double now = model_time(time_);
+    const double now = clock_;
     const Dynamics& dynamics = system_->dynamics_at(now, state_);
     double integrated[kMaxStateSize];
     if (!state_derivative(params_, dynamics, integrated)) {
@@ -172,7 +173,7 @@ GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
 
 GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
     refresh_held_inputs();
-    const double now = model_time(time_);
+    const double now = clock_;
     if (now < chattering_.dwell_until) {
         // The chattering guard holds the modes: the indicators keep the values of its start, so that
         // the host sees no crossing before the time event that ends the hold.
@@ -203,7 +204,7 @@ GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
 GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     update = DiscreteUpdate{};
     refresh_held_inputs();
-    const double now = model_time(time_);
+    const double now = clock_;
     const bool holding = chattering_.holding();
     if (holding && now < chattering_.dwell_until) {
         update.next_time_defined = true;
@@ -316,7 +317,7 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
     }
     const bool use_jacobian = any_state_seed && std::any_of(jacobian_row.begin(), jacobian_row.end(), [](int r) { return r >= 0; });
     if (use_jacobian) {
-        system_->jacobian(model_time(time_), state_, jacobian);
+        system_->jacobian(clock_, state_, jacobian);
         for (std::size_t i = 0; i < unknown_count; ++i) {
             if (jacobian_row[i] < 0) continue;
             double sum = 0.0;

@@ -113,6 +113,7 @@ private:
         int integers[kIntegerVariableCount];
         bool outputs_saved = false;
         double time;
+        double clock;
     };
     GimbalStatus integrate_step(double current_time, double step_size, StepStart& start, double* early = nullptr);
     GimbalStatus advance_step(double current_time, double step_size, double* early, double& reached);
@@ -154,11 +155,14 @@ private:
     bool at_rest_ = false;             // exact equilibrium under the running inputs: steps need no integration
     std::string last_integrator_error_;
     double voltage_rate_[2] = {0.0, 0.0};  // for the next step only
-    double time_ = 0.0;
-    // The model runs on time since initialization: results do not depend on where the master's clock
-    // starts, and event times keep their resolution at large start times.
+    double time_ = 0.0;  // the host's time of the current point: epoch_ + clock_
+    // The model runs on its own clock, the time since initialization: results do not depend on where
+    // the host's clock starts, and event times keep their resolution at large start times. A step
+    // advances it by communicationStepSize (never by differences of the host's times, which lose the
+    // step's low bits at a large start time); in the continuous-time interface the host owns time and
+    // clock_ is its time less the start.
     double epoch_ = 0.0;
-    double model_time(double time) const { return time - epoch_; }
+    double clock_ = 0.0;
     bool master_tolerance_defined_ = false;
     double master_tolerance_ = 0.0;
     bool rtol_set_ = false;            // solver.rtol set by the user: the master's tolerance does not apply
