@@ -371,11 +371,7 @@ static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], s
             return fmi2Error;
         }
     }
-    for (size_t i = 0; i < nvr; ++i) {
-        const fmi2Status status = from_core(gimbal_core_set_real(instance->core, vr[i], value[i]));
-        if (status > fmi2Warning) return status;
-    }
-    return fmi2OK;
+    return nvr == 0 ? fmi2OK : from_core(gimbal_core_set_reals(instance->core, vr, nvr, value));
 }
 
 static fmi2Status impl_GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {

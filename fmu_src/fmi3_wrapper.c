@@ -351,11 +351,7 @@ static fmi3Status set_float64(Instance3* i, const fmi3ValueReference vr[], size_
         say(i, fmi3Error, "logStatusError", "fmi3SetFloat64: %s = %g refused: values must be finite", info.name, values[k]);
         return fmi3Error;
     }
-    for (size_t k = 0; k < nvr; ++k) {
-        const fmi3Status status = from_core(gimbal_core_set_real(i->core, vr[k], values[k]));
-        if (status > fmi3Warning) return status;
-    }
-    return fmi3OK;
+    return nvr == 0 ? fmi3OK : from_core(gimbal_core_set_reals(i->core, vr, nvr, values));
 }
 
 static fmi3Status get_integers(Instance3* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,

@@ -104,6 +104,10 @@ GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value) {
     return guarded(core, [&] { return core->instance.set_real(vr, value); });
 }
 
+GimbalStatus gimbal_core_set_reals(GimbalCore* core, const unsigned* vr, size_t count, const double* values) {
+    return guarded(core, [&] { return core->instance.set_reals(vr, count, values); });
+}
+
 GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value) {
     return guarded(core, [&] { return core->instance.get_real(vr, *value); });
 }

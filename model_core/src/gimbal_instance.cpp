@@ -175,25 +175,34 @@ GimbalStatus GimbalInstance::refuse(GimbalStatus status, const std::string& mess
     return status;
 }
 
-GimbalStatus GimbalInstance::set_real(unsigned vr, double value) {
-    if (vr >= kRealVariableCount) {
-        return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Real variable");
+GimbalStatus GimbalInstance::set_real(unsigned vr, double value) { return set_reals(&vr, 1, &value); }
+
+GimbalStatus GimbalInstance::set_reals(const unsigned* vr, std::size_t count, const double* values) {
+    // All checks first: a refused call sets nothing.
+    for (std::size_t k = 0; k < count; ++k) {
+        if (vr[k] >= kRealVariableCount)
+            return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr[k]) + " is not a Real variable");
+        if (!std::isfinite(values[k])) {
+            std::ostringstream s;
+            s << kRealVariables[vr[k]].name << " = " << values[k] << " refused: values must be finite";
+            return refuse(GIMBAL_ERROR, s.str());
+        }
     }
-    if (!std::isfinite(value)) {
-        std::ostringstream s;
-        s << kRealVariables[vr].name << " = " << value << " refused: values must be finite";
-        return refuse(GIMBAL_ERROR, s.str());
+    bool input_set = false;
+    for (std::size_t k = 0; k < count; ++k) {
+        const unsigned variable = vr[k];
+        reals_[variable] = values[k];
+        input_set |= kRealVariables[variable].causality == Causality::input;
+        if (variable == vr_solver_rtol) rtol_set_ = true;
+        // A new voltage starts a new ramp: its derivative must be given again.
+        if (variable == vr_u_R1) voltage_rate_[0] = 0.0;
+        if (variable == vr_u_R2) voltage_rate_[1] = 0.0;
     }
-    reals_[vr] = value;
     preview_current_ = false;
-    if (kRealVariables[vr].causality == Causality::input) {
+    if (input_set) {
         inputs_stale_ = outputs_stale_ = true;
         decided_here_ = false;
     }
-    if (vr == vr_solver_rtol) rtol_set_ = true;
-    // A new voltage starts a new ramp: its derivative must be given again.
-    if (vr == vr_u_R1) voltage_rate_[0] = 0.0;
-    if (vr == vr_u_R2) voltage_rate_[1] = 0.0;
     return GIMBAL_OK;
 }
 

@@ -147,6 +147,7 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     params.multibody.d_ab = read_vector(values, kBasePointB);
     if (!check.non_negative(vr_g)) return false;
     params.multibody.gravity = values[vr_g];
+    prepare_multibody(params.multibody);
 
     struct MotorVariables { RealVariable R, L, k_torque, k_emf, i_L, U_L; };
     const MotorVariables motors[2] = {

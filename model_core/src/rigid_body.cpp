@@ -89,11 +89,6 @@ BodyMotion motion_about_x(const JointRotation& r, double rate, const Vec3& paren
 //   axis . (d x F + T),
 // the component along the axis of the moment about b. With the inertia about b, that moment is the
 // single rigid-body equation below, and the mass matrix entries are axis_i . I_b axis_j.
-struct PivotInertia {
-    Mat3 inertia;       // about point b, own frame: I + m (|d|^2 1 - d d^T)
-    Vec3 first_moment;  // m d
-};
-
 // The helpers below build every Vec3 from scalar expressions and never use Eigen's vector operators on
 // 3-vectors: those load two components as one SSE packet right after they were stored one by one, and
 // the failed store-to-load forwarding cost more than the arithmetic (about half of the call, measured).
@@ -122,6 +117,12 @@ inline Vec3 cross(const Vec3& a, const Vec3& b) {
     return Vec3(a.y() * b.z() - a.z() * b.y(), a.z() * b.x() - a.x() * b.z(), a.x() * b.y() - a.y() * b.x());
 }
 
+void derive_constants(const MultibodyModel& model, MultibodyConstants& constants) {
+    for (int k = 0; k < 4; ++k) constants.pivot[k] = about_pivot(model.bodies[k]);
+    constants.rotor1_axisymmetric = axisymmetric_about_z(model.bodies[kAzimuthRotor]);
+    constants.rotor2_axisymmetric = axisymmetric_about_x(model.bodies[kElevationRotor]);
+}
+
 // Moment about b of apparent gravity and the inertial forces with qdd = 0 (the d'Alembert moment).
 // m d x (w x (w x d)) = w x (m (|d|^2 1 - d d^T) w) folds the centre-of-mass terms into the gyroscopic one.
 inline Vec3 bias_moment(const PivotInertia& p, const BodyMotion& m, const Vec3& apparent_gravity) {
@@ -136,8 +137,16 @@ inline Vec3 bias_moment(const PivotInertia& p, const BodyMotion& m, const Vec3& 
 
 }  // namespace
 
+void prepare_multibody(MultibodyModel& model) {
+    derive_constants(model, model.constants);
+    model.prepared = true;
+}
+
 void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinematics& base,
                                   const Vec4& q, const Vec4& qd, Mat4& mass_matrix, Vec4& bias) {
+    MultibodyConstants derived_here;
+    if (!model.prepared) derive_constants(model, derived_here);
+    const MultibodyConstants& constants = model.prepared ? model.constants : derived_here;
     const Vec3& base_rate = base.angular_velocity;
     // Point b is fixed on the carrier: rigid-body acceleration transfer from point a.
     const Vec3 transport = cross(base.angular_accel, model.d_ab);
@@ -151,7 +160,7 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
     const JointRotation azimuth = joint_rotation(q[kAzimuthBody]);
     const BodyMotion housing = motion_about_z(azimuth, qd[kAzimuthBody], base_rate, base.angular_accel);
     const Vec3 apparent_gravity1 = into_frame_turned_about_z(azimuth, apparent_gravity0);
-    const PivotInertia housing_inertia = about_pivot(model.bodies[kAzimuthBody]);
+    const PivotInertia& housing_inertia = constants.pivot[kAzimuthBody];
     const Vec3 housing_moment = bias_moment(housing_inertia, housing, apparent_gravity1);
 
     // Rotor R1 (body 1) turns about z of frame 0 on its own: it couples to no other coordinate.
@@ -159,7 +168,7 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
     mass_matrix.setZero();
     mass_matrix(kAzimuthBody, kAzimuthBody) = housing_inertia.inertia(2, 2);
     bias[kAzimuthBody] = housing_moment.z();
-    if (axisymmetric_about_z(rotor1)) {
+    if (constants.rotor1_axisymmetric) {
         // The general terms at angle 0 with the centre of mass at (0, 0, d): I_b is diagonal with equal
         // transverse entries and I_b,zz = I_zz, so gravity and the gyroscopic moment have no z
         // component; only the base's angular acceleration about z remains.
@@ -168,7 +177,7 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
     } else {
         const JointRotation turn = joint_rotation(q[kAzimuthRotor]);
         const BodyMotion motion = motion_about_z(turn, qd[kAzimuthRotor], base_rate, base.angular_accel);
-        const PivotInertia pivot = about_pivot(rotor1);
+        const PivotInertia& pivot = constants.pivot[kAzimuthRotor];
         mass_matrix(kAzimuthRotor, kAzimuthRotor) = pivot.inertia(2, 2);
         bias[kAzimuthRotor] = bias_moment(pivot, motion, into_frame_turned_about_z(turn, apparent_gravity0)).z();
     }
@@ -178,13 +187,12 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
     const Vec3& housing_rate = housing.angular_velocity;
     const Vec3& housing_accel = housing.angular_accel_bias;
     const RigidBody& rotor2 = model.bodies[kElevationRotor];
-    const bool symmetric_rotor2 = axisymmetric_about_x(rotor2);
+    const bool symmetric_rotor2 = constants.rotor2_axisymmetric;
     for (int k : {kElevationBody, kElevationRotor}) {
         if (k == kElevationRotor && symmetric_rotor2) continue;
-        const RigidBody& body = model.bodies[k];
         const JointRotation turn = joint_rotation(q[k]);
         const BodyMotion motion = motion_about_x(turn, qd[k], housing_rate, housing_accel);
-        const PivotInertia pivot = about_pivot(body);
+        const PivotInertia& pivot = constants.pivot[k];
         const Vec3 moment = bias_moment(pivot, motion, into_frame_turned_about_x(turn, apparent_gravity1));
         const Mat3& I = pivot.inertia;
         // (0, s, c) . I_b (0, s, c), (0, s, c) . I_b ex and ex . I_b (0, s, c).

@@ -44,6 +44,9 @@ void gimbal_core_destroy(GimbalCore* core);
 GimbalStatus gimbal_core_reset(GimbalCore* core);
 
 GimbalStatus gimbal_core_set_real(GimbalCore* core, unsigned vr, double value);
+/* Several at once, all or nothing: none is set if one is refused (an unknown value reference, a
+ * value that is not finite). One call per fmi*SetReal / fmi3SetFloat64 of the host. */
+GimbalStatus gimbal_core_set_reals(GimbalCore* core, const unsigned* vr, size_t count, const double* values);
 GimbalStatus gimbal_core_get_real(GimbalCore* core, unsigned vr, double* value);
 GimbalStatus gimbal_core_set_input_derivative(GimbalCore* core, unsigned vr, int order, double value);
 GimbalStatus gimbal_core_set_integer(GimbalCore* core, unsigned vr, int value);

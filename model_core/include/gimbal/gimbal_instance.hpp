@@ -41,6 +41,8 @@ public:
     void set_master_tolerance(bool defined, double tolerance);
     GimbalStatus initialize(double start_time);
     // fmi2SetRealInputDerivatives: the voltages may ramp over the next step (order 1 only).
+    // All or nothing.
+    GimbalStatus set_reals(const unsigned* vr, std::size_t count, const double* values);
     GimbalStatus set_input_derivative(unsigned vr, int order, double value);
 
     // Everything a rollback needs, as plain bytes (fmi2GetFMUstate / serialization). Saving ends the

@@ -22,11 +22,31 @@ struct RigidBody {
 // Bodies are stored in the order of the generalized coordinates q = [alpha, alpha_m, beta, beta_m].
 enum BodyIndex { kAzimuthBody = 0, kAzimuthRotor = 1, kElevationBody = 2, kElevationRotor = 3 };
 
+// A body's inertia about point b, where every joint axis passes, in its own frame.
+struct PivotInertia {
+    Mat3 inertia = Mat3::Zero();        // I + m (|d|^2 1 - d d^T)
+    Vec3 first_moment = Vec3::Zero();   // m d
+};
+
+// What the mass matrix and bias need of the bodies at every evaluation, derived from them once.
+struct MultibodyConstants {
+    PivotInertia pivot[4];
+    bool rotor1_axisymmetric = false;  // about its axis z, centre of mass on it: its angle drops out
+    bool rotor2_axisymmetric = false;  // the same about x
+};
+
 struct MultibodyModel {
     RigidBody bodies[4];
     Vec3 d_ab = Vec3::Zero();  // frame 0
     double gravity = 9.81;
+    // Set by prepare_multibody() once the bodies are final; an unprepared model is still evaluated
+    // correctly, deriving the constants at every call.
+    bool prepared = false;
+    MultibodyConstants constants;
 };
+
+// Derives model.constants from model.bodies and marks the model prepared.
+void prepare_multibody(MultibodyModel& model);
 
 struct MultibodyEnergy {
     double kinetic = 0.0;    // inertial kinetic energy
