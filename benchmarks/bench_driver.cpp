@@ -626,6 +626,14 @@ struct Report {
     double simulated = 0, wall = 0, cpu = 0, dostep_wall = NAN, master_cpu = NAN;
     // --time-dostep: single doSteps' wall times [s], median, 99th and 99.9th percentile, maximum.
     double dostep_p50 = NAN, dostep_p99 = NAN, dostep_p999 = NAN, dostep_max = NAN;
+    // The median doStep by the mode changes located in it (none, one, more), their counts, and the
+    // share of the slowest 0.1 % of doSteps that located at least one.
+    double dostep_median_by_events[3] = {NAN, NAN, NAN};
+    long dostep_count_by_events[3] = {0, 0, 0};
+    double slowest_with_events = NAN;
+    // Right-hand sides per doStep: the median, the 99.9th percentile and the maximum (the work, free of
+    // the machine's noise), and the median over the slowest 0.1 % of doSteps in wall time.
+    double rhs_per_dostep_median = NAN, rhs_per_dostep_p999 = NAN, rhs_per_dostep_max = NAN, rhs_per_slowest_median = NAN;
     long dostep_calls = 0;
     long counters[5] = {-1, -1, -1, -1, -1};  // rhs, jacobian, steps, events, method switches
     uint64_t instance_allocations = 0;
@@ -706,6 +714,14 @@ void print_report(const Options& o, const Report& r) {
     if (!std::isnan(r.dostep_p50))
         std::printf("\n  single doStep      median %.3g us, p99 %.3g us, p99.9 %.3g us, max %.3g us (wall)",
                     1e6 * r.dostep_p50, 1e6 * r.dostep_p99, 1e6 * r.dostep_p999, 1e6 * r.dostep_max);
+    if (!std::isnan(r.slowest_with_events))
+        std::printf("\n  by mode changes    none: median %.3g us (%ld doSteps), one: %.3g us (%ld), more: %.3g us (%ld); "
+                    "%.0f %% of the slowest 0.1 %% had one or more\n"
+                    "  right-hand sides  per doStep: median %.0f, p99.9 %.0f, max %.0f; median %.0f in the slowest 0.1 %% (wall)",
+                    1e6 * r.dostep_median_by_events[0], r.dostep_count_by_events[0], 1e6 * r.dostep_median_by_events[1],
+                    r.dostep_count_by_events[1], 1e6 * r.dostep_median_by_events[2], r.dostep_count_by_events[2],
+                    100.0 * r.slowest_with_events, r.rhs_per_dostep_median, r.rhs_per_dostep_p999, r.rhs_per_dostep_max,
+                    r.rhs_per_slowest_median);
     std::printf("\n  CPU time           %.6g s = %.4g us per doStep\n", r.cpu, 1e6 * r.cpu / std::max(1L, r.dostep_calls));
     std::printf("  real-time factor   %.6g (simulated / CPU time)\n", rtf);
     if (!std::isnan(r.master_cpu))
@@ -861,7 +877,17 @@ struct Run {
         double in_step = 0.0;
         // Reserved before the loop: the driver allocates nothing while doSteps are counted.
         std::vector<double> step_times;
-        if (o.time_dostep) step_times.reserve(static_cast<size_t>(n) + 1);
+        std::vector<int> step_events;  // mode changes in each timed doStep
+        std::vector<long> step_rhs;     // right-hand sides in each timed doStep
+        if (o.time_dostep) {
+            step_times.reserve(static_cast<size_t>(n) + 1);
+            step_events.reserve(static_cast<size_t>(n) + 1);
+            step_rhs.reserve(static_cast<size_t>(n) + 1);
+        }
+        const bool count_events = o.time_dostep && md.has("events.total") && md.has("solver.rhs_evaluations");
+        const fmi2ValueReference counter_vr[2] = {count_events ? md.vr("events.total", 'I') : 0,
+                                                  count_events ? md.vr("solver.rhs_evaluations", 'I') : 0};
+        fmi2Integer counters_before[2] = {0, 0};
         long k = 0;
         // The communication points are accumulated (t += h), as the FMU accumulates its own time:
         // the FMU refuses a currentCommunicationPoint more than 1e-12 relative from its time, and
@@ -890,6 +916,13 @@ struct Run {
                 const double spent = clock_seconds(CLOCK_MONOTONIC) - s0;
                 in_step += spent;
                 if (step_times.size() < step_times.capacity()) step_times.push_back(spent);
+                fmi2Integer counters_after[2] = {counters_before[0], counters_before[1]};
+                if (count_events) fmi.get_integer(component, counter_vr, 2, counters_after);
+                if (step_events.size() < step_events.capacity()) {
+                    step_events.push_back(counters_after[0] - counters_before[0]);
+                    step_rhs.push_back(counters_after[1] - counters_before[1]);
+                }
+                counters_before[0] = counters_after[0], counters_before[1] = counters_after[1];
             } else {
                 status = fmi.do_step(component, t, h, fmi2True);
             }
@@ -910,6 +943,34 @@ struct Run {
         report.wall = clock_seconds(CLOCK_MONOTONIC) - wall0;
         if (o.time_dostep) {
             report.dostep_wall = in_step;
+            if (!step_times.empty() && step_events.size() == step_times.size()) {
+                std::vector<double> by_events[3];
+                for (size_t k = 0; k < step_times.size(); ++k)
+                    by_events[std::min(step_events[k], 2)].push_back(step_times[k]);
+                for (int e = 0; e < 3; ++e) {
+                    report.dostep_count_by_events[e] = static_cast<long>(by_events[e].size());
+                    if (by_events[e].empty()) continue;
+                    std::sort(by_events[e].begin(), by_events[e].end());
+                    report.dostep_median_by_events[e] = by_events[e][by_events[e].size() / 2];
+                }
+                std::vector<size_t> order(step_times.size());
+                for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+                std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return step_times[a] > step_times[b]; });
+                const size_t slowest = std::max<size_t>(1, order.size() / 1000);
+                size_t with_events = 0;
+                std::vector<long> slowest_rhs, all_rhs(step_rhs);
+                for (size_t k = 0; k < slowest; ++k) {
+                    with_events += step_events[order[k]] > 0;
+                    slowest_rhs.push_back(step_rhs[order[k]]);
+                }
+                report.slowest_with_events = static_cast<double>(with_events) / static_cast<double>(slowest);
+                std::sort(slowest_rhs.begin(), slowest_rhs.end());
+                std::sort(all_rhs.begin(), all_rhs.end());
+                report.rhs_per_slowest_median = static_cast<double>(slowest_rhs[slowest_rhs.size() / 2]);
+                report.rhs_per_dostep_median = static_cast<double>(all_rhs[all_rhs.size() / 2]);
+                report.rhs_per_dostep_p999 = static_cast<double>(all_rhs[std::min(all_rhs.size() - 1, all_rhs.size() * 999 / 1000)]);
+                report.rhs_per_dostep_max = static_cast<double>(all_rhs.back());
+            }
             if (!step_times.empty()) {
                 std::sort(step_times.begin(), step_times.end());
                 const auto at = [&](double q) {
