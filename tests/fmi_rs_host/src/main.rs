@@ -1,18 +1,36 @@
 //! fmi_rs_host FMU OUT.csv me|cs STOP OUTPUT_INTERVAL EULER_STEP [NAME=VALUE ...]
+//! fmi_rs_host validate MODEL_DESCRIPTION.xml
 //!
 //! Simulates an FMI 3.0 FMU with fmi-rs from time 0 to STOP, recording every output variable at each
 //! OUTPUT_INTERVAL into OUT.csv. `me`: Model Exchange with fmi-rs' forward Euler of step EULER_STEP
 //! (its own event handling); `cs`: Co-Simulation, one doStep per output interval, with Event Mode and
-//! early return allowed. NAME=VALUE pairs are start values. Exit status 0 on success, 1 with the
-//! reason on stderr otherwise.
+//! early return allowed. NAME=VALUE pairs are start values. `validate`: fmi-rs' own checks of an FMI
+//! 2.0 or 3.0 model description, one problem a line on stdout. Exit status 0 on success (no problem),
+//! 1 with the reason on stderr otherwise.
 use std::{env, process::ExitCode, sync::Arc};
 
 use fmi_rs::fmi3::{builder::FMU3Builder, LibraryKind};
 use fmi_rs::model_description::fmi3::{Causality, ModelDescription};
+use fmi_rs::model_description::{fmi2, peek_fmi_major_version, FMIMajorVersion};
 use fmi_rs::sim::fmi3::{csv::write_csv, recorder::Recorder, SimulationSettings, Trajectories};
 use fmi_rs::sim::solver::ForwardEulerFactory;
 
+fn validate(path: &str) -> Result<(), String> {
+    let path = std::path::Path::new(path);
+    let problems = match peek_fmi_major_version(path).map_err(|e| format!("{}: {e}", path.display()))? {
+        FMIMajorVersion::V2 => fmi2::ModelDescription::from_path(path).map_err(|e| format!("{e}"))?.validate(),
+        FMIMajorVersion::V3 => ModelDescription::from_path(path).map_err(|e| format!("{e}"))?.validate(),
+    };
+    for problem in &problems {
+        println!("{}", problem.message);
+    }
+    if problems.is_empty() { Ok(()) } else { Err(format!("{} problem(s)", problems.len())) }
+}
+
 fn run(args: &[String]) -> Result<(), String> {
+    if args.len() == 3 && args[1] == "validate" {
+        return validate(&args[2]);
+    }
     if args.len() < 7 {
         return Err("usage: fmi_rs_host FMU OUT.csv me|cs STOP OUTPUT_INTERVAL EULER_STEP [NAME=VALUE ...]".into());
     }
