@@ -1,4 +1,4 @@
-"""The FMU under fmi-sim, the command-line simulator of the Rust `fmi-rs` project, compared with fmpy.
+"""The FMU under fmi-sim, the command-line simulator of the Rust `rust-fmi` crates, compared with fmpy.
 
 fmi-sim (crate `fmi-sim`, version pinned below, installed with cargo into the build directory by the
 fixture) drives an FMI 2.0 co-simulation FMU like this (`src/sim/fmi2/cs.rs`, `src/sim/mod.rs`,
