@@ -24,6 +24,7 @@ StateLayout StateLayout::from(const Fidelity& fidelity, bool energy_accounting) 
         layout.backlash_slot[axis] = fidelity.gear[axis] == GearModel::backlash ? slot++ : -1;
     layout.energy_slot = energy_accounting ? slot : -1;
     layout.size = slot + (energy_accounting ? kEnergyFlowCount : 0);
+    layout.canonical = slot == kStateSize;
     return layout;
 }
 
@@ -73,6 +74,16 @@ Vec4 other_torques(const Mat4& mass_matrix, const Vec4& applied_torque, const Mo
     return modified.partialPivLu().solve(rhs);
 }
 
+Mat4 coordinate_reduction(const ModelParameters& params) {
+    Mat4 reduction = Mat4::Identity();
+    for (int axis = 0; axis < 2; ++axis) {
+        if (params.fidelity.gear[axis] != GearModel::rigid) continue;
+        reduction(rotor_index(axis), rotor_index(axis)) = 0.0;
+        reduction(rotor_index(axis), load_index(axis)) = params.gear[axis].ratio;
+    }
+    return reduction;
+}
+
 double applied_voltage(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, int axis,
                        double time) {
     if (inputs.voltage_rate[axis] == 0.0) return inputs.voltage[axis];
@@ -84,6 +95,18 @@ FullState expand_state(const ModelParameters& params, const Modes& modes, const 
                        const double* state) {
     const StateLayout& layout = params.layout;
     FullState full;
+    if (layout.canonical) {
+        for (int body = 0; body < 4; ++body) {
+            full.angle[body] = state[kAngles + body];
+            full.rate[body] = state[kRates + body];
+        }
+        for (int axis = 0; axis < 2; ++axis) {
+            const int limited = modes.motor_limited[axis];
+            full.current[axis] = limited != 0 ? limited * params.motor[axis].current_limit : state[kCurrents + axis];
+            full.backlash[axis] = state[kBacklash + axis];
+        }
+        return full;
+    }
     for (int body = 0; body < 4; ++body) {
         if (layout.independent(body)) {
             full.angle[body] = state[layout.angle_slot[body]];
@@ -118,14 +141,13 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     const Vec4& q = out.full.angle;
     const Vec4& qd = out.full.rate;
 
-    Mat4 mass_matrix;
+    // Assembled in place: the reduced model's padding below changes it, keeping J itself only then.
+    Mat4& reduced_mass = out.reduced_mass;
     Vec4 bias;
-    compute_mass_matrix_and_bias(params.multibody, base, q, qd, mass_matrix, bias);
+    compute_mass_matrix_and_bias(params.multibody, base, q, qd, reduced_mass, bias);
 
     Vec4 force;  // generalized forces on the four bodies, without dry friction
     for (int body = 0; body < 4; ++body) force[body] = -params.viscous_friction[body] * qd[body];
-    // q_full = reduction * q_padded: a rigid axis's rotor follows its load.
-    Mat4 reduction = Mat4::Identity();
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params.gear[axis];
         const MotorParameters& motor = params.motor[axis];
@@ -141,8 +163,7 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
 
         double shaft_torque = 0.0, backlash_rate = 0.0;
         if (model == GearModel::rigid) {
-            reduction(rotor, rotor) = 0.0;
-            reduction(rotor, load) = gear.ratio;
+            // No shaft state: the rotor follows the load (coordinate_reduction).
         } else if (model == GearModel::compliant || gear.half_backlash == 0.0) {
             shaft_torque = gear_shaft_torque(gear, deflection, deflection_rate, 0.0, 0.0);
         } else if (dead_zone_gear(gear)) {
@@ -176,7 +197,8 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     }
 
     const bool reduced = params.fidelity.gear[0] == GearModel::rigid || params.fidelity.gear[1] == GearModel::rigid;
-    Mat4 reduced_mass = mass_matrix;
+    Mat4 mass_matrix;
+    if (reduced) mass_matrix = reduced_mass;
     Vec4 applied = force + bias;
     // T^T J T and T^T (force + bias) for each rigid axis, written out: T only adds N times the rotor's
     // row and column to the load's, and the rotor's become the padding identity (a trivial equation).
@@ -221,8 +243,6 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     for (int axis = 0; axis < 2 && reduced; ++axis)
         if (params.fidelity.gear[axis] == GearModel::rigid)
             out.full_acceleration[rotor_index(axis)] = params.gear[axis].ratio * out.acceleration[load_index(axis)];
-    out.reduced_mass = reduced_mass;
-    out.reduction = reduction;
 
     // A rigid gear still transmits a torque: the one that makes the rotor follow, from its own equation.
     for (int axis = 0; axis < 2; ++axis) {
@@ -304,7 +324,7 @@ void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const 
     }
 
     // To padded coordinates: q_full = T q_padded, forces projected with T^T.
-    const Mat4& T = d.reduction;
+    const Mat4 T = coordinate_reduction(params);
     Mat4x12 applied;
     applied.block<4, 4>(0, 0) = T.transpose() * force.block<4, 4>(0, 0) * T;
     applied.block<4, 4>(0, 4) = T.transpose() * force.block<4, 4>(0, 4) * T;
@@ -403,14 +423,25 @@ bool evaluate_state_derivative(const ModelParameters& params, const StepInputs& 
 
 bool state_derivative(const ModelParameters& params, const Dynamics& d, double* derivative) {
     const StateLayout& layout = params.layout;
-    for (int body = 0; body < 4; ++body) {
-        if (!layout.independent(body)) continue;
-        derivative[layout.angle_slot[body]] = d.full.rate[body];
-        derivative[layout.rate_slot[body]] = d.acceleration[body];
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-        if (layout.current_slot[axis] >= 0) derivative[layout.current_slot[axis]] = d.current_rate[axis];
-        if (layout.backlash_slot[axis] >= 0) derivative[layout.backlash_slot[axis]] = d.backlash_rate[axis];
+    if (layout.canonical) {
+        for (int body = 0; body < 4; ++body) {
+            derivative[kAngles + body] = d.full.rate[body];
+            derivative[kRates + body] = d.acceleration[body];
+        }
+        for (int axis = 0; axis < 2; ++axis) {
+            derivative[kCurrents + axis] = d.current_rate[axis];
+            derivative[kBacklash + axis] = d.backlash_rate[axis];
+        }
+    } else {
+        for (int body = 0; body < 4; ++body) {
+            if (!layout.independent(body)) continue;
+            derivative[layout.angle_slot[body]] = d.full.rate[body];
+            derivative[layout.rate_slot[body]] = d.acceleration[body];
+        }
+        for (int axis = 0; axis < 2; ++axis) {
+            if (layout.current_slot[axis] >= 0) derivative[layout.current_slot[axis]] = d.current_rate[axis];
+            if (layout.backlash_slot[axis] >= 0) derivative[layout.backlash_slot[axis]] = d.backlash_rate[axis];
+        }
     }
     if (layout.energy_slot >= 0) {
         double* flow = derivative + layout.energy_slot;
@@ -432,9 +463,10 @@ bool state_derivative(const ModelParameters& params, const Dynamics& d, double* 
             flow[kDryFriction] -= d.friction_torque[body] * rate;
         }
     }
-    for (int k = 0; k < layout.size; ++k)
-        if (!std::isfinite(derivative[k])) return false;
-    return true;
+    // x * 0 is NaN exactly when x is not finite: one test instead of one per component.
+    double finite_check = 0.0;
+    for (int k = 0; k < layout.size; ++k) finite_check += derivative[k] * 0.0;
+    return finite_check == 0.0;
 }
 
 ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,

@@ -47,6 +47,7 @@ struct StateLayout {
     int backlash_slot[2];
     int energy_slot;  // first of kEnergyFlowCount, or -1
     int size;
+    bool canonical;   // every quantity present, in StateIndex order (full fidelity): no slot lookups
 
     static StateLayout from(const Fidelity& fidelity, bool energy_accounting);
     bool independent(int body) const { return angle_slot[body] >= 0; }
@@ -129,11 +130,13 @@ struct Dynamics {
     Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
     double voltage[2];              // applied
     Mat4 reduced_mass;              // padded coordinates
-    Mat4 reduction;                 // q_full = reduction * q_padded
 };
 
 // Gears whose damping is 0 are pure dead zones: theta_b follows theta_d inside the gap.
 inline bool dead_zone_gear(const GearParameters& gear) { return gear.half_backlash > 0.0 && gear.damping == 0.0; }
+
+// q_full = coordinate_reduction * q_padded: a rigid axis's rotor follows its load (N times its angle).
+Mat4 coordinate_reduction(const ModelParameters& params);
 
 // The voltage at the motor terminals' input at `time` (after the clamp of 2.142-2.145).
 double applied_voltage(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, int axis,
