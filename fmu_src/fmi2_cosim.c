@@ -335,7 +335,10 @@ static int check_set(Instance* instance, Function id, GimbalType type, const fmi
     const char* function = kFunctions[id].name;
     if (nvr == 0) return 1;
     if (!not_null(instance, function, vr, "vr") || !not_null(instance, function, value, "value")) return 0;
-    for (size_t i = 0; i < nvr; ++i) {
+    /* The common case in one pass through the core's table; the variable at fault is then named below. */
+    const int initialized = !(instance->state & (STATE_INSTANTIATED | STATE_INITIALIZATION));
+    const size_t first_refused = gimbal_first_unsettable(type, vr, nvr, initialized);
+    for (size_t i = first_refused; i < nvr; ++i) {
         GimbalVariableInfo info;
         if (!gimbal_variable_info(type, vr[i], &info)) {
             log_message(instance, fmi2Error, "logStatusError", "%s: value reference %u is not a%s %s variable", function,
@@ -361,16 +364,7 @@ static int check_get(Instance* instance, Function id, const fmi2ValueReference v
 static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     Instance* instance = (Instance*)c;
     if (!check_set(instance, FN_SetReal, GIMBAL_REAL, vr, nvr, value)) return fmi2Error;
-    /* All or nothing: a refused call must not leave some of its values applied. */
-    for (size_t i = 0; i < nvr; ++i) {
-        if (!isfinite(value[i])) {
-            GimbalVariableInfo info;
-            gimbal_variable_info(GIMBAL_REAL, vr[i], &info);
-            log_message(instance, fmi2Error, "logStatusError", "fmi2SetReal: %s = %g refused: values must be finite",
-                        info.name, value[i]);
-            return fmi2Error;
-        }
-    }
+    /* The core checks every value before it applies any (all or nothing) and names a non-finite one. */
     return nvr == 0 ? fmi2OK : from_core(gimbal_core_set_reals(instance->core, vr, nvr, value));
 }
 

@@ -76,6 +76,24 @@ int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info)
     return 1;
 }
 
+size_t gimbal_first_unsettable(GimbalType type, const unsigned* vr, size_t count, int initialized) {
+    const gimbal::VariableInfo* table = gimbal::kRealVariables;
+    unsigned variables = gimbal::kRealVariableCount;
+    if (type == GIMBAL_INTEGER) table = gimbal::kIntegerVariables, variables = gimbal::kIntegerVariableCount;
+    if (type == GIMBAL_BOOLEAN) table = gimbal::kBooleanVariables, variables = gimbal::kBooleanVariableCount;
+    if (vr == nullptr) return 0;
+    for (std::size_t k = 0; k < count; ++k) {
+        if (vr[k] >= variables) return k;
+        const gimbal::VariableInfo& v = table[vr[k]];
+        const bool settable = v.causality == gimbal::Causality::input ||
+                              (initialized ? v.causality == gimbal::Causality::parameter &&
+                                                 v.variability == gimbal::Variability::tunable
+                                           : v.initial == gimbal::Initial::exact);
+        if (!settable) return k;
+    }
+    return count;
+}
+
 GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction enabled, void* log_context) {
     try {
         auto logger = [log, log_context](GimbalStatus status, const char* category, const std::string& message) {

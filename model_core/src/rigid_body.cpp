@@ -155,8 +155,7 @@ void compute_mass_matrix_and_bias(const MultibodyModel& model, const BaseKinemat
         mass_matrix_and_bias(model, model.constants, base, q, qd, mass_matrix, bias);
         return;
     }
-    // Constructed only here: zeroing the constants at every call of a prepared model cost 3 % of the
-    // right-hand side.
+    // Constructed only here: a prepared model (every right-hand side of a run) need not zero them.
     MultibodyConstants derived_here;
     derive_constants(model, derived_here);
     mass_matrix_and_bias(model, derived_here, base, q, qd, mass_matrix, bias);

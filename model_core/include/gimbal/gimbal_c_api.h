@@ -37,6 +37,11 @@ typedef enum { GIMBAL_REAL = 0, GIMBAL_INTEGER = 1, GIMBAL_BOOLEAN = 2 } GimbalT
 
 /* Returns 0 when vr is not a variable of that type. */
 int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info);
+/* The index of the first of vr[0..count) that is not a variable of that type or cannot be set, or
+ * count when all can. Settable before initialization (initialized = 0): inputs and variables with an
+ * exact start value; after it: inputs and tunable parameters. One call per set of values: the
+ * master's per-step input setting checks a value in a few instructions. */
+size_t gimbal_first_unsettable(GimbalType type, const unsigned* vr, size_t count, int initialized);
 
 GimbalCore* gimbal_core_create(GimbalLogFunction log, GimbalLogEnabledFunction enabled, void* log_context);
 void gimbal_core_destroy(GimbalCore* core);
