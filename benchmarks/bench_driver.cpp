@@ -792,7 +792,12 @@ struct Run {
         if (!std::isnan(o.atol)) set_real("solver.atol", o.atol);
         for (const auto& [name, v] : o.real_parameters) {
             if (!md.has(name)) die("--set: the FMU has no variable '" + name + "'");
-            set_real(name, v);
+            if (md.variables.at(name).type == 'I') {
+                if (v != std::floor(v)) die("--set " + name + ": an Integer variable takes a whole number");
+                set_integer(name, static_cast<int>(v));
+            } else {
+                set_real(name, v);
+            }
         }
         report.instance_allocations = g_alloc.allocations - a0;
         report.instance_bytes = g_alloc.live - live0;

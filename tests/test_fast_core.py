@@ -58,7 +58,7 @@ def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapsho
     return {name: record[:, j] for j, name in enumerate(RECORDED)}
 
 
-@pytest.mark.parametrize("method", [4, 5, 6])
+@pytest.mark.parametrize("method", [4, 5, 6, 7])
 @pytest.mark.parametrize("action", ["get", "get-set"])
 def test_snapshots_at_every_step_leave_the_trajectory_bit_identical(gimbal_fmu, method, action):
     start = {"solver.method": method}

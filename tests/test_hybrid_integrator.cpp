@@ -163,8 +163,87 @@ void check_method(IntegrationMethod method) {
     }
 }
 
+namespace {
+
+// x' = -x + sin t, x(0) = 1: x = (sin t - cos t) / 2 + 1.5 e^-t. No events.
+class ForcedDecay final : public HybridSystem {
+public:
+    int state_size() const override { return 1; }
+    int event_count() const override { return 0; }
+    bool derivative(double time, const double* x, double* dx) override {
+        dx[0] = -x[0] + std::sin(time);
+        return true;
+    }
+    bool has_jacobian() const override { return true; }
+    bool jacobian(double, const double*, double* column_major) override {
+        column_major[0] = -1.0;
+        return true;
+    }
+    void event_functions(double, const double*, double*) override {}
+    int update_modes(double, double*, const int*) override { return 0; }
+    static double exact(double t) { return 0.5 * (std::sin(t) - std::cos(t)) + 1.5 * std::exp(-t); }
+};
+
+// The real-time method: RODAS4 on a fixed grid of substeps, bounded event work.
+void check_real_time() {
+    auto quiet = [](const std::string&) {};
+    {
+        // Order 4 in the substeps on a problem with a known solution (communication steps of 0.1 s).
+        double errors[3];
+        for (int k = 0; k < 3; ++k) {
+            ForcedDecay decay;
+            IntegratorSettings settings;
+            settings.method = IntegrationMethod::real_time;
+            settings.substeps = 1 << k;
+            auto integrator = HybridIntegrator::create(decay, settings, quiet, quiet);
+            double x[1] = {1.0};
+            CHECK(integrator->restart(0.0, x));
+            for (int step = 1; step <= 20; ++step) CHECK(integrator->advance(0.1 * step, x));
+            errors[k] = std::fabs(x[0] - ForcedDecay::exact(2.0));
+            // Every step is taken, none rejected: substeps per communication step exactly.
+            CHECK(integrator->statistics().steps == 20 * (1 << k));
+            CHECK(integrator->statistics().rejected_steps == 0);
+        }
+        CHECK(errors[0] < 1e-5);
+        CHECK(errors[0] / errors[1] > 12.0 && errors[0] / errors[1] < 22.0);
+        CHECK(errors[1] / errors[2] > 12.0 && errors[1] / errors[2] < 22.0);
+    }
+    {
+        // A bouncing ball: each bounce located within the iteration bound, at its known time, until
+        // the bounces crowd towards their accumulation point and one step holds more than the bound.
+        BouncingBall ball(0.5);
+        IntegratorSettings settings;
+        settings.method = IntegrationMethod::real_time;
+        settings.substeps = 2;
+        settings.event_iterations = 10;
+        settings.mode_changes_per_step = 3;
+        std::string error;
+        auto integrator = HybridIntegrator::create(ball, settings, [&](const std::string& m) { error = m; }, quiet);
+        double x[2] = {1.0, 0.0};
+        CHECK(integrator->restart(0.0, x));
+        const double first = std::sqrt(2.0 / 9.81);
+        const double third = first * (1.0 + 2.0 * 0.5 * (1.0 - 0.25) / 0.5);
+        double time = 0.0;
+        while (time + 0.01 < third - 1e-3) CHECK(integrator->advance(time += 0.01, x));
+        CHECK(ball.bounces == 2);
+        CHECK(integrator->advance(time += 0.01, x));
+        CHECK(ball.bounces == 3);
+        // After the third bounce at `third` the ball rises with 1/8 of the first impact speed.
+        CHECK_NEAR(x[1], 0.125 * 9.81 * first - 9.81 * (time - third), 1e-6);
+        const double accumulation = first * 3.0;
+        bool failed = false;
+        while (!failed && time < accumulation + 0.1) failed = !integrator->advance(time += 0.01, x);
+        CHECK(failed);
+        CHECK(time <= accumulation + 0.01);
+        CHECK(error.find("more than 3 mode changes in the communication step") != std::string::npos);
+    }
+}
+
+}  // namespace
+
 int main() {
     // The same hybrid layer over every backend.
+    check_real_time();
     for (IntegrationMethod method : {IntegrationMethod::bdf_difference_jacobian, IntegrationMethod::adams,
                                      IntegrationMethod::explicit_runge_kutta, IntegrationMethod::automatic,
                                      IntegrationMethod::dormand_prince, IntegrationMethod::rosenbrock}) {

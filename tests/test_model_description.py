@@ -22,7 +22,7 @@ ENUMERATIONS = {  # name: (declared type, value reference, item names by value)
     "motor1.model": ("MotorModel", 22, ["quasi_static", "inductive"]),
     "motor2.model": ("MotorModel", 23, ["quasi_static", "inductive"]),
     "solver.method": ("IntegrationMethod", 24, ["cvode_bdf", "cvode_bdf_dq", "cvode_adams", "arkode_erk", "automatic",
-                                                "dormand_prince", "rodas4"]),
+                                                "dormand_prince", "rodas4", "real_time"]),
 }
 DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}
 

@@ -81,7 +81,7 @@ def test_declared_bounds_are_the_validation_rules_of_single_variables(gimbal_fmu
             declared[v.name] = (bound, high) if side == "min" else (low, bound)
     assert declared == EXPECTED_REAL_BOUNDS
     integers = {v.name: (v.min, v.max) for v in md.modelVariables if v.type == "Integer" and (v.min or v.max)}
-    assert integers == {"solver.max_steps": ("1", None)}
+    assert integers == {"solver.max_steps": ("1", None), "solver.substeps": ("1", "10000")}
     for v in md.modelVariables:
         if v.causality != "parameter":
             assert v.min is None and v.max is None, f"{v.name}: bounds are declared for parameters only"

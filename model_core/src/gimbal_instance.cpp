@@ -14,6 +14,11 @@
 namespace gimbal {
 namespace {
 
+// The real-time method's bounds (solver.method = 7, docs/real_time.md): chosen by measurement.
+constexpr int kRealTimeEventIterations = 10;        // Illinois iterations per located mode change
+constexpr int kRealTimeModeChangesPerSubstep = 8;   // located mode changes per substep, on average
+constexpr double kRealTimeContactResolution = 1.0;  // largest omega h of a gear's contact oscillation
+
 // Whether the voltages at the start of a step continue the running ramps: then nothing jumps. A
 // master's own arithmetic may differ from ours in the last bits, hence the tolerance.
 bool continues(const StepInputs& running, const StepInputs& next, double time) {
@@ -408,6 +413,11 @@ std::unique_ptr<HybridIntegrator> GimbalInstance::make_integrator(GimbalHybridSy
     settings.absolute_tolerance = params.absolute_tolerance;
     settings.max_steps = params.max_steps;
     settings.method = static_cast<IntegrationMethod>(params.method);
+    if (settings.method == IntegrationMethod::real_time) {
+        settings.substeps = params.substeps;
+        settings.event_iterations = kRealTimeEventIterations;
+        settings.mode_changes_per_step = kRealTimeModeChangesPerSubstep * params.substeps;
+    }
     settings.events_logged = [this] { return log_filter_("logEvents"); };
     return HybridIntegrator::create(
         system, settings,
@@ -849,10 +859,47 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
     return GIMBAL_WARNING;
 }
 
+// Fixed L-stable steps damp an oscillation they do not resolve instead of following it; at a gear's
+// contact that turns bounces into sticking and, with the contact's onset located only to the
+// substep's precision, feeds energy in (docs/real_time.md has the measurements). The contact
+// oscillation of each compliant gear, the load against the rotor reflected through N^2, must be
+// resolved by the substeps: omega h <= kRealTimeContactResolution.
+GimbalStatus GimbalInstance::check_real_time_resolution(double step_size) {
+    const double substep = step_size / params_.substeps;
+    const Dynamics& dynamics = system_->dynamics_at(clock_, state_);
+    std::ostringstream unresolved;
+    unresolved.precision(4);
+    double needed = 0.0;
+    for (int axis = 0; axis < 2; ++axis) {
+        const GearParameters& gear = params_.gear[axis];
+        if (params_.fidelity.gear[axis] == GearModel::rigid || gear.stiffness == 0.0) continue;
+        const double load_inertia = dynamics.reduced_mass(load_index(axis), load_index(axis));
+        const double rotor_inertia = dynamics.reduced_mass(rotor_index(axis), rotor_index(axis));
+        const double contact_frequency =
+            std::sqrt(gear.stiffness * (1.0 / load_inertia + 1.0 / (gear.ratio * gear.ratio * rotor_inertia)));
+        if (!(contact_frequency * substep > kRealTimeContactResolution)) continue;
+        needed = std::max(needed, std::ceil(contact_frequency * step_size / kRealTimeContactResolution));
+        unresolved << (needed > 0.0 && unresolved.tellp() > 0 ? "; " : "") << "gear" << axis + 1
+                   << "'s contact oscillation (" << contact_frequency << " rad/s at k_s = " << gear.stiffness
+                   << " N.m/rad: omega h = " << contact_frequency * substep << ")";
+    }
+    if (needed == 0.0) return GIMBAL_OK;
+    std::ostringstream s;
+    s << "the real-time method cannot resolve " << unresolved.str() << " with substeps of " << substep
+      << " s (omega h at most " << kRealTimeContactResolution << "): set solver.substeps >= "
+      << static_cast<long long>(needed) << " for this communication step, or make a gear rigid (gear<k>.model = 0) "
+      << "if the scene does not need its shaft";
+    return refuse(GIMBAL_ERROR, s.str());
+}
+
 GimbalStatus GimbalInstance::integrate_step(double current_time, double step_size, StepStart& start, double* early) {
 
     const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) return base_status;
+    if (params_.method == static_cast<int>(IntegrationMethod::real_time)) {
+        const GimbalStatus resolution = check_real_time_resolution(step_size);
+        if (resolution != GIMBAL_OK) return resolution;
+    }
     // From the instance's own clock (the host's current_time was checked against its time by the
     // interface): any start time gives the same model times, bit for bit.
     const double step_start = clock_;

@@ -31,6 +31,7 @@ std::unique_ptr<HybridIntegrator> HybridIntegrator::create(HybridSystem& system,
         case IntegrationMethod::automatic:
         case IntegrationMethod::dormand_prince:
         case IntegrationMethod::rosenbrock:
+        case IntegrationMethod::real_time:
             break;
     }
     return std::make_unique<OneStepIntegrator>(system, settings, std::move(error_sink), std::move(event_sink));

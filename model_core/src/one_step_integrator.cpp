@@ -50,7 +50,7 @@ OneStepIntegrator::OneStepIntegrator(HybridSystem& system, const IntegratorSetti
     for (Vector& v : dense_) v.setZero(n);
     jacobian_.setZero(n, n);
     iteration_matrix_.setZero(n, n);
-    if (settings_.method == IntegrationMethod::rosenbrock) memory_.stiff = 1;
+    if (settings_.method == IntegrationMethod::rosenbrock || real_time()) memory_.stiff = 1;
 }
 
 bool OneStepIntegrator::rhs(double time, const Vector& y, Vector& dy) {
@@ -110,7 +110,7 @@ bool OneStepIntegrator::restart(double time, const double* state) {
 
 bool OneStepIntegrator::resume(double time, const double* state, const IntegratorMemory& memory) {
     memory_ = memory;
-    if (settings_.method == IntegrationMethod::rosenbrock) memory_.stiff = 1;
+    if (settings_.method == IntegrationMethod::rosenbrock || real_time()) memory_.stiff = 1;
     if (settings_.method == IntegrationMethod::dormand_prince) memory_.stiff = 0;
     return restart(time, state);
 }
@@ -291,7 +291,8 @@ OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, doubl
     solve(error_, k[5] / (h * gamma));
     const double err = error_norm(error_, y_, y_new_);
     const double raw = std::pow(err, 0.25) / kSafety;
-    if (!(err <= 1.0)) {
+    // The real-time method takes every step: its grid is fixed.
+    if (!(err <= 1.0) && !real_time()) {
         memory_.step_size = h / std::min(1.0 / kMaxShrink, raw);
         memory_.last_step_rejected = 1;
         return StepResult::rejected;
@@ -436,7 +437,7 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
     const double tolerance = 100.0 * kEpsilon * (std::fabs(t_) + (t_new_ - t_));
     double weight = 1.0;
     int previous_side = 0;
-    for (int iteration = 0; iteration < 100 && high - low > tolerance; ++iteration) {
+    for (int iteration = 0; iteration < settings_.event_iterations && high - low > tolerance; ++iteration) {
         double estimate = high;
         for (int k = 0; k < event_count_; ++k) {
             if (!crossed(g_low_[k], g_high_[k])) continue;
@@ -521,7 +522,7 @@ bool OneStepIntegrator::advance(double end_time, double* state) {
     // A failed advance leaves the controller where it was (the caller rolls the state back): a step
     // size shrunk to nothing on the way must not fail the next attempt from a healthy point.
     const IntegratorMemory at_start = memory_;
-    if (advance_steps(end_time, state)) return true;
+    if (real_time() ? advance_fixed_substeps(end_time, state) : advance_steps(end_time, state)) return true;
     memory_ = at_start;
     return false;
 }
@@ -532,6 +533,80 @@ bool OneStepIntegrator::advance_until_mode_change(double end_time, double* state
     stop_at_mode_change_ = false;
     reached = t_;
     return advanced;
+}
+
+bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
+    // The grid is fixed by the communication step alone: a mode change located inside a substep ends
+    // that step early, and a shorter one finishes it, so the work per communication step is bounded by
+    // the substeps plus, per located mode change, its iterations and one step.
+    const double start = t_;
+    const int substeps = std::max(1, settings_.substeps);
+    const double grid_step = (end_time - start) / substeps;
+    std::int64_t changes_here = 0;
+    for (int k = 1; k <= substeps; ++k) {
+        const double grid_end = k == substeps ? end_time : start + k * grid_step;
+        while (t_ < grid_end) {
+            if (memory_.chattering.dwell_until > -1e300 && t_ >= memory_.chattering.dwell_until && !reselect_after_dwell())
+                return false;
+            const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
+            const double remaining = grid_end - t_;
+            if (remaining <= smallest) {
+                // A mode change located a few ulp short of the grid point: the derivative is exact to
+                // rounding over such a span.
+                for (int i = 0; i < size_; ++i) y_[i] += remaining * f_[i];
+                t_ = grid_end;
+                if (!refresh_at_current_point()) return false;
+                break;
+            }
+            t_new_ = grid_end;
+            if (t_ < memory_.chattering.dwell_until && memory_.chattering.dwell_until < t_new_ &&
+                memory_.chattering.dwell_until - t_ > smallest)
+                t_new_ = memory_.chattering.dwell_until;
+            if (!jacobian_at(t_, y_) || !time_derivative_at_current_point()) {
+                error_sink_("the Jacobian or the right-hand side is not finite at t = " + std::to_string(t_));
+                return false;
+            }
+            if (rosenbrock_step(t_new_ - t_, t_new_) != StepResult::accepted) {
+                std::ostringstream s;
+                s.precision(17);
+                s << "the real-time method's step from t = " << t_ << " to " << t_new_
+                  << " is not finite: solver.substeps = " << substeps << " is too few for this model";
+                error_sink_(s.str());
+                return false;
+            }
+            ++totals_.steps;
+            bool event_found = false;
+            const std::int64_t events_before = totals_.events;
+            if (!handle_events(event_found)) return false;
+            changes_here += totals_.events - events_before;
+            if (settings_.mode_changes_per_step > 0 && changes_here > settings_.mode_changes_per_step) {
+                std::ostringstream s;
+                s.precision(17);
+                s << "more than " << settings_.mode_changes_per_step << " mode changes in the communication step "
+                  << "ending at t = " << end_time << " (the real-time method's bound: its work per step is "
+                  << "fixed, and switching later is not safe at a stiff contact); raise solver.substeps, or "
+                  << "model the gear without backlash if the scene does not need it";
+                error_sink_(s.str());
+                return false;
+            }
+            if (event_found) {
+                if (stop_at_mode_change_ && totals_.events > events_before && t_ < end_time) {
+                    for (int i = 0; i < size_; ++i) state[i] = y_[i];
+                    return true;
+                }
+                continue;
+            }
+            t_ = t_new_;
+            std::swap(y_, y_new_);
+            std::swap(f_, f_new_);
+            std::swap(g_, g_new_);
+            if (event_count_ > 0 && t_ >= memory_.chattering.dwell_until && memory_.chattering.dwell_until > -1e300 &&
+                !reselect_after_dwell())
+                return false;
+        }
+    }
+    for (int i = 0; i < size_; ++i) state[i] = y_[i];
+    return true;
 }
 
 bool OneStepIntegrator::advance_steps(double end_time, double* state) {

@@ -46,6 +46,9 @@ private:
     enum class StepResult { accepted, rejected, failed };
 
     bool advance_steps(double end_time, double* state);
+    // The real-time method: RODAS4 over a fixed grid of equal substeps, every step accepted.
+    bool advance_fixed_substeps(double end_time, double* state);
+    bool real_time() const { return settings_.method == IntegrationMethod::real_time; }
     bool rhs(double time, const Vector& y, Vector& dy);
     bool event_values(double time, const Vector& y, std::vector<double>& values);
     bool guards_at(double time, const double* state, double* values);

@@ -81,6 +81,7 @@ static_assert(IntegrationMethod_cvode_bdf == static_cast<int>(IntegrationMethod:
                   IntegrationMethod_automatic == static_cast<int>(IntegrationMethod::automatic) &&
                   IntegrationMethod_dormand_prince == static_cast<int>(IntegrationMethod::dormand_prince) &&
                   IntegrationMethod_rodas4 == static_cast<int>(IntegrationMethod::rosenbrock) &&
+                  IntegrationMethod_real_time == static_cast<int>(IntegrationMethod::real_time) &&
                   items_are("IntegrationMethod", 0, kIntegrationMethodCount - 1),
               "IntegrationMethod items are the core's methods, and the validation accepts 0..kIntegrationMethodCount-1");
 static_assert(variable_table::joins(variable_table::kInteger[vi_gear1_model].declared_type, "GearModel", "") &&
@@ -183,7 +184,8 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     if (integers[vi_solver_method] < 0 || integers[vi_solver_method] >= kIntegrationMethodCount) {
         error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
                 " is invalid: it must be 4 (automatic: Dormand-Prince 5(4), RODAS4 while stiff; the default), "
-                "5 (Dormand-Prince 5(4) only), 6 (RODAS4 only), or a SUNDIALS reference method: 0 (CVODE BDF, "
+                "5 (Dormand-Prince 5(4) only), 6 (RODAS4 only), 7 (real time: RODAS4 in fixed substeps), or a "
+                "SUNDIALS reference method: 0 (CVODE BDF, "
                 "analytic Jacobian), 1 (CVODE BDF, difference quotients), 2 (CVODE Adams) or 3 (ARKODE explicit "
                 "Runge-Kutta)";
         return false;
@@ -192,10 +194,17 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
                 " is not available in this binary: it was built without SUNDIALS (as the FMU's win64 binary and "
                 "builds from its sources/ are), and methods 0-3 are SUNDIALS' CVODE and ARKODE; use 4 (automatic: "
-                "Dormand-Prince 5(4), RODAS4 while stiff; the default), 5 (Dormand-Prince 5(4) only) or 6 (RODAS4 only)";
+                "Dormand-Prince 5(4), RODAS4 while stiff; the default), 5 (Dormand-Prince 5(4) only), 6 (RODAS4 only) "
+                "or 7 (real time)";
         return false;
     }
     params.method = integers[vi_solver_method];
+    if (integers[vi_solver_substeps] < 1 || integers[vi_solver_substeps] > 10000) {
+        error = "solver.substeps = " + std::to_string(integers[vi_solver_substeps]) +
+                " is invalid: it must lie in [1, 10000]";
+        return false;
+    }
+    params.substeps = integers[vi_solver_substeps];
 
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
     const IntegerVariable motor_models[2] = {vi_motor1_model, vi_motor2_model};

@@ -103,6 +103,7 @@ private:
     bool build_parameters(ModelParameters& params, std::string& error) const;
     void load_start_state();
     GimbalStatus check_fixed_base() const;
+    GimbalStatus check_real_time_resolution(double step_size);
     std::unique_ptr<HybridIntegrator> make_integrator(GimbalHybridSystem& system, const ModelParameters& params);
     void create_integrator();
     // What a failed or interrupted step returns to.

@@ -65,6 +65,7 @@ struct ModelParameters {
     double absolute_tolerance = 1e-8;
     long max_steps = 100000;  // per communication step
     int method = 0;           // IntegrationMethod
+    int substeps = 1;         // real-time method: equal substeps per communication step
 
     // Derived by finalize(): the layout, dry friction per padded coordinate (a rigid axis merges its
     // rotor's friction into the load's), and the share of a merged element attributed to the rotor.

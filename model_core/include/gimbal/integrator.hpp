@@ -38,8 +38,9 @@ enum class IntegrationMethod : int {
     automatic = 4,                // own: Dormand-Prince 5(4), RODAS4 while the problem is stiff (default)
     dormand_prince = 5,           // own: Dormand-Prince 5(4) only
     rosenbrock = 6,               // own: RODAS4 only
+    real_time = 7,                // own: RODAS4 in a fixed number of equal substeps, bounded event work
 };
-constexpr int kIntegrationMethodCount = 7;
+constexpr int kIntegrationMethodCount = 8;
 
 inline bool is_sundials_method(IntegrationMethod method) { return static_cast<int>(method) <= 3; }
 
@@ -58,6 +59,12 @@ struct IntegratorSettings {
     double absolute_tolerance = 1e-8;
     long max_steps = 100000;  // internal steps per call of advance
     double max_step = 0.0;    // 0: unlimited. Events are seen as sign changes between steps.
+    // Real-time method: equal substeps per communication step, at most `event_iterations` Illinois
+    // iterations to locate each mode change, at most `mode_changes_per_step` located mode changes in
+    // one communication step (more fail the step: switching late is not safe at a stiff contact).
+    int substeps = 1;
+    int event_iterations = 100;
+    int mode_changes_per_step = 0;  // 0: no limit
     // Chattering guard: this many located roots in a row, each within `zeno_window` seconds of the
     // previous one, freeze the event functions for `zeno_dwell` seconds; modes are then re-selected
     // from the functions' signs. Switches further apart than the window (chatter below 1 GHz) are
