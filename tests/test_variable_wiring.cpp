@@ -172,6 +172,7 @@ const std::map<std::string, IntegerField>& integer_parameter_fields() {
         {"motor2.model", [](const ModelParameters& m) { return static_cast<long>(m.fidelity.motor[1]); }},
         {"solver.method", [](const ModelParameters& m) { return static_cast<long>(m.method); }},
         {"solver.max_steps", [](const ModelParameters& m) { return m.max_steps; }},
+        {"solver.substeps", [](const ModelParameters& m) { return static_cast<long>(m.substeps); }},
     };
     return fields;
 }
@@ -231,9 +232,9 @@ void check_integer_parameters() {
     // every pair differs in one of these two.
     const std::map<std::string, int> settings[2] = {
         {{"gear1.model", 2}, {"gear2.model", 1}, {"motor1.model", 0}, {"motor2.model", 1}, {"solver.method", 6},
-         {"solver.max_steps", 12345}},
+         {"solver.max_steps", 12345}, {"solver.substeps", 3}},
         {{"gear1.model", 0}, {"gear2.model", 2}, {"motor1.model", 1}, {"motor2.model", 0}, {"solver.method", 2},
-         {"solver.max_steps", 777}},
+         {"solver.max_steps", 777}, {"solver.substeps", 250}},
     };
     for (const auto& setting : settings) {
         Values values;
