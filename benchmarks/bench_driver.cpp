@@ -687,6 +687,9 @@ void print_report(const Options& o, const Report& r) {
         std::printf(", \"dostep_p50_s\": %s, \"dostep_p99_s\": %s, \"dostep_p999_s\": %s, "
                     "\"dostep_max_s\": %s", num(r.dostep_p50).c_str(), num(r.dostep_p99).c_str(),
                     num(r.dostep_p999).c_str(), num(r.dostep_max).c_str());
+        std::printf(", \"rhs_per_dostep_median\": %s, \"rhs_per_dostep_p999\": %s, \"rhs_per_dostep_max\": %s",
+                    num(r.rhs_per_dostep_median).c_str(), num(r.rhs_per_dostep_p999).c_str(),
+                    num(r.rhs_per_dostep_max).c_str());
         for (int c = 0; c < 5; ++c) std::printf(", \"%s\": %ld", kCounterKeys[c], r.counters[c]);
         std::printf(", \"instance_allocations\": %llu, \"instance_bytes\": %lld, \"first_step_allocations\": %llu, "
                     "\"dostep_allocations\": %llu, \"dostep_alloc_bytes\": %llu",

@@ -12,14 +12,17 @@ disturb it. Steps:
    tolerance (rtol 1e-12, atol 1e-14, method 0 or the FMU's default), and a second one with ARKODE's
    explicit RK (method 3) at the same tolerance to show how far the reference itself can be trusted;
 2. the work-precision sweep: the integrators of `solver.method` (by default 4 automatic, 5
-   Dormand-Prince, 6 RODAS4, and the references 0 CVODE BDF and 3 ARKODE explicit Runge-Kutta) x
-   fidelity x rtol in 1e-4 ... 1e-10 (atol = rtol * 1e-2): CPU time and the max error of alpha, beta
-   and los.omega against the reference at every communication point;
+   Dormand-Prince, 6 RODAS4, 7 the real-time method, and the references 0 CVODE BDF and 3 ARKODE
+   explicit Runge-Kutta) x fidelity x rtol in 1e-4 ... 1e-10 (atol = rtol * 1e-2; the real-time
+   method x 1, 2, 4, 8 substeps instead): CPU time and the max error of alpha, beta and los.omega
+   against the reference at every communication point;
 3. cost against simulated time (1, 10, 100, 1000 s) with the FMU's default integrator, full fidelity;
 4. the FMI overhead (doStep of a model at rest, 1 us steps) and the instance memory;
 5. heap allocations inside doStep and their call sites;
 6. the stiff variants (L = 1e-7 H, k_s = 1e8 N.m/rad, c_s = 1e-6 N.m.s/rad) at default settings,
-   against CVODE BDF at rtol 1e-11 and at its own defaults.
+   against CVODE BDF at rtol 1e-11 and at its own defaults;
+7. single doSteps of the default and of the real-time method (1, 2, 4 substeps): median, p99, p99.9
+   and maximum in wall time and in right-hand sides.
 
 Writes benchmarks/results/results.json and benchmarks/results/work_precision.png, prints a summary.
 """
@@ -51,7 +54,11 @@ METHOD_NAMES = {
     4: "automatic DP5 / RODAS4 (default)",
     5: "Dormand-Prince 5(4)",
     6: "RODAS4",
+    7: "real time: RODAS4, fixed substeps",
 }
+REAL_TIME = 7
+# The real-time method has no tolerance: its accuracy is set by the substeps per doStep.
+REAL_TIME_SUBSTEPS = (1, 2, 4, 8)
 FIDELITIES = ("full", "reduced")
 TARGET_BETA_ERROR = 1e-6
 TARGET_RTF = {"full": 1e3, "reduced": 3e3}
@@ -96,8 +103,10 @@ class Driver:
 
     def run(self, *, method=None, fidelity="full", rtol=None, atol=None, duration=10.0, step=1e-3,
             trajectory=False, overhead=False, overhead_steps=None, trace=False, timeout=None,
-            parameters=None) -> dict:
+            parameters=None, time_dostep=False) -> dict:
         cmd = [str(self.bench), "--fmu", str(self.so), "--json", "--fidelity", fidelity]
+        if time_dostep:
+            cmd.append("--time-dostep")
         for name, value in (parameters or {}).items():
             cmd += ["--set", f"{name}={value!r}"]
         if not trace:
@@ -201,7 +210,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--rtols", default="1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10")
     ap.add_argument("--atol-factor", type=float, default=1e-2, help="atol = rtol * this (default 1e-2)")
     ap.add_argument("--methods", default=None,
-                    help="comma-separated solver.method values (default 4,5,6,0,3: the project's own methods and the "
+                    help="comma-separated solver.method values (default 4,5,6,7,0,3: the project's own methods and the "
                          "SUNDIALS BDF and explicit references; 1 and 2 on request)")
     ap.add_argument("--stiff-duration", type=float, default=2.0, help="simulated time of the stiff variants [s]")
     ap.add_argument("--fidelities", default="full,reduced")
@@ -256,6 +265,7 @@ def main(argv=None) -> int:
         results["fmi_overhead"] = fmi_overhead(drv, fidelities, args.overhead_steps)
         results["allocations_in_dostep"] = allocations_in_dostep(drv, fidelities, args.step)
         results["stiff_cases"] = stiff_cases(drv, args.stiff_duration, args.step, args.run_timeout)
+        results["single_dosteps"] = single_dosteps(drv, args.duration, args.step)
 
     results["elapsed_s"] = round(time.time() - t_start, 1)
     write_results(results, args.out, methods, fidelities, args.duration)
@@ -299,7 +309,7 @@ def choose_methods(drv: Driver, requested: str | None) -> list | None:
             return None
         return methods
     if drv.has_method:
-        return [4, 5, 6, 0, 3] if drv.default_method == 4 else [0, 1, 2, 3]
+        return [4, 5, 6, REAL_TIME, 0, 3] if drv.default_method == 4 else [0, 1, 2, 3]
     log("note: the FMU has no parameter 'solver.method': only its default integrator is measured")
     return [None]
 
@@ -336,15 +346,18 @@ def work_precision_sweep(drv: Driver, methods, fidelities, rtols, args, referenc
     sweep = []
     for fid in fidelities:
         for m in methods:
-            for rtol in rtols:
-                atol = rtol * args.atol_factor
+            # The real-time method's axis is its substeps (rtol None), every other method's its tolerance.
+            settings = ([(None, None, n) for n in REAL_TIME_SUBSTEPS] if m == REAL_TIME else
+                        [(rtol, rtol * args.atol_factor, None) for rtol in rtols])
+            for rtol, atol, substeps in settings:
+                parameters = {"solver.substeps": substeps} if substeps else None
                 run = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
-                              step=args.step, trajectory=True)
+                              step=args.step, trajectory=True, parameters=parameters)
                 # Cheap runs are noisy: keep the fastest of up to three.
                 if not run.get("failure") and run["cpu_s"] < 0.5:
                     for _ in range(2):
                         again = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
-                                        step=args.step)
+                                        step=args.step, parameters=parameters)
                         if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
                             for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
                                 run[key] = again[key]
@@ -352,10 +365,10 @@ def work_precision_sweep(drv: Driver, methods, fidelities, rtols, args, referenc
                     fmu_cpu = run["cpu_s"] - (run.get("master_cpu_s") or 0.0)
                     run["fmu_cpu_s"] = fmu_cpu
                     run["fmu_rtf"] = run["simulated"] / fmu_cpu if fmu_cpu > 0 else None
-                point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol,
+                point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol, "substeps": substeps,
                          **errors_against(run, references[fid]), **strip(run)}
                 sweep.append(point)
-                log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} rtol {rtol:.0e}: "
+                log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} {setting_label(point):>7s}: "
                     + (f"FAILED {run['failure']}" if run.get("failure") else
                        f"cpu {run['cpu_s']:.3f} s  rtf {run['rtf']:9.1f}  err beta {fmt(point['err_beta'])}  "
                        f"alpha {fmt(point['err_alpha'])}  omega {fmt(point['err_omega'])}  "
@@ -364,6 +377,13 @@ def work_precision_sweep(drv: Driver, methods, fidelities, rtols, args, referenc
                     log("  (tighter tolerances of this method skipped)")
                     break
     return sweep
+
+
+def setting_label(point: dict) -> str:
+    """What sets a sweep point's accuracy: its rtol, or the real-time method's substeps."""
+    if point.get("substeps"):
+        return f"n={point['substeps']}"
+    return f"{point['rtol']:.0e}".replace("e-0", "e-")
 
 
 def at_target_error(sweep: list, methods, fidelities) -> list:
@@ -375,7 +395,8 @@ def at_target_error(sweep: list, methods, fidelities) -> list:
                   and p["err_beta"] <= TARGET_BETA_ERROR]
             if ok:
                 p = min(ok, key=lambda p: p["cpu_s"])
-                best.append({"fidelity": fid, "method": m, "rtol": p["rtol"], "cpu_s": p["cpu_s"],
+                best.append({"fidelity": fid, "method": m, "rtol": p["rtol"], "substeps": p.get("substeps"),
+                             "cpu_s": p["cpu_s"],
                              "rtf": p["rtf"], "fmu_rtf": p.get("fmu_rtf"),
                              "cpu_us_per_step": p["cpu_us_per_step"], "err_beta": p["err_beta"], "err_alpha": p["err_alpha"],
                              "err_omega": p["err_omega"], "target_rtf": TARGET_RTF.get(fid),
@@ -455,6 +476,26 @@ def write_results(results: dict, out: pathlib.Path, methods, fidelities, duratio
         f"{png.relative_to(REPO) if png.is_relative_to(REPO) else png} in {results['elapsed_s']:.0f} s")
 
 
+def single_dosteps(drv: Driver, duration: float, step: float) -> list:
+    """Step 7: the distribution of single doSteps, in wall time (the machine's noise included) and in
+    right-hand sides (the work, free of it): the default and the real-time method at 1, 2, 4 substeps."""
+    runs = []
+    for label, method, parameters in (("default", None, None),
+                                      *((f"real time, {n} substep{'s' if n > 1 else ''}", REAL_TIME,
+                                         {"solver.substeps": n}) for n in (1, 2, 4))):
+        log(f"[doStep] {label}: {duration:g} s, every doStep timed ...")
+        run = drv.run(method=method, duration=duration, step=step, parameters=parameters, time_dostep=True)
+        entry = {"label": label, "method": method, "parameters": parameters, **strip(run)}
+        runs.append(entry)
+        if run.get("failure"):
+            log(f"  FAILED {run['failure']}")
+            continue
+        log(f"  wall us: median {1e6 * run['dostep_p50_s']:.2f}  p99 {1e6 * run['dostep_p99_s']:.2f}  "
+            f"p99.9 {1e6 * run['dostep_p999_s']:.2f}  max {1e6 * run['dostep_max_s']:.2f};  right-hand sides: median "
+            f"{run['rhs_per_dostep_median']:.0f}  p99.9 {run['rhs_per_dostep_p999']:.0f}  max {run['rhs_per_dostep_max']:.0f}")
+    return runs
+
+
 def stiff_cases(drv: Driver, duration: float, step: float, timeout: float) -> list:
     """Each stiff variant at default settings, against CVODE BDF at rtol 1e-11 and at its default."""
     cases = []
@@ -489,7 +530,7 @@ def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float
     import matplotlib.pyplot as plt
 
     colors = {None: "k", 0: "tab:blue", 1: "tab:orange", 2: "tab:green", 3: "tab:red", 4: "k", 5: "tab:purple",
-              6: "tab:brown"}
+              6: "tab:brown", REAL_TIME: "tab:cyan"}
     styles = {"full": ("-", "o"), "reduced": ("--", "s")}
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.8), sharey=True)
     for ax, key, label in ((axes[0], "err_beta", "max error of beta [rad]"),
@@ -506,7 +547,7 @@ def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float
                 ax.loglog(x, y, ls=ls, marker=mk, color=colors.get(m, "gray"), ms=4,
                           label=f"{METHOD_NAMES.get(m, m)}, {fid}")
                 for p, xi, yi in zip(pts, x, y):
-                    ax.annotate(f"{p['rtol']:.0e}".replace("e-0", "e-"), (xi, yi), fontsize=6, alpha=0.6,
+                    ax.annotate(setting_label(p), (xi, yi), fontsize=6, alpha=0.6,
                                 xytext=(2, 2), textcoords="offset points")
         ax.set_xlabel(label)
         ax.grid(True, which="both", alpha=0.3)
@@ -524,7 +565,7 @@ def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float
     fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=4, frameon=False)
     m = results["machine"]
     fig.suptitle(f"Gimbal2Axis work-precision, ship stabilization {duration:g} s at 1 kHz "
-                 f"(labels: rtol; atol = rtol/100)\n{m['cpu']}, {m['compiler']}, commit {m['git_commit'][:10]}"
+                 f"(labels: rtol, atol = rtol/100; n = the real-time method's substeps)\n{m['cpu']}, {m['compiler']}, commit {m['git_commit'][:10]}"
                  f"{' (dirty)' if m['git_dirty'] else ''}", fontsize=9)
     fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=90)
@@ -537,9 +578,9 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
         f"{'err alpha':>9s} {'err omega':>9s} {'steps':>8s} {'rhs':>9s} {'jac':>7s} {'events':>6s}")
     for p in results["sweep"]:
         if p.get("failure"):
-            log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {p['rtol']:7.0e}  FAILED: {p['failure'][:60]}")
+            log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {setting_label(p):>7s}  FAILED: {p['failure'][:60]}")
             continue
-        log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {p['rtol']:7.0e} {p['cpu_s']:9.3f} "
+        log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {setting_label(p):>7s} {p['cpu_s']:9.3f} "
             f"{p['rtf']:10.1f} {fmt(p['err_beta']):>9s} {fmt(p['err_alpha']):>9s} {fmt(p['err_omega']):>9s} "
             f"{p['solver_steps']:8d} {p['rhs_evaluations']:9d} {p['jacobian_evaluations']:7d} {p['events']:6d}")
     log(f"\n=== at max beta error <= {TARGET_BETA_ERROR:g} rad (cheapest tolerance of the sweep) ===")
@@ -547,7 +588,8 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
     for b in results["at_target_error"]:
         log(f"{b['fidelity']:8s} {METHOD_NAMES.get(b['method'], b['method'])!s:38s} {fmt(b['rtol'], '.0e'):>7s} "
             f"{fmt(b.get('cpu_us_per_step'), '.2f'):>8s} {fmt(b['rtf'], '.1f'):>9s} {fmt(b.get('fmu_rtf'), '.1f'):>9s} "
-            f"{fmt(b['target_rtf'], '.0f'):>7s}  {'yes' if b['meets_target'] else 'NO'}")
+            f"{fmt(b['target_rtf'], '.0f'):>7s}  {'yes' if b['meets_target'] else 'NO'}"
+            + (f"  (substeps {b['substeps']})" if b.get("substeps") else ""))
     log("(RTF = simulated / CPU time of the whole master loop; RTF FMU leaves out the master's own share)")
     log("\n=== cost against simulated time (FMU default integrator, full fidelity) ===")
     for g in results["cost_vs_duration"]["runs"]:
@@ -584,6 +626,18 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
             log(f"{c['case']:22s} {label:13s} " + (f"FAILED {r['failure'][:60]}" if r.get("failure") else
                 f"RTF {r['rtf']:8.1f}  {r['cpu_us_per_step']:8.1f} us/step  err beta {fmt(r['err_beta'])}  "
                 f"alpha {fmt(r['err_alpha'])}  omega {fmt(r['err_omega'])}"))
+
+    log("\n=== single doSteps (wall time includes the machine's noise; right-hand sides are the work) ===")
+    log(f"{'':26s} {'median':>8s} {'p99':>8s} {'p99.9':>8s} {'max':>8s}  [us wall]   {'median':>6s} {'p99.9':>6s} "
+        f"{'max':>6s}  [right-hand sides]  max/median")
+    for r in results.get("single_dosteps", []):
+        if r.get("failure"):
+            log(f"{r['label']:26s} FAILED {r['failure'][:60]}")
+            continue
+        wall = [1e6 * r[k] for k in ("dostep_p50_s", "dostep_p99_s", "dostep_p999_s", "dostep_max_s")]
+        work = [r[k] for k in ("rhs_per_dostep_median", "rhs_per_dostep_p999", "rhs_per_dostep_max")]
+        log(f"{r['label']:26s} " + " ".join(f"{w:8.2f}" for w in wall) + "             "
+            + " ".join(f"{w:6.0f}" for w in work) + f"                      {wall[3] / wall[0]:.1f} / {work[2] / work[0]:.1f}")
 
 
 if __name__ == "__main__":
