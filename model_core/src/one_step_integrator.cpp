@@ -570,7 +570,8 @@ bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
                 std::ostringstream s;
                 s.precision(17);
                 s << "the real-time method's step from t = " << t_ << " to " << t_new_
-                  << " is not finite: solver.substeps = " << substeps << " is too few for this model";
+                  << " failed (a state or right-hand side not finite, or a singular iteration matrix): "
+                  << "solver.substeps = " << substeps << " is too few for this model";
                 error_sink_(s.str());
                 return false;
             }
