@@ -494,7 +494,12 @@ def stability_margins(frequencies, L) -> StabilityMargins:
     interpolated on the unwrapped phase). Of several crossings the worst is reported: the gain crossover
     with the smallest |phase margin| and the phase crossover with the smallest |gain margin| in dB (a
     resonance may cross twice). A -180 deg crossing is one where the phase of -L passes 0 (L on the
-    negative real axis), not a jump of the wrapped phase at +-180 deg of -L."""
+    negative real axis), not a jump of the wrapped phase at +-180 deg of -L.
+
+    Not python-control's `stability_margins(frd(L, 2 pi f), returnall=True)`, although it finds the
+    same crossings (to 1e-5 on the textbook loops of tests/test_loop_gain.py, control 0.10.2): on the
+    40,000-point grids used here it took 3.9 s of CPU per call against 2.8 ms for this one (measured
+    2026-11-25), and `predicted_margins` calls it per axis and per scene."""
     f = np.asarray(frequencies, float)
     L = np.asarray(L, complex)
     if f.ndim != 1 or f.shape != L.shape or len(f) < 2 or np.any(np.diff(f) <= 0) or np.any(f <= 0):
