@@ -40,7 +40,7 @@ bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
 }
 
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 6;
+constexpr std::uint32_t kSnapshotVersion = 7;
 
 // Plain integers and doubles only, flags as bytes: any byte pattern decodes without undefined
 // behaviour, and check_snapshot() decides whether it is a state this model can be in.
@@ -676,9 +676,13 @@ GimbalStatus GimbalInstance::check_snapshot(const void* buffer, bool& initialize
         for (std::int64_t value : statistics) check.count("integrator statistic", value);
         const IntegratorMemory& m = snap.integrator_memory;
         const double memory_reals[] = {m.step_size, m.previous_error, m.chattering.last_event_time,
-                                       m.chattering.dwell_until};
-        check.finite("integrator memory", memory_reals, 4);
+                                       m.chattering.dwell_until, m.accuracy_step, m.accuracy_time,
+                                       m.explicit_step, m.stable_product, m.jump_time, m.jump_step};
+        check.finite("integrator memory", memory_reals, 10);
         if (!(m.step_size >= 0.0)) check.fail("the saved step size is negative");
+        if (!(m.accuracy_step >= 0.0) || !(m.explicit_step >= 0.0) || !(m.stable_product >= 0.0))
+            check.fail("a saved step of the switch rule is negative");
+        if (!(m.jump_step >= 0.0) || m.steps_since_jump < -1) check.fail("the saved input jump is invalid");
         if (!(m.previous_error > 0.0)) check.fail("the saved error estimate is not positive");
         check.flag("stiff", static_cast<std::uint8_t>(m.stiff < 0 || m.stiff > 1 ? 2 : m.stiff));
         check.flag("last_step_rejected",

@@ -27,6 +27,51 @@ constexpr int kVotesForStiff = 3, kVotesForNonstiff = 3;
 // The explicit method counts as stable at |h lambda| below this (its boundary is ~3.3), with margin.
 constexpr double kExplicitStableBound = 2.5;
 
+// Automatic method: the work of one step of each method in right-hand-side equivalents, for the switch
+// rule's predicted costs. Measured with callgrind (valgrind 3.19, g++ 12.2 -O3, gimbal_bench on 0.2 s
+// of the ship scene with methods 5 and 6; instructions inclusive, per accepted step, over those of one
+// GimbalHybridSystem::derivative: 1,745 at full fidelity, 1,558 reduced):
+// - Dormand-Prince: dormand_prince_step + handle_events = 8.9 RHS at full fidelity (12 states), 8.4
+//   reduced (4 states): 6 right-hand sides, the stage arithmetic, the error norm, the event functions.
+// - RODAS4: rosenbrock_step + jacobian_at + time_derivative_at_current_point + handle_events = 24.9 RHS
+//   at full fidelity, 16.8 reduced: 6 + 1 right-hand sides, the analytic Jacobian (6.4 and 5.9: mostly
+//   the rigid body's, which does not shrink with the fidelity), the event functions, and the LU with 7
+//   solves, which grow with the state size: 17,900 instructions besides the right-hand sides at 12
+//   states, 4,500 at 4, i.e. 1.6 + 0.063 n^2 RHS. Fitted: 9.6 + 0.063 n^2 + the Jacobian.
+// So RODAS4 costs 2.8 Dormand-Prince steps at full fidelity and 2.0 reduced: the ratio depends on the
+// state size, and on the Jacobian (by differences it costs n right-hand sides; 6.2 is this model's
+// analytic one).
+constexpr double kExplicitStepCost = 8.7;
+constexpr double kRosenbrockStepCostFixed = 9.6;       // 7 right-hand sides, the event functions, the rest
+constexpr double kRosenbrockStepCostPerState2 = 0.063;  // LU and solves, per n^2
+constexpr double kAnalyticJacobianCost = 6.2;
+// Switch only when the other method is predicted cheaper by this factor: the prediction is rough (the
+// stability limit from an estimate of |lambda_max|, the accuracy step from the last one seen) and a
+// switch costs a Jacobian and a restarted controller. Measured (docs/benchmarks.md): 1.15, 1.3 and 1.5
+// did equally well on the 25 random cases of scripts/random_cases.py (worst 1.009-1.012 times the
+// better single method's work, in all 0.957-0.958 times), 1.5 with the fewest switches (539 against
+// 551 and 587) and on the k_s = 1e8 variant the least work (1.3: 1.8 % more).
+constexpr double kSwitchMargin = 1.5;
+// While the explicit method runs at its stability limit it cannot see RODAS4's accuracy step: the last
+// one seen is assumed to grow by this much per unit time (1 ms per second), so that an outdated short
+// one cannot keep the explicit method forever; RODAS4 is then tried again and measures it. (0.01 made
+// the explicit method hand over too early where its stable step is close to RODAS4's: a round trip
+// every few milliseconds on the random cases.)
+constexpr double kAccuracyStepGrowth = 0.001;
+// An explicit step this far inside the stability region (h |lambda|, Hairer's estimate) was limited by
+// accuracy: its proposal is the accuracy step.
+constexpr double kAccuracyLimited = 0.5 * kExplicitStableBound;
+// Bound on the explicit method's step at its stability limit times the estimate of |lambda_max|.
+constexpr double kMaxStableProduct = 10.0;
+// After an input jump both methods take short steps through the transient, growing them over tens of
+// steps; until RODAS4's step is back to this fraction of the step before the jump, it neither votes
+// nor is remembered: at such a step any method is stable, but the explicit method would meet its
+// stability limit a few steps later, with only the transient's short steps to compare with.
+constexpr double kSettledFraction = 0.5;
+// Nor while its steps still grow by more than this per step (from the first step of a run, or after a
+// switch, which restarts the step size controller).
+constexpr double kSettledGrowth = 1.5;
+
 }  // namespace
 
 OneStepIntegrator::OneStepIntegrator(HybridSystem& system, const IntegratorSettings& settings,
@@ -51,6 +96,10 @@ OneStepIntegrator::OneStepIntegrator(HybridSystem& system, const IntegratorSetti
     jacobian_.setZero(n, n);
     iteration_matrix_.setZero(n, n);
     if (settings_.method == IntegrationMethod::rosenbrock || real_time()) memory_.stiff = 1;
+    const double states = size_;
+    cost_ratio_ = (kRosenbrockStepCostFixed + kRosenbrockStepCostPerState2 * states * states +
+                   (system.has_jacobian() ? kAnalyticJacobianCost : states)) /
+                  kExplicitStepCost;
 }
 
 bool OneStepIntegrator::rhs(double time, const Vector& y, Vector& dy) {
@@ -98,6 +147,22 @@ bool OneStepIntegrator::refresh_at_current_point(const int* decided) {
 }
 
 bool OneStepIntegrator::restart(double time, const double* state) {
+    if (settings_.method == IntegrationMethod::automatic) {
+        // An input jump. If RODAS4 ran all the way from the previous one, its mean step over the
+        // interval, transient included, is the accuracy step it is remembered by: with inputs that jump
+        // at every communication point, the transients can take most of its steps.
+        if (memory_.steps_since_jump > 0 && time > memory_.jump_time) {
+            memory_.accuracy_step = (time - memory_.jump_time) / memory_.steps_since_jump;
+            memory_.accuracy_time = time;
+        }
+        memory_.jump_time = time;
+        memory_.jump_step = memory_.step_size;
+        memory_.steps_since_jump = memory_.stiff ? 0 : -1;
+    }
+    return start_at(time, state);
+}
+
+bool OneStepIntegrator::start_at(double time, const double* state) {
     if (size_ > kMaxStates) {
         error_sink_("the one-step integrators hold at most " + std::to_string(kMaxStates) + " states");
         return false;
@@ -112,7 +177,7 @@ bool OneStepIntegrator::resume(double time, const double* state, const Integrato
     memory_ = memory;
     if (settings_.method == IntegrationMethod::rosenbrock || real_time()) memory_.stiff = 1;
     if (settings_.method == IntegrationMethod::dormand_prince) memory_.stiff = 0;
-    return restart(time, state);
+    return start_at(time, state);
 }
 
 double OneStepIntegrator::error_norm(const Vector& error, const Vector& y_old, const Vector& y_new) const {
@@ -201,6 +266,7 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
         return StepResult::rejected;
     }
     double factor = raw / std::pow(memory_.previous_error, kPiBeta) / kSafety;
+    proposal_limited_ = factor < 1.0 / kMaxGrowth || memory_.last_step_rejected;
     factor = std::clamp(factor, 1.0 / kMaxGrowth, 1.0 / kMaxShrink);
     double next = h / factor;
     if (memory_.last_step_rejected) next = std::min(next, h);
@@ -297,6 +363,7 @@ OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, doubl
         memory_.last_step_rejected = 1;
         return StepResult::rejected;
     }
+    proposal_limited_ = raw < 1.0 / 6.0 || memory_.last_step_rejected;
     double next = h / std::clamp(raw, 1.0 / 6.0, 1.0 / kMaxShrink);
     if (memory_.last_step_rejected) next = std::min(next, h);
     memory_.last_step_rejected = 0;
@@ -375,33 +442,115 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
     return std::pow(growth, 1.0 / kIterations);
 }
 
-bool OneStepIntegrator::explicit_stable_at(double h) const {
-    // Only stable or not matters: a growth far beyond the bound after two iterations settles it without
-    // the rest. An overshoot there only keeps the Rosenbrock method one step longer.
-    return spectral_radius_estimate(20.0 * kExplicitStableBound / h) * h <= kExplicitStableBound;
+// The switch rule of the automatic method, as LSODA's: predicted work per unit time, explicit = its
+// cost per step / min(its accuracy step, its stable step), RODAS4 = its cost per step / its accuracy
+// step. Both accuracy steps are taken as the same (Dormand-Prince's order 5 against RODAS4's 4 and its
+// order-3 error estimate: on the random cases of scripts/random_cases.py RODAS4's steps were 0.7-1.5
+// times Dormand-Prince's where neither is stiff), so RODAS4 over explicit is
+// cost_ratio_ * min(1, stable_step / accuracy_step).
+double OneStepIntegrator::rosenbrock_over_explicit_cost(double accuracy_step, double stable_step) const {
+    return cost_ratio_ * std::min(1.0, stable_step / accuracy_step);
 }
 
-void OneStepIntegrator::vote_on_stiffness_explicit() {
+// The explicit method's stable step at |lambda_max| = lambda: kExplicitStableBound / lambda, or what it
+// was seen to reach. The power iteration's |lambda_max| is rough for the model's non-normal Jacobian
+// (a complex pair, an overshoot): the explicit method has been seen at 1.3-2.7 times 2.5 / lambda.
+double OneStepIntegrator::explicit_stable_step(double lambda) const {
+    return std::max(kExplicitStableBound, memory_.stable_product) / lambda;
+}
+
+// The accuracy step last seen, grown by what the time since may have allowed; 0 if none was seen.
+double OneStepIntegrator::predicted_accuracy_step() const {
+    if (!(memory_.accuracy_step > 0.0)) return 0.0;
+    return memory_.accuracy_step + kAccuracyStepGrowth * std::max(0.0, t_ - memory_.accuracy_time);
+}
+
+void OneStepIntegrator::remember_accuracy_step(double h) {
+    memory_.accuracy_step = h;
+    memory_.accuracy_time = t_;
+}
+
+void OneStepIntegrator::switch_to_rosenbrock() {
+    memory_.stiff = 1;
+    memory_.stiff_votes = memory_.nonstiff_votes = 0;
+    memory_.previous_error = 1e-4;
+    ++totals_.method_switches;
+}
+
+void OneStepIntegrator::vote_on_stiffness_explicit(double h, bool accepted) {
     // stiffness_estimate_ is already h |lambda| of the step just taken.
     if (settings_.method != IntegrationMethod::automatic) return;
+    // The step this one proposes next (h may have been cut short to end on a communication point).
+    const double next = std::max(h, memory_.step_size);
+    memory_.steps_since_jump = -1;
+    if (accepted) memory_.explicit_step = stiffness_estimate_ > kAccuracyLimited ? next : 0.0;
     if (stiffness_estimate_ > tableau::dopri5::stiffness_threshold) {
         memory_.nonstiff_votes = 0;
         if (++memory_.stiff_votes >= kVotesForStiff) {
-            memory_.stiff = 1;
-            memory_.stiff_votes = 0;
-            memory_.previous_error = 1e-4;
-            ++totals_.method_switches;
+            // At the stability boundary: RODAS4 takes over if it is predicted cheaper, at the accuracy
+            // step last seen, than the explicit method at the step it now takes (Hairer's |lambda| is
+            // too rough for this: up to 4 times the power iteration's after a rejected step). Until
+            // RODAS4 has run once (no accuracy step of its own seen) it is tried, and measures it.
+            // Declined, every further accepted step at the boundary asks again, as the remembered
+            // accuracy step ages.
+            memory_.stiff_votes = kVotesForStiff;
+            const double accuracy_step = predicted_accuracy_step();
+            if (memory_.stable_product > 0.0 && accuracy_step > 0.0 &&
+                (!accepted || rosenbrock_over_explicit_cost(accuracy_step, next) * kSwitchMargin >= 1.0))
+                return;
+            if (!accepted) memory_.explicit_step = memory_.step_size;
+            switch_to_rosenbrock();
         }
-    } else if (++memory_.nonstiff_votes >= 6) {
-        memory_.stiff_votes = 0;
+    } else {
+        // The explicit method's accuracy step only raises the one remembered: after an input jump it
+        // runs through the transient at short steps, below its stability limit, while the step RODAS4
+        // took (and will take again) once the transient has passed is the one to compare with.
+        if (accepted && stiffness_estimate_ <= kAccuracyLimited && proposal_ <= kSettledGrowth * h &&
+            !proposal_limited_ && next > predicted_accuracy_step())
+            remember_accuracy_step(next);
+        if (++memory_.nonstiff_votes >= 6) memory_.stiff_votes = 0;
     }
 }
 
-void OneStepIntegrator::vote_on_stiffness_rosenbrock(double h) {
+void OneStepIntegrator::vote_on_stiffness_rosenbrock(double taken) {
     if (settings_.method != IntegrationMethod::automatic) return;
-    // Would the explicit method be stable at the step size the Rosenbrock method takes for accuracy?
-    // (It is at least as accurate there: order 5 against 4.)
-    if (explicit_stable_at(h)) {
+    // Judged at the step RODAS4 proposes next, not the one just taken (which may have been cut short
+    // to end on a communication point).
+    const double h = std::max(taken, memory_.step_size);
+    // h: the step RODAS4 takes for accuracy, also taken as the explicit method's (see above). The
+    // explicit method takes over if it is predicted cheaper by the margin: at most at
+    // |lambda_max| < max(kExplicitStableBound, stable_product) * cost_ratio_ / (kSwitchMargin h).
+    const double limit =
+        std::max(kExplicitStableBound, memory_.stable_product) * cost_ratio_ / (kSwitchMargin * h);
+    double lambda;
+    if (memory_.explicit_step > 0.0 || !(memory_.stable_product > 0.0)) {
+        // The first step after the explicit method handed over (or RODAS4's first step at all): how far
+        // the explicit method got at its stability limit, in units of 1 / |lambda_max| (bounded: it may
+        // have been taken under other modes).
+        lambda = spectral_radius_estimate();
+        memory_.stable_product = std::clamp(memory_.explicit_step * lambda, kExplicitStableBound, kMaxStableProduct);
+        memory_.explicit_step = 0.0;
+    } else {
+        // A growth far beyond the limit after two iterations settles it without the rest.
+        lambda = spectral_radius_estimate(20.0 * limit);
+    }
+    bool explicit_cheaper = rosenbrock_over_explicit_cost(h, explicit_stable_step(lambda)) > kSwitchMargin;
+    if (memory_.steps_since_jump >= 0) ++memory_.steps_since_jump;
+    if (memory_.steps_since_jump >= 0 && memory_.accuracy_time == memory_.jump_time && memory_.accuracy_step > 0.0) {
+        // RODAS4 ran through the whole last interval between input jumps: judged by its mean step there.
+        explicit_cheaper =
+            rosenbrock_over_explicit_cost(memory_.accuracy_step, explicit_stable_step(lambda)) > kSwitchMargin;
+    } else if (h >= kSettledFraction * memory_.jump_step && proposal_ <= kSettledGrowth * taken && !proposal_limited_) {
+        remember_accuracy_step(h);
+    } else if (explicit_cheaper) {
+        // In the transient after an input jump every method is stable at the short steps: the explicit
+        // method takes over only if it would keep running once the steps have grown back, i.e. if at
+        // the step RODAS4 took before the jump it would not be predicted dearer by the margin.
+        const double accuracy_step = predicted_accuracy_step();
+        explicit_cheaper = accuracy_step > 0.0 &&
+                           rosenbrock_over_explicit_cost(accuracy_step, explicit_stable_step(lambda)) * kSwitchMargin >= 1.0;
+    }
+    if (explicit_cheaper) {
         if (++memory_.nonstiff_votes >= kVotesForNonstiff) {
             memory_.stiff = 0;
             memory_.nonstiff_votes = 0;
@@ -487,11 +636,14 @@ bool OneStepIntegrator::handle_events(bool& event_found) {
 void OneStepIntegrator::check_stiffness_after_switch() {
     if (settings_.method != IntegrationMethod::automatic || memory_.stiff || memory_.step_size <= 0.0) return;
     if (!jacobian_at(t_, y_)) return;
-    if (spectral_radius_estimate() * memory_.step_size > tableau::dopri5::stiffness_threshold) {
-        memory_.stiff = 1;
-        memory_.stiff_votes = memory_.nonstiff_votes = 0;
-        memory_.previous_error = 1e-4;
-        ++totals_.method_switches;
+    const double lambda = spectral_radius_estimate();
+    if (lambda * memory_.step_size > tableau::dopri5::stiffness_threshold) {
+        // Beyond the explicit method's stability at its step: RODAS4 takes over if predicted cheaper,
+        // at the accuracy step last seen or, none seen, at the explicit method's step.
+        double accuracy_step = predicted_accuracy_step();
+        if (!(accuracy_step > 0.0)) accuracy_step = memory_.step_size;
+        if (rosenbrock_over_explicit_cost(accuracy_step, explicit_stable_step(lambda)) * kSwitchMargin >= 1.0) return;
+        switch_to_rosenbrock();
         // The Jacobian just taken is the one the first Rosenbrock step needs.
         jacobian_current_ = time_derivative_at_current_point();
     }
@@ -681,7 +833,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         }
         if (result == StepResult::rejected) {
             ++totals_.rejected_steps;
-            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit();
+            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit(h, false);
             continue;
         }
         ++totals_.steps;
@@ -706,8 +858,8 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
             return false;
         // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
         // input jump it takes a few short steps, at which any method would be stable.
-        if (memory_.stiff) vote_on_stiffness_rosenbrock(std::max(h, memory_.step_size));
-        else vote_on_stiffness_explicit();
+        if (memory_.stiff) vote_on_stiffness_rosenbrock(h);
+        else vote_on_stiffness_explicit(h, true);
     }
     for (int k = 0; k < size_; ++k) state[k] = y_[k];
     return true;

@@ -49,6 +49,7 @@ private:
     // The real-time method: RODAS4 over a fixed grid of equal substeps, every step accepted.
     bool advance_fixed_substeps(double end_time, double* state);
     bool real_time() const { return settings_.method == IntegrationMethod::real_time; }
+    bool start_at(double time, const double* state);
     bool rhs(double time, const Vector& y, Vector& dy);
     bool event_values(double time, const Vector& y, std::vector<double>& values);
     bool guards_at(double time, const double* state, double* values);
@@ -61,9 +62,14 @@ private:
     bool jacobian_at(double time, const Vector& y);
     // Stops early once the estimate exceeds `enough`.
     double spectral_radius_estimate(double enough = std::numeric_limits<double>::infinity()) const;
-    bool explicit_stable_at(double h) const;
-    void vote_on_stiffness_explicit();
-    void vote_on_stiffness_rosenbrock(double h);
+    // Automatic method: RODAS4's predicted work per unit time over the explicit method's.
+    double rosenbrock_over_explicit_cost(double accuracy_step, double stable_step) const;
+    double explicit_stable_step(double lambda) const;
+    void switch_to_rosenbrock();
+    double predicted_accuracy_step() const;
+    void remember_accuracy_step(double h);
+    void vote_on_stiffness_explicit(double h, bool accepted);
+    void vote_on_stiffness_rosenbrock(double taken);
     void check_stiffness_after_switch();
     bool time_derivative_at_current_point();
     // Looks for sign changes between g_ (at t_) and g_new_ (at t_new_); if any, locates the first root on
@@ -103,8 +109,10 @@ private:
     SmallLU<kMaxStates> lu_;
     Vector time_derivative_, perturbed_;
     double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
+    double cost_ratio_ = 1.0;          // work of a RODAS4 step over a Dormand-Prince step
     bool jacobian_current_ = false;    // jacobian_ and time_derivative_ belong to (t_, y_) and the modes
     double proposal_ = 0.0;            // the controller's next step size after the last accepted step
+    bool proposal_limited_ = false;    // ... held back by the growth bound or a rejection just before
     bool stop_at_mode_change_ = false; // advance_until_mode_change: return after the first one
 };
 

@@ -94,6 +94,14 @@ struct IntegratorMemory {
     int nonstiff_votes = 0;       // consecutive steps that voted the other way
     int last_step_rejected = 0;
     ChatteringMemory chattering;
+    // Automatic method, for the switch rule's predicted costs (one_step_integrator.cpp):
+    double accuracy_step = 0.0;    // the last step seen limited by accuracy, not stability (0: none)
+    double accuracy_time = 0.0;    // when it was seen
+    double explicit_step = 0.0;    // the explicit method's last step at its stability limit (0: none)
+    double stable_product = 0.0;   // that step times |lambda_max| when RODAS4 took over (0: RODAS4 not run yet)
+    double jump_time = 0.0;        // the last restart (an input jump)
+    double jump_step = 0.0;        // the controller's proposal then
+    int steps_since_jump = -1;     // RODAS4's steps since, if it has run all along (else -1)
 };
 
 class HybridIntegrator {
