@@ -9,22 +9,12 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from scene_lib.fmu import simulate
+from test_fast_core import ship_inputs as ship_loop  # a PD loop against a rolling, pitching carrier
 
 ERROR, DISCARD = 3, 2
 REAL_TIME = 7
 OUTPUTS = ["alpha", "beta", "alpha_dot", "beta_dot", "i_R1", "events.total", "solver.steps",
            "solver.rhs_evaluations", "solver.jacobian_evaluations"]
-
-
-def ship_loop(t, y):
-    """A PD loop holding both axes against a rolling, pitching carrier: backlash, friction and
-    current-limit events, and a voltage jump at every 1 ms step."""
-    return {"u_R1": 60.0 * (0.2 - y["alpha"]) - 1.5 * y["alpha_dot"],
-            "u_R2": 80.0 * (-0.1 - y["beta"]) - 2.0 * y["beta_dot"],
-            "base.gamma": 0.08 * np.sin(1.3 * t), "base.gamma_dot": 0.104 * np.cos(1.3 * t),
-            "base.gamma_ddot": -0.1352 * np.sin(1.3 * t),
-            "base.delta": 0.03 * np.sin(0.7 * t), "base.delta_dot": 0.021 * np.cos(0.7 * t),
-            "base.delta_ddot": -0.0147 * np.sin(0.7 * t)}
 
 
 def angle_error(run, reference):
