@@ -24,6 +24,7 @@
 #include "host_fp_environment.h"
 
 enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_EVENT_INDICATORS = 3000, FMI3_TIME = 3001 };
+_Static_assert(sizeof(fmi3ValueReference) == sizeof(unsigned), "value references are passed to the core as unsigned");
 
 typedef enum {
     S_INSTANTIATED = 1 << 0,
@@ -286,6 +287,14 @@ static int check_access(Instance3* i, const char* f, int set, Kind kind, const f
     if (!allowed(i, f, set ? S_SET : S_GET)) return 0;
     if (nvr == 0) return 1;
     if (!not_null(i, f, vr, "valueReferences") || !not_null(i, f, values, "values")) return 0;
+    if (set && kind == KIND_FLOAT64 && nvalues == nvr) {
+        /* The master's inputs at every step: one pass through the core's table (the loop below then
+         * names whatever it refused). */
+        int scalar_reals = 1;
+        for (size_t k = 0; k < nvr && scalar_reals; ++k) scalar_reals = vr[k] < FMI3_INTEGER_BASE;
+        const int initialized = !(i->state & (S_INSTANTIATED | S_INITIALIZATION));
+        if (scalar_reals && gimbal_first_unsettable(GIMBAL_REAL, (const unsigned*)vr, nvr, initialized) == nvr) return 1;
+    }
     size_t expected = 0;
     for (size_t k = 0; k < nvr; ++k) {
         Kind actual;
