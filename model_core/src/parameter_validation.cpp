@@ -28,10 +28,38 @@ struct Checker {
         s << kRealVariables[vr].name << " = " << values[vr] << " is invalid: " << rule;
         return fail(s.str());
     }
-    bool non_negative(RealVariable vr) { return require(vr, values[vr] >= 0.0, "it must be >= 0"); }
-    // "> 0" as modelDescription.xml's min = kAboveZero states it: subnormal numbers are refused too.
-    bool positive(RealVariable vr) { return require(vr, values[vr] >= kAboveZero, "it must be > 0 (and not subnormal)"); }
+    // The variable's own min and max of the .def table (modelDescription.xml's, inclusive). "> 0" is
+    // min = kAboveZero, "< 1" max = kBelowOne: subnormal numbers are refused too.
+    bool within_declared_bounds(RealVariable vr) {
+        const VariableInfo& v = kRealVariables[vr];
+        const double x = values[vr];
+        if (x >= v.min && x <= v.max) return true;
+        std::ostringstream rule;
+        if (v.min == kAboveZero && v.max == kBelowOne) {
+            rule << "it must lie in (0, 1) (and not be subnormal)";
+        } else if (v.min == kAboveZero) {
+            rule << "it must be > 0 (and not subnormal)";
+        } else if (x < v.min) {
+            rule << "it must be >= " << v.min;
+        } else {
+            rule << "it must be <= " << v.max;
+        }
+        return require(vr, false, rule.str().c_str());
+    }
 };
+
+// The same for an Integer parameter (its bounds are whole numbers).
+bool integer_within_declared_bounds(IntegerVariable vi, int value, std::string& error) {
+    const VariableInfo& v = kIntegerVariables[vi];
+    if (value >= v.min && value <= v.max) return true;
+    std::ostringstream s;
+    s << v.name << " = " << value << " is invalid: it must ";
+    if (v.max == kNoMax) s << "be >= " << v.min;
+    else if (v.min == kNoMin) s << "be <= " << v.max;
+    else s << "lie in [" << v.min << ", " << v.max << "]";
+    error = s.str();
+    return false;
+}
 
 // The Enumeration items of modelDescription.xml (enumeration_types.def) are the core's enum values
 // and exactly the values accepted below.
@@ -120,16 +148,24 @@ bool build_inertia(Checker& check, const BodyParameterVariables& body, Mat3& ine
 bool build_model_parameters(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
                             const bool (&flags)[kBooleanVariableCount], ModelParameters& params, std::string& error) {
     Checker check{values, error};
+    // Rules of one variable alone: finite, and within its declared bounds. Only the rules that tie
+    // variables together are written out below.
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
-        if (kRealVariables[vr].causality == Causality::parameter &&
-            !check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "it must be finite"))
+        if (kRealVariables[vr].causality != Causality::parameter) continue;
+        if (!check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "it must be finite") ||
+            !check.within_declared_bounds(static_cast<RealVariable>(vr)))
+            return false;
+    }
+    for (unsigned vi = 0; vi < kIntegerVariableCount; ++vi) {
+        if (kIntegerVariables[vi].causality == Causality::parameter &&
+            kIntegerVariables[vi].declared_type[0] == '\0' &&
+            !integer_within_declared_bounds(static_cast<IntegerVariable>(vi), integers[vi], error))
             return false;
     }
 
     for (int k = 0; k < 4; ++k) {
         const BodyParameterVariables& vars = kBodyParameters[k];
         RigidBody& body = params.multibody.bodies[k];
-        if (!check.non_negative(vars.mass) || !check.non_negative(vars.viscous_friction)) return false;
         if (!build_inertia(check, vars, body.inertia)) return false;
         body.mass = values[vars.mass];
         body.centre_of_mass = read_vector(values, vars.centre_of_mass);
@@ -137,8 +173,7 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
 
         const RealVariable slip = vars.dry_friction.slip_torque, breakaway = vars.dry_friction.breakaway_torque,
                            stick_speed = vars.dry_friction.stick_speed, damping = vars.dry_friction.damping_factor;
-        if (!check.non_negative(slip) || !check.non_negative(breakaway) || !check.non_negative(damping) ||
-            !check.require(slip, values[slip] <= values[breakaway], "T_din must not exceed T_max") ||
+        if (!check.require(slip, values[slip] <= values[breakaway], "T_din must not exceed T_max") ||
             (values[breakaway] > 0.0 && !check.require(stick_speed, values[stick_speed] > 0.0,
                                                        "it must be > 0 when the body has dry friction (T_max > 0)")))
             return false;
@@ -146,7 +181,6 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     }
     params.energy_accounting = flags[vb_energy_accounting];
     params.multibody.d_ab = read_vector(values, kBasePointB);
-    if (!check.non_negative(vr_g)) return false;
     params.multibody.gravity = values[vr_g];
     prepare_multibody(params.multibody);
 
@@ -160,26 +194,13 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
                                     {vr_gear2_N, vr_gear2_k_s, vr_gear2_c_s, vr_gear2_eta}};
     for (int j = 0; j < 2; ++j) {
         const MotorVariables& m = motors[j];
-        if (!check.positive(m.R) || !check.positive(m.L) || !check.non_negative(m.k_torque) ||
-            !check.non_negative(m.k_emf) || !check.positive(m.i_L) || !check.positive(m.U_L))
-            return false;
         params.motor[j] = MotorParameters{values[m.R], values[m.L], values[m.k_torque], values[m.k_emf],
                                           values[m.i_L], values[m.U_L]};
         const GearVariables& g = gears[j];
-        if (!check.require(g.N, values[g.N] != 0.0, "a gear ratio must not be 0") || !check.non_negative(g.k_s) ||
-            !check.non_negative(g.c_s) || !check.non_negative(g.eta))
-            return false;
+        if (!check.require(g.N, values[g.N] != 0.0, "a gear ratio must not be 0")) return false;
         params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], values[g.eta]};
     }
 
-    if (!check.require(vr_solver_rtol, values[vr_solver_rtol] >= kAboveZero && values[vr_solver_rtol] <= kBelowOne,
-                       "it must lie in (0, 1) (and not be subnormal)") ||
-        !check.positive(vr_solver_atol))
-        return false;
-    if (integers[vi_solver_max_steps] <= 0) {
-        error = "solver.max_steps = " + std::to_string(integers[vi_solver_max_steps]) + " is invalid: it must be > 0";
-        return false;
-    }
     params.max_steps = integers[vi_solver_max_steps];
     if (integers[vi_solver_method] < 0 || integers[vi_solver_method] >= kIntegrationMethodCount) {
         error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
@@ -199,11 +220,6 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         return false;
     }
     params.method = integers[vi_solver_method];
-    if (integers[vi_solver_substeps] < 1 || integers[vi_solver_substeps] > 10000) {
-        error = "solver.substeps = " + std::to_string(integers[vi_solver_substeps]) +
-                " is invalid: it must lie in [1, 10000]";
-        return false;
-    }
     params.substeps = integers[vi_solver_substeps];
 
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
