@@ -6,6 +6,7 @@
 
 #include "check.hpp"
 #include "one_step_integrator.hpp"
+#include "iteration_matrix.hpp"
 #include "small_lu.hpp"
 
 #include <random>
@@ -149,8 +150,48 @@ void check_small_lu() {
     CHECK(!lu.factorize(singular.data(), 3));
 }
 
+// The iteration matrix d I - J with the kinematic rows eliminated first, against Eigen's LU of the
+// whole matrix: every layout of the model (4, 3 or 2 coordinates with their rates, other states
+// after them, the rates not next to their angles), and the full LU kept when a kinematic row is not
+// exactly a unit vector.
+void check_iteration_matrix() {
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    struct Layout { int n, pairs; int position[4], velocity[4]; };
+    const Layout layouts[] = {{12, 4, {0, 1, 2, 3}, {4, 5, 6, 7}},  // full fidelity
+                              {17, 4, {0, 1, 2, 3}, {4, 5, 6, 7}},  // with the energy accumulators
+                              {9, 3, {0, 1, 2}, {3, 4, 5}},
+                              {4, 2, {0, 1}, {2, 3}},               // reduced
+                              {6, 2, {3, 0}, {1, 5}}};
+    for (const Layout& layout : layouts) {
+        for (bool exact_rows : {true, false}) {
+            const int n = layout.n;
+            Eigen::MatrixXd jacobian(n, n);
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) jacobian(i, j) = 100.0 * unit(random);
+            for (int k = 0; k < layout.pairs; ++k) {
+                jacobian.row(layout.position[k]).setZero();
+                jacobian(layout.position[k], layout.velocity[k]) = 1.0;
+            }
+            if (!exact_rows) jacobian(layout.position[0], layout.velocity[0]) = 1.0 + 1e-9;
+            const double diagonal = 37.0;
+            IterationMatrix<24> matrix;
+            matrix.set_structure(n, layout.position, layout.velocity, layout.pairs);
+            CHECK(matrix.factorize(jacobian.data(), diagonal));
+            Eigen::VectorXd b(n);
+            for (int i = 0; i < n; ++i) b[i] = unit(random);
+            Eigen::VectorXd x = b;
+            matrix.solve(x.data());
+            const Eigen::MatrixXd a = diagonal * Eigen::MatrixXd::Identity(n, n) - jacobian;
+            const Eigen::VectorXd expected = a.partialPivLu().solve(b);
+            CHECK((x - expected).norm() <= 1e-12 * (1.0 + expected.norm()));
+        }
+    }
+}
+
 int main() {
     check_small_lu();
+    check_iteration_matrix();
     check_order("Dormand-Prince 5(4)", IntegrationMethod::dormand_prince, 5.0, 4.0);
     check_order("RODAS4", IntegrationMethod::rosenbrock, 4.0, 3.0);
 

@@ -121,6 +121,16 @@ const Dynamics& GimbalHybridSystem::dynamics_at(double time, const double* state
     return cache_;
 }
 
+int GimbalHybridSystem::kinematic_pairs(int* position, int* velocity) const {
+    int pairs = 0;
+    for (int body = 0; body < 4; ++body) {
+        if (!params_.layout.independent(body)) continue;
+        position[pairs] = params_.layout.angle_slot[body];
+        velocity[pairs++] = params_.layout.rate_slot[body];
+    }
+    return pairs;
+}
+
 bool GimbalHybridSystem::derivative(double time, const double* state, double* derivative) {
     // A restart asks again for the point where the mode decision just evaluated the dynamics.
     return state_derivative(params_, dynamics_at(time, state), derivative);

@@ -94,7 +94,17 @@ OneStepIntegrator::OneStepIntegrator(HybridSystem& system, const IntegratorSetti
     for (Vector& v : stage_) v.setZero(n);
     for (Vector& v : dense_) v.setZero(n);
     jacobian_.setZero(n, n);
-    iteration_matrix_.setZero(n, n);
+    int position[kMaxStates], velocity[kMaxStates];
+    const int pairs = system.kinematic_pairs(position, velocity);
+    iteration_matrix_.set_structure(n, position, velocity, pairs);
+    // The power iteration's start: uneven, as a uniform vector lies in the null space of, e.g., a
+    // spring between two equal coordinates (J 1 = 0 there), and the estimate would read 0.
+    double start_norm = 0.0;
+    for (int i = 0; i < n; ++i) {
+        power_iteration_start_[i] = 1.0 + std::fmod(0.6180339887 * (i + 1), 1.0);
+        start_norm += power_iteration_start_[i] * power_iteration_start_[i];
+    }
+    for (int i = 0; i < n; ++i) power_iteration_start_[i] /= std::sqrt(start_norm);
     if (settings_.method == IntegrationMethod::rosenbrock || real_time()) memory_.stiff = 1;
     const double states = size_;
     cost_ratio_ = (kRosenbrockStepCostFixed + kRosenbrockStepCostPerState2 * states * states +
@@ -306,19 +316,17 @@ bool OneStepIntegrator::jacobian_at(double time, const Vector& y) {
 
 OneStepIntegrator::StepResult OneStepIntegrator::rosenbrock_step(double h, double t_new) {
     using namespace tableau::rodas4;
-    iteration_matrix_ = -jacobian_;
-    iteration_matrix_.diagonal().array() += 1.0 / (h * gamma);
     Vector* k = stage_;
     auto reject = [&] {
         memory_.step_size = 0.25 * h;
         memory_.last_step_rejected = 1;
         return StepResult::rejected;
     };
-    if (!lu_.factorize(iteration_matrix_.data(), size_)) return reject();
+    if (!iteration_matrix_.factorize(jacobian_.data(), 1.0 / (h * gamma))) return reject();
     // Stage i solves (I/(h gamma) - J) k_i = rhs in place.
     auto solve = [&](Vector& stage, const auto& rhs) {
         stage = rhs;
-        lu_.solve(stage.data());
+        iteration_matrix_.solve(stage.data());
     };
     const double hd1 = h * d1, hd2 = h * d2, hd3 = h * d3, hd4 = h * d4;
     const double hc21 = c21 / h, hc31 = c31 / h, hc32 = c32 / h, hc41 = c41 / h, hc42 = c42 / h, hc43 = c43 / h;
@@ -403,14 +411,7 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
     constexpr int kIterations = 8;
     const int n = size_;
     double v[kMaxStates], w[kMaxStates];
-    // An uneven start: a uniform vector lies in the null space of, e.g., a spring between two equal
-    // coordinates (J 1 = 0 there), and the estimate would read 0.
-    double start_norm = 0.0;
-    for (int i = 0; i < n; ++i) {
-        v[i] = 1.0 + std::fmod(0.6180339887 * (i + 1), 1.0);
-        start_norm += v[i] * v[i];
-    }
-    for (int i = 0; i < n; ++i) v[i] /= std::sqrt(start_norm);
+    for (int i = 0; i < n; ++i) v[i] = power_iteration_start_[i];
     double growth = 1.0;  // |J^m v| / |v|: at most (1e38)^8 before it counts as infinite
     for (int iteration = 0; iteration < kIterations; ++iteration) {
         double norm = 0.0;
@@ -434,7 +435,7 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
         }
         growth *= norm;
         for (int i = 0; i < n; ++i) v[i] = w[i] / norm;
-        if (iteration >= 1) {
+        if (iteration >= 1 && enough < std::numeric_limits<double>::infinity()) {
             const double estimate = std::pow(growth, 1.0 / (iteration + 1));
             if (estimate > enough) return estimate;
         }

@@ -15,7 +15,7 @@
 
 #include "gimbal/event_handling.hpp"
 #include "gimbal/integrator.hpp"
-#include "small_lu.hpp"
+#include "iteration_matrix.hpp"
 
 namespace gimbal {
 
@@ -105,10 +105,11 @@ private:
     double dense_t0_ = 0.0, dense_h_ = 0.0;
     Vector dense_[5];
     // Rosenbrock: Jacobian, df/dt and the factorized iteration matrix.
-    Matrix jacobian_, iteration_matrix_;
-    SmallLU<kMaxStates> lu_;
+    Matrix jacobian_;
+    IterationMatrix<kMaxStates> iteration_matrix_;
     Vector time_derivative_, perturbed_;
     double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
+    double power_iteration_start_[kMaxStates] = {};  // spectral_radius_estimate's start vector, unit length
     double cost_ratio_ = 1.0;          // work of a RODAS4 step over a Dormand-Prince step
     bool jacobian_current_ = false;    // jacobian_ and time_derivative_ belong to (t_, y_) and the modes
     double proposal_ = 0.0;            // the controller's next step size after the last accepted step

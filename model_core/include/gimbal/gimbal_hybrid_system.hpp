@@ -29,6 +29,7 @@ public:
     int state_size() const override { return params_.state_size(); }
     int event_count() const override { return event_count_; }
     bool derivative(double time, const double* state, double* derivative) override;
+    int kinematic_pairs(int* position, int* velocity) const override;
     bool has_jacobian() const override { return true; }
     bool jacobian(double time, const double* state, double* column_major) override;
     void event_functions(double time, const double* state, double* values) override;

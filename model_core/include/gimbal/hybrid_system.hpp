@@ -22,6 +22,12 @@ public:
         (void)time, (void)state, (void)column_major;
         return false;
     }
+    // Pairs of states whose derivative is exactly another state (a coordinate and its rate):
+    // position[k]' = state[velocity[k]]. An implicit method may eliminate them first. Returns the count.
+    virtual int kinematic_pairs(int* position, int* velocity) const {
+        (void)position, (void)velocity;
+        return 0;
+    }
     virtual void event_functions(double time, const double* state, double* values) = 0;
     // Re-selects the modes at `time`. `directions[k]` is +1 / -1 when event function k has just
     // crossed zero upward / downward, 0 otherwise; nullptr when re-selecting after an input change.
