@@ -992,22 +992,16 @@ struct Run {
                 report.rhs_per_dostep_p999 = static_cast<double>(all_rhs[std::min(all_rhs.size() - 1, all_rhs.size() * 999 / 1000)]);
                 report.rhs_per_dostep_max = static_cast<double>(all_rhs.back());
             }
-            if (!step_times.empty()) {
-                std::sort(step_times.begin(), step_times.end());
-                const auto at = [&](double q) {
-                    return step_times[std::min(step_times.size() - 1, static_cast<size_t>(q * step_times.size()))];
-                };
-                report.dostep_p50 = at(0.5), report.dostep_p99 = at(0.99), report.dostep_p999 = at(0.999);
-                report.dostep_max = step_times.back();
-            }
-            if (!step_cpu_times.empty()) {
-                std::sort(step_cpu_times.begin(), step_cpu_times.end());
-                const auto at = [&](double q) {
-                    return step_cpu_times[std::min(step_cpu_times.size() - 1, static_cast<size_t>(q * step_cpu_times.size()))];
-                };
-                report.dostep_cpu_p50 = at(0.5), report.dostep_cpu_p99 = at(0.99), report.dostep_cpu_p999 = at(0.999);
-                report.dostep_cpu_max = step_cpu_times.back();
-            }
+            // Median, 99th and 99.9th percentile and maximum of one clock's doStep times.
+            const auto percentiles = [](std::vector<double>& times, double& p50, double& p99, double& p999, double& max) {
+                if (times.empty()) return;
+                std::sort(times.begin(), times.end());
+                const auto at = [&](double q) { return times[std::min(times.size() - 1, static_cast<size_t>(q * times.size()))]; };
+                p50 = at(0.5), p99 = at(0.99), p999 = at(0.999), max = times.back();
+            };
+            percentiles(step_times, report.dostep_p50, report.dostep_p99, report.dostep_p999, report.dostep_max);
+            percentiles(step_cpu_times, report.dostep_cpu_p50, report.dostep_cpu_p99, report.dostep_cpu_p999,
+                        report.dostep_cpu_max);
         }
         report.dostep_calls = k + (report.failure.empty() ? 0 : 1);
         report.simulated = k * h;
