@@ -162,7 +162,8 @@ void check_iteration_matrix() {
                               {17, 4, {0, 1, 2, 3}, {4, 5, 6, 7}},  // with the energy accumulators
                               {9, 3, {0, 1, 2}, {3, 4, 5}},
                               {4, 2, {0, 1}, {2, 3}},               // reduced
-                              {6, 2, {3, 0}, {1, 5}}};
+                              {6, 2, {3, 0}, {1, 5}},
+                              {6, 2, {0, 1}, {1, 3}}};             // a velocity that is a position: full LU
     for (const Layout& layout : layouts) {
         for (bool exact_rows : {true, false}) {
             const int n = layout.n;

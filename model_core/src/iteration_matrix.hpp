@@ -16,9 +16,16 @@ public:
     // `position[k]`' derivative is `velocity[k]`, exactly, for k < pairs (from the system).
     void set_structure(int n, const int* position, const int* velocity, int pairs) {
         n_ = n;
-        pairs_ = pairs;
+        pairs_ = 0;
         bool kinematic[Capacity] = {};
-        for (int k = 0; k < pairs; ++k) position_[k] = position[k], velocity_[k] = velocity[k], kinematic[position[k]] = true;
+        for (int k = 0; k < pairs; ++k)
+            if (position[k] < 0 || position[k] >= n || velocity[k] < 0 || velocity[k] >= n) return;  // full LU
+        for (int k = 0; k < pairs; ++k) kinematic[position[k]] = true;
+        // A velocity that is itself eliminated leaves nothing to fold its position into: full LU.
+        for (int k = 0; k < pairs; ++k)
+            if (kinematic[velocity[k]]) return;
+        for (int k = 0; k < pairs; ++k) position_[k] = position[k], velocity_[k] = velocity[k];
+        pairs_ = pairs;
         rest_count_ = 0;
         for (int i = 0; i < n; ++i) {
             rest_index_[i] = -1;
