@@ -110,6 +110,11 @@ private:
     Vector time_derivative_, perturbed_;
     double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
     double power_iteration_start_[kMaxStates] = {};  // spectral_radius_estimate's start vector, unit length
+    // The switch rule's |lambda_max|, reused for kLambdaReuseSteps Rosenbrock steps within a mode and a
+    // communication step (-1: none).
+    static constexpr int kLambdaReuseSteps = 4;
+    double reused_lambda_ = 0.0;
+    int reused_lambda_age_ = -1;
     double cost_ratio_ = 1.0;          // work of a RODAS4 step over a Dormand-Prince step
     bool jacobian_current_ = false;    // jacobian_ and time_derivative_ belong to (t_, y_) and the modes
     double proposal_ = 0.0;            // the controller's next step size after the last accepted step
