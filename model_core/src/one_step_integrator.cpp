@@ -699,6 +699,25 @@ bool OneStepIntegrator::advance_until_mode_change(double end_time, double* state
     return advanced;
 }
 
+// A few ulp left (an event located just short of the end): no step can be that short; move there with
+// the derivative, which is exact to rounding over such a span.
+bool OneStepIntegrator::creep_to(double end) {
+    const double remaining = end - t_;
+    for (int i = 0; i < size_; ++i) y_[i] += remaining * f_[i];
+    t_ = end;
+    return refresh_at_current_point();
+}
+
+// The accepted step's end becomes the current point; a chattering hold that ended there is lifted.
+bool OneStepIntegrator::move_to_step_end() {
+    t_ = t_new_;
+    std::swap(y_, y_new_);
+    std::swap(f_, f_new_);
+    std::swap(g_, g_new_);
+    return !(event_count_ > 0 && t_ >= memory_.chattering.dwell_until && memory_.chattering.dwell_until > -1e300) ||
+           reselect_after_dwell();
+}
+
 bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
     // The grid is fixed by the communication step alone: a mode change located inside a substep ends
     // that step early, and a shorter one finishes it, so the work per communication step is bounded by
@@ -715,11 +734,7 @@ bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
             const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
             const double remaining = grid_end - t_;
             if (remaining <= smallest) {
-                // A mode change located a few ulp short of the grid point: the derivative is exact to
-                // rounding over such a span.
-                for (int i = 0; i < size_; ++i) y_[i] += remaining * f_[i];
-                t_ = grid_end;
-                if (!refresh_at_current_point()) return false;
+                if (!creep_to(grid_end)) return false;
                 break;
             }
             t_new_ = grid_end;
@@ -761,13 +776,7 @@ bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
                 }
                 continue;
             }
-            t_ = t_new_;
-            std::swap(y_, y_new_);
-            std::swap(f_, f_new_);
-            std::swap(g_, g_new_);
-            if (event_count_ > 0 && t_ >= memory_.chattering.dwell_until && memory_.chattering.dwell_until > -1e300 &&
-                !reselect_after_dwell())
-                return false;
+            if (!move_to_step_end()) return false;
         }
     }
     for (int i = 0; i < size_; ++i) state[i] = y_[i];
@@ -804,11 +813,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
         }
         const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
         if (remaining <= smallest) {
-            // A few ulp left (an event located just short of the end): no step can be that short;
-            // move there with the derivative, which is exact to rounding over such a span.
-            for (int i = 0; i < size_; ++i) y_[i] += remaining * f_[i];
-            t_ = end_time;
-            if (!refresh_at_current_point()) return false;
+            if (!creep_to(end_time)) return false;
             break;
         }
         if (h <= smallest) {
@@ -862,12 +867,7 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
             if (stop_at_mode_change_ && totals_.events > events_before && t_ < end_time) break;
             continue;
         }
-        t_ = t_new_;
-        std::swap(y_, y_new_);
-        std::swap(f_, f_new_);
-        std::swap(g_, g_new_);
-        if (event_count_ > 0 && t_ >= memory_.chattering.dwell_until && memory_.chattering.dwell_until > -1e300 && !reselect_after_dwell())
-            return false;
+        if (!move_to_step_end()) return false;
         // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
         // input jump it takes a few short steps, at which any method would be stable.
         if (memory_.stiff) vote_on_stiffness_rosenbrock(h);

@@ -49,6 +49,8 @@ private:
     // The real-time method: RODAS4 over a fixed grid of equal substeps, every step accepted.
     bool advance_fixed_substeps(double end_time, double* state);
     bool real_time() const { return settings_.method == IntegrationMethod::real_time; }
+    bool creep_to(double end);
+    bool move_to_step_end();
     bool start_at(double time, const double* state);
     bool rhs(double time, const Vector& y, Vector& dy);
     bool event_values(double time, const Vector& y, std::vector<double>& values);
