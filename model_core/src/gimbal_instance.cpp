@@ -871,28 +871,33 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
 GimbalStatus GimbalInstance::check_real_time_resolution(double step_size) {
     const double substep = step_size / params_.substeps;
     const Dynamics& dynamics = system_->dynamics_at(clock_, state_);
-    std::ostringstream unresolved;
-    unresolved.precision(4);
+    double contact_frequency[2] = {0.0, 0.0};
     double needed = 0.0;
     for (int axis = 0; axis < 2; ++axis) {
         const GearParameters& gear = params_.gear[axis];
         if (params_.fidelity.gear[axis] == GearModel::rigid || gear.stiffness == 0.0) continue;
         const double load_inertia = dynamics.reduced_mass(load_index(axis), load_index(axis));
         const double rotor_inertia = dynamics.reduced_mass(rotor_index(axis), rotor_index(axis));
-        const double contact_frequency =
+        contact_frequency[axis] =
             std::sqrt(gear.stiffness * (1.0 / load_inertia + 1.0 / (gear.ratio * gear.ratio * rotor_inertia)));
-        if (!(contact_frequency * substep > kRealTimeContactResolution)) continue;
-        needed = std::max(needed, std::ceil(contact_frequency * step_size / kRealTimeContactResolution));
-        unresolved << (needed > 0.0 && unresolved.tellp() > 0 ? "; " : "") << "gear" << axis + 1
-                   << "'s contact oscillation (" << contact_frequency << " rad/s at k_s = " << gear.stiffness
-                   << " N.m/rad: omega h = " << contact_frequency * substep << ")";
+        if (contact_frequency[axis] * substep > kRealTimeContactResolution)
+            needed = std::max(needed, std::ceil(contact_frequency[axis] * step_size / kRealTimeContactResolution));
     }
-    if (needed == 0.0) return GIMBAL_OK;
+    if (needed == 0.0) return GIMBAL_OK;  // every doStep: nothing formatted
     std::ostringstream s;
-    s << "the real-time method cannot resolve " << unresolved.str() << " with substeps of " << substep
-      << " s (omega h at most " << kRealTimeContactResolution << "): set solver.substeps >= "
-      << static_cast<long long>(needed) << " for this communication step, or make a gear rigid (gear<k>.model = 0) "
-      << "if the scene does not need its shaft";
+    s.precision(4);
+    s << "the real-time method cannot resolve ";
+    const char* separator = "";
+    for (int axis = 0; axis < 2; ++axis) {
+        if (!(contact_frequency[axis] * substep > kRealTimeContactResolution)) continue;
+        s << separator << "gear" << axis + 1 << "'s contact oscillation (" << contact_frequency[axis]
+          << " rad/s at k_s = " << params_.gear[axis].stiffness
+          << " N.m/rad: omega h = " << contact_frequency[axis] * substep << ")";
+        separator = "; ";
+    }
+    s << " with substeps of " << substep << " s (omega h at most " << kRealTimeContactResolution
+      << "): set solver.substeps >= " << static_cast<long long>(needed)
+      << " for this communication step, or make a gear rigid (gear<k>.model = 0) if the scene does not need its shaft";
     return refuse(GIMBAL_ERROR, s.str());
 }
 
