@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A sweep of a user controller: its cases in lockstep (the batch form, GyroStabilizerBatch of
-examples/gyro_stabilizer.py, scene_lib/lockstep.py) against one case at a time (the scalar form,
+examples/gyro_stabilizer.py, gimbal2axis/master/lockstep.py) against one case at a time (the scalar form,
 GyroStabilizer, in master.run's Python loop), for batches of N = 1, 4, 16 cases, on one core.
 
 Cases: examples/user_controller.toml (sea state, full drive train) with per case its own gains and
@@ -12,7 +12,7 @@ sea-state seed, --stop-time s each. Per N, in one process, best of --repeat, on 
   - the FMU alone: each case's commanded voltages replayed through the compiled loop (Replay).
 Reported: simulated seconds per CPU second, and the master's own cost per case-step (the run's
 CPU time minus the FMU alone, per case and step; includes the user's step(), shared out over the
-cases in lockstep). Also, with --sweep-cases > 0, a whole serial sweep (scripts/sweep.py --serial)
+cases in lockstep). Also, with --sweep-cases > 0, a whole serial sweep (gimbal2axis sweep --serial)
 of that many cases with each class. Writes benchmarks/results/batch_controller.json.
 
 Usage: .venv/bin/python benchmarks/batch_controller_throughput.py [--stop-time 2] [--repeat 3] [--sweep-cases 32]
@@ -30,9 +30,9 @@ import time
 
 import numpy as np
 
-from scene_lib import FMU, load_scene, run
-from scene_lib.controllers import Replay
-from scene_lib.lockstep import run_lockstep
+from gimbal2axis import FMU, load_scene, run
+from gimbal2axis.scene.controllers import Replay
+from gimbal2axis.master.lockstep import run_lockstep
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "user_controller.toml"
@@ -89,7 +89,7 @@ def measure(fmu, n: int, stop_time: float, repeat: int) -> dict:
 
 
 def sweep(fmu_path, count: int, stop_time: float) -> dict:
-    from sweep_lib import SweepOptions, run_sweep
+    from gimbal2axis.sweep import SweepOptions, run_sweep
 
     text = (f'name = "bench"\nseed = 2\nsamples = {max(1, count // 4)}\nstop_time = {stop_time}\n'
             '[grid]\n"controller.options.kp" = [200.0, 400.0]\n"controller.options.k_gyro" = [4.0, 8.0]\n'

@@ -18,8 +18,8 @@ import sys
 import tempfile
 import time
 
-from sweep_lib import SweepOptions, make_client, run_sweep
-from sweep_lib.table import read_rows
+from gimbal2axis.sweep import SweepOptions, make_client, run_sweep
+from gimbal2axis.sweep.table import read_rows
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 

@@ -22,9 +22,9 @@ import math
 
 import numpy as np
 
-from scene_lib.controllers import gyro_axis_rates
-from scene_lib.geometry import gimbal_angles_for
-from scene_lib.setpoints import target_angles
+from gimbal2axis.scene.controllers import gyro_axis_rates
+from gimbal2axis.scene.geometry import gimbal_angles_for
+from gimbal2axis.scene.setpoints import target_angles
 
 
 class GyroStabilizer:
@@ -93,7 +93,7 @@ class GyroStabilizerBatch(GyroStabilizer):
 
 
 def gimbal_angles(target, attitude, alpha_near):
-    """scene_lib.geometry.gimbal_angles_for on arrays: target (3,) or (N, 3), attitude (N, 3)
+    """gimbal2axis.scene.geometry.gimbal_angles_for on arrays: target (3,) or (N, 3), attitude (N, 3)
     [delta, psi, gamma], alpha_near (N,) -> alpha, beta (N,)."""
     alpha, beta = target_angles(target, *np.asarray(attitude).T)
     alpha = alpha + 2.0 * math.pi * np.round((alpha_near - alpha) / (2.0 * math.pi))

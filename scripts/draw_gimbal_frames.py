@@ -24,7 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-from scene_lib.geometry import rx, ry, rz  # noqa: E402
+from gimbal2axis.scene.geometry import rx, ry, rz  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 # No software version or date in the files: rerunning with another matplotlib changes fewer bytes.

@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 
-from scene_lib import FMU, SceneError, load_scene, run
+from gimbal2axis import FMU, SceneError, load_scene, run
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 

@@ -17,7 +17,7 @@ import sys
 import numpy as np
 from fmpy.fmi1 import FMICallException
 
-from scene_lib.fmu import FMU, simulate
+from gimbal2axis.fmu import FMU, simulate
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 

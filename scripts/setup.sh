@@ -62,21 +62,21 @@ if ! "$venv/bin/python" -c "import $modules" >/dev/null 2>&1 || [ "$requirements
   chmod +x "$venv"/lib/python3*/site-packages/ecospy/binaries/proxyfmu "$venv"/lib/python3*/site-packages/ecospy/binaries/ecos 2>/dev/null || true
   touch "$marker"
 fi
-# The project's own package (pyproject.toml: scene_lib and sweep_lib, which stay in scripts/), installed
-# editable: .venv imports them from this checkout, so the scripts, the tests, the notebook's kernel and
-# the sweeps' worker processes always run the working tree's code (a copy in site-packages would go
-# stale at the first edit; its C kernels, an extension, are rebuilt here when their sources change).
+# The project's own package, gimbal2axis/ (pyproject.toml), with its command `gimbal2axis`, installed
+# editable: .venv imports it from this checkout, so the command, the tests, the notebook's kernel and the
+# sweeps' worker processes always run the working tree's code (a copy in site-packages would go stale
+# at the first edit; its C kernels, an extension, are rebuilt here when their sources change).
 # --no-deps: its dependencies are requirements-run.txt, installed above.
 # Looked up (not imported) with -I: not fooled by the current directory or PYTHONPATH.
 package_marker="$venv/.package-installed"
 if ! "$venv/bin/python" -I -c "import importlib.util as u, sys
-sys.exit(not (u.find_spec('scene_lib') and u.find_spec('sweep_lib')))" >/dev/null 2>&1 ||
+sys.exit(not u.find_spec('gimbal2axis'))" >/dev/null 2>&1 || [ ! -x "$venv/bin/gimbal2axis" ] ||
    [ "$repo/pyproject.toml" -nt "$package_marker" ] || [ "$repo/requirements-run.txt" -nt "$package_marker" ] ||
-   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/scripts/scene_lib/native" -newer "$package_marker" 2>/dev/null)" ] ||
+   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/gimbal2axis/native" -name '*.c' -newer "$package_marker" 2>/dev/null)" ] ||
    [ "$repo/CMakeLists.txt" -nt "$package_marker" ] ||   # the package's version is the CMake project's
-   ! ls "$repo"/scripts/scene_lib/_native*.so >/dev/null 2>&1; then
-  echo "[setup] installing the project's Python package (scene_lib, sweep_lib, their C kernels) into .venv, editable"
-  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps -e "$repo"
+   ! ls "$repo"/gimbal2axis/native/_native*.so >/dev/null 2>&1; then
+  echo "[setup] installing the project's Python package (gimbal2axis, its command and C kernels) into .venv, editable"
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps -e "$repo"
   touch "$package_marker"
 fi
 
@@ -85,7 +85,7 @@ cmake -S "$repo" -B "$build_dir" -G Ninja -DPython3_EXECUTABLE="$venv/bin/python
 if [ "$setup_for" = test ]; then
   cmake --build "$build_dir"
 else
-  # the FMU, and the analysis library scripts/linearize.py loads; no tests, no fuzzer, no benchmarks
+  # the FMU, and the analysis library `gimbal2axis linearize` loads; no tests, no fuzzer, no benchmarks
   cmake --build "$build_dir" --target fmu gimbal_probe
 fi
-echo "[setup] FMU ready: $build_dir/Gimbal2Axis.fmu"
+echo "[setup] FMU ready: $build_dir/Gimbal2Axis.fmu (the gimbal2axis command of .venv finds it)"

@@ -7,6 +7,12 @@ import pytest
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 BUILD_DIR = pathlib.Path(os.environ.get("GIMBAL_BUILD_DIR", REPO_ROOT / "build")).resolve()
 
+# The package finds the build through these when not told (gimbal2axis/locations.py): the tests' build,
+# GIMBAL_BUILD_DIR's (the sanitizer pass's), not the one the package was configured with; set here, they
+# also reach the commands the tests start.
+os.environ["GIMBAL2AXIS_FMU"] = str(BUILD_DIR / "Gimbal2Axis.fmu")
+os.environ["GIMBAL2AXIS_PROBE_LIBRARY"] = str(BUILD_DIR / "libgimbal_probe.so")
+
 
 @pytest.fixture(scope="session")
 def build_dir() -> pathlib.Path:
@@ -34,7 +40,7 @@ def probe_lib_path(build_dir) -> pathlib.Path:
 @pytest.fixture(scope="session")
 def gimbal_fmu(fmu_path):
     """The packaged FMU, extracted once for the whole session."""
-    from scene_lib.fmu import FMU
+    from gimbal2axis.fmu import FMU
 
     with FMU(fmu_path) as fmu:
         yield fmu
@@ -43,7 +49,7 @@ def gimbal_fmu(fmu_path):
 @pytest.fixture(scope="module")
 def client():
     """A local Dask cluster of 2 worker processes (the product's default), 1 thread each."""
-    from sweep_lib import make_client
+    from gimbal2axis.sweep import make_client
 
     client, cluster = make_client(workers=2, processes=True)
     client.wait_for_workers(2, timeout=60)
@@ -54,9 +60,9 @@ def client():
 
 @pytest.fixture(scope="session")
 def ship_scene():
-    """scenes/ship_stabilization.toml: the PID loop the linear predictions (scene_lib.isolation_prediction)
+    """scenes/ship_stabilization.toml: the PID loop the linear predictions (gimbal2axis.analysis.isolation_prediction)
     are checked on; they assume ideal sensors."""
-    from scene_lib import load_scene
+    from gimbal2axis import load_scene
 
     scene = load_scene(REPO_ROOT / "scenes" / "ship_stabilization.toml")
     assert scene.sensors().ideal, "the prediction assumes ideal sensors"
@@ -66,7 +72,7 @@ def ship_scene():
 @pytest.fixture(scope="session")
 def ship_linear_loop(ship_scene, gimbal_fmu):
     """The ship loop's linear sampled-data model without backlash and dry friction."""
-    from scene_lib import isolation_prediction
-    from scene_lib.frequency_response import LINEAR_FIDELITY
+    from gimbal2axis.analysis import isolation_prediction
+    from gimbal2axis.analysis.frequency_response import LINEAR_FIDELITY
 
     return isolation_prediction.build_loop(ship_scene, gimbal_fmu, LINEAR_FIDELITY)

@@ -19,7 +19,7 @@ InputFunction = Callable[[float], dict]
 
 
 class ModelExchangeInstance:
-    """One initialized FMU2Model with the value references of the scene_lib FMU wrapper."""
+    """One initialized FMU2Model with the value references of the gimbal2axis FMU wrapper."""
 
     def __init__(self, fmu, start_values: dict, inputs: InputFunction | None, start_time: float = 0.0,
                  log: list | None = None, name: str = "me"):
@@ -29,7 +29,7 @@ class ModelExchangeInstance:
                                modelIdentifier=md.modelExchange.modelIdentifier, instanceName=name)
         callbacks = None
         if log is not None:
-            from scene_lib.fmu import _capturing_callbacks
+            from gimbal2axis.fmu.fmu import _capturing_callbacks
             callbacks = _capturing_callbacks(self.model, log)
         self.model.instantiate(callbacks=callbacks, loggingOn=log is not None)
         self.nx = md.numberOfContinuousStates

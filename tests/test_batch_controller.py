@@ -1,4 +1,4 @@
-"""The batch (lockstep) form of a user controller (`batch = True`, scene_lib/lockstep.py): a sweep
+"""The batch (lockstep) form of a user controller (`batch = True`, gimbal2axis/master/lockstep.py): a sweep
 steps the cases of a task together, one step() call for all. Checked against the scalar form of
 the same controller case by case, with a failing case inside a batch, with a class returning the
 wrong shape, and serial against Dask."""
@@ -7,8 +7,8 @@ import pathlib
 import numpy as np
 import pytest
 
-from scene_lib import FMU, SceneError, load_scene, run
-from scene_lib.lockstep import run_lockstep
+from gimbal2axis import FMU, SceneError, load_scene, run
+from gimbal2axis.master.lockstep import run_lockstep
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "user_controller.toml"
@@ -17,9 +17,9 @@ MODULE = REPO / "examples" / "gyro_stabilizer.py"
 pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
-from sweep_lib import SweepOptions, prepare, run_sweep  # noqa: E402
-from sweep_lib.table import read_rows  # noqa: E402
-from sweep_lib.worker import metrics  # noqa: E402
+from gimbal2axis.sweep import SweepOptions, prepare, run_sweep  # noqa: E402
+from gimbal2axis.sweep.table import read_rows  # noqa: E402
+from gimbal2axis.sweep.worker import metrics  # noqa: E402
 
 METRICS = ["los_rms_mrad", "los_peak_mrad", "los_final_mrad", "i_peak_R1_A", "i_peak_R2_A", "i_peak_A"]
 EXACT = ["events", "requirements_met"]

@@ -1,4 +1,4 @@
-"""The compiled communication loop (scene_lib/_master_loop.c) against the Python loop: for every
+"""The compiled communication loop (gimbal2axis/native/master_loop.c) against the Python loop: for every
 built-in controller, sensor model and delay, the two runs must agree to the bit in every recorded
 signal; and a failing FMU call must stop both with the same message."""
 import pathlib
@@ -8,8 +8,8 @@ import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
-from scene_lib import FMU, SceneError, load_scene, run
-from scene_lib import compiled_loop
+from gimbal2axis import FMU, SceneError, load_scene, run
+from gimbal2axis.master import compiled_loop
 
 SCENES = REPO / "scenes"
 NOISY_SENSORS = {"encoder_resolution_deg": 0.001, "gyro_noise_deg_s": 0.02, "imu_attitude_noise_deg": 0.01, "seed": 3}

@@ -200,6 +200,7 @@ def test_user_facing_files_point_to_the_physics_page_not_outside_the_repository(
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     assert "docs/physics.md" in readme
     files = [REPO / "README.md", *(REPO / "docs").glob("*.md"), *(REPO / "scripts").rglob("*.py"),
+             *(REPO / "gimbal2axis").rglob("*.py"),
              *(REPO / "examples").glob("*"), *(REPO / "scenes").glob("*.toml")]
     offenders = [str(f.relative_to(REPO)) for f in files
                  if f.is_file() and re.search(r"shared/(spec|seed)", f.read_text(encoding="utf-8", errors="replace"))]

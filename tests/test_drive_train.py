@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 TIGHT = {"solver.rtol": 1e-10, "solver.atol": 1e-12}
 # Rotor 1 on its own: the azimuth gear transmits nothing, and without gravity nothing else moves.

@@ -4,12 +4,12 @@ Both scenes drive the non-smooth parts on purpose (backlash traversals, current 
 releasing, rotor stick-slip, voltage clamp) and assert that they did, since a balance or an agreement
 over a scene that never switches a mode would prove little about the hybrid integrator.
 
-They run their own small fmpy master loop rather than `scene_lib.fmu.simulate`, which returns every
+They run their own small fmpy master loop rather than `gimbal2axis.fmu.simulate`, which returns every
 output as a float: the Integer event counters stay integers here, and inputs are chosen by step index.
 """
 import numpy as np
 
-from scene_lib.fmu import STATES
+from gimbal2axis.fmu import STATES
 
 STORED = ["energy.kinetic", "energy.potential", "energy.spring", "energy.magnetic"]
 DISSIPATED = ["energy.resistive", "energy.viscous", "energy.shaft_damping", "energy.dry_friction"]

@@ -7,7 +7,7 @@ turns stiff and back when it stops being so, and the first stage is refreshed af
 import numpy as np
 import pytest
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 RECORDED = ["alpha", "beta", "alpha_dot", "beta_dot", "i_R1", "i_R2", "theta_b1", "theta_b2", "T_E1",
             "los.omega[1]", "los.omega[2]", "los.omega[3]", "events.total", "solver.steps",
@@ -25,7 +25,7 @@ def ship_inputs(t, y):
 
 
 def run_loop(fmu, stop_time, step, start_values, inputs, start_time=0.0, snapshot=None, clock="product"):
-    """Like scene_lib.fmu.simulate, with a start time and an optional FMU-state action at every step:
+    """Like gimbal2axis.fmu.simulate, with a start time and an optional FMU-state action at every step:
     'get' (take and free a state), 'get-set' (take it, set it back, free it). The master's clock is
     start + k h ('product') or a running sum t += h ('sum')."""
     slave = fmu.instantiate()

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 ANGLES = ["alpha", "beta", "alpha_dot", "beta_dot"]
 COUNTERS = ["solver.states", "solver.steps", "solver.rhs_evaluations"]

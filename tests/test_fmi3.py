@@ -18,7 +18,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 from fmpy.validation import validate_fmu
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 # The sanitizer pass's FMU links the sanitizer runtimes dynamically and has no Windows binary; a build
 # from sources/ uses fmpy's flags: these run in the release pass.

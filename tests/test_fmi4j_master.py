@@ -13,10 +13,10 @@ in the jar), and every call below goes straight through it to the FMU:
   > start, so this is exactly fmpy's `setupExperiment(startTime=0.0)`. A defined tolerance would
   replace the FMU's default `solver.rtol` (here START sets `solver.rtol`, which wins anyway).
 - `writeReal(vrs, values)` of the start values in one fmi2SetReal, then fmi2EnterInitializationMode
-  and fmi2ExitInitializationMode, as `scene_lib.fmu.simulate` does.
+  and fmi2ExitInitializationMode, as `gimbal2axis.fmu.simulate` does.
 - Each step k: `writeReal` of the inputs (the rolling base), `doStep(k * h, h)`, `readReal` of the
   outputs. FMI4j 0.38 keeps no clock of its own: `CoSimulationSlave.doStep(t, h)` hands t and h to
-  fmi2DoStep unchanged. The harness passes t = k * h, the double `scene_lib.fmu.simulate` passes, and the
+  fmi2DoStep unchanged. The harness passes t = k * h, the double `gimbal2axis.fmu.simulate` passes, and the
   constant h (0.001 is 0.001 at every step, unlike libcosim's integer-nanosecond clock, see
   test_other_masters.py). FMI4j always passes noSetFMUStatePriorToCurrentPoint = fmi2True, as fmpy
   does by default (the FMU ignores the flag).
@@ -46,7 +46,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 from test_other_masters import OUTPUTS, SCENES, START, STOP_TIME, as_matrix, assert_bitwise_equal
 
 pytestmark = pytest.mark.skipif(
@@ -87,7 +87,7 @@ def run_fmi4j(master: list, fmu_path: pathlib.Path, workdir: pathlib.Path, step:
     for name, value in start_values.items():
         arguments += ["--start", f"{name}={float(value).hex()}"]
     if inputs is not None:
-        # The values set before the step starting at t_k = k * step, as scene_lib.fmu.simulate sets them.
+        # The values set before the step starting at t_k = k * step, as gimbal2axis.fmu.simulate sets them.
         rows = [inputs(k * step) for k in range(n_steps)]
         names = list(rows[0])
         table = workdir / "inputs.csv"

@@ -6,7 +6,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2DoStepStatus
 
-from scene_lib.fmu import STATES, simulate
+from gimbal2axis.fmu import STATES, simulate
 
 OUTPUTS = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
 START = {"beta": 0.3, "beta_m": 18.0, "solver.rtol": 1e-8, "solver.atol": 1e-10}

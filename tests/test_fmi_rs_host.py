@@ -21,7 +21,7 @@ import time
 import numpy as np
 import pytest
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 from test_fmi_sim_master import find_cargo
 
 pytestmark = pytest.mark.skipif(

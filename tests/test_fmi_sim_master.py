@@ -36,7 +36,7 @@ k h, and the same interpolated inputs, computed operation by operation as fmi-si
 and the time column then agree to the last bit; that is asserted for every scene. The one argument
 not copied is `visible = true`, which this FMU ignores.
 
-For a fixed base, fmi-sim's calls differ from `scene_lib.fmu.simulate` only in where the start values
+For a fixed base, fmi-sim's calls differ from `gimbal2axis.fmu.simulate` only in where the start values
 are set (before instead of after `fmi2SetupExperiment`, both in the instantiated state) and in
 `loggingOn`; neither changes the solution, and the plain `simulate` agrees bit for bit too.
 With inputs from a table, the interpolated values are not always the scene function's: for the
@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from scene_lib.fmu import FMU, simulate
+from gimbal2axis.fmu import FMU, simulate
 from test_other_masters import GAMMA_DOT, OUTPUTS, START, STOP_TIME, assert_bitwise_equal
 
 pytestmark = pytest.mark.skipif(

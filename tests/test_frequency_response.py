@@ -1,4 +1,4 @@
-"""Frequency responses by sine dwell (scene_lib.frequency_response) against a known linear case, and the
+"""Frequency responses by sine dwell (gimbal2axis.analysis.frequency_response) against a known linear case, and the
 backlash's describing-function gain drop."""
 import cmath
 import math
@@ -8,8 +8,8 @@ import warnings
 import numpy as np
 import pytest
 
-from scene_lib import load_scene
-from scene_lib.frequency_response import Dwell, Excitation, fundamental, measure_point, zoh_fundamental
+from gimbal2axis import load_scene
+from gimbal2axis.analysis.frequency_response import Dwell, Excitation, fundamental, measure_point, zoh_fundamental
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
@@ -160,7 +160,7 @@ def test_backlash_lowers_the_gain_where_the_motion_is_comparable_to_the_play(gim
 
 def test_sweep_on_dask_equals_the_serial_sweep(client, fmu_path):
     """The frequencies of a closed-loop isolation sweep run as Dask tasks give the serial sweep's rows."""
-    from scene_lib.frequency_response import LINEAR_FIDELITY, sweep
+    from gimbal2axis.analysis.frequency_response import LINEAR_FIDELITY, sweep
 
     scene = load_scene(REPO / "scenes" / "ship_stabilization.toml")
     excitation = Excitation("base", "pitch", math.radians(1.0))
@@ -182,10 +182,10 @@ def test_command_writes_a_csv_row_per_point_and_a_bode_plot(fmu_path, tmp_path):
     import subprocess
     import sys
 
-    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), "isolation", "--axis", "yaw",
+    out = subprocess.run([sys.executable, "-m", "gimbal2axis", "freqresp", "isolation", "--axis", "yaw",
                           "--fmin", "30", "--fmax", "60", "--points", "2", "--settle-periods", "2", "--settle-s", "0.1",
                           "--measure-periods", "2", "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path)],
-                         capture_output=True, text=True, timeout=300)
+                         capture_output=True, text=True, timeout=300, cwd=REPO)
     assert out.returncode == 0, out.stderr
     rows = list(csv.DictReader(open(tmp_path / "frequency_response_isolation_yaw.csv")))
     # (2 variants + the linear prediction) x 2 frequencies x (los.omega[1], los.omega[3], los)
@@ -202,11 +202,11 @@ def test_simulated_response_matches_the_linear_model_from_0p1_to_100_hz(gimbal_f
     """Compliant gears without backlash, no dry friction, inductive motors (both gear resonances, 84 and
     122 Hz, and the current poles, 150-260 Hz, inside or near the band), a small voltage (0.5 V): the sine
     dwell of the nonlinear FMU against the linear model's G(j w) = C (j w I - A)^-1 B + D from the core
-    (scene_lib.linearization), 1 % in gain and 1 deg in phase, 0.1-100 Hz, u_R<axis> -> the axis rate and
+    (gimbal2axis.analysis.linearization), 1 % in gain and 1 deg in phase, 0.1-100 Hz, u_R<axis> -> the axis rate and
     the line-of-sight rate it moves. (Measured: within 5e-5 and 0.003 deg; against the sampled-data form of
     the same model, held_frequency_response, within 1e-7: what is left is the hold's aliasing.)"""
-    from scene_lib import linearization
-    from scene_lib.frequency_response import LINEAR_FIDELITY, linear_point, linear_rows
+    from gimbal2axis.analysis import linearization
+    from gimbal2axis.analysis.frequency_response import LINEAR_FIDELITY, linear_point, linear_rows
 
     path = tmp_path / "fr_linear.toml"
     path.write_text(SCENE.format(models='"gear1.model" = 1\n"gear2.model" = 1'))   # inductive motors
@@ -238,11 +238,12 @@ def test_open_loop_command_adds_the_linear_models_curve(fmu_path, build_dir, tmp
     import subprocess
     import sys
 
-    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), "open-loop", "--axis", "2",
+    out = subprocess.run([sys.executable, "-m", "gimbal2axis", "freqresp", "open-loop", "--axis", "2",
                           "--fmin", "5", "--fmax", "10", "--points", "2", "--settle-periods", "2", "--settle-s", "0.1",
                           "--measure-periods", "2", "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path),
                           "--set", "body2.d_bd[2]=0", "--set", "body2.d_bd[3]=0"],
-                         capture_output=True, text=True, timeout=300, env={**os.environ, "GIMBAL_BUILD_DIR": str(build_dir)})
+                         capture_output=True, text=True, timeout=300, cwd=REPO,
+                         env={**os.environ, "GIMBAL2AXIS_PROBE_LIBRARY": str(build_dir / "libgimbal_probe.so")})
     assert out.returncode == 0, out.stderr
     rows = list(csv.DictReader(open(tmp_path / "frequency_response_open_loop_2.csv")))
     # (2 variants + the linear model) x 2 frequencies x (beta_dot, los.omega[1])
@@ -261,11 +262,11 @@ def test_several_amplitudes_give_a_curve_each(fmu_path, tmp_path):
     import subprocess
     import sys
 
-    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), "open-loop", "--axis", "1",
+    out = subprocess.run([sys.executable, "-m", "gimbal2axis", "freqresp", "open-loop", "--axis", "1",
                           "--fmin", "5", "--fmax", "5", "--points", "1", "--settle-periods", "2", "--settle-s", "0.1",
                           "--measure-periods", "2", "--serial", "--fmu", str(fmu_path), "--out", str(tmp_path),
                           "--amplitude", "0.5", "2", "--full-only", "--no-linear"],
-                         capture_output=True, text=True, timeout=300)
+                         capture_output=True, text=True, timeout=300, cwd=REPO)
     assert out.returncode == 0, out.stderr
     rows = list(csv.DictReader(open(tmp_path / "frequency_response_open_loop_1.csv")))
     assert {r["curve"] for r in rows} == {"full model, 0.5 V", "full model, 2 V"} and len(rows) == 4
@@ -284,7 +285,8 @@ def test_command_refusals_name_the_culprit_without_a_traceback(fmu_path, tmp_pat
     import subprocess
     import sys
 
-    out = subprocess.run([sys.executable, str(REPO / "scripts" / "frequency_response.py"), *args, "--serial",
-                          "--fmu", str(fmu_path), "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    out = subprocess.run([sys.executable, "-m", "gimbal2axis", "freqresp", *args, "--serial",
+                          "--fmu", str(fmu_path), "--out", str(tmp_path)], capture_output=True, text=True, timeout=300,
+                         cwd=REPO)
     assert out.returncode == 1
     assert message in out.stderr and "Traceback" not in out.stderr, out.stderr

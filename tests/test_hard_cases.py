@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from scene_lib.fmu import STATES, simulate
+from gimbal2axis.fmu import STATES, simulate
 
 COST = ["solver.steps", "solver.rhs_evaluations"]
 STORED = ["energy.kinetic", "energy.potential", "energy.spring", "energy.magnetic"]

@@ -1,4 +1,4 @@
-"""The linear prediction of the closed loop's isolation ratio (scene_lib.isolation_prediction) against the
+"""The linear prediction of the closed loop's isolation ratio (gimbal2axis.analysis.isolation_prediction) against the
 sine dwell of the nonlinear FMU in the ship-stabilization scene's own PID loop (ideal sensors, 1 ms step,
 delay_steps = 1), without backlash and dry friction and at a small carrier rate (0.1 deg/s)."""
 import copy
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from scene_lib.errors import SceneError
-from scene_lib.frequency_response import LINEAR_CURVE, LINEAR_FIDELITY, Dwell, Excitation, prediction_errors, sweep
-from scene_lib import isolation_prediction
+from gimbal2axis.errors import SceneError
+from gimbal2axis.analysis.frequency_response import LINEAR_CURVE, LINEAR_FIDELITY, Dwell, Excitation, prediction_errors, sweep
+from gimbal2axis.analysis import isolation_prediction
 
 FREQUENCIES_HZ = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0)
 RATE_AMPLITUDE = math.radians(0.1)     # rad/s: small enough to stay linear, large against the solver's tolerance
@@ -85,7 +85,7 @@ def test_a_wrong_loop_misses_the_simulation(loop, dwell_rows, mistake):
 def test_rows_and_lines(ship_scene, gimbal_fmu, tmp_path):
     """Rows in the CSV format of frequency_response (the 'los' row without phase) and dense lines that
     plot_bode draws."""
-    from scene_lib.frequency_response import plot_bode, write_csv
+    from gimbal2axis.analysis.frequency_response import plot_bode, write_csv
 
     loop = isolation_prediction.build_loop(ship_scene, gimbal_fmu, LINEAR_FIDELITY)
     rows = isolation_prediction.isolation_rows(loop, "roll", [1.0, 10.0])

@@ -1,4 +1,4 @@
-"""The linear model A, B, C, D (scene_lib.linearization, through libgimbal_probe.so) against the FMU itself,
+"""The linear model A, B, C, D (gimbal2axis.analysis.linearization, through libgimbal_probe.so) against the FMU itself,
 and against the textbook transfer function of a single rigid axis with a quasi-static motor."""
 import math
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from scene_lib import linearization
-from scene_lib.errors import SceneError
+from gimbal2axis.analysis import linearization
+from gimbal2axis.errors import SceneError
 
 H = 5e-4   # the step over which the FMU's flow is differenced
 

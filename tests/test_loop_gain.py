@@ -1,5 +1,5 @@
 """The loop gain of the ship-stabilization scene's PID loop measured by voltage injection (sine dwell,
-Excitation("injection", ...)) against its linear prediction (scene_lib.isolation_prediction.loop_gain),
+Excitation("injection", ...)) against its linear prediction (gimbal2axis.analysis.isolation_prediction.loop_gain),
 without backlash and dry friction and at a small injected amplitude (0.05 V); the margins helper on
 loops with known margins; the command's CSV and PNG."""
 import cmath
@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from scene_lib import isolation_prediction
-from scene_lib.errors import SceneError
-from scene_lib.frequency_response import (LINEAR_CURVE, LINEAR_FIDELITY, LOOP_GAIN, SENSITIVITY, Dwell, Excitation,
+from gimbal2axis.analysis import isolation_prediction
+from gimbal2axis.errors import SceneError
+from gimbal2axis.analysis.frequency_response import (LINEAR_CURVE, LINEAR_FIDELITY, LOOP_GAIN, SENSITIVITY, Dwell, Excitation,
                                           InjectingController, prediction_errors, sweep)
 
 FREQUENCIES_HZ = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0)
@@ -149,7 +149,7 @@ def test_the_injecting_controller_is_the_scenes_controller_plus_the_sine(ship_sc
         u, v = inner(*args, step=k), wrapped(*args, step=k)
         assert v[0] == u[0] and v[1] == pytest.approx(u[1] + 0.3 * math.sin(2 * math.pi * 5.0 * t), abs=1e-15)
         assert wrapped.reference == inner.reference
-    from scene_lib.master import choose_loop
+    from gimbal2axis.master.master import choose_loop
 
     assert choose_loop(wrapped, None) == "python"   # the compiled loop stays as it is
     with pytest.raises(SceneError, match="'3'"):
@@ -159,16 +159,14 @@ def test_the_injecting_controller_is_the_scenes_controller_plus_the_sine(ship_sc
 
 
 def test_command_writes_rows_and_plot(fmu_path, tmp_path):
-    import importlib.util
     import pathlib
 
-    script = pathlib.Path(__file__).resolve().parents[1] / "scripts" / "frequency_response.py"
-    spec = importlib.util.spec_from_file_location("frequency_response_command", script)
-    command = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(command)
-    assert command.main(["loop-gain", "--axis", "2", "--amplitude", "0.05", "--points", "2", "--fmin", "3",
-                         "--fmax", "30", "--linear-only", "--serial", "--settle-s", "1", "--measure-periods", "1",
-                         "--fmu", str(fmu_path), "--out", str(tmp_path), "--name", "lg"]) == 0
+    from gimbal2axis.cli.main import main
+
+    ship = pathlib.Path(__file__).resolve().parents[1] / "scenes" / "ship_stabilization.toml"
+    assert main(["freqresp", "loop-gain", "--scene", str(ship), "--axis", "2", "--amplitude", "0.05", "--points", "2",
+                 "--fmin", "3", "--fmax", "30", "--linear-only", "--serial", "--settle-s", "1", "--measure-periods", "1",
+                 "--fmu", str(fmu_path), "--out", str(tmp_path), "--name", "lg"]) == 0
     with open(tmp_path / "lg.csv") as f:
         rows = list(csv.DictReader(f))
     curves = {(r["curve"], r["output"]) for r in rows}

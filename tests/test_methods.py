@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 OUTPUTS = ["alpha", "beta", "alpha_dot", "beta_dot", "i_R1", "theta_b2", "los.omega[1]",
            "events.total", "solver.steps", "solver.rhs_evaluations", "solver.jacobian_evaluations"]

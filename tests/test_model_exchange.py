@@ -21,7 +21,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from model_exchange_host import ModelExchangeInstance, simulate_model_exchange
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 ANGLES = ["alpha", "alpha_m", "beta", "beta_m"]
@@ -340,7 +340,7 @@ def test_directional_derivatives_match_the_linear_model_of_the_core(gimbal_fmu, 
     core's linearization at the same point, column by column. d der(x) / dx is the analytic Jacobian
     the implicit integrators use (equal to rounding); the rest are central differences along the seed,
     and the analytic part is checked against a central difference of fmi2GetDerivatives."""
-    from scene_lib.linearization import linearize
+    from gimbal2axis.analysis.linearization import linearize
     from test_linearization import RICH_POINT, RIGID_POINT, split, with_contact
 
     values = with_contact(gimbal_fmu, RICH_POINT) if point == "rich" else dict(RIGID_POINT)

@@ -8,7 +8,7 @@ Same FMU, same start values, same inputs, same communication steps: the outputs 
 last bit. They do, once "same communication steps" is taken literally:
 
 - ecos keeps time as a double and passes the constant step `h` (0.001 is 0.001) to every
-  `fmi2DoStep`, exactly like `scene_lib.fmu.simulate`: bit-identical results.
+  `fmi2DoStep`, exactly like `gimbal2axis.fmu.simulate`: bit-identical results.
 - libcosim keeps time as integer nanoseconds and converts each step to a double as
   `to_double_duration(d, t) = double(t + d) - double(t)` (`cosim/time.hpp`), with
   `double(t) = t_ns / 1e9`. So the step it passes varies in the last bits: for h = 1 ms,
@@ -34,7 +34,7 @@ import stat
 import numpy as np
 import pytest
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 
 START = {"solver.rtol": 1e-9, "gear2.eta": 1e-4, "beta": 0.3, "beta_m": 18.0,
          "u_R1": 2.0, "u_R2": -1.5}  # constant voltages, held by every master from initialization on
@@ -57,7 +57,7 @@ def as_matrix(result: dict) -> np.ndarray:
 
 
 def fmpy_on_schedule(fmu, times: list, start_values: dict, inputs) -> np.ndarray:
-    """`scene_lib.fmu.simulate`, but with given communication points: step k goes from times[k] with
+    """`gimbal2axis.fmu.simulate`, but with given communication points: step k goes from times[k] with
     step size times[k+1] - times[k] (what libcosim passes)."""
     slave = fmu.instantiate("fmpy_schedule")
     try:
@@ -210,7 +210,7 @@ def run_ecos(uri: str, step: float, n_steps: int, start_values: dict, inputs) ->
         rows = []
         for k in range(n_steps):
             if inputs is not None:
-                for name, value in inputs(k * step).items():  # the times scene_lib.fmu.simulate uses
+                for name, value in inputs(k * step).items():  # the times gimbal2axis.fmu.simulate uses
                     simulation.set_real(f"gimbal::{name}", float(value))
             simulation.step(1)
             rows.append([simulation.get_real(f"gimbal::{n}") for n in OUTPUTS])

@@ -1,7 +1,7 @@
 """Physical invariants of the integrated FMU: energy, Galilean invariance, convergence."""
 import numpy as np
 
-from scene_lib.fmu import STATES, simulate
+from gimbal2axis.fmu import STATES, simulate
 
 CONSERVATIVE = {
     # Fixed base, no friction, no damping, motors that exert no torque: only gravity and gear springs act

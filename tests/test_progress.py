@@ -1,10 +1,10 @@
-"""Progress displays (scene_lib.progress for a scene run, sweep_lib.progress for a sweep), both
+"""Progress displays (gimbal2axis.progress for a scene run, gimbal2axis.sweep.progress for a sweep), both
 through tqdm: into a pipe or a log whole lines and never a carriage return; on a terminal a bar
 redrawn in place, also on one that reports no size."""
 import io
 
-from scene_lib.progress import Progress as SceneProgress
-from sweep_lib.progress import Progress as SweepProgress
+from gimbal2axis.progress import Progress as SceneProgress
+from gimbal2axis.sweep.progress import Progress as SweepProgress
 
 
 class Terminal(io.StringIO):

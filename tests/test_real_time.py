@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
-from scene_lib.fmu import simulate
+from gimbal2axis.fmu import simulate
 from test_fast_core import ship_inputs as ship_loop  # a PD loop against a rolling, pitching carrier
 
 ERROR, DISCARD = 3, 2

@@ -1,7 +1,7 @@
 """A closed-loop scene on a moving base against an independent high-accuracy solution."""
 import numpy as np
 
-from scene_lib.fmu import STATES, simulate
+from gimbal2axis.fmu import STATES, simulate
 from reference_model import ReferenceModel
 
 STEP = 2e-3

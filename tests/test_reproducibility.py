@@ -7,13 +7,13 @@ import sys
 
 import numpy as np
 
-from scene_lib import load_scene
+from gimbal2axis import load_scene
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
 SAMPLE = """
 import sys, numpy as np
-from scene_lib import load_scene
+from gimbal2axis import load_scene
 motion = load_scene({scene!r}).base_motion()
 np.save(sys.argv[1], motion.sample(np.arange(20001) * 1e-3))
 """

@@ -12,12 +12,12 @@ import warnings
 import numpy as np
 import pytest
 
-from scene_lib import FMU, SceneError, load_scene, run
-from scene_lib.errors import SceneWarning
+from gimbal2axis import FMU, SceneError, load_scene, run
+from gimbal2axis.errors import SceneWarning
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
-RUN_SCENE = REPO / "scripts" / "run_scene.py"
+RUN_SCENE = [sys.executable, "-m", "gimbal2axis", "run"]   # the installed package's command
 
 # a scene that draws no warning: fixed base said twice, an explicit (open-loop) controller
 QUIET = """name = "quiet"
@@ -45,7 +45,7 @@ GOOD_MOTION = "time,gamma\n0,0\n0.005,0.001\n0.01,0.002\n0.015,0.003\n"
 
 
 def run_cli(*args, cwd):
-    done = subprocess.run([sys.executable, str(RUN_SCENE), *map(str, args)], capture_output=True, text=True,
+    done = subprocess.run([*RUN_SCENE, *map(str, args)], capture_output=True, text=True,
                           cwd=cwd, timeout=300)
     assert "Traceback" not in done.stderr, done.stderr
     return done
@@ -54,7 +54,7 @@ def run_cli(*args, cwd):
 def assert_one_line_error(done, *fragments):
     assert done.returncode == 2, (done.returncode, done.stdout, done.stderr)
     lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("run_scene.py: error: "), done.stderr
+    assert len(lines) == 1 and lines[0].startswith("gimbal2axis run: error: "), done.stderr
     for fragment in fragments:
         assert fragment in lines[0], (fragment, lines[0])
     return lines[0]
@@ -169,7 +169,7 @@ def test_a_pid_without_an_azimuth_table_runs_with_a_warning_naming_it(tmp_path, 
     done = run_cli(path, "--fmu", fmu_path, "--out", tmp_path / "out", "--quiet", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("run_scene.py: warning: "), done.stderr
+    assert len(lines) == 1 and lines[0].startswith("gimbal2axis run: warning: "), done.stderr
     assert "[controller.azimuth]" in lines[0] and "0 V" in lines[0]
     assert (tmp_path / "out" / "scene.csv").exists()
 
@@ -264,7 +264,7 @@ def los_axes(fig):
 
 
 def test_the_line_of_sight_panel_draws_every_sample_and_its_rms_where_it_belongs(fmu_path):
-    from scene_lib.plotting import figure
+    from gimbal2axis.master.plotting import figure
 
     scene = load_scene(REPO / "scenes" / "pointing_step.toml")
     with FMU(fmu_path) as fmu:
@@ -284,7 +284,7 @@ def test_the_line_of_sight_panel_draws_every_sample_and_its_rms_where_it_belongs
 
 
 def test_an_error_of_zero_is_drawn_at_zero_not_dropped(fmu_path):
-    from scene_lib.plotting import ROUND_OFF_MRAD, figure
+    from gimbal2axis.master.plotting import ROUND_OFF_MRAD, figure
 
     scene = load_scene(REPO / "scenes" / "ship_stabilization.toml")   # starts on target: error 0 at t = 0
     with FMU(fmu_path) as fmu:
@@ -299,7 +299,7 @@ def test_an_error_of_zero_is_drawn_at_zero_not_dropped(fmu_path):
 # --- help texts and docs ------------------------------------------------------------------------------
 
 def test_help_is_whole_sentences_without_internal_jargon():
-    done = subprocess.run([sys.executable, str(RUN_SCENE), "--help"], capture_output=True, text=True, timeout=60)
+    done = subprocess.run([*RUN_SCENE, "--help"], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0
     text = " ".join(done.stdout.split())
     assert "real-time factor, events, requirements)." in text                      # the description is whole

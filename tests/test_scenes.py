@@ -1,13 +1,13 @@
-"""Scenes (scenes/*.toml) and the scene runner (scripts/run_scene.py, scripts/scene_lib/)."""
+"""Scenes (scenes/*.toml) and the scene runner (gimbal2axis run, gimbal2axis/)."""
 import math
 import pathlib
 
 import numpy as np
 import pytest
 
-from scene_lib import FMU, SceneError, check_against_fmu, load_scene, run, run_scene_file
-from scene_lib import geometry
-from scene_lib.base_motion import INPUTS, make_base_motion
+from gimbal2axis import FMU, SceneError, check_against_fmu, load_scene, run, run_scene_file
+from gimbal2axis.scene import geometry
+from gimbal2axis.scene.base_motion import INPUTS, make_base_motion
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 

@@ -1,4 +1,4 @@
-"""Sweeps on Dask (scripts/sweep.py, scripts/sweep_lib/): expansion of sweep files, a local cluster
+"""Sweeps on Dask (gimbal2axis sweep, gimbal2axis/sweep/): expansion of sweep files, a local cluster
 of 2 workers against serial runs case by case, failed cases reported with the FMU's log, reruns
 that skip the cases already done."""
 import math
@@ -11,10 +11,10 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
-from scene_lib import FMU, run  # noqa: E402
-from sweep_lib import SweepError, SweepOptions, load_sweep, prepare, run_sweep  # noqa: E402
-from sweep_lib.table import read_rows  # noqa: E402
-from sweep_lib.worker import metrics  # noqa: E402
+from gimbal2axis import FMU, run  # noqa: E402
+from gimbal2axis.sweep import SweepError, SweepOptions, load_sweep, prepare, run_sweep  # noqa: E402
+from gimbal2axis.sweep.table import read_rows  # noqa: E402
+from gimbal2axis.sweep.worker import metrics  # noqa: E402
 
 SCENE = REPO / "scenes" / "ship_stabilization.toml"
 METRICS = ["los_rms_mrad", "los_peak_mrad", "los_final_mrad", "i_peak_R1_A", "i_peak_R2_A", "i_peak_A", "events",

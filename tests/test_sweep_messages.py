@@ -1,4 +1,4 @@
-"""What a sweep tells its user and how it ends, run as a user runs it (scripts/sweep.py in a
+"""What a sweep tells its user and how it ends, run as a user runs it (gimbal2axis sweep in a
 subprocess): a misspelt parameter name is refused before any case runs, naming the closest valid
 names; failed cases end the sweep with exit status 1 and say where their errors are; a `cases`
 limit that drops grid points says so; Ctrl-C and SIGTERM keep the finished cases and print no
@@ -19,19 +19,19 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
-from scene_lib import FMU  # noqa: E402
-from sweep_lib import SweepError, SweepOptions, load_sweep, prepare, run_sweep  # noqa: E402
-from sweep_lib import table  # noqa: E402
-from sweep_lib.runner import SCHEDULER_TIMEOUT_S  # noqa: E402
-from sweep_lib.table import read_rows  # noqa: E402
+from gimbal2axis import FMU  # noqa: E402
+from gimbal2axis.sweep import SweepError, SweepOptions, load_sweep, prepare, run_sweep  # noqa: E402
+from gimbal2axis.sweep import table  # noqa: E402
+from gimbal2axis.sweep.runner import SCHEDULER_TIMEOUT_S  # noqa: E402
+from gimbal2axis.sweep.table import read_rows  # noqa: E402
 
 SCENE = REPO / "scenes" / "ship_stabilization.toml"
-SWEEP_PY = REPO / "scripts" / "sweep.py"
+SWEEP = [sys.executable, "-m", "gimbal2axis", "sweep"]   # the installed package's command
 
-# sweep.py and its Dask workers as processes of their own: under the preloaded AddressSanitizer
+# gimbal2axis sweep and its Dask workers as processes of their own: under the preloaded AddressSanitizer
 # runtime they test nothing the release pass does not (scripts/test.sh leaves test_sweep.py out too).
 as_a_process = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
-                                  reason="sweep.py processes under AddressSanitizer test nothing more")
+                                  reason="sweep processes under AddressSanitizer test nothing more")
 
 TYPO = """
 stop_time = 0.04
@@ -69,7 +69,7 @@ def write(tmp_path, text, name="s"):
 
 
 def cli(fmu_path, out, *args, **kwargs):
-    return subprocess.run([sys.executable, str(SWEEP_PY), *map(str, args), "--fmu", str(fmu_path), "--out", str(out)],
+    return subprocess.run([*SWEEP, *map(str, args), "--fmu", str(fmu_path), "--out", str(out)],
                           capture_output=True, text=True, cwd=REPO, **kwargs)
 
 
@@ -144,7 +144,7 @@ def test_limit_warning_counts_grid_points_and_samples(tmp_path):
 def _start_then_signal(fmu_path, out, sweep, sig, whole_group):
     """Starts a sweep on a local cluster of 2 worker processes and, once a case is finished, sends
     `sig` to it (or, as a terminal's Ctrl-C does, to its whole process group)."""
-    proc = subprocess.Popen([sys.executable, str(SWEEP_PY), str(SCENE), str(sweep), "--fmu", str(fmu_path),
+    proc = subprocess.Popen([*SWEEP, str(SCENE), str(sweep), "--fmu", str(fmu_path),
                              "--out", str(out), "--workers", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, cwd=REPO, start_new_session=True,
                             # a shell running us in the background may have SIGINT ignored
@@ -195,7 +195,7 @@ def test_scheduler_that_does_not_answer_fails_within_seconds_in_one_line(tmp_pat
     assert run.returncode == 2
     lines = run.stderr.strip().splitlines()
     assert [line for line in lines if "warning" not in line] == [lines[-1]], run.stderr
-    assert lines[-1].startswith(f"sweep.py: error: no Dask scheduler answered at tcp://127.0.0.1:{port} "
+    assert lines[-1].startswith(f"gimbal2axis sweep: error: no Dask scheduler answered at tcp://127.0.0.1:{port} "
                                 f"within {SCHEDULER_TIMEOUT_S:g} s")
     assert SCHEDULER_TIMEOUT_S <= 10
 

@@ -6,14 +6,14 @@ import pathlib
 import numpy as np
 import pytest
 
-from scene_lib import FMU, SceneError, load_scene, run
+from gimbal2axis import FMU, SceneError, load_scene, run
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
 EXAMPLE = REPO / "examples" / "user_controller.toml"
 
 PID_AS_USER_CLASS = '''
-from scene_lib.controllers import PID
+from gimbal2axis.scene.controllers import PID
 
 class PIDAsUser:
     """The built-in PID behind the user interface."""

@@ -38,7 +38,7 @@ def digest(values) -> str:
 
 
 def scene_digests(fmu_path) -> dict:
-    from scene_lib import FMU, load_scene, run
+    from gimbal2axis import FMU, load_scene, run
 
     scenes = sorted((REPO / "scenes").glob("*.toml")) + [REPO / "examples" / "user_controller.toml"]
     out = {}
@@ -52,7 +52,7 @@ def scene_digests(fmu_path) -> dict:
 
 def sweep_digests(fmu_path, workdir: pathlib.Path) -> dict:
     import pyarrow.parquet as pq
-    from sweep_lib import SweepOptions, run_sweep
+    from gimbal2axis.sweep import SweepOptions, run_sweep
 
     sweep = workdir / "golden.toml"
     sweep.write_text(SWEEP)
@@ -72,7 +72,7 @@ def sweep_digests(fmu_path, workdir: pathlib.Path) -> dict:
 
 
 def linearization_digests(fmu_path) -> dict:
-    from scene_lib.linearization import linearize
+    from gimbal2axis.analysis.linearization import linearize
 
     out = {}
     model = linearize({"gear1.model": 0, "motor1.model": 0, "beta": 0.3, "u_R1": 2.0})

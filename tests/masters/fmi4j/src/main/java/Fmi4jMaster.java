@@ -23,7 +23,7 @@ import no.ntnu.ihb.fmi4j.modeldescription.variables.ModelVariables;
  *             [--start NAME=VALUE]... [--inputs CSV] [--rollback-at K]
  * </pre>
  *
- * It makes the calls of {@code scene_lib.fmu.simulate} (scripts/scene_lib/fmu.py), in the same order and
+ * It makes the calls of {@code gimbal2axis.fmu.simulate} (gimbal2axis/fmu/fmu.py), in the same order and
  * with the same arguments: fmi2Instantiate (not visible, logging off); fmi2SetupExperiment with
  * no tolerance, start time 0 and no stop time; one fmi2SetReal of the start values;
  * fmi2EnterInitializationMode; fmi2ExitInitializationMode; then for k = 0 .. N-1: one fmi2SetReal
@@ -127,7 +127,7 @@ public final class Fmi4jMaster {
 
     private static void step(CoSimulationSlave slave, int k, double h, InputTable inputs, long[] inputVrs) {
         if (inputs != null) check(slave.writeReal(inputVrs, inputs.rows[k]), slave, "fmi2SetReal (inputs of step " + k + ")");
-        // The same double as scene_lib.fmu.simulate's currentCommunicationPoint: k * step_size.
+        // The same double as gimbal2axis.fmu.simulate's currentCommunicationPoint: k * step_size.
         double t = k * h;
         check(slave.doStep(t, h), slave, "fmi2DoStep(" + t + ", " + h + ")");
     }

@@ -1,0 +1,34 @@
+"""gimbal2axis: scenes, a co-simulation master, analyses and sweeps for the Gimbal2Axis FMU, and the
+`gimbal2axis` command (subcommands run, sweep, linearize, freqresp, bench; `python -m gimbal2axis`).
+
+    from gimbal2axis import FMU, load_scene, run
+    with FMU("build/Gimbal2Axis.fmu") as fmu:
+        result = run(load_scene("scenes/free_swing.toml"), fmu)
+
+Layout, and the one direction imports go (tests/test_package_layout.py refuses any other):
+
+    cli                      the command and its subcommands, one module each
+     -> sweep | analysis     sweeps on Dask | linearization, frequency responses, isolation prediction
+     -> master               the co-simulation loop (Python, compiled, lockstep), results, plots
+     -> scene                scene files, base motion, references, controllers, sensors, geometry
+     -> fmu                  the FMU wrapper, an FMU kept per worker
+     -> errors, progress, native, locations    leaves: error types, progress bars, the C kernels
+                                               (native/*.c, the extension gimbal2axis.native._native),
+                                               where the build is
+
+A module imports from its own subpackage and from the layers below it, never from above or from its
+sibling (sweep and analysis do not import each other); this file imports only the public API below.
+
+Where the FMU and libgimbal_probe.so (the linearization's library) are: `--fmu` (linearize:
+`--build-dir`), else $GIMBAL2AXIS_FMU and $GIMBAL2AXIS_PROBE_LIBRARY, else gimbal2axis/build_locations.json,
+which configuring the repository's CMake build writes; nothing is found by looking around the source
+tree (gimbal2axis.locations says more). Default files of the commands (a scene, an output directory)
+are paths relative to the current directory, as in the repository's root: `gimbal2axis run` runs
+scenes/free_swing.toml there and writes results/.
+"""
+from .errors import SceneError
+from .fmu import FMU
+from .master import run, run_scene_file
+from .scene import Scene, check_against_fmu, load_scene
+
+__all__ = ["SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run", "run_scene_file"]

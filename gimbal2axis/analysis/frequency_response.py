@@ -1,0 +1,464 @@
+"""Frequency responses of the nonlinear FMU by simulation: sine dwell, one run per frequency.
+
+Three excitations:
+  - "voltage": a motor voltage u_R<axis> = offset + amplitude sin(w t), open loop (the Replay
+    controller; the other motor at 0 V). The scene's base motion is used as given (normally fixed).
+  - "base": the carrier's roll, pitch or yaw *rate* is a sine of the given rate amplitude (base motion
+    type "sinusoids" on that one axis, angle amplitude = rate amplitude / w), through the scene's own
+    closed loop (its controller).
+  - "injection": the loop gain of the scene's own closed loop broken at one motor's voltage (the
+    control engineer's voltage injection): the scene's controller runs, wrapped (InjectingController)
+    so that D_k = amplitude sin(w t_k) is added to axis <axis>'s *computed* voltage at t_k, after the
+    controller's own clamp and before the master's delay and hold. What the master records as the
+    command u_R<axis>_cmd is then A = U + D, U the controller's own output; A is what the delay line
+    and the hold pass on to the motor. The loop gain at that point is L = -U / A (the other axis's loop
+    closed), the sensitivity A / D = 1 / (1 + L). The base is fixed (a carrier at rest).
+
+Each run settles for max(settle_periods / f, settle_s) and then measures over exactly
+`measure_periods` periods. The frequency is snapped so that those periods span an integer number of
+communication steps (the reported frequency_hz is the one simulated): the single-bin DFT
+    X = (2 / n) sum_k x_k exp(-j w t_k)       (k over the measurement window)
+is then exactly orthogonal to the mean and to every other harmonic. Gain and phase are Y / U.
+
+The input's fundamental is the *continuous-time* one: an applied motor voltage is a staircase
+(held over each step, zero-order hold), whose fundamental is the samples' one times
+exp(-j w h / 2) sin(w h / 2) / (w h / 2); without that correction the phase would be off by w h / 2
+(1.8 deg at 10 Hz with h = 1 ms). The base rates are exact sine values at the step starts (the FMU
+moves the carrier on with the exact acceleration), the outputs are exact samples: no correction.
+
+"coherence" here is the fraction of the output's power (its variance over the window) that is in
+the fundamental: |Y|^2 / 2 / var(y). 1 for a linear response without noise; less when the nonlinear
+plant puts power into harmonics, sub-harmonics or a drift. It is NOT Welch's magnitude-squared
+coherence (a sine dwell has one frequency per run, so that estimator has nothing to average over).
+
+For a base excitation the combined line-of-sight output "los" is sqrt(|G_1|^2 + |G_3|^2) of the two
+gyro components that move the line of sight (los.omega[1], elevation; los.omega[3], cross-elevation):
+the isolation (stabilization) ratio, LOS inertial rate / carrier rate. It has no phase (NaN).
+"""
+from __future__ import annotations
+
+import csv
+import dataclasses
+import hashlib
+import math
+import pathlib
+
+import numpy as np
+
+from ..errors import SceneError
+
+BASE_AXES = {"pitch": "base.delta_dot", "yaw": "base.psi_dot", "roll": "base.gamma_dot"}
+LOS_OUTPUTS = ["los.omega[1]", "los.omega[3]"]
+LINEAR_FIDELITY = {"gear1.model": 1, "gear2.model": 1, "dry_friction": False}
+
+
+MOTOR_AXES = ("1", "2")
+LOOP_GAIN = "loop_gain"        # output: -U / A at the injection point
+SENSITIVITY = "sensitivity"    # output: A / D = 1 / (1 + L)
+INJECTION_OUTPUTS = {"1": ["los.omega[3]"], "2": ["los.omega[1]"]}   # the LOS rate each motor moves
+
+
+@dataclasses.dataclass(frozen=True)
+class Excitation:
+    kind: str                 # "voltage", "base" or "injection"
+    axis: str                 # "1" / "2" (motor) or "roll" / "pitch" / "yaw"
+    amplitude: float          # V, or rad/s (rate amplitude of the carrier)
+    offset: float = 0.0       # V, a constant voltage added (voltage only)
+
+    def __post_init__(self):
+        if self.kind not in ("voltage", "base", "injection"):
+            raise ValueError(f"excitation kind must be 'voltage', 'base' or 'injection', got {self.kind!r}")
+        if self.kind in ("voltage", "injection") and self.axis not in MOTOR_AXES:
+            raise ValueError(f"a {self.kind} excitation needs axis '1' or '2', got {self.axis!r}")
+        if self.kind == "base" and self.axis not in BASE_AXES:
+            raise ValueError(f"a base excitation needs axis roll, pitch or yaw, got {self.axis!r}")
+
+    @property
+    def input_signal(self) -> str:
+        """The signal the gains are referred to: for an injection the injected sine D itself."""
+        if self.kind == "voltage":
+            return f"u_R{self.axis}"
+        return BASE_AXES[self.axis] if self.kind == "base" else injection_signal(self.axis)
+
+    def default_outputs(self) -> list[str]:
+        if self.kind == "voltage":
+            return ["alpha_dot", "los.omega[3]"] if self.axis == "1" else ["beta_dot", "los.omega[1]"]
+        if self.kind == "injection":
+            return list(INJECTION_OUTPUTS[self.axis])
+        return list(LOS_OUTPUTS)
+
+
+def injection_signal(axis: str) -> str:
+    """The name of the injected sine D on motor `axis` (rows' input of the responses to it)."""
+    return f"injection_R{axis}"
+
+
+def command_signal(axis: str) -> str:
+    """The recorded computed voltage of motor `axis`: A = U + D during an injection."""
+    return f"u_R{axis}_cmd"
+
+
+class InjectingController:
+    """The scene's controller with `amplitude sin(2 pi f t_k)` added to motor `axis`'s computed voltage.
+
+    The sine is added to what the controller returns at t_k (after its own clamp and anti-windup, which
+    see only its own output U), so the master records A = U + D as the command and delays and holds A
+    like any command. Everything else (prepare, start, the references it records) is the wrapped
+    controller's: it behaves as in the scene. Being no built-in class, it runs in the Python loop."""
+
+    kind = "injection"
+
+    def __init__(self, controller, axis: str, amplitude: float, frequency_hz: float):
+        if axis not in MOTOR_AXES:
+            raise SceneError(f"injection axis must be '1' or '2', got {axis!r}")
+        self.controller = controller
+        self.index = int(axis) - 1
+        self.amplitude = float(amplitude)
+        self.w = 2 * math.pi * float(frequency_hz)
+
+    def injection(self, t):
+        """D at the time(s) t: the same expression the loop adds, for the analysis to subtract."""
+        return self.amplitude * np.sin(self.w * np.asarray(t, float))
+
+    @property
+    def reference(self):
+        return self.controller.reference
+
+    @property
+    def u_limit(self):
+        return self.controller.u_limit
+
+    def prepare(self, times, h, attitude, rates) -> None:
+        self.controller.prepare(times, h, attitude, rates)
+
+    def start(self, step_size: float, scene_name: str) -> None:
+        self.controller.start(step_size, scene_name)
+
+    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
+        u = list(self.controller(t, h, alpha, beta, gyro, base_attitude, base_rates, step=step))
+        u[self.index] += self.amplitude * math.sin(self.w * t)
+        return tuple(u)
+
+
+@dataclasses.dataclass(frozen=True)
+class Dwell:
+    settle_periods: float = 5.0
+    settle_s: float = 0.0      # at least this long (for a closed loop slower than a few periods)
+    measure_periods: int = 4
+
+
+def log_frequencies(f_min: float, f_max: float, points: int) -> list[float]:
+    return np.logspace(math.log10(f_min), math.log10(f_max), points).tolist()
+
+
+def snapped_grid(frequency: float, h: float, dwell: Dwell):
+    """(f actually simulated, steps to settle, steps to measure)."""
+    n_measure = max(int(round(dwell.measure_periods / (frequency * h))), 1)
+    f = dwell.measure_periods / (n_measure * h)
+    n_settle = int(math.ceil(max(dwell.settle_periods / f, dwell.settle_s) / h - 1e-9))
+    return f, n_settle, n_measure
+
+
+def fundamental(x: np.ndarray, t: np.ndarray, f: float) -> complex:
+    """Complex amplitude X of x ~ Re(X exp(j w t)) over a window of whole periods (single-bin DFT)."""
+    return complex(2.0 / len(x) * np.sum(x * np.exp(-2j * math.pi * f * t)))
+
+
+def zoh_fundamental(samples_fundamental: complex, f: float, h: float) -> complex:
+    """The continuous-time fundamental of a staircase held over each step from its samples' one."""
+    half = math.pi * f * h
+    return samples_fundamental * complex(math.cos(half), -math.sin(half)) * (math.sin(half) / half)
+
+
+def power_fraction(x: np.ndarray, X: complex) -> float:
+    var = float(np.var(x))
+    return float(abs(X) ** 2 / 2.0 / var) if var > 0 else math.nan
+
+
+def _scene_for(scene, excitation: Excitation, f: float, stop_time: float, fidelity: dict | None):
+    changes = {"stop_time": stop_time}
+    if fidelity:
+        merged = dict(scene.fidelity)
+        merged.update(fidelity)
+        changes["fidelity"] = merged
+    if excitation.kind == "injection":   # the loop gain at the operating point of a carrier at rest
+        changes["base_motion_spec"] = {"type": "fixed"}
+    if excitation.kind == "base":
+        changes["base_motion_spec"] = {
+            "type": "sinusoids",
+            excitation.axis: {"amplitude_deg": math.degrees(excitation.amplitude / (2 * math.pi * f)),
+                              "frequency_hz": f}}
+    return scene.with_changes(**changes)
+
+
+def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: Dwell = Dwell(),
+                  outputs: list[str] | None = None, fidelity: dict | None = None, slave=None, log=None) -> list[dict]:
+    """One sine dwell at `frequency`: one row per output (and 'los' for a base excitation; for an
+    injection first 'loop_gain' = -U / A, input u_R<axis>_cmd, coherence that of U, and 'sensitivity' =
+    A / D, then the outputs per D, input injection_R<axis>)."""
+    from ..master.master import run
+
+    h = scene.step_size
+    f, n_settle, n_measure = snapped_grid(frequency, h, dwell)
+    n = n_settle + n_measure
+    run_scene = _scene_for(scene, excitation, f, n * h, fidelity)
+    controller = _controller_for(run_scene, fmu, excitation, f, n)
+    result = run(run_scene, fmu, controller=controller, slave=slave, log=log)
+    sig = dict(result.signals)
+    if excitation.kind == "injection":
+        sig[excitation.input_signal] = controller.injection(sig["time"])
+    window = slice(n_settle, n_settle + n_measure)
+    t = sig["time"][window]
+    u = np.asarray(sig[excitation.input_signal])[window]
+    U = fundamental(u, t, f)
+    if excitation.kind == "voltage":
+        U = zoh_fundamental(U, f, h)
+    limited = np.zeros(n_measure, bool)
+    for j in (1, 2):
+        if f"motor{j}.limited" in sig:
+            limited |= np.asarray(sig[f"motor{j}.limited"])[window] != 0
+    common = dict(frequency_hz=f, requested_hz=frequency, input=excitation.input_signal,
+                  input_amplitude=abs(U), samples_per_period=1.0 / (f * h), settle_s=n_settle * h,
+                  measure_periods=dwell.measure_periods, current_limited_fraction=float(limited.mean()))
+    rows = _injection_rows(common, sig, window, t, f, excitation.axis, U) if excitation.kind == "injection" else []
+    gains = {}
+    for name in outputs or excitation.default_outputs():
+        y = np.asarray(sig[name])[window]
+        Y = fundamental(y, t, f)
+        gains[name] = Y / U
+        rows.append(_gain_row(common, name, Y / U, y, Y))
+    if excitation.kind == "base" and all(name in gains for name in LOS_OUTPUTS):
+        g = math.sqrt(sum(abs(gains[name]) ** 2 for name in LOS_OUTPUTS))
+        parts = [r for r in rows if r["output"] in LOS_OUTPUTS]
+        total_var = sum(r["output_variance"] for r in parts)
+        rows.append(dict(common, output="los", gain=g, gain_db=20 * math.log10(g) if g > 0 else -math.inf,
+                         phase_deg=math.nan,
+                         coherence=sum(r["output_amplitude"] ** 2 / 2 for r in parts) / total_var if total_var > 0 else math.nan,
+                         output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var))
+    return rows
+
+
+def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
+    """The controller of the run: None (the scene's own), Replay of the sine (voltage), or the scene's
+    own wrapped by InjectingController (injection)."""
+    from ..scene.controllers import Replay
+    from ..scene.scene import parameter_value
+
+    h = run_scene.step_size
+    if excitation.kind == "voltage":
+        t = np.arange(n + 1) * h
+        voltages = np.zeros((n + 1, 2))
+        # the command at t_k is applied delay steps later: its phase does not matter, u_R<j> is measured
+        voltages[:, int(excitation.axis) - 1] = excitation.offset + excitation.amplitude * np.sin(2 * math.pi * f * t)
+        return Replay(voltages)
+    if excitation.kind == "injection":
+        u_limit = tuple(float(parameter_value(run_scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+        return InjectingController(run_scene.controller(u_limit), excitation.axis, excitation.amplitude, f)
+    return None
+
+
+def _gain_row(common: dict, output: str, G: complex, y: np.ndarray, Y: complex, **extra) -> dict:
+    """A row of gain G for `output` whose samples over the window are y, fundamental Y."""
+    return dict(common, output=output, gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=power_fraction(y, Y),
+                output_amplitude=abs(Y), output_mean=float(np.mean(y)), output_variance=float(np.var(y)), **extra)
+
+
+def _injection_rows(common: dict, sig: dict, window: slice, t: np.ndarray, f: float, axis: str, D: complex) -> list:
+    """'loop_gain' = -U / A (A = the recorded command, U = A - D the controller's own output; all samples
+    at t_k, so no hold correction: the prediction is of samples too) and 'sensitivity' = A / D."""
+    a = np.asarray(sig[command_signal(axis)])[window]
+    d = np.asarray(sig[injection_signal(axis)])[window]
+    u = a - d
+    A, U = fundamental(a, t, f), fundamental(u, t, f)
+    loop_gain = _gain_row(dict(common, input=command_signal(axis), input_amplitude=abs(A)), LOOP_GAIN, -U / A, u, U)
+    return [loop_gain, _gain_row(common, SENSITIVITY, A / D, a, A)]
+
+
+# -- the linear model's prediction ------------------------------------------------------------------
+
+LINEAR_CURVE = "linear model"
+
+
+def linear_point(scene, fmu, excitation: Excitation, fidelity: dict | None = None) -> dict:
+    """The operating point of an open-loop dwell as linearize() takes it: the scene's fidelity (with
+    `fidelity` over it), parameters and initial state, the base fixed, the voltage at its offset."""
+    from ..scene.scene import start_values
+
+    if excitation.kind != "voltage":
+        raise ValueError("the linear model's prediction is drawn for the open-loop (voltage) excitation only")
+    values = start_values(scene, fmu, np.zeros(15))
+    values.update(fidelity or {})
+    values["base.fixed"] = True
+    values[excitation.input_signal] = excitation.offset
+    return values
+
+
+def linear_rows(model, rows: list[dict]) -> list[dict]:
+    """The linear model's G(j w) = C (j w I - A)^-1 B + D at the frequencies and for the outputs of the
+    simulated `rows` (one row each, curve LINEAR_CURVE; coherence 1 by definition)."""
+    out, seen = [], set()
+    for row in rows:
+        key = (row["output"], row["frequency_hz"])
+        if key in seen or row["output"] not in model.outputs:
+            continue
+        seen.add(key)
+        G = complex(model.frequency_response([row["frequency_hz"]], row["input"], row["output"])[0])
+        out.append(dict(curve=LINEAR_CURVE, input=row["input"], output=row["output"], requested_hz=row["requested_hz"],
+                        frequency_hz=row["frequency_hz"], gain=abs(G),
+                        gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
+                        phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=1.0))
+    return out
+
+
+def prediction_errors(rows: list[dict], predicted) -> list[tuple]:
+    """(row, gain ratio - 1, phase difference in deg) of each measured row against `predicted(output,
+    frequency_hz)`, a complex gain; the phase difference is wrapped to +-180 and NaN where the row has no
+    phase (the combined 'los')."""
+    out = []
+    for row in rows:
+        G = complex(predicted(row["output"], row["frequency_hz"]))
+        phase = math.nan if math.isnan(row["phase_deg"]) else \
+            (row["phase_deg"] - math.degrees(math.atan2(G.imag, G.real)) + 180) % 360 - 180
+        out.append((row, row["gain"] / abs(G) - 1, phase))
+    return out
+
+
+def linear_lines(model, input_signal: str, outputs: list[str], f_min: float, f_max: float, points: int = 400) -> list:
+    """Dense Bode lines of the linear model for plot_bode: [(label, frequencies, complex G), ...] (a 4th
+    element False marks a line without phase)."""
+    f = np.logspace(math.log10(f_min), math.log10(f_max), points)
+    return [(f"{LINEAR_CURVE}: {name}", f, model.frequency_response(f, input_signal, name)) for name in outputs
+            if name in model.outputs]
+
+
+# -- many frequencies: serially or on Dask -----------------------------------------------------------
+
+def _point_task(fmu_bytes: bytes, digest: str, scene, frequency, excitation, dwell, outputs, fidelity):
+    from ..fmu.worker_cache import loaded_fmu
+
+    loaded = loaded_fmu(fmu_bytes, digest)
+    return measure_point(scene, loaded.fmu, frequency, excitation, dwell, outputs, fidelity,
+                         slave=loaded.instance(), log=loaded.log)
+
+
+def sweep(scene, fmu_path, frequencies, excitation: Excitation, dwell: Dwell = Dwell(), outputs=None,
+          fidelity: dict | None = None, client=None, curve: str = "") -> list[dict]:
+    """measure_point at every frequency; on `client` (a Dask Client) in parallel, else serially in this
+    process on one FMU instance. Rows carry `curve` (a label of the variant)."""
+    fmu_path = pathlib.Path(fmu_path)
+    if client is None:
+        from ..fmu import FMU
+
+        rows = []
+        with FMU(fmu_path) as fmu:
+            log: list = []
+            slave = fmu.instantiate("frequency_response", log)
+            try:
+                for f in frequencies:
+                    rows += measure_point(scene, fmu, f, excitation, dwell, outputs, fidelity, slave=slave, log=log)
+            finally:
+                slave.freeInstance()
+    else:
+        data = fmu_path.read_bytes()
+        digest = hashlib.sha256(data).hexdigest()
+        # a key of its own (hash=False): a second sweep scattering the same bytes must not share the key
+        # the first one releases when it returns
+        data_future = client.scatter(data, broadcast=True, hash=False)
+        futures = [client.submit(_point_task, data_future, digest, scene, f, excitation, dwell, outputs, fidelity,
+                                 pure=False) for f in frequencies]
+        rows = [row for future in futures for row in future.result()]
+    for row in rows:
+        row["curve"] = curve
+    return rows
+
+
+COLUMNS = ["curve", "input", "output", "requested_hz", "frequency_hz", "gain", "gain_db", "phase_deg", "coherence",
+           "input_amplitude", "output_amplitude", "output_mean", "output_variance", "current_limited_fraction", "samples_per_period",
+           "settle_s", "measure_periods"]
+
+
+def write_csv(rows: list[dict], path) -> None:
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: (f"{v:.10g}" if isinstance(v, float) else v) for k, v in row.items()})
+
+
+def curves(rows: list[dict]) -> dict:
+    """{(curve, output): rows sorted by frequency}."""
+    out: dict = {}
+    for row in rows:
+        out.setdefault((row["curve"], row["output"]), []).append(row)
+    return {key: sorted(value, key=lambda r: r["frequency_hz"]) for key, value in out.items()}
+
+
+GAIN_RANGE_DB = 120.0   # the gain axis spans at most this far below the largest gain; lower points sit on its floor
+
+
+def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None) -> None:
+    """Gain (dB), phase (deg, unwrapped along each curve) and coherence against frequency, every point
+    marked, each curve with its own marker and line style (coinciding curves stay visible). The phase and
+    coherence axes are autoscaled to every value. The gain axis spans at most GAIN_RANGE_DB below the
+    largest gain: a lower gain (a load that does not move at all gives -200 dB or less) or a gain of exactly 0
+    is drawn on the floor as a downward triangle and counted in the legend; its value is in the CSV.
+    `lines` (linear_lines) are drawn as thin continuous lines under the points; the linear model's rows
+    among `rows` are then not drawn again as points."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_g, ax_p, ax_c) = plt.subplots(3, 1, figsize=(9, 10), sharex=True)
+    if lines:
+        rows = [r for r in rows if r.get("curve") != LINEAR_CURVE]
+    groups = curves(rows)
+    finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
+    for _, _, G, *_ in lines or []:
+        finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
+    top = max(finite_gains) if finite_gains else 0.0
+    floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
+    for index, line in enumerate(lines or []):
+        label, f, G = line[:3]
+        has_phase = line[3] if len(line) > 3 else True
+        style = ["-", "--", ":"][index % 3]
+        gain = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
+        shown = gain >= floor
+        ax_g.semilogx(f[shown], gain[shown], style, color="k", lw=0.9,
+                      label=label + ("" if has_phase else " (gain only)")
+                      + ("" if shown.all() else f" ({(~shown).sum()} points below {floor:.0f} dB not drawn)"))
+        if has_phase:
+            ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(G))), style, color="k", lw=0.9)
+    markers, styles = "osD^vP*X", ["-", "--", ":", "-."]
+    for index, ((curve, output), cr) in enumerate(groups.items()):
+        marker, style = markers[index % len(markers)], styles[index % len(styles)]
+        size = max(7 - index, 3)
+        f = np.array([r["frequency_hz"] for r in cr])
+        g = np.array([r["gain_db"] for r in cr], float)
+        p = np.array([r["phase_deg"] for r in cr], float)
+        c = np.array([r["coherence"] for r in cr], float)
+        label = f"{curve}: {output}" if curve else output
+        low = ~(np.isfinite(g) & (g >= floor))
+        if low.any():
+            label += f" ({low.sum()} below {floor:.0f} dB: on the floor)"
+        line, = ax_g.semilogx(f, np.where(low, floor, g), style, marker=marker, ms=size, mfc="none", label=label)
+        if low.any():
+            ax_g.semilogx(f[low], np.full(low.sum(), floor), "v", color=line.get_color(), ms=9)
+        kw = dict(color=line.get_color(), linestyle=style, marker=marker, ms=size, mfc="none")
+        finite = np.isfinite(p)
+        if finite.any():
+            unwrapped = np.degrees(np.unwrap(np.radians(p[finite])))
+            ax_p.semilogx(f[finite], unwrapped, **kw)
+        ax_c.semilogx(f, c, **kw)
+    ax_g.set_ylabel("gain [dB]")
+    ax_p.set_ylabel("phase [deg] (unwrapped)")
+    ax_c.set_ylabel("power fraction at the fundamental")
+    ax_c.set_xlabel("frequency [Hz]")
+    for ax in (ax_g, ax_p, ax_c):
+        ax.grid(True, which="both", alpha=0.3)
+    ax_g.legend(fontsize=7)
+    ax_g.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,130 @@
+"""What the scene runner's simulation loop costs, and how much of it is the master's own:
+
+    gimbal2axis bench [--scene scenes/ship_stabilization.toml] [--stop-time 20]
+
+1. runs the scene through the master (gimbal2axis.master.run: sensors, controller, delay, records),
+   once with the compiled loop (the default for the built-in controllers) and once with the Python
+   loop (what a user controller runs in), and takes the CPU time of each loop;
+2. replays exactly the voltages that run commanded (a Replay controller, same delay) through the
+   compiled loop: the FMU alone, with nothing of the master but the loop itself; and through the
+   Python loop: the FMU plus the cost of calling it from Python;
+3. the master's own cost per step is the difference to the replay. Each replay must reproduce the
+   run's outputs bit for bit, which checks that they measured the same work.
+
+All repeated (--repeat, best of) in one process, on CPU time (machines are shared and noisy).
+Writes benchmarks/results/scene_runner.json and prints the figures docs/benchmarks.md quotes.
+"""
+from __future__ import annotations
+
+import datetime
+import json
+import math
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+from ..errors import SceneError
+from ..fmu import FMU
+from ..locations import fmu_path
+from ..master import REAL_OUTPUTS, run
+from ..scene import load_scene
+from ..scene.controllers import Replay
+from .defaults import scene_file
+
+SUMMARY = "CPU time of the scene runner's loop: the FMU alone, the master's own cost per step"
+PROG = "gimbal2axis bench"
+DEFAULT_SCENE = pathlib.Path("scenes", "ship_stabilization.toml")   # relative to the current directory
+LOOPS = ("compiled", "python")
+
+
+def loop_cpu(scene, fmu, compiled: bool, controller=None):
+    """CPU seconds of the run's loop, of the whole run (with the base motion evaluated up front and
+    the set points), and the result."""
+    before = time.process_time()
+    result = run(scene, fmu, compiled=compiled, controller=controller)
+    return result.loop_cpu_time, time.process_time() - before, result
+
+
+def same_outputs(a, b, fmu) -> bool:
+    return all(np.array_equal(a.signals[name], b.signals[name]) for name in REAL_OUTPUTS if fmu.has(name))
+
+
+def measure(scene, fmu, repeat: int) -> dict:
+    """Best-of-`repeat` CPU seconds: 'run_<loop>', 'whole_<loop>' and 'replay_<loop>' per loop; None
+    when a replay did not reproduce its run."""
+    best: dict = {}
+    for _ in range(repeat):
+        for loop in LOOPS:
+            cpu, whole, result = loop_cpu(scene, fmu, loop == "compiled")
+            commands = np.column_stack([result.signals["u_R1_cmd"], result.signals["u_R2_cmd"]])
+            replay, _, replayed = loop_cpu(scene, fmu, loop == "compiled", Replay(commands))
+            if not same_outputs(result, replayed, fmu):
+                return None
+            for key, value in (("run", cpu), ("whole", whole), ("replay", replay)):
+                best[f"{key}_{loop}"] = min(best.get(f"{key}_{loop}", np.inf), value)
+    return best
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--scene", default=None,
+                        help=f"the scene to measure (default: {DEFAULT_SCENE} in the current directory, the "
+                             "repository's when run from its root)")
+    parser.add_argument("--fmu", default=None,
+                        help="the FMU (default $GIMBAL2AXIS_FMU, else the build the package was configured with)")
+    parser.add_argument("--stop-time", type=float, default=20.0, help="simulated seconds per run (default 20)")
+    parser.add_argument("--repeat", type=int, default=3, help="runs of each kind; the fastest counts (default 3)")
+    parser.add_argument("--out", default="benchmarks/results/scene_runner.json",
+                        help="the JSON of the figures (default benchmarks/results/scene_runner.json in the current "
+                             "directory)")
+
+
+def execute(args) -> int:
+    if not (math.isfinite(args.stop_time) and args.stop_time > 0):
+        args.command_parser.error(f"--stop-time {args.stop_time:g}: need a positive number of seconds")
+    if args.repeat < 1:
+        args.command_parser.error(f"--repeat {args.repeat}: need at least 1")
+    try:
+        scene = load_scene(scene_file(args.scene, DEFAULT_SCENE, "--scene SCENE.toml"))
+        scene = scene.with_changes(stop_time=args.stop_time)
+        with FMU(fmu_path(args.fmu)) as fmu:
+            best = measure(scene, fmu, args.repeat)
+    except SceneError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    if best is None:
+        print(f"{PROG}: a replay did not reproduce its run's outputs", file=sys.stderr)
+        return 1
+    steps = int(round(args.stop_time / scene.step_size))
+    per_step = 1e6 / steps
+    figures = {
+        "scene": scene.name, "controller": scene.controller_spec.get("type", "none"), "stop_time_s": args.stop_time,
+        "steps": steps, "date": datetime.date.today().isoformat(),
+        "fmu_alone_cpu_s": best["replay_compiled"], "fmu_alone_real_time_factor": args.stop_time / best["replay_compiled"],
+        "fmu_us_per_step": best["replay_compiled"] * per_step,
+        "note": "loop CPU time includes the instance's set-up and initialization and the recording; the base "
+                "motion and the set points of the whole run, evaluated before the loop, are in whole_run_cpu_s only",
+    }
+    for loop in LOOPS:
+        figures[loop] = {
+            "loop_cpu_s": best[f"run_{loop}"], "real_time_factor_cpu": args.stop_time / best[f"run_{loop}"],
+            "whole_run_cpu_s": best[f"whole_{loop}"],
+            "replay_cpu_s": best[f"replay_{loop}"],
+            "master_own_us_per_step": (best[f"run_{loop}"] - best["replay_compiled"]) * per_step,
+            "loop_alone_us_per_step": (best[f"replay_{loop}"] - best["replay_compiled"]) * per_step,
+        }
+    out = pathlib.Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(figures, indent=2) + "\n")
+    print(f"{scene.name}, {args.stop_time:g} s at h = {scene.step_size:g} s ({steps} steps), "
+          f"controller {figures['controller']}, CPU time, best of {args.repeat}:")
+    print(f"  FMU alone (compiled replay)  {best['replay_compiled']:.3f} s = "
+          f"{figures['fmu_alone_real_time_factor']:.0f}x real time, {figures['fmu_us_per_step']:.2f} us per step")
+    for loop in LOOPS:
+        f = figures[loop]
+        print(f"  {loop + ' loop':<28} {f['loop_cpu_s']:.3f} s = {f['real_time_factor_cpu']:.0f}x real time; master's own "
+              f"{f['master_own_us_per_step']:.2f} us per step (the loop alone, without the controller: {f['loop_alone_us_per_step']:.2f}); "
+              f"whole run {f['whole_run_cpu_s']:.3f} s")
+    print(f"wrote {out}")
+    return 0

@@ -1,0 +1,249 @@
+"""Frequency responses of the Gimbal2Axis FMU by sine dwell (gimbal2axis.analysis.frequency_response; how
+to read the results: docs/frequency_response.md).
+
+  open-loop: the plant from a motor voltage u_R<axis> to the line-of-sight and gimbal rates, on a fixed
+             base, motor voltage = offset + amplitude sin(w t) (no controller, the other motor at 0 V)
+  isolation: the carrier's roll/pitch/yaw rate as a sine through the scene's closed loop: LOS inertial
+             rate / carrier rate (the stabilization ratio)
+  loop-gain: the scene's closed loop on a carrier at rest, a sine of --amplitude V injected into motor
+             --axis's computed voltage: the loop gain L = -U/A broken there (U the controller's output,
+             A = U + D what goes on to the motor), the sensitivity A/D and the LOS rate per D
+All for the scene's model ("full model") and with backlash and dry friction switched off
+(gear*.model = 1, dry_friction = false).
+
+The linear prediction without backlash and dry friction is drawn over the simulated curves as thin
+lines, and its values at the simulated frequencies are rows of curve "linear model" in the CSV
+(--no-linear: not): open loop, the plant's G(jw) from the core's A, B, C, D
+(gimbal2axis.analysis.linearization); isolation and loop-gain, the sampled-data closed loop of the scene's
+PID controller (gimbal2axis.analysis.isolation_prediction; for another controller, or a loop that does not
+settle, the command says so and measures without it). loop-gain also prints the predicted crossover,
+phase and gain margins.
+
+Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
+Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
+
+  gimbal2axis freqresp isolation --axis roll --fmin 0.1 --fmax 100 --points 13
+  gimbal2axis freqresp open-loop --axis 1 --amplitude 1 --serial
+  gimbal2axis freqresp loop-gain --axis 1 --amplitude 0.2
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+import sys
+import time
+import warnings
+
+from ..analysis import frequency_response as fr
+from ..errors import SceneError
+from ..locations import fmu_path
+from ..scene import load_scene
+from .defaults import scene_file
+
+SUMMARY = "frequency responses by sine dwell: open loop, isolation, loop gain, with the linear prediction"
+PROG = "gimbal2axis freqresp"
+DEFAULT_SCENE = pathlib.Path("scenes", "ship_stabilization.toml")   # relative to the current directory
+
+
+def with_overrides(scene, assignments: list[str]):
+    """The scene with NAME=VALUE assignments: a name of [fidelity] (gear1.model, dry_friction, ...) goes
+    there, any other name to [parameters]."""
+    from ..fmu import FIDELITY
+
+    fidelity, parameters = dict(scene.fidelity), dict(scene.parameters)
+    for item in assignments:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise SceneError(f"--set {item!r}: expected NAME=VALUE")
+        low = text.strip().lower()
+        value = True if low == "true" else False if low == "false" else float(text)
+        if isinstance(value, float) and value.is_integer() and name.strip() in FIDELITY:
+            value = int(value)
+        (fidelity if name.strip() in FIDELITY else parameters)[name.strip()] = value
+    return scene.with_changes(fidelity=fidelity, parameters=parameters)
+
+
+def check_arguments(args) -> None:
+    """What argparse cannot say: ranges."""
+    if not (args.fmin > 0 and args.fmax >= args.fmin):
+        raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
+    if args.points < 1:
+        raise SceneError(f"--points {args.points}: need at least 1")
+    for amplitude in args.amplitude or []:
+        if not (amplitude > 0 and math.isfinite(amplitude)):
+            raise SceneError(f"--amplitude {amplitude:g}: need a positive amplitude")
+
+
+def unit_of(mode: str) -> str:
+    """The unit of --amplitude."""
+    return "deg/s" if mode == "isolation" else "V"
+
+
+def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
+    """The linear model's Bode lines, a function giving its rows at the simulated points and a line of
+    text to print (or None): open loop, the plant's G(jw) (analysis.linearization); isolation and loop
+    gain, the sampled-data closed loop of the scene's PID controller (analysis.isolation_prediction),
+    the loop gain with its predicted margins. All without backlash and dry friction."""
+    from ..fmu import FMU
+
+    with FMU(fmu_path) as fmu:
+        if excitation.kind == "voltage":
+            from ..analysis import linearization
+
+            model = linearization.linearize(fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY))
+            lines = fr.linear_lines(model, excitation.input_signal, outputs, f_min, f_max)
+            return lines, lambda rows: fr.linear_rows(model, rows), None
+        from ..analysis import isolation_prediction as isolation
+
+        loop = isolation.build_loop(scene, fmu, fr.LINEAR_FIDELITY)
+    def at_simulated(function):
+        return lambda rows: function(loop, excitation.axis, sorted({r["frequency_hz"] for r in rows}))
+    if excitation.kind == "injection":
+        margins = isolation.predicted_margins(loop, excitation.axis)
+        summary = f"linear model, loop gain at u_R{excitation.axis}: {margins.describe()}"
+        return (isolation.loop_gain_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.loop_gain_rows),
+                summary)
+    return (isolation.isolation_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.isolation_rows),
+            None)
+
+
+def measured_margins(rows: list[dict]) -> list[str]:
+    """A line per simulated curve: the margins of its loop_gain points (interpolated between the dwell's
+    frequencies, so only as fine as its grid; a point of low coherence may place a crossing anywhere)."""
+    from ..analysis.isolation_prediction import stability_margins
+
+    lines = []
+    for (curve, output), points in fr.curves(rows).items():
+        if output != fr.LOOP_GAIN or curve == fr.LINEAR_CURVE or len(points) < 2:
+            continue
+        f = [r["frequency_hz"] for r in points]
+        L = [r["gain"] * complex(math.cos(math.radians(r["phase_deg"])), math.sin(math.radians(r["phase_deg"])))
+             for r in points]
+        lines.append(f"{curve}, from its {len(points)} points: {stability_margins(f, L).describe()}")
+    return lines
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("mode", choices=["open-loop", "isolation", "loop-gain"])
+    parser.add_argument("--scene", default=None,
+                        help=f"scene whose parameters, fidelity, step size and controller are used (default: "
+                             f"{DEFAULT_SCENE} in the current directory, the repository's when run from its root)")
+    parser.add_argument("--fmu", default=None,
+                        help="the FMU (default $GIMBAL2AXIS_FMU, else the build the package was configured with)")
+    parser.add_argument("--axis", default=None,
+                        help="open-loop, loop-gain: motor 1 or 2 (default 1); isolation: roll, pitch or yaw "
+                             "(default roll)")
+    parser.add_argument("--amplitude", type=float, nargs="+", default=None, metavar="A",
+                        help="open-loop: voltage amplitude in V (default 1); isolation: carrier rate amplitude "
+                             "in deg/s (default 1); loop-gain: injected voltage amplitude in V (default 0.2). Several: a curve per amplitude (the nonlinear model's "
+                             "describing function changes with it; the linear one does not)")
+    parser.add_argument("--offset", type=float, default=0.0, help="open-loop: constant voltage added, V")
+    parser.add_argument("--fmin", type=float, default=0.1)
+    parser.add_argument("--fmax", type=float, default=100.0)
+    parser.add_argument("--points", type=int, default=13, help="log-spaced frequencies (default 13)")
+    parser.add_argument("--settle-periods", type=float, default=5.0)
+    parser.add_argument("--settle-s", type=float, default=1.0, help="settle at least this long, s (default 1)")
+    parser.add_argument("--measure-periods", type=int, default=4)
+    parser.add_argument("--linear-only", action="store_true",
+                        help="only the curve without backlash and dry friction")
+    parser.add_argument("--full-only", action="store_true", help="only the scene's model (its own fidelity)")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override an FMU parameter or fidelity switch of the scene, e.g. --set body2.d_bd[3]=0 "
+                             "(repeatable; numbers, true/false)")
+    parser.add_argument("--no-linear", action="store_true",
+                        help="do not add the linear prediction (it needs libgimbal_probe.so, found through "
+                             "$GIMBAL2AXIS_PROBE_LIBRARY or the configured build; isolation: a PID scene)")
+    parser.add_argument("--serial", action="store_true", help="run the frequencies one after the other here")
+    parser.add_argument("--workers", type=int, default=4, help="local Dask workers (default 4)")
+    parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    parser.add_argument("--out", default="results", help="directory of the CSV and PNG (default results/ in the "
+                                                         "current directory)")
+    parser.add_argument("--name", default=None, help="file name stem (default frequency_response_<mode>_<axis>)")
+
+
+def execute(args) -> int:
+    try:
+        check_arguments(args)
+        fmu = fmu_path(args.fmu)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
+            scene = load_scene(scene_file(args.scene, DEFAULT_SCENE, "--scene SCENE.toml"))
+        scene = with_overrides(scene, args.set)
+        frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
+        dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
+        amplitudes = args.amplitude or [0.2 if args.mode == "loop-gain" else 1.0]
+        if args.mode == "open-loop":
+            axis = args.axis or "1"
+            excitations = [fr.Excitation("voltage", axis, a, args.offset) for a in amplitudes]
+            scene = scene.with_changes(base_motion_spec={"type": "fixed"},
+                                       fidelity={**scene.fidelity, "base.fixed": True},
+                                       controller_spec={"type": "none"})
+            outputs = excitations[0].default_outputs()
+        elif args.mode == "loop-gain":
+            axis = args.axis or "1"
+            if axis not in fr.MOTOR_AXES:
+                raise SceneError(f"loop-gain --axis must be 1 or 2, got {axis!r}")
+            excitations = [fr.Excitation("injection", axis, a) for a in amplitudes]
+            outputs = None
+        else:
+            axis = args.axis or "roll"
+            excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
+            outputs = None
+        excitation = excitations[0]
+        variants = []
+        if not args.linear_only:
+            variants.append(("full model", None))
+        if not args.full_only:
+            variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
+        lines, predict_rows = None, None
+        if not args.no_linear:
+            try:
+                lines, predict_rows, summary = linear_prediction(scene, fmu, excitation, outputs, args.fmin,
+                                                                 args.fmax)
+                if summary:
+                    print(summary)
+            except SceneError as exc:   # e.g. not a PID scene, or a loop that does not settle: measure anyway
+                print(f"{PROG}: no linear prediction: {exc}", file=sys.stderr)
+        client = cluster = None
+        if not args.serial:
+            from ..sweep import make_client
+            client, cluster = make_client(args.scheduler, workers=args.workers)
+        rows = []
+        wall = time.perf_counter()
+        try:
+            for each, amplitude in zip(excitations, amplitudes):
+                for label, fidelity in variants:
+                    curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode)}"
+                    rows += fr.sweep(scene, fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
+        finally:
+            if client is not None:
+                from ..sweep import close_client
+                close_client(client, cluster)
+    except (SceneError, ValueError) as exc:   # ValueError: an Excitation refusing its axis
+        print(f"{PROG}: {exc}", file=sys.stderr)
+        return 1
+    if predict_rows is not None:
+        rows += predict_rows(rows)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
+    csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
+    fr.write_csv(rows, csv_path)
+    shown = ", ".join(f"{a:g}" for a in amplitudes)
+    if excitation.kind == "injection":
+        title = (f"{scene.name}: loop gain L = -U/A at u_R{axis}_cmd (other axis closed) and sensitivity A/D, "
+                 f"injection {shown} V")
+    else:
+        title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
+                 f"{shown} {unit_of(args.mode)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
+    plotted_rows, plotted_lines = rows, lines
+    if excitation.kind == "injection":   # the LOS rate per D (-90 dB) would squeeze L and S: it is in the CSV
+        shown_outputs = (fr.LOOP_GAIN, fr.SENSITIVITY)
+        plotted_rows = [r for r in rows if r["output"] in shown_outputs]
+        plotted_lines = lines and [line for line in lines if line[0].rsplit(": ", 1)[-1] in shown_outputs]
+    fr.plot_bode(plotted_rows, png_path, title, plotted_lines)
+    if excitation.kind == "injection":
+        for line in measured_margins(rows):
+            print(line)
+    print(f"{len(rows)} points in {time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
+    return 0

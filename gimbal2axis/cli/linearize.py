@@ -1,0 +1,196 @@
+"""Linearizes the gimbal's continuous model at an operating point and writes A, B, C, D
+(gimbal2axis.analysis.linearization; docs/linearization.md).
+
+The operating point is the FMU's start values, changed by a scene's parameters, fidelity and initial
+state (--scene) and by --set NAME=VALUE (parameters, fidelity switches, start values of states such as
+beta=0.3, inputs such as u_R1=2 or base.gamma=0.1). With --at-time T the scene is run with its
+controller up to T and the model is linearized where the simulation is then: its state and modes, the
+voltages applied from T on and the carrier's motion at T (--set may change these inputs).
+
+Writes <out> (.npz or .mat: A, B, C, D, the names of states, inputs and outputs, the modes and the
+point) and prints the states, the modes and the poles. With --bode INPUT:OUTPUT (repeatable) it also
+writes <out stem>_bode.png and .csv of those transfer functions.
+
+  gimbal2axis linearize --set gear1.model=0 --set motor1.model=0 --out results/azimuth.npz \\
+      --bode u_R1:alpha_dot
+  gimbal2axis linearize --scene scenes/ship_stabilization.toml --at-time 5 --out results/ship_5s.mat
+"""
+from __future__ import annotations
+
+import csv
+import math
+import pathlib
+import sys
+import warnings
+
+import numpy as np
+
+from ..analysis import linearization
+from ..errors import SceneError
+from ..locations import fmu_path
+from ..scene import load_scene
+
+SUMMARY = "linearize the model at an operating point: A, B, C, D, poles, Bode plots"
+
+
+def parse_assignments(assignments: list[str]) -> dict:
+    values = {}
+    for item in assignments:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise SceneError(f"--set {item!r}: expected NAME=VALUE")
+        low = text.strip().lower()
+        try:
+            values[name.strip()] = True if low == "true" else False if low == "false" else float(text)
+        except ValueError:
+            raise SceneError(f"--set {item!r}: {text!r} is not a number, true or false") from None
+    return values
+
+
+def scene_point(scene_path: str, fmu_file, at_time: float | None, overrides: dict, build_dir: str | None = None):
+    """The linear model of the scene's operating point: its start values, or where its run is at `at_time`."""
+    from ..fmu import FMU
+    from ..master import Plan, run
+    from ..scene import start_values
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
+        scene = load_scene(scene_path)
+    with FMU(fmu_file) as fmu:
+        if at_time is None:
+            plan = Plan(scene, fmu, scene.step_size, None)
+            values = start_values(scene, fmu, plan.base[0])
+            values.update(overrides)
+            if not plan.motion.fixed:
+                names = ["base.delta", "base.psi", "base.gamma", "base.delta_dot", "base.psi_dot", "base.gamma_dot",
+                         "base.delta_ddot", "base.psi_ddot", "base.gamma_ddot", "base.v_a[1]", "base.v_a[2]",
+                         "base.v_a[3]", "base.a_a[1]", "base.a_a[2]", "base.a_a[3]"]
+                for name, value in zip(names, plan.base[0].tolist()):
+                    values.setdefault(name, value)
+            return linearization.linearize(values, build_dir)
+        bad = [name for name in overrides if fmu.variable(name).causality != "input"]
+        if bad:
+            raise SceneError(f"--at-time: only inputs can be changed at a running simulation's point, not {bad} "
+                             f"(change parameters in the scene)")
+        steps = at_time / scene.step_size
+        if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
+            raise SceneError(f"--at-time {at_time:g}: not a whole number of the scene's steps ({scene.step_size:g} s)")
+        scene = scene.with_changes(stop_time=at_time)
+        log: list = []
+        slave = fmu.instantiate("linearize", log)
+        try:
+            signals = run(scene, fmu, slave=slave, log=log).signals
+            return linearization.linearize_instance(fmu, slave, {**inputs_at_end(scene, signals), **overrides},
+                                                    build_dir)
+        finally:
+            slave.freeInstance()
+
+
+def inputs_at_end(scene, signals: dict) -> dict:
+    """The inputs of the step that would start at the run's end: the voltages applied from there (the
+    controller's commands of `delay_steps` before) and the carrier's motion there. The instance itself
+    still holds those of the step that ended."""
+    from ..scene.base_motion import INPUTS as BASE_INPUTS
+
+    inputs = {"u_R1": float(signals["u_R1"][-1]), "u_R2": float(signals["u_R2"][-1])}
+    if not (scene.fidelity.get("base.fixed", False) or scene.base_motion().fixed):
+        inputs.update({name: float(signals[name][-1]) for name in BASE_INPUTS})
+    return inputs
+
+
+def parse_pair(pair: str) -> tuple[str, str]:
+    source, sep, target = pair.partition(":")
+    if not sep or not source or not target:
+        raise SceneError(f"--bode {pair!r}: expected INPUT:OUTPUT, e.g. u_R1:alpha_dot")
+    return source, target
+
+
+def write_bode(model, pairs: list[tuple[str, str]], stem: pathlib.Path, f_min: float, f_max: float) -> list[pathlib.Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    frequencies = np.logspace(math.log10(f_min), math.log10(f_max), 400)
+    fig, (ax_g, ax_p) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    rows = []
+    for source, target in pairs:
+        G = model.frequency_response(frequencies, source, target)
+        gain_db = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
+        phase = np.degrees(np.unwrap(np.angle(G)))
+        ax_g.semilogx(frequencies, gain_db, label=f"{source} -> {target}")
+        ax_p.semilogx(frequencies, phase)
+        rows += [dict(input=source, output=target, frequency_hz=f, gain=abs(g), gain_db=db, phase_deg=p)
+                 for f, g, db, p in zip(frequencies, G, gain_db, phase)]
+    ax_g.set_ylabel("gain [dB]")
+    ax_p.set_ylabel("phase [deg] (unwrapped)")
+    ax_p.set_xlabel("frequency [Hz]")
+    for ax in (ax_g, ax_p):
+        ax.grid(True, which="both", alpha=0.3)
+    ax_g.legend(fontsize=8)
+    ax_g.set_title(f"linear model at t = {model.time:g} s", fontsize=10)
+    fig.tight_layout()
+    png, csv_path = stem.with_name(stem.name + "_bode.png"), stem.with_name(stem.name + "_bode.csv")
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    with open(csv_path, "w", newline="") as f:
+        writer = csv.DictWriter(f, ["input", "output", "frequency_hz", "gain", "gain_db", "phase_deg"])
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: (f"{v:.10g}" if isinstance(v, float) else v) for k, v in row.items()})
+    return [png, csv_path]
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--scene", default=None, help="take parameters, fidelity and initial state from this scene")
+    parser.add_argument("--at-time", type=float, default=None,
+                        help="run the scene (with its controller) to this time and linearize there")
+    parser.add_argument("--fmu", default=None, help="the FMU a scene runs on (default $GIMBAL2AXIS_FMU, else the build "
+                                                    "the package was configured with)")
+    parser.add_argument("--build-dir", default=None, help="where libgimbal_probe.so is (default "
+                                                          "$GIMBAL2AXIS_PROBE_LIBRARY, else the build the package was "
+                                                          "configured with)")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="a parameter, fidelity switch, start value or input (repeatable; numbers, true/false)")
+    parser.add_argument("--out", default="results/linear_model.npz",
+                        help=".npz or .mat (default results/linear_model.npz in the current directory)")
+    parser.add_argument("--bode", action="append", default=[], metavar="INPUT:OUTPUT",
+                        help="also plot this transfer function (repeatable), e.g. u_R1:alpha_dot")
+    parser.add_argument("--fmin", type=float, default=0.01, help="Bode plot from (Hz)")
+    parser.add_argument("--fmax", type=float, default=1000.0, help="Bode plot to (Hz)")
+
+
+def execute(args) -> int:
+    try:
+        overrides = parse_assignments(args.set)
+        if args.at_time is not None and args.scene is None:
+            raise SceneError("--at-time needs --scene: the run that reaches the operating point")
+        if args.at_time is not None and not (args.at_time > 0 and math.isfinite(args.at_time)):
+            raise SceneError(f"--at-time {args.at_time:g}: need a positive time (s)")
+        if args.bode and not (0 < args.fmin <= args.fmax):
+            raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
+        bode_pairs = [parse_pair(pair) for pair in args.bode]
+        if args.scene is not None:
+            model = scene_point(args.scene, fmu_path(args.fmu), args.at_time, overrides, args.build_dir)
+        else:
+            model = linearization.linearize(overrides, args.build_dir)
+        for source, target in bode_pairs:
+            if source not in model.inputs or target not in model.outputs:
+                raise SceneError(f"--bode '{source}:{target}': expected INPUT:OUTPUT with an input of {model.inputs} "
+                                 f"and an output of {model.outputs}")
+        out = pathlib.Path(args.out)
+        if out.suffix not in (".npz", ".mat"):
+            raise SceneError(f"--out {out}: write .npz or .mat")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        model.save(out)
+        written = [out]
+        if bode_pairs:
+            written += write_bode(model, bode_pairs, out.with_suffix(""), args.fmin, args.fmax)
+    except SceneError as exc:
+        text = str(exc)   # the linearization's own messages start with "linearize: "
+        print(f"gimbal2axis {text}" if text.startswith("linearize: ") else f"gimbal2axis linearize: {text}",
+              file=sys.stderr)
+        return 1
+    print(model.summary())
+    print("wrote " + ", ".join(str(p) for p in written))
+    return 0

@@ -1,0 +1,110 @@
+"""Run a scene file (scenes/*.toml) on the Gimbal2Axis FMU.
+
+An fmpy master steps the FMU with the scene's controller in the loop (the voltage computed from the
+sensors at one communication point is applied over the step after the next) and writes
+<out>/<scene>.csv (every recorded signal, SI units) and <out>/<scene>.png (plots), where <scene> is
+the scene file's name without .toml; then it prints a summary line (line-of-sight error, wall time,
+real-time factor, events, requirements).
+"""
+import math
+import os
+import pathlib
+import sys
+import tempfile
+import warnings
+
+from ..errors import SceneError, SceneWarning
+from ..locations import fmu_path
+from ..master import run_scene_file
+from ..scene import load_scene
+from .defaults import scene_file
+
+SUMMARY = "run a scene file: CSV, plots and a summary line"
+PROG = "gimbal2axis run"
+EXIT_ERROR, EXIT_INTERRUPTED = 2, 130
+DEFAULT_SCENE = pathlib.Path("scenes", "free_swing.toml")   # relative to the current directory
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None):
+    """Scene warnings as one line each; anything else as Python prints it."""
+    if issubclass(category, SceneWarning):
+        print(f"{PROG}: warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+def check_stop_time(stop_time: float, scene) -> None:
+    if not math.isfinite(stop_time) or stop_time <= 0:
+        raise SceneError(f"--stop-time must be a positive number of seconds, got {stop_time:g}")
+    if stop_time > scene.stop_time * (1 + 1e-12):
+        raise SceneError(f"--stop-time {stop_time:g} is after the scene's stop_time ({scene.stop_time:g} s); "
+                         "it can only shorten a run (change stop_time in the scene file to run longer)")
+    steps = stop_time / scene.step_size
+    if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
+        raise SceneError(f"--stop-time {stop_time:g} is not a whole number of steps of the scene's step_size "
+                         f"({scene.step_size:g} s)")
+
+
+def check_output_directory(out: pathlib.Path, stem: str) -> None:
+    """Fails before the run, not after it, when the results cannot be written."""
+    if out.exists() and not out.is_dir():
+        raise SceneError(f"--out {out}: exists and is not a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SceneError(f"--out {out}: cannot create the directory: {exc.strerror or exc}") from None
+    try:
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as exc:
+        raise SceneError(f"--out {out}: cannot write there: {exc.strerror or exc}") from None
+    for suffix in (".csv", ".png"):
+        target = out / f"{stem}{suffix}"
+        if target.is_dir() or (target.exists() and not os.access(target, os.W_OK)):
+            raise SceneError(f"cannot write {target}: {'it is a directory' if target.is_dir() else 'not writable'}")
+
+
+def add_arguments(parser) -> None:
+    parser.epilog = ("Warnings (a scene that runs, but probably not as meant) and errors go to stderr, one line\n"
+                     f"each. Exit status: 0 done, 1 --check found unmet requirements, {EXIT_ERROR} the scene or an\n"
+                     "option was refused or the run failed.")
+    parser.add_argument("scene", nargs="?", default=None,
+                        help=f"the scene file (default: {DEFAULT_SCENE} in the current directory, the "
+                             "repository's free swing when run from its root)")
+    parser.add_argument("--fmu", default=None,
+                        help="the FMU to run (default: $GIMBAL2AXIS_FMU, else the build the package was configured "
+                             "with)")
+    parser.add_argument("--out", default="results",
+                        help="directory for the CSV and PNG, created if missing (default: results/ in the current "
+                             "directory); files of the same scene are overwritten")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--stop-time", type=float, default=None, metavar="T",
+                        help="end the run at T seconds, before the scene's stop_time (a whole number of steps)")
+    parser.add_argument("--check", action="store_true",
+                        help="exit with status 1 when the scene's [requirements] are not met")
+
+
+def execute(args) -> int:
+    warnings.showwarning = show_warning
+    try:
+        scene_path = scene_file(args.scene, DEFAULT_SCENE, "the scene file: gimbal2axis run SCENE.toml")
+        scene = load_scene(scene_path)
+        if args.stop_time is not None:
+            check_stop_time(args.stop_time, scene)
+        fmu = fmu_path(args.fmu)
+        check_output_directory(pathlib.Path(args.out), scene.name)
+        result, csv_path, png_path = run_scene_file(scene_path, fmu, args.out, progress=not args.quiet,
+                                                    stop_time=args.stop_time)
+    except SceneError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except OSError as exc:   # writing the results (the directory was writable a moment ago)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"{PROG}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print(result.summary())
+    print(f"wrote {csv_path} and {png_path}")
+    return 1 if args.check and result.requirement_failures() else 0

@@ -1,0 +1,97 @@
+"""Run a parameter sweep or Monte Carlo study of a scene on Dask.
+
+Every case of SWEEP.toml (a grid and/or seeded random draws) is applied to SCENE.toml and run, in
+parallel on a local cluster (worker processes of one thread each) or on the workers of an existing
+Dask scheduler. Each worker extracts the FMU once and reuses its instance (fmi2Reset) case after case.
+
+Writes <out>/<sweep>__<scene>.parquet and .csv (one row per case: parameters, seeds, metrics,
+status, and the error and FMU log of a failed case) and .png (a summary plot). A rerun skips the
+cases already in the table, so an interrupted sweep (Ctrl-C, SIGTERM) continues where it stopped.
+"""
+import signal
+import sys
+
+from ..errors import SceneError
+from ..locations import fmu_path
+from ..sweep import SweepError, SweepOptions, run_sweep
+from ..sweep.runner import Stopped
+
+SUMMARY = "run a parameter sweep or Monte Carlo study of a scene on Dask"
+PROG = "gimbal2axis sweep"
+
+EPILOG = """\
+sweep file:
+  [grid] (every combination) and/or [random] (seeded draws) tables of parameters, named by
+  their path into the scene (controller.azimuth.kp, base_motion.seed) or as FMU parameters
+  (gear1.k_s); a 'cases' limit; optional stop_time and metrics_from_s. The format in full:
+  README.md, section "Sweeps and Monte Carlo on Dask", and gimbal2axis/sweep/spec.py.
+
+exit status:
+  0  every case of the sweep ran to the end (status ok)
+  1  some cases failed: their rows in the table have status = failed, the error in
+     the column 'message' and the FMU's log in 'fmu_log'
+  2  nothing ran: the scene, the sweep file or the options were refused
+     (a misspelt parameter name, a scheduler that does not answer, ...)
+  130, 143  interrupted by Ctrl-C or SIGTERM: the cases finished so far are kept
+
+example:
+  gimbal2axis sweep scenes/ship_stabilization.toml sweeps/gains_1000.toml --workers 2
+"""
+
+
+def _terminated(signum, frame):
+    raise Stopped("terminated (SIGTERM)")
+
+
+def add_arguments(parser) -> None:
+    parser.epilog = EPILOG
+    parser.add_argument("scene", metavar="SCENE.toml", help="scene file (scenes/*.toml)")
+    parser.add_argument("sweep", metavar="SWEEP.toml", help="sweep file (sweeps/*.toml): what to vary and how")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="run on the workers of this Dask scheduler (e.g. tcp://10.0.0.5:8786) instead of a "
+                             "local cluster")
+    parser.add_argument("--workers", type=int, default=2, metavar="N",
+                        help="worker processes of the local cluster (default 2)")
+    parser.add_argument("--out", default="results/sweeps", metavar="DIR",
+                        help="directory of the table and plot (default results/sweeps in the current directory)")
+    parser.add_argument("--fmu", default=None,
+                        help="the FMU to run (default $GIMBAL2AXIS_FMU, else the build the package was configured "
+                             "with)")
+    parser.add_argument("--quiet", action="store_true", help="no progress counter (warnings are still shown)")
+    parser.add_argument("--serial", action="store_true", help="no Dask: run the cases one after the other in this "
+                                                              "process")
+    parser.add_argument("--threads", action="store_true",
+                        help="local cluster of threads in this process instead of worker processes")
+    parser.add_argument("--redo", choices=["failed", "all"], default=None,
+                        help="run the failed cases (or all cases) again, although the table has them")
+
+
+def execute(args) -> int:
+    if args.workers < 1:
+        args.command_parser.error("--workers must be >= 1")
+    signal.signal(signal.SIGTERM, _terminated)
+    try:
+        options = SweepOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
+                               serial=args.serial, redo=args.redo, progress=not args.quiet)
+        outcome = run_sweep(args.scene, args.sweep, fmu_path(args.fmu), args.out, options)
+    except (SceneError, SweepError) as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        if not getattr(exc, "reported", False):
+            print(f"\nsweep: {str(exc) or 'interrupted'}", file=sys.stderr)
+        return 128 + (signal.SIGTERM if isinstance(exc, Stopped) else signal.SIGINT)
+    total = outcome.ran + outcome.skipped
+    print(f"{total} cases ({outcome.ran} run, {outcome.skipped} already done): {total - outcome.failed} ok, "
+          f"{outcome.failed} failed; {outcome.wall_time:.1f} s")
+    print(f"wrote {outcome.parquet}, {outcome.csv} and {outcome.png}")
+    if not outcome.failed:
+        return 0
+    for r in [r for r in outcome.rows if r.get("status") != "ok"][:3]:
+        print(f"  failed case {r['case']} ({r['case_id']}): {r['message'].splitlines()[0][:200]}")
+    before = (f" ({outcome.failed_before} of them from an earlier run; --redo failed runs them again)"
+              if outcome.failed_before else "")
+    print(f"{PROG}: {outcome.failed} of {total} cases failed{before}: their rows in {outcome.csv} (and "
+          f".parquet) have status = failed, the error in the column 'message' and the FMU's log in 'fmu_log'",
+          file=sys.stderr)
+    return 1

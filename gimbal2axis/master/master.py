@@ -1,0 +1,240 @@
+"""The co-simulation master: one FMU2Slave, fixed communication steps, the controller with the
+zero-order-hold delay of the voltages.
+
+At each communication point t_k the master reads the FMU's outputs, lets the sensors measure and
+the controller compute u_k from them, and then steps the FMU over [t_k, t_{k+1}] with
+  - the voltages u_{k-d} (d = delay_steps, default 1: the voltage computed from the sensors at t_k
+    is applied over [t_{k+1}, t_{k+2}]; before the first command is due, 0 V), held constant;
+  - the base inputs at t_k (attitude, rates, accelerations, v_a, a_a), exact values of the base
+    motion; the FMU extrapolates them inside the step with constant acceleration (docs/physics.md,
+    section 2).
+With a fixed base the base inputs are never set (they stay 0).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from . import compiled_loop
+from ..scene.base_motion import INPUTS as BASE_INPUTS
+from ..errors import SceneError
+from ..fmu import FMU, STATES
+from ..progress import Progress
+from .results import RunResult
+from ..scene.scene import Scene, check_against_fmu, parameter_value, start_values
+
+class FMUCallFailed(Exception):
+    def __init__(self, function: str):
+        super().__init__(f"{function} returned fmi2Discard or fmi2Error")
+
+
+class RawCalls:
+    """The four functions of the loop, called through ctypes with plain addresses: fmpy's wrappers
+    convert and check every argument, which costs more than the FMU's own step."""
+
+    def __init__(self, slave):
+        import ctypes
+
+        status, pointer, size = ctypes.c_int, ctypes.c_void_p, ctypes.c_size_t
+        array_call = ctypes.CFUNCTYPE(status, pointer, pointer, size, pointer)
+        self.get_real = array_call(("fmi2GetReal", slave.dll))
+        self.get_integer = array_call(("fmi2GetInteger", slave.dll))
+        self.set_real = array_call(("fmi2SetReal", slave.dll))
+        self.do_step = ctypes.CFUNCTYPE(status, pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int)(
+            ("fmi2DoStep", slave.dll))
+
+
+REAL_OUTPUTS = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
+MODE_OUTPUTS = ["gear1.contact", "gear2.contact", "motor1.limited", "motor2.limited", "body1.stick_slip",
+                "rotor1.stick_slip", "body2.stick_slip", "rotor2.stick_slip", "events.total"]
+
+
+class Plan:
+    """Everything a run is decided by before the FMU starts: the time grid, the base motion of the
+    whole run (evaluated once, vectorised), the controller, the sensors, what is recorded and the
+    preallocated arrays the loop fills: the FMU reads its inputs from row k of `inputs` (base columns
+    filled up front) and writes its outputs into row k of the records, through raw pointers."""
+
+    def __init__(self, scene: Scene, fmu: FMU, stop_time: float | None, controller):
+        check_against_fmu(scene, fmu)
+        self.scene, self.h = scene, scene.step_size
+        self.t_end = scene.stop_time if stop_time is None else stop_time
+        self.n = int(round(self.t_end / self.h))
+        self.times = np.arange(self.n + 1) * self.h
+        self.motion = scene.base_motion()
+        self.base = self.motion.sample(self.times)
+        u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+        self.controller = controller or scene.controller(u_limit)
+        self.sensors = scene.sensors()
+        self.delay = scene.delay_steps
+        # What the IMU measures (the sensors' noise of the whole run drawn here), and from it the
+        # built-in controllers' set points of the whole run.
+        self.measured_attitude = self.sensors.prepare(self.base[:, :3])
+        self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
+
+        self.real_names = [name for name in REAL_OUTPUTS if fmu.has(name)]
+        self.mode_names = [name for name in MODE_OUTPUTS
+                           if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
+        for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]"):
+            if needed not in self.real_names:
+                raise SceneError(f"{fmu.path} has no output '{needed}', which the sensors need")
+        self.real_vrs = [fmu.vr(name) for name in self.real_names]
+        self.mode_vrs = [fmu.vr(name) for name in self.mode_names]
+        self.i_alpha, self.i_beta = self.real_names.index("alpha"), self.real_names.index("beta")
+        self.i_gyro = [self.real_names.index(f"los.omega[{j}]") for j in (1, 2, 3)]
+        self.input_vrs = [fmu.vr("u_R1"), fmu.vr("u_R2")] + ([] if self.motion.fixed else
+                                                              [fmu.vr(b) for b in BASE_INPUTS])
+
+        self.rec_real = np.zeros((self.n + 1, len(self.real_names)))
+        self.rec_mode = np.zeros((self.n + 1, len(self.mode_names)), dtype=np.int32)
+        self.inputs = np.zeros((self.n + 1, len(self.input_vrs)))
+        if not self.motion.fixed:
+            self.inputs[:, 2:] = self.base
+        self.u_cmd, self.refs = [], []  # lists: appending costs less than writing a numpy row
+        self.k = 0                      # the step reached (for the message of a failure)
+
+
+def initialize(slave, scene: Scene, fmu: FMU, plan: Plan) -> None:
+    """Set-up and initialization: start values, the first inputs (0 V, the base at t = 0)."""
+    slave.setupExperiment(startTime=0.0, stopTime=plan.t_end)
+    base_eps = plan.motion.sample(np.array([1e-6]))[0]
+    fmu.set_values(slave, start_values(scene, fmu, plan.base[0], base_eps))
+    slave.enterInitializationMode()
+    slave.setReal(plan.input_vrs, [0.0, 0.0] + ([] if plan.motion.fixed else plan.base[0].tolist()))
+    slave.exitInitializationMode()
+
+
+def step_loop(slave, plan: Plan, bar: Progress) -> None:
+    """The communication steps: outputs at t_k, sensors, controller, the delayed voltage, one step.
+    Locals only inside the loop: it is the master's whole per-step cost."""
+    calls = RawCalls(slave)
+    vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
+    (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
+        [a.ctypes.data for a in vr_arrays], [len(a) for a in vr_arrays]
+    rec_real, rec_mode, inputs = plan.rec_real, plan.rec_mode, plan.inputs
+    real_row, real_stride = rec_real.ctypes.data, rec_real.strides[0]
+    mode_row, mode_stride = rec_mode.ctypes.data, rec_mode.strides[0]
+    input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
+    component = slave.component
+    get_real, get_integer, set_real, do_step = calls.get_real, calls.get_integer, calls.set_real, calls.do_step
+    measure, controller = plan.sensors.measure, plan.controller
+    h, n, delay = plan.h, plan.n, plan.delay
+    # Python floats: reading them per step costs less than indexing numpy rows
+    attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
+    i_alpha, i_beta, i_gyro = plan.i_alpha, plan.i_beta, plan.i_gyro
+    u_cmd, refs = plan.u_cmd, plan.refs
+    zero = (0.0, 0.0)
+    for k in range(n + 1):
+        plan.k = k
+        t = k * h
+        if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
+            raise FMUCallFailed("fmi2GetReal")
+        if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
+            raise FMUCallFailed("fmi2GetInteger")
+        y = rec_real[k].tolist()
+        alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro])
+        u = controller(t, h, alpha, beta, gyro, attitude_rows[k], rate_rows[k], step=k)
+        u_cmd.append(u)
+        refs.append(controller.reference)
+        applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
+        if k == n:
+            break
+        inputs[k, 0], inputs[k, 1] = applied
+        if set_real(component, input_refs, input_count, input_row + k * input_stride) > 1:
+            raise FMUCallFailed("fmi2SetReal")
+        if do_step(component, t, h, 1) > 1:
+            raise FMUCallFailed("fmi2DoStep")
+        if k % 256 == 0:
+            bar.update((k + 1) * h)
+
+
+def compiled_step_loop(slave, plan: Plan, bar: Progress) -> None:
+    """step_loop for the built-in controllers, compiled (compiled_loop.py): the same results."""
+    loop = compiled_loop.CompiledLoop(slave, RawCalls(slave), plan)
+    chunk = 4096   # steps between progress updates (and chances to take Ctrl-C)
+    for first in range(0, plan.n + 1, chunk):
+        last = min(first + chunk - 1, plan.n)
+        loop.run(first, last)
+        bar.update(min(last + 1, plan.n) * plan.h)
+    plan.u_cmd, plan.refs = loop.u_cmd, loop.refs
+
+
+def choose_loop(controller, compiled: bool | None) -> str:
+    """'compiled' or 'python': `compiled` None takes the compiled loop where it can run this
+    controller, True insists on it (an error says why it cannot), False takes the Python loop."""
+    if compiled is False:
+        return "python"
+    why_not = compiled_loop.available()
+    if why_not is None and not compiled_loop.supports(controller):
+        why_not = f"the compiled loop runs the built-in controllers only, not {type(controller).__name__}"
+    if why_not is None:
+        return "compiled"
+    if compiled:
+        raise SceneError(why_not)
+    return "python"
+
+
+def failure_message(scene: Scene, plan: Plan, exc: Exception, log: list | None) -> str:
+    """The message of a run stopped by `exc` at step plan.k, with the FMU's last log messages."""
+    details = "; ".join(map(str, (log or [])[-5:])) or "no log message"
+    return f"{scene.name}: the FMU failed at t = {plan.k * plan.h:.6g} s ({exc}): {details}"
+
+
+def recorded_signals(plan: Plan) -> dict:
+    """'time' and one array per signal; row k: outputs at t_k, the voltage applied over
+    [t_k, t_k+1], the controller's output at t_k, the base inputs at t_k."""
+    u_cmd = np.array(plan.u_cmd, dtype=float).reshape(-1, 2)
+    refs = np.array(plan.refs, dtype=float).reshape(-1, 2)
+    # Applied over [t_k, t_k+1]: the command of `delay` steps before (0 V until the first is due).
+    u_applied = np.zeros_like(u_cmd)
+    u_applied[plan.delay:] = u_cmd[:len(u_cmd) - plan.delay]
+    signals = {"time": plan.times}
+    signals.update({name: plan.rec_real[:, j] for j, name in enumerate(plan.real_names)})
+    signals.update({name: plan.rec_mode[:, j].astype(float) for j, name in enumerate(plan.mode_names)})
+    signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0],
+                    "u_R2_cmd": u_cmd[:, 1], "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
+    signals.update({name: plan.base[:, j] for j, name in enumerate(BASE_INPUTS)})
+    signals["heave"] = plan.motion.position(plan.times)[:, 2]
+    return signals
+
+
+def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None = None,
+        controller=None, slave=None, log: list | None = None, compiled: bool | None = None) -> RunResult:
+    """Runs `scene` (to `stop_time` if given) and returns the recorded signals (recorded_signals),
+    with line-of-sight signals added.
+
+    `slave` (with the `log` list its logger appends to, from `fmu.instantiate(name, log)`): reuse this
+    instance instead of instantiating a fresh one; it is reset first (fmi2Reset: back to the start
+    values, state 'instantiated'), the log is cleared, and the instance is left alive for the next run.
+    `compiled`: which loop (choose_loop); the result's `loop` says which ran."""
+    plan = Plan(scene, fmu, stop_time, controller)
+    loop = choose_loop(plan.controller, compiled)
+    owned = slave is None
+    if owned:
+        log = []
+        slave = fmu.instantiate(scene.name, log)
+    else:
+        if log is not None:
+            log.clear()
+        slave.reset()
+    bar = Progress(plan.t_end, enabled=progress)
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    try:
+        initialize(slave, scene, fmu, plan)
+        plan.controller.start(plan.h, scene.name)
+        (compiled_step_loop if loop == "compiled" else step_loop)(slave, plan, bar)
+        bar.close()
+        slave.terminate()
+    except SceneError:
+        raise
+    except Exception as exc:   # a refused FMI call, or fmpy raising on fmi2Error / fmi2Discard
+        raise SceneError(failure_message(scene, plan, exc, log)) from None
+    finally:
+        if owned:
+            slave.freeInstance()
+    wall, loop_cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    result = RunResult(scene, recorded_signals(plan), wall, plan.t_end)
+    result.loop_cpu_time = loop_cpu  # set-up, initialization and the loop; not the base motion's evaluation
+    result.loop = loop
+    return result

@@ -1,0 +1,382 @@
+"""Prescribed motion of the carrier (body 0): fixed, sinusoids, sea-state spectrum, recorded CSV.
+
+Every generator returns, for an array of times, the 15 base inputs of the FMU in the order of
+INPUTS: attitude (pitch delta, yaw psi, roll gamma), their rates and accelerations, the velocity
+v_a and acceleration a_a of point a in G. Analytic motions give exact derivatives, so the values
+the master sets at each step start are kinematically consistent (the FMU extrapolates them inside
+the step with constant acceleration). Translations: the bow points along y (roll gamma turns about
+y_0, pitch delta about x), so surge = y_G, sway = x_G, heave = z_G (for a zero mean yaw).
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+
+import numpy as np
+
+from .. import native
+from ..errors import SceneError, check_keys as _check_keys, positive as _positive
+
+INPUTS = ["base.delta", "base.psi", "base.gamma",
+          "base.delta_dot", "base.psi_dot", "base.gamma_dot",
+          "base.delta_ddot", "base.psi_ddot", "base.gamma_ddot",
+          "base.v_a[1]", "base.v_a[2]", "base.v_a[3]",
+          "base.a_a[1]", "base.a_a[2]", "base.a_a[3]"]
+
+# scene axis name -> (index of the angle / translation, is an angle)
+ANGLE_AXES = {"pitch": 0, "yaw": 1, "roll": 2}           # delta, psi, gamma
+TRANSLATION_AXES = {"sway": 0, "surge": 1, "heave": 2}   # x_G, y_G, z_G: the bow along y, as roll is about y
+
+
+class BaseMotion:
+    """Base class: `fixed` means every base input stays 0 (the runner then never sets them)."""
+    fixed = False
+    kind = "?"
+
+    def sample(self, t: np.ndarray) -> np.ndarray:
+        """(len(t), 15) array of base inputs in INPUTS order."""
+        raise NotImplementedError
+
+    def position(self, t: np.ndarray) -> np.ndarray:
+        """(len(t), 3) position of point a in G relative to its start (for plots); zeros if unknown."""
+        return np.zeros((len(t), 3))
+
+
+class FixedBase(BaseMotion):
+    fixed = True
+    kind = "fixed"
+
+    def sample(self, t):
+        return np.zeros((len(np.atleast_1d(t)), 15))
+
+
+class _SumOfSines(BaseMotion):
+    """q(t) = offset + sum_i A_i sin(w_i t + phi_i) per axis, plus a constant velocity of point a."""
+
+    def __init__(self, angle_terms: dict, translation_terms: dict, offsets: dict, velocity=(0.0, 0.0, 0.0)):
+        # terms: axis index -> (A, w, phi) arrays
+        self.angle_terms, self.translation_terms = angle_terms, translation_terms
+        self.offsets = offsets        # angle axis index -> offset [rad]
+        self.velocity = np.asarray(velocity, dtype=float)
+
+    # Rows of a uniform time grid evaluated per block: sin and cos of every component at the block's
+    # start, rotated to the rows inside it by exp(i w m h) (tabulated once per run). In C
+    # (native/sum_of_sines.c) when the package's kernels are built, else with numpy; both within
+    # 1e-13 of sin and cos of every entry (tested); the C kernel's bits do not depend on threads or on
+    # how many rows are asked for.
+    _BLOCK = 128
+    _CHUNK_ROWS = 8192   # bounds the memory of a long run's (rows x components) arrays (numpy)
+
+    @classmethod
+    def _eval(cls, terms, t):
+        """sum_i A_i sin(w_i t + phi_i) and its first two time derivatives, at the times t."""
+        amplitude, omega, phase = terms
+        weights = (amplitude, amplitude * omega, -amplitude * omega**2)
+        n = len(t)
+        step = t[1] - t[0] if n > 1 else 0.0
+        # Every uniform grid, however short: a row's value then depends only on its index and the step
+        # (blocks start at fixed multiples), so a shortened run gives the same bits as the full one.
+        uniform = n > 1 and step > 0 and np.array_equal(t, t[0] + np.arange(n) * step)
+        kernels = native.library()
+        if uniform and kernels is not None:
+            return cls._eval_compiled(kernels, weights, omega, phase, float(t[0]), float(step), n)
+        results = [np.empty(n) for _ in weights]
+        rotation = np.exp(1j * np.outer(np.arange(cls._BLOCK) * step, omega)) if uniform else None
+        for first in range(0, n, cls._CHUNK_ROWS):
+            rows = slice(first, min(first + cls._CHUNK_ROWS, n))
+            if uniform:
+                count = rows.stop - rows.start
+                blocks = -(-count // cls._BLOCK)
+                starts = t[0] + (first + np.arange(blocks) * cls._BLOCK) * step
+                at_starts = np.exp(1j * (np.outer(starts, omega) + phase))
+                z = (at_starts[:, None, :] * rotation[None, :, :]).reshape(blocks * cls._BLOCK, -1)[:count]
+                s, c = z.imag, z.real
+            else:
+                arg = np.outer(t[rows], omega) + phase
+                s, c = np.sin(arg), np.cos(arg)
+            # Not `s @ amplitude`: a BLAS matrix-vector product sums in an order that depends on its
+            # thread count (Dask workers run BLAS single-threaded), so a case would give other bits on a
+            # worker than in a serial sweep. einsum's own loop sums the same way everywhere.
+            results[0][rows] = np.einsum("ij,j->i", s, weights[0])
+            results[1][rows] = np.einsum("ij,j->i", c, weights[1])
+            results[2][rows] = np.einsum("ij,j->i", s, weights[2])
+        return tuple(results)
+
+    @classmethod
+    def _eval_compiled(cls, kernels, weights, omega, phase, t0: float, step: float, n: int):
+        omega, phase = np.ascontiguousarray(omega, dtype=float), np.ascontiguousarray(phase, dtype=float)
+        stacked = np.ascontiguousarray(np.concatenate(weights), dtype=float)
+        rotation = np.empty(2 * cls._BLOCK * len(omega))
+        results = [np.empty(n) for _ in weights]
+        kernels.gimbal_sum_of_sines(n, t0, step, len(omega), omega.ctypes.data, phase.ctypes.data, stacked.ctypes.data,
+                                    cls._BLOCK, rotation.ctypes.data, *(r.ctypes.data for r in results))
+        return tuple(results)
+
+    def sample(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = np.zeros((len(t), 15))
+        for axis in range(3):
+            out[:, axis] = self.offsets.get(axis, 0.0)
+        for axis, terms in self.angle_terms.items():
+            q, qd, qdd = self._eval(terms, t)
+            out[:, axis] += q
+            out[:, 3 + axis] = qd
+            out[:, 6 + axis] = qdd
+        out[:, 9:12] = self.velocity
+        for axis, terms in self.translation_terms.items():
+            _, v, a = self._eval(terms, t)
+            out[:, 9 + axis] += v
+            out[:, 12 + axis] = a
+        return out
+
+    def position(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        pos = np.outer(t, self.velocity)
+        for axis, terms in self.translation_terms.items():
+            q, _, _ = self._eval(terms, t)
+            q0, _, _ = self._eval(terms, np.zeros(1))
+            pos[:, axis] += q - q0
+        return pos
+
+
+class Sinusoids(_SumOfSines):
+    kind = "sinusoids"
+
+
+class SeaState(_SumOfSines):
+    kind = "sea_state"
+
+
+def spectrum_shape(omega: np.ndarray, peak_period: float, gamma: float) -> np.ndarray:
+    """Unnormalized JONSWAP shape (gamma = 1: Pierson-Moskowitz), as a function of omega [rad/s]."""
+    wp = 2.0 * math.pi / peak_period
+    sigma = np.where(omega <= wp, 0.07, 0.09)
+    shape = omega**-5.0 * np.exp(-1.25 * (wp / omega) ** 4)
+    return shape * gamma ** np.exp(-((omega - wp) ** 2) / (2.0 * sigma**2 * wp**2))
+
+
+def sea_state_components(significant_amplitude: float, peak_period: float, gamma: float, components: int,
+                         rng: np.random.Generator, band=(0.5, 3.0)):
+    """Amplitudes, frequencies and phases of a sum of sinusoids whose one-sided spectrum has the
+    JONSWAP shape and whose variance is (significant_amplitude / 2)**2 (significant amplitude =
+    mean of the highest third of the amplitudes = 2 sigma for a narrow-band Gaussian process).
+    Frequencies: one per equal bin of [band[0], band[1]] * omega_peak, at a random place in its bin
+    (so the sum does not repeat); phases uniform; both from `rng` (seeded, reproducible)."""
+    wp = 2.0 * math.pi / peak_period
+    edges = np.linspace(band[0] * wp, band[1] * wp, components + 1)
+    dw = np.diff(edges)
+    omega = edges[:-1] + rng.uniform(0.0, 1.0, components) * dw
+    phase = rng.uniform(0.0, 2.0 * math.pi, components)
+    s = spectrum_shape(omega, peak_period, gamma) * dw
+    sigma = significant_amplitude / 2.0
+    amplitude = np.sqrt(2.0 * s / s.sum()) * sigma   # sum(A^2 / 2) = sigma^2
+    return amplitude, omega, phase
+
+
+def read_csv_columns(path: pathlib.Path) -> tuple[list[str], list[np.ndarray]]:
+    """The columns of a recorded motion: a header row of names, then rows of numbers, all separated
+    by commas ('#' starts a comment). Anything else is refused with the file, line and column."""
+    where = f"base_motion: recorded motion {path}"
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise SceneError(f"{where}: cannot read it: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{where}: not a text file (byte {exc.start} is not UTF-8)") from None
+    lines = [(number, line.split("#", 1)[0].strip()) for number, line in enumerate(text.splitlines(), start=1)]
+    lines = [(number, line) for number, line in lines if line]
+    if not lines:
+        raise SceneError(f"{where}: the file is empty (expected a header such as 'time,gamma' and rows of numbers)")
+    header_line, header = lines[0]
+    if ";" in header and "," not in header:
+        raise SceneError(f"{where}: line {header_line} is separated by semicolons ({header!r}); the file must be "
+                         "comma-separated with '.' as the decimal point (save it as CSV with ',' separators)")
+    names = [name.strip().strip('"').strip() for name in header.split(",")]
+    for index, name in enumerate(names, start=1):
+        if not name:
+            raise SceneError(f"{where}: line {header_line} (the header): column {index} has no name")
+        if names.index(name) != index - 1:
+            raise SceneError(f"{where}: line {header_line} (the header): column '{name}' appears twice")
+    if "time" not in names:
+        raise SceneError(f"{where}: no 'time' column in the header (line {header_line}: {', '.join(names)})")
+    rows = []
+    for row, (number, line) in enumerate(lines[1:], start=1):
+        cells = line.split(",")
+        if len(cells) != len(names):
+            hint = " (semicolons: the file must be comma-separated)" if ";" in line else ""
+            raise SceneError(f"{where}: line {number} (data row {row}) has {len(cells)} cells, the header "
+                             f"{len(names)}{hint}")
+        values = []
+        for name, cell in zip(names, cells):
+            cell = cell.strip()
+            try:
+                value = float(cell)
+            except ValueError:
+                what = "is empty" if not cell else f"is not a number: {cell!r}"
+                raise SceneError(f"{where}: line {number} (data row {row}), column '{name}' {what}") from None
+            if not math.isfinite(value):
+                raise SceneError(f"{where}: line {number} (data row {row}), column '{name}' is {cell!r}, "
+                                 "not a finite number")
+            values.append(value)
+        rows.append(values)
+    if len(rows) < 4:
+        raise SceneError(f"{where}: {len(rows)} data rows; a cubic spline needs at least 4")
+    table = np.array(rows)
+    t = table[:, names.index("time")]
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if len(bad):
+        i = int(bad[0]) + 1
+        raise SceneError(f"{where}: 'time' must increase strictly, but line {lines[i + 1][0]} has {t[i]:g} after "
+                         f"{t[i - 1]:g}")
+    return names, [table[:, j] for j in range(len(names))]
+
+
+class Recorded(BaseMotion):
+    """A recorded motion: a comma-separated file with a header row of names (`#` starts a comment).
+    Column `time` [s] and any of: delta, psi, gamma [rad] (or pitch_deg, yaw_deg, roll_deg), their
+    `_dot` and `_ddot` [rad/s, rad/s2], x, y, z [m] of point a in G. Missing derivatives come from a
+    C2 cubic spline through the samples, so attitude, rates and accelerations stay consistent;
+    absent quantities are 0."""
+    kind = "recorded"
+
+    def __init__(self, path: pathlib.Path):
+        from scipy.interpolate import CubicSpline
+
+        names, columns = read_csv_columns(path)
+        data = dict(zip(names, columns))
+        t = data["time"]
+        self.t_end = float(t[-1])
+        self.t_start = float(t[0])
+        allowed = {"time"}
+        self.splines = {}
+        for i, (rad, deg) in enumerate([("delta", "pitch_deg"), ("psi", "yaw_deg"), ("gamma", "roll_deg")]):
+            allowed |= {rad, deg, rad + "_dot", rad + "_ddot"}
+            if rad in names and deg in names:
+                raise SceneError(f"base_motion: {path}: columns '{rad}' and '{deg}' are the same angle; give one")
+            for derivative in (rad + "_dot", rad + "_ddot"):
+                if derivative in names and rad not in names and deg not in names:
+                    raise SceneError(f"base_motion: {path}: column '{derivative}' without the angle '{rad}' "
+                                     f"(or '{deg}') would be ignored; add the angle")
+            if rad in names or deg in names:
+                q = data[rad] if rad in names else np.radians(data[deg])
+                spline = CubicSpline(t, q)
+                self.splines[i] = spline
+                self.splines[3 + i] = CubicSpline(t, data[rad + "_dot"]) if rad + "_dot" in names else spline.derivative(1)
+                self.splines[6 + i] = (CubicSpline(t, data[rad + "_ddot"]) if rad + "_ddot" in names
+                                       else spline.derivative(2))
+        self.position_splines = {}
+        for i, name in enumerate("xyz"):
+            allowed.add(name)
+            if name in names:
+                spline = CubicSpline(t, data[name])
+                self.position_splines[i] = spline
+                self.splines[9 + i] = spline.derivative(1)
+                self.splines[12 + i] = spline.derivative(2)
+        unknown = set(names) - allowed
+        if unknown:
+            raise SceneError(f"base_motion: {path}: unknown columns {sorted(unknown)} (allowed: {sorted(allowed)})")
+
+    def sample(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = np.zeros((len(t), 15))
+        for column, spline in self.splines.items():
+            out[:, column] = spline(t)
+        return out
+
+    def position(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        pos = np.zeros((len(t), 3))
+        for i, spline in self.position_splines.items():
+            pos[:, i] = spline(t) - spline(t[0])
+        return pos
+
+
+def _sine_terms(axis: str, spec, angle: bool):
+    """One table or a list of tables {amplitude_deg | amplitude_m, period_s | frequency_hz, phase_deg}."""
+    specs = spec if isinstance(spec, list) else [spec]
+    amplitude, omega, phase = [], [], []
+    unit = "amplitude_deg" if angle else "amplitude_m"
+    for item in specs:
+        if not isinstance(item, dict):
+            raise SceneError(f"base_motion.{axis}: expected a table or a list of tables")
+        _check_keys(f"base_motion.{axis}", item, {unit, "period_s", "frequency_hz", "phase_deg"} | (
+            {"offset_deg"} if angle else set()))
+        if unit not in item:
+            raise SceneError(f"base_motion.{axis}: missing '{unit}'")
+        if ("period_s" in item) == ("frequency_hz" in item):
+            raise SceneError(f"base_motion.{axis}: give exactly one of 'period_s' and 'frequency_hz'")
+        f = 1.0 / _positive(f"base_motion.{axis}.period_s", item["period_s"]) if "period_s" in item else \
+            _positive(f"base_motion.{axis}.frequency_hz", item["frequency_hz"])
+        a = float(item[unit])
+        amplitude.append(math.radians(a) if angle else a)
+        omega.append(2.0 * math.pi * f)
+        phase.append(math.radians(float(item.get("phase_deg", 0.0))))
+    offset = sum(math.radians(float(item.get("offset_deg", 0.0))) for item in specs) if angle else 0.0
+    return (np.array(amplitude), np.array(omega), np.array(phase)), offset
+
+
+def _velocity(spec: dict) -> tuple:
+    v = spec.get("velocity_m_s", [0.0, 0.0, 0.0])
+    if not (isinstance(v, list) and len(v) == 3 and all(isinstance(x, (int, float)) for x in v)):
+        raise SceneError("base_motion.velocity_m_s must be a list of 3 numbers (constant velocity of point a in G)")
+    return tuple(float(x) for x in v)
+
+
+def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
+    """Builds the base motion of a scene's [base_motion] table (absent = fixed base)."""
+    spec = dict(spec or {"type": "fixed"})
+    kind = spec.get("type", "fixed")
+    axes = set(ANGLE_AXES) | set(TRANSLATION_AXES)
+    if kind == "fixed":
+        _check_keys("base_motion", spec, {"type"})
+        return FixedBase()
+    if kind == "sinusoids":
+        _check_keys("base_motion", spec, {"type", "velocity_m_s"} | axes)
+        angle_terms, translation_terms, offsets = {}, {}, {}
+        for name, axis in ANGLE_AXES.items():
+            if name in spec:
+                angle_terms[axis], offsets[axis] = _sine_terms(name, spec[name], True)
+        for name, axis in TRANSLATION_AXES.items():
+            if name in spec:
+                translation_terms[axis], _ = _sine_terms(name, spec[name], False)
+        return Sinusoids(angle_terms, translation_terms, offsets, _velocity(spec))
+    if kind == "sea_state":
+        _check_keys("base_motion", spec, {"type", "velocity_m_s", "components", "seed"} | axes)
+        components = spec.get("components", 100)
+        seed = spec.get("seed", 1)
+        if not isinstance(components, int) or isinstance(components, bool) or components < 1:
+            raise SceneError("base_motion.components must be a positive integer")
+        if not isinstance(seed, int) or isinstance(seed, bool):
+            raise SceneError("base_motion.seed must be an integer")
+        angle_terms, translation_terms, offsets = {}, {}, {}
+        for index, name in enumerate(["pitch", "yaw", "roll", "surge", "sway", "heave"]):
+            if name not in spec:
+                continue
+            item = spec[name]
+            angle = name in ANGLE_AXES
+            unit = "significant_amplitude_deg" if angle else "significant_amplitude_m"
+            if not isinstance(item, dict):
+                raise SceneError(f"base_motion.{name}: expected a table")
+            _check_keys(f"base_motion.{name}", item, {unit, "peak_period_s", "gamma", "components"})
+            for key in (unit, "peak_period_s"):
+                if key not in item:
+                    raise SceneError(f"base_motion.{name}: missing '{key}'")
+            amplitude = float(item[unit])
+            gamma = float(item.get("gamma", 3.3))
+            if gamma < 1.0:
+                raise SceneError(f"base_motion.{name}.gamma (JONSWAP peak enhancement) must be >= 1 (1 = Pierson-Moskowitz)")
+            rng = np.random.default_rng([seed, index])
+            terms = sea_state_components(math.radians(amplitude) if angle else amplitude,
+                                         _positive(f"base_motion.{name}.peak_period_s", item["peak_period_s"]),
+                                         gamma, int(item.get("components", components)), rng)
+            if angle:
+                angle_terms[ANGLE_AXES[name]] = terms
+            else:
+                translation_terms[TRANSLATION_AXES[name]] = terms
+        return SeaState(angle_terms, translation_terms, offsets, _velocity(spec))
+    if kind == "recorded":
+        _check_keys("base_motion", spec, {"type", "file"})
+        if "file" not in spec:
+            raise SceneError("base_motion: type 'recorded' needs 'file' (a CSV path relative to the scene file)")
+        return Recorded((scene_dir / spec["file"]).resolve())
+    raise SceneError(f"base_motion.type must be one of 'fixed', 'sinusoids', 'sea_state', 'recorded'; got {kind!r}")

@@ -1,0 +1,342 @@
+"""Scene files: loading and validation.
+
+A scene is a TOML file (comments allowed). Top level: name (the title of the plot; default the
+file's name), description, stop_time [s], step_size [s] (communication step), output_interval [s]
+(CSV rows; default every step). The result files are named after the scene file, not after `name`
+(scenes/x.toml -> x.csv, x.png), so a copy of a scene never overwrites the original's results. Tables:
+
+  [fidelity]      structural parameters of the FMU (gear1.model, gear2.model, motor1.model,
+                  motor2.model, dry_friction, base.fixed); absent = the FMU's defaults (full model)
+  [parameters]    any FMU parameter by its name, SI units
+  [initial]       start values of the FMU's states (alpha, beta_m, i_R1, ...), SI units; a rotor
+                  angle/rate not given follows its load through the gear (alpha_m = N1 alpha, ...)
+  [base_motion]   type = "fixed" | "sinusoids" | "sea_state" | "recorded" (base_motion.py)
+  [target]        azimuth_deg, elevation_deg: the fixed inertial direction the line of sight should
+                  hold (geometry.py); start_on_target = true starts the gimbal pointing at it
+  [controller]    type = "none" | "pid" | "state_feedback" | "python", delay_steps (default 1)
+                  (controllers.py)
+  [sensors]       encoder quantization, gyro and IMU noise (sensors.py; default ideal)
+  [requirements]  los_rms_max_mrad, los_final_max_mrad, from_s: line-of-sight bounds the run must meet
+  [test]          stop_time: the shortened end time the test suite runs the scene to
+  [plot]          optional: panel name = [recorded signal names], replaces the default panels
+
+Validation has two levels: `load_scene` checks everything a file alone can say; `check_against_fmu`
+checks the FMU variable names, causalities and types (the FMU's model description is the truth).
+A scene that runs, but likely not as meant (no controller, a motor the controller leaves at 0 V, a
+moving-base model with no base motion), loads with a SceneWarning per finding (Python's warnings
+module, so it shows on stderr; the list is also Scene.warnings).
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+import tomllib
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import geometry
+from .base_motion import Recorded, make_base_motion
+from .controllers import make_controller
+from ..errors import SceneError, SceneWarning, check_keys, number, positive
+from ..fmu import FIDELITY, FMU, STATES
+from .sensors import Sensors
+
+TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", "fidelity", "parameters",
+            "initial", "base_motion", "target", "controller", "sensors", "requirements", "test", "plot"}
+
+
+@dataclass
+class Scene:
+    path: pathlib.Path
+    name: str                 # the scene file's stem: names the result files and the FMU instance
+    title: str                # the file's `name`: the title of the plot
+    description: str
+    stop_time: float
+    step_size: float
+    output_interval: float
+    fidelity: dict
+    parameters: dict
+    initial: dict
+    base_motion_spec: dict
+    target_spec: dict | None
+    controller_spec: dict
+    sensors_spec: dict
+    requirements: dict
+    test: dict
+    plot: dict
+    raw: dict = field(repr=False, default_factory=dict)
+    warnings: list = field(repr=False, default_factory=list)
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.stop_time / self.step_size))
+
+    @property
+    def target(self):
+        """Unit vector of the target in G, or None."""
+        if self.target_spec is None:
+            return None
+        return tuple(float(x) for x in geometry.target_direction(math.radians(self.target_spec["azimuth_deg"]),
+                                                                 math.radians(self.target_spec["elevation_deg"])))
+
+    @property
+    def delay_steps(self) -> int:
+        return int(self.controller_spec.get("delay_steps", 1))
+
+    def base_motion(self):
+        return make_base_motion(self.base_motion_spec, self.path.parent)
+
+    def controller(self, u_limit=(math.inf, math.inf)):
+        return make_controller(self.controller_spec, self.target, u_limit, base_dir=self.path.parent)
+
+    def sensors(self):
+        return Sensors(self.sensors_spec)
+
+    def with_changes(self, **changes) -> "Scene":
+        """A copy with top-level fields replaced (e.g. stop_time, controller_spec), re-validated."""
+        import dataclasses
+        scene = dataclasses.replace(self, **changes)
+        _validate(scene)
+        return scene
+
+
+def _table(raw: dict, key: str, flatten: bool = False) -> dict:
+    value = raw.get(key, {})
+    if not isinstance(value, dict):
+        raise SceneError(f"'{key}' must be a table ([{key}])")
+    return _flatten(value) if flatten else value
+
+
+def _flatten(table: dict, prefix: str = "") -> dict:
+    """FMU names have dots; unquoted in TOML (gear1.eta = 1e-3) they make nested tables: join them back."""
+    flat = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            flat[f"{prefix}{key}"] = value
+    return flat
+
+
+def load_scene(path: pathlib.Path | str) -> Scene:
+    """Reads and validates a scene file (everything but the FMU variable names)."""
+    path = pathlib.Path(path)
+    try:
+        with open(path, "rb") as f:
+            raw = tomllib.load(f)
+    except OSError as exc:
+        raise SceneError(f"{path}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    try:
+        check_keys("top level", raw, TOP_KEYS)
+        for key in ("stop_time", "step_size"):
+            if key not in raw:
+                raise SceneError(f"missing required key '{key}'")
+        title = raw.get("name", path.stem)
+        if not isinstance(title, str) or not title.strip():
+            raise SceneError("'name' (the title of the plot) must be a non-empty string")
+        step = positive("step_size", raw["step_size"])
+        target = raw.get("target")
+        if target is not None:
+            check_keys("target", target, {"azimuth_deg", "elevation_deg", "start_on_target"})
+            target = {"azimuth_deg": number("target.azimuth_deg", target.get("azimuth_deg", 0.0)),
+                      "elevation_deg": number("target.elevation_deg", target.get("elevation_deg", 0.0)),
+                      "start_on_target": bool(target.get("start_on_target", False))}
+        scene = Scene(path=path, name=path.stem, title=title, description=str(raw.get("description", "")),
+                      stop_time=positive("stop_time", raw["stop_time"]), step_size=step,
+                      output_interval=positive("output_interval", raw.get("output_interval", step)),
+                      fidelity=_table(raw, "fidelity", True), parameters=_table(raw, "parameters", True),
+                      initial=_table(raw, "initial", True), base_motion_spec=_table(raw, "base_motion"),
+                      target_spec=target, controller_spec=_table(raw, "controller"),
+                      sensors_spec=_table(raw, "sensors"), requirements=_table(raw, "requirements"),
+                      test=_table(raw, "test"), plot=_table(raw, "plot"), raw=raw)
+        _validate(scene)
+    except SceneError as exc:
+        raise SceneError(f"{path}: {exc}") from None
+    for message in scene.warnings:
+        # stacklevel 1: one registry entry per message, so loading a scene twice warns once
+        warnings.warn(SceneWarning(f"{path}: {message}"))
+    return scene
+
+
+def _validate(scene: Scene) -> None:
+    if abs(scene.n_steps * scene.step_size - scene.stop_time) > 1e-9 * scene.stop_time:
+        raise SceneError("stop_time must be a whole number of steps")
+    ratio = scene.output_interval / scene.step_size
+    if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+        raise SceneError("output_interval must be a whole multiple of step_size")
+    unknown = set(scene.fidelity) - set(FIDELITY)
+    if unknown:
+        raise SceneError(f"[fidelity]: unknown switch(es) {sorted(unknown)}; known: {FIDELITY}")
+    for name, value in scene.initial.items():
+        if name not in STATES:
+            raise SceneError(f"[initial]: '{name}' is not a state (states: {STATES})")
+        number(f"initial.{name}", value)
+    overlap = sorted(set(scene.fidelity) & set(scene.parameters))
+    if overlap:
+        # start_values would let [parameters] win without a word
+        raise SceneError(f"{', '.join(repr(n) for n in overlap)} set in both [fidelity] and [parameters]: "
+                         "set each FMU variable in one table only")
+    if scene.target_spec is not None:
+        elevation = number("target.elevation_deg", scene.target_spec["elevation_deg"])
+        if not -90.0 <= elevation <= 90.0:
+            raise SceneError(f"target.elevation_deg = {elevation:g} is outside [-90, 90] deg (0 = horizon, "
+                             f"90 = straight up); the direction behind is azimuth_deg + 180 with elevation "
+                             f"{math.copysign(180.0, elevation) - elevation:g}")
+    delay = scene.controller_spec.get("delay_steps", 1)
+    if not isinstance(delay, int) or isinstance(delay, bool) or delay < 0:
+        raise SceneError("[controller] delay_steps must be an integer >= 0 (1 = a one-sample delay: the voltage "
+                         "computed at t_k is applied over [t_k+1, t_k+2])")
+    found = _check_controller(scene.controller_spec)
+    if not scene.base_motion_spec and scene.fidelity.get("base.fixed") is not True:
+        setting = "= false" if "base.fixed" in scene.fidelity else "is not set (the FMU's default is false)"
+        found.append(f"no [base_motion] while [fidelity] base.fixed {setting}: the base stays still, but the FMU "
+                     "runs its moving-base model; for a fixed base say [base_motion] type = \"fixed\" and "
+                     "\"base.fixed\" = true, for a moving one give the motion")
+    motion = scene.base_motion()
+    if scene.fidelity.get("base.fixed") is True and not motion.fixed:
+        raise SceneError("[fidelity] base.fixed = true needs a fixed base: [base_motion] type = 'fixed'")
+    if isinstance(motion, Recorded) and (motion.t_start > 0 or motion.t_end < scene.stop_time):
+        raise SceneError(f"[base_motion] the recording covers [{motion.t_start:g}, {motion.t_end:g}] s, "
+                         f"not [0, {scene.stop_time:g}] s")
+    scene.controller()
+    scene.warnings = found
+    scene.sensors()
+    check_keys("requirements", scene.requirements, {"los_rms_max_mrad", "los_final_max_mrad", "from_s"})
+    for key, value in scene.requirements.items():
+        positive(f"requirements.{key}", value) if key != "from_s" else number("requirements.from_s", value)
+    if scene.requirements and scene.target_spec is None:
+        raise SceneError("[requirements] on the line of sight need a [target]")
+    check_keys("test", scene.test, {"stop_time"})
+    if "stop_time" in scene.test:
+        positive("test.stop_time", scene.test["stop_time"])
+    for panel, names in scene.plot.items():
+        if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
+            raise SceneError(f"[plot] {panel} must be a list of signal names")
+
+
+AXIS_MOTOR = {"azimuth": "u_R1", "elevation": "u_R2"}
+PID_GAINS = ("kp", "ki", "kd", "k_gyro", "k_ff")
+WHY_NOT_NEGATIVE = {
+    "kp": "a negative gain pushes the axis away from its set point",
+    "ki": "a negative gain integrates the axis away from its set point",
+    "kd": "a negative gain feeds the error's rate back with the wrong sign",
+    "k_gyro": "negative rate feedback undamps the axis",
+    "k_ff": "the feed-forward cancels the motor's back-emf (k_ff = N k_emf); a negative one adds to it",
+    "d_filter_s": "it is the time constant of the derivative filter",
+    "i_limit_V": "it bounds |ki * integral|",
+}
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check_controller(spec: dict) -> list[str]:
+    """Refuses gains of the wrong sign in the built-in controllers; returns warnings for a scene
+    without a controller and for motors a controller leaves at 0 V. Values that are not numbers
+    are left to the controller's own checks (make_controller), which run next. A "python"
+    controller's options are its own business."""
+    if "type" not in spec:
+        where = "no [controller]" if not spec else "[controller] has no type"
+        return [f"{where}: the gimbal runs open loop, both motors at 0 V (say [controller] type = \"none\" "
+                "if that is the point)"]
+    found = []
+    kind = spec["type"]
+    if kind == "pid":
+        for axis in AXIS_MOTOR:
+            table = spec.get(axis)
+            if table is None:
+                found.append(f"[controller] type = \"pid\" has no [controller.{axis}] table: the {axis} motor "
+                             f"({AXIS_MOTOR[axis]}) gets 0 V")
+                continue
+            if not isinstance(table, dict):
+                raise SceneError(f"[controller] '{axis}' must be a table ([controller.{axis}]), got {table!r}")
+            for key, why in WHY_NOT_NEGATIVE.items():
+                value = table.get(key, 0.0)
+                if _is_number(value) and value < 0:
+                    raise SceneError(f"controller.{axis}.{key} = {value:g} is negative: {why}")
+            if all(table.get(key, 0.0) == 0 for key in PID_GAINS):
+                found.append(f"[controller.{axis}] has no nonzero gain ({', '.join(PID_GAINS)}): the {axis} "
+                             f"motor ({AXIS_MOTOR[axis]}) gets 0 V")
+    elif kind == "state_feedback":
+        K, ki = spec.get("K"), spec.get("ki", [0.0, 0.0])
+        if not (isinstance(ki, list) and len(ki) == 2):
+            raise SceneError(f"controller.ki must be [ki of u_R1, ki of u_R2], got {ki!r}")
+        if not (isinstance(K, list) and len(K) == 2 and all(isinstance(row, list) and len(row) == 4 for row in K)):
+            return found
+        for i, axis in enumerate(AXIS_MOTOR):
+            motor = AXIS_MOTOR[axis]
+            # u = -K x: the gains of an axis's own angle error and rate must be >= 0 to pull it back
+            for j, what in ((i, "angle error"), (2 + i, "rate")):
+                if _is_number(K[i][j]) and K[i][j] < 0:
+                    raise SceneError(f"controller.K[{i}][{j}] = {K[i][j]:g} ({motor} per {axis} {what}) is negative: "
+                                     f"u = -K x then pushes the {axis} away from its set point")
+            if _is_number(ki[i]) and ki[i] < 0:
+                raise SceneError(f"controller.ki[{i}] = {ki[i]:g} ({motor}) is negative: "
+                                 f"{WHY_NOT_NEGATIVE['ki']}")
+            if all(k == 0 for k in K[i]) and ki[i] == 0:
+                found.append(f"[controller] K[{i}] and ki[{i}] are all zero: the {axis} motor ({motor}) gets 0 V")
+    return found
+
+
+def check_against_fmu(scene: Scene, fmu: FMU) -> None:
+    """Refuses FMU variable names the FMU does not have, wrong causalities and wrong value types."""
+    try:
+        fmu.check("fidelity", scene.fidelity, {"parameter", "structuralParameter"})
+        fmu.check("parameters", scene.parameters, {"parameter", "structuralParameter"})
+        fmu.check("initial", scene.initial, {"output", "local"})
+        names = {n for names in scene.plot.values() for n in names}
+        for name in names:
+            if not fmu.has(name) and name not in DERIVED_SIGNALS:
+                raise SceneError(f"[plot] '{name}' is neither an FMU variable nor a signal of the runner "
+                                 f"({sorted(DERIVED_SIGNALS)})")
+    except SceneError as exc:
+        raise SceneError(f"{scene.path}: {exc}") from None
+
+
+DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
+                   "los_azimuth", "los_elevation", "heave"} | {f"base.{n}" for n in (
+                       "delta", "psi", "gamma", "delta_dot", "psi_dot", "gamma_dot",
+                       "delta_ddot", "psi_ddot", "gamma_ddot")}
+
+
+def parameter_value(scene: Scene, fmu: FMU, name: str):
+    """A parameter's value in this scene: the scene's, else the FMU's start value."""
+    if name in scene.parameters:
+        return scene.parameters[name]
+    if name in scene.fidelity:
+        return scene.fidelity[name]
+    return fmu.start(name) if fmu.has(name) else None
+
+
+def start_values(scene: Scene, fmu: FMU, base_row0: np.ndarray, base_row_eps: np.ndarray | None = None,
+                 eps: float = 1e-6) -> dict:
+    """All values to set before initialization: fidelity, parameters, initial state; rotors follow
+    their loads when not given; start_on_target points the gimbal at the target for the base
+    attitude at t = 0 (and gives it the rates that keep it there, from base_row_eps at t = eps)."""
+    initial = dict(scene.initial)
+    if scene.target_spec is not None and scene.target_spec["start_on_target"]:
+        a0, b0 = geometry.gimbal_angles_for(scene.target, *base_row0[:3])
+        initial.setdefault("alpha", a0)
+        initial.setdefault("beta", b0)
+        if base_row_eps is not None:
+            a1, b1 = geometry.gimbal_angles_for(scene.target, *base_row_eps[:3], alpha_near=a0)
+            initial.setdefault("alpha_dot", (a1 - a0) / eps)
+            initial.setdefault("beta_dot", (b1 - b0) / eps)
+    for axis, (load, rotor) in enumerate([("alpha", "alpha_m"), ("beta", "beta_m")], start=1):
+        gear_model = parameter_value(scene, fmu, f"gear{axis}.model")
+        if gear_model == 0:   # rigid gear: the FMU has no rotor state of its own
+            continue
+        ratio = float(parameter_value(scene, fmu, f"gear{axis}.N"))
+        if load in initial and rotor not in initial:
+            initial[rotor] = ratio * initial[load]
+        if load + "_dot" in initial and rotor + "_dot" not in initial:
+            initial[rotor + "_dot"] = ratio * initial[load + "_dot"]
+    values = dict(scene.fidelity)
+    values.update(scene.parameters)
+    values.update(initial)
+    return values
