@@ -29,7 +29,7 @@ SCENE = REPO / "scenes" / "ship_stabilization.toml"
 SWEEP = [sys.executable, "-m", "gimbal2axis", "sweep"]   # the installed package's command
 
 # gimbal2axis sweep and its Dask workers as processes of their own: under the preloaded AddressSanitizer
-# runtime they test nothing the release pass does not (scripts/test.sh leaves test_sweep.py out too).
+# runtime they test nothing the release pass does not (scripts/test.sh leaves tests/test_sweep.py out too).
 as_a_process = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
                                   reason="sweep processes under AddressSanitizer test nothing more")
 
