@@ -12,7 +12,8 @@
    run's outputs bit for bit, which checks that they measured the same work.
 
 All repeated (--repeat, best of) in one process, on CPU time (machines are shared and noisy).
-Writes benchmarks/results/scene_runner.json and prints the figures docs/benchmarks.md quotes.
+Writes the figures as JSON (--out, default benchmarks/results/scene_runner.json) and prints those
+docs/benchmarks.md quotes.
 """
 from __future__ import annotations
 
@@ -73,8 +74,10 @@ def add_arguments(parser) -> None:
                              "repository's when run from its root)")
     parser.add_argument("--fmu", default=None,
                         help="the FMU (default $GIMBAL2AXIS_FMU, else the build the package was configured with)")
-    parser.add_argument("--stop-time", type=float, default=20.0, help="simulated seconds per run (default 20)")
-    parser.add_argument("--repeat", type=int, default=3, help="runs of each kind; the fastest counts (default 3)")
+    parser.add_argument("--stop-time", type=float, default=20.0, metavar="T",
+                        help="simulated seconds per run (default 20)")
+    parser.add_argument("--repeat", type=int, default=3, metavar="N",
+                        help="runs of each kind; the fastest counts (default 3)")
     parser.add_argument("--out", default="benchmarks/results/scene_runner.json",
                         help="the JSON of the figures (default benchmarks/results/scene_runner.json in the current "
                              "directory)")
