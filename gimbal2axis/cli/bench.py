@@ -1,6 +1,6 @@
 """What the scene runner's simulation loop costs, and how much of it is the master's own:
 
-    gimbal2axis bench [--scene scenes/ship_stabilization.toml] [--stop-time 20]
+    gimbal2axis bench [scenes/ship_stabilization.toml] [--stop-time 20]
 
 1. runs the scene through the master (gimbal2axis.master.run: sensors, controller, delay, records),
    once with the compiled loop (the default for the built-in controllers) and once with the Python
@@ -69,9 +69,11 @@ def measure(scene, fmu, repeat: int) -> dict:
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--scene", default=None,
+    parser.add_argument("scene", nargs="?", default=None,
                         help=f"the scene to measure (default: {DEFAULT_SCENE} in the current directory, the "
                              "repository's when run from its root)")
+    parser.add_argument("--scene", dest="scene_option", default=None, metavar="SCENE",
+                        help="the same, as an option")
     parser.add_argument("--fmu", default=None,
                         help="the FMU (default $GIMBAL2AXIS_FMU, else the build the package was configured with)")
     parser.add_argument("--stop-time", type=float, default=20.0, metavar="T",
@@ -88,8 +90,11 @@ def execute(args) -> int:
         args.command_parser.error(f"--stop-time {args.stop_time:g}: need a positive number of seconds")
     if args.repeat < 1:
         args.command_parser.error(f"--repeat {args.repeat}: need at least 1")
+    if args.scene is not None and args.scene_option is not None and args.scene != args.scene_option:
+        args.command_parser.error(f"two scenes, {args.scene} and --scene {args.scene_option}: give one")
     try:
-        scene = load_scene(scene_file(args.scene, DEFAULT_SCENE, "--scene SCENE.toml"))
+        scene = load_scene(scene_file(args.scene or args.scene_option, DEFAULT_SCENE, "the scene: gimbal2axis bench "
+                                                                                     "SCENE.toml"))
         scene = scene.with_changes(stop_time=args.stop_time)
         with FMU(fmu_path(args.fmu)) as fmu:
             best = measure(scene, fmu, args.repeat)
@@ -118,8 +123,12 @@ def execute(args) -> int:
             "loop_alone_us_per_step": (best[f"replay_{loop}"] - best["replay_compiled"]) * per_step,
         }
     out = pathlib.Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(figures, indent=2) + "\n")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(figures, indent=2) + "\n")
+    except OSError as exc:
+        print(f"{PROG}: error: --out {out}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
     print(f"{scene.name}, {args.stop_time:g} s at h = {scene.step_size:g} s ({steps} steps), "
           f"controller {figures['controller']}, CPU time, best of {args.repeat}:")
     print(f"  FMU alone (compiled replay)  {best['replay_compiled']:.3f} s = "

@@ -24,7 +24,7 @@ sweep file:
   [grid] (every combination) and/or [random] (seeded draws) tables of parameters, named by
   their path into the scene (controller.azimuth.kp, base_motion.seed) or as FMU parameters
   (gear1.k_s); a 'cases' limit; optional stop_time and metrics_from_s. The format in full:
-  README.md, section "Sweeps and Monte Carlo on Dask", and gimbal2axis/sweep/spec.py.
+  docs/sweeps.md in the repository, and gimbal2axis/sweep/spec.py.
 
 exit status:
   0  every case of the sweep ran to the end (status ok)

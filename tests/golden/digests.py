@@ -29,8 +29,9 @@ metrics_from_s = 0.02
 "base_motion.seed" = { integers = [0, 9999] }
 "body2.m" = { uniform = [1.5, 3.0] }
 """
-# Columns of the sweep table that record the run, not its result.
-SWEEP_UNTIMED = ("wall", "cpu_time", "fmu_sha", "host", "worker", "elapsed", "duration")
+# Columns of the sweep table that record the run, not its result (instance_use counts the cases an
+# instance ran before, which depends on what else ran in the process).
+SWEEP_UNTIMED = ("wall", "cpu_time", "fmu_sha", "host", "worker", "elapsed", "duration", "instance_use")
 
 
 def digest(values) -> str:
