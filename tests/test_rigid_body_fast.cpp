@@ -15,8 +15,8 @@
 #include <random>
 #include <utility>
 
-#include "gimbal/base_kinematics.hpp"
-#include "gimbal/rigid_body.hpp"
+#include "gimbal/multibody/base_kinematics.hpp"
+#include "gimbal/multibody/rigid_body.hpp"
 
 // ---------------------------------------------------------------------------------------------------
 // Reference: the generic implementation as it was before the specialisation (rotation matrices built
