@@ -3,64 +3,7 @@
 #include <algorithm>
 
 namespace gimbal {
-namespace {
-
-bool same_modes(const Modes& a, const Modes& b) {
-    for (int axis = 0; axis < 2; ++axis)
-        if (a.gear_contact[axis] != b.gear_contact[axis] || a.motor_limited[axis] != b.motor_limited[axis] ||
-            a.voltage_clamped[axis] != b.voltage_clamped[axis])
-            return false;
-    for (int body = 0; body < 4; ++body)
-        if (a.friction[body] != b.friction[body]) return false;
-    return true;
-}
-
-}  // namespace
-
-GimbalHybridSystem::GimbalHybridSystem(const ModelParameters& params) : params_(params) {
-    // One element per switching part present, each with its own slice of the event vector.
-    int guards = 0;
-    // Each element's guards also get their fixed place among the indicators (kIndicatorCount).
-    const auto place = [this, &guards](int count, int first_indicator) {
-        for (int k = 0; k < count; ++k) guard_indicator_.push_back(first_indicator + k);
-        guards += count;
-    };
-    for (int axis = 0; axis < 2; ++axis) {
-        if (params.layout.backlash_slot[axis] < 0) continue;
-        backlash_.emplace_back(axis, guards);
-        place(backlash_.back().guard_count(), 2 * axis);
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-        clamps_.emplace_back(axis, guards);
-        place(clamps_.back().guard_count(), 4 + 2 * axis);
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-        limiters_.emplace_back(axis, guards);
-        place(limiters_.back().guard_count(), 8 + 2 * axis);
-    }
-    for (int body = 0; body < 4; ++body) {
-        if (!params.coordinate_friction[body].present()) continue;
-        friction_.emplace_back(body, guards);
-        place(friction_.back().guard_count(), 12 + 6 * body);
-    }
-    event_count_ = guards;
-    for (const auto& e : backlash_) elements_.push_back(&e);
-    for (const auto& e : clamps_) elements_.push_back(&e);
-    for (const auto& e : limiters_) elements_.push_back(&e);
-    for (const auto& e : friction_) elements_.push_back(&e);
-}
-
-int friction_mode_indicator(FrictionMode mode, double rate) {
-    switch (mode) {
-        case FrictionMode::slip_positive: return 2;
-        case FrictionMode::slip_negative: return -2;
-        case FrictionMode::hold: return 0;
-        case FrictionMode::at_max_positive: return -1;  // friction pushes +: the body is driven -
-        case FrictionMode::at_max_negative: return 1;
-        case FrictionMode::none: break;
-    }
-    return rate >= 0.0 ? 2 : -2;
-}
+GimbalHybridSystem::GimbalHybridSystem(const ModelParameters& params) : params_(params), elements_(params) {}
 
 const BaseKinematics& GimbalHybridSystem::base_at(double time) {
     // The integrator asks for the same instant several times (right-hand side, events, Jacobian), and
@@ -144,14 +87,14 @@ bool GimbalHybridSystem::jacobian(double time, const double* state, double* colu
 
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     const SwitchingContext context{params_, inputs_, dynamics_at(time, state), time};
-    for (const SwitchingElement* element : elements_) element->guards(context, modes_, values);
+    elements_.guards(context, modes_, values);
 }
 
 void GimbalHybridSystem::event_indicators(double time, const double* state, double* values) {
     std::fill(values, values + kIndicatorCount, 1.0);
     double guards[kIndicatorCount];
     event_functions(time, state, guards);
-    for (int k = 0; k < event_count_; ++k) values[guard_indicator_[k]] = guards[k];
+    for (int k = 0; k < event_count(); ++k) values[elements_.indicator_of_guard(k)] = guards[k];
 }
 
 int GimbalHybridSystem::update_modes(double time, double* state, const int* directions) {
@@ -164,32 +107,10 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
     cache_valid_ = false;  // new modes, and perhaps a projected state
     const BaseKinematics base = base_at(time);
     const SwitchingContext context{params_, inputs_, d, time};
+    elements_.decide(context, previous, modes_, state, directions,
+                     [&] { evaluate_dynamics(params_, inputs_, base, time, state, modes_, d); });
 
-    for (const BacklashElement& element : backlash_) element.decide(context, previous, modes_, state, directions);
-    bool clamp_changed = false;
-    for (const VoltageClampElement& element : clamps_) {
-        element.decide(context, previous, modes_, state, directions);
-        clamp_changed = clamp_changed || element.describe(previous, modes_).size() > 0;
-    }
-    // The limiters' steady current depends on the voltage the clamps now apply.
-    if (clamp_changed) evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
-    for (const CurrentLimiterElement& element : limiters_) element.decide(context, previous, modes_, state, directions);
-    for (const DryFrictionElement& element : friction_) element.decide(context, previous, modes_, state, directions);
-    // The other torques of the low-speed bodies depend on the modes and the state chosen so far.
-    bool any_low_speed = false;
-    for (int body = 0; body < 4; ++body) any_low_speed = any_low_speed || low_speed(modes_.friction[body]);
-    if (any_low_speed && (!same_modes(modes_, previous) || !std::equal(state, state + n, state_before)))
-        evaluate_dynamics(params_, inputs_, base, time, state, modes_, d);
-    for (const DryFrictionElement& element : friction_) element.decide_torque(context, previous, modes_, directions);
-
-    int changes = 0;
-    for (int axis = 0; axis < 2; ++axis) {
-        if (modes_.voltage_clamped[axis] != previous.voltage_clamped[axis]) ++changes;
-        if (modes_.gear_contact[axis] != previous.gear_contact[axis]) ++counters_.backlash[axis], ++changes;
-        if (modes_.motor_limited[axis] != previous.motor_limited[axis]) ++counters_.current_limit[axis], ++changes;
-    }
-    for (int body = 0; body < 4; ++body)
-        if (modes_.friction[body] != previous.friction[body]) ++counters_.stick_slip, ++changes;
+    const int changes = elements_.count_changes(previous, modes_, counters_);
     counters_.total += changes;
     if (changes > 0) counters_.last_event_time = time;
     // Unchanged modes and state: the dynamics just evaluated are those of this point.
@@ -202,15 +123,6 @@ int GimbalHybridSystem::update_modes(double time, double* state, const int* dire
     return changes;
 }
 
-std::string GimbalHybridSystem::describe_last_changes() const {
-    std::string text;
-    for (const SwitchingElement* element : elements_) {
-        const std::string change = element->describe(previous_modes_, modes_);
-        if (change.empty()) continue;
-        if (!text.empty()) text += "; ";
-        text += element->name() + ": " + change;
-    }
-    return text;
-}
+std::string GimbalHybridSystem::describe_last_changes() const { return elements_.describe(previous_modes_, modes_); }
 
 }  // namespace gimbal

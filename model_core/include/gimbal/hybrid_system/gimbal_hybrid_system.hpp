@@ -2,22 +2,11 @@
 // limiter, stick/slip), their event functions and their switching rules.
 #pragma once
 
-#include <cstdint>
-#include "gimbal/model/gimbal_model.hpp"
 #include "gimbal/hybrid_system/hybrid_system.hpp"
-#include "gimbal/switching_elements/switching_elements.hpp"
-
-#include <vector>
+#include "gimbal/model/gimbal_model.hpp"
+#include "gimbal/switching_elements/element_registry.hpp"
 
 namespace gimbal {
-
-struct EventCounters {
-    std::int64_t total = 0;
-    std::int64_t backlash[2] = {0, 0};
-    std::int64_t current_limit[2] = {0, 0};
-    std::int64_t stick_slip = 0;
-    double last_event_time = 0.0;
-};
 
 class GimbalHybridSystem final : public HybridSystem {
 public:
@@ -27,7 +16,7 @@ public:
     GimbalHybridSystem& operator=(const GimbalHybridSystem&) = delete;
 
     int state_size() const override { return params_.state_size(); }
-    int event_count() const override { return event_count_; }
+    int event_count() const override { return elements_.guard_count(); }
     bool derivative(double time, const double* state, double* derivative) override;
     int kinematic_pairs(int* position, int* velocity) const override;
     bool has_jacobian() const override { return true; }
@@ -48,13 +37,11 @@ public:
     }
 
     // The guards of every switching element the model can have, in one fixed order whatever the
-    // fidelity (Model Exchange's event indicators): gear 1 and 2 backlash (2 each), motor 1 and 2
-    // voltage clamp (2 each), current limiter (2 each), then dry friction of body1, rotor1, body2,
-    // rotor2 (6 each). An element this fidelity lacks contributes constants 1 (never crossing).
-    static constexpr int kIndicatorCount = 36;
+    // fidelity (Model Exchange's event indicators; element_registry.hpp).
+    static constexpr int kIndicatorCount = kEventIndicatorCount;
     void event_indicators(double time, const double* state, double* values);
     // Where guard k of event_functions() sits among the indicators.
-    int indicator_of_guard(int guard) const { return guard_indicator_[guard]; }
+    int indicator_of_guard(int guard) const { return elements_.indicator_of_guard(guard); }
     // The dynamics at (time, state) under the current modes: those of the last right-hand side when it
     // was evaluated there (the usual case at the end of a step), else evaluated now.
     const Dynamics& dynamics_at(double time, const double* state);
@@ -75,14 +62,8 @@ private:
     const BaseKinematics& base_at(double time);
 
     const ModelParameters& params_;
-    // The switching elements present, in decision order, and all of them for guards and the log.
-    std::vector<BacklashElement> backlash_;
-    std::vector<VoltageClampElement> clamps_;
-    std::vector<CurrentLimiterElement> limiters_;
-    std::vector<DryFrictionElement> friction_;
-    std::vector<const SwitchingElement*> elements_;
-    int event_count_ = 0;
-    std::vector<int> guard_indicator_;
+    // The switching elements present (registered in element_registry.cpp).
+    SwitchingElementSet elements_;
     bool inputs_held_ = false;
     StepInputs inputs_;
     BaseKinematics base_;
@@ -100,8 +81,5 @@ private:
     double cache_state_[kMaxStateSize];
     bool cache_valid_ = false;
 };
-
-// Friction mode as the FMU reports it: 0 stuck, +-1 breaking away, +-2 slipping (sign = motion).
-int friction_mode_indicator(FrictionMode mode, double rate);
 
 }  // namespace gimbal
