@@ -143,26 +143,40 @@ bool build_inertia(Checker& check, const BodyParameterVariables& body, Mat3& ine
     return true;
 }
 
-}  // namespace
-
-bool build_model_parameters(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
-                            const bool (&flags)[kBooleanVariableCount], ModelParameters& params, std::string& error) {
-    Checker check{values, error};
-    // Rules of one variable alone: finite, and within its declared bounds. Only the rules that tie
-    // variables together are written out below.
+// Rules of one variable alone: finite, and within its declared bounds. Only the rules that tie
+// variables together are written out below.
+bool check_single_variable_rules(Checker& check, const int (&integers)[kIntegerVariableCount]) {
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
         if (kRealVariables[vr].causality != Causality::parameter) continue;
-        if (!check.require(static_cast<RealVariable>(vr), std::isfinite(values[vr]), "it must be finite") ||
+        if (!check.require(static_cast<RealVariable>(vr), std::isfinite(check.values[vr]), "it must be finite") ||
             !check.within_declared_bounds(static_cast<RealVariable>(vr)))
             return false;
     }
     for (unsigned vi = 0; vi < kIntegerVariableCount; ++vi) {
         if (kIntegerVariables[vi].causality == Causality::parameter &&
             kIntegerVariables[vi].declared_type[0] == '\0' &&
-            !integer_within_declared_bounds(static_cast<IntegerVariable>(vi), integers[vi], error))
+            !integer_within_declared_bounds(static_cast<IntegerVariable>(vi), integers[vi], check.error))
             return false;
     }
+    return true;
+}
 
+// The dry friction element's parameters of one body (switching_elements/dry_friction.hpp).
+bool read_dry_friction(Checker& check, const DryFrictionVariables& vars, DryFrictionParameters& friction) {
+    const double (&values)[kRealVariableCount] = check.values;
+    const RealVariable slip = vars.slip_torque, breakaway = vars.breakaway_torque, stick_speed = vars.stick_speed,
+                       damping = vars.damping_factor;
+    if (!check.require(slip, values[slip] <= values[breakaway], "T_din must not exceed T_max") ||
+        (values[breakaway] > 0.0 && !check.require(stick_speed, values[stick_speed] > 0.0,
+                                                   "it must be > 0 when the body has dry friction (T_max > 0)")))
+        return false;
+    friction = DryFrictionParameters{values[slip], values[breakaway], values[stick_speed], values[damping]};
+    return true;
+}
+
+// The four bodies (multibody/) with their viscous and dry friction, the base point and gravity.
+bool read_bodies(Checker& check, ModelParameters& params) {
+    const double (&values)[kRealVariableCount] = check.values;
     for (int k = 0; k < 4; ++k) {
         const BodyParameterVariables& vars = kBodyParameters[k];
         RigidBody& body = params.multibody.bodies[k];
@@ -170,20 +184,17 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         body.mass = values[vars.mass];
         body.centre_of_mass = read_vector(values, vars.centre_of_mass);
         params.viscous_friction[k] = values[vars.viscous_friction];
-
-        const RealVariable slip = vars.dry_friction.slip_torque, breakaway = vars.dry_friction.breakaway_torque,
-                           stick_speed = vars.dry_friction.stick_speed, damping = vars.dry_friction.damping_factor;
-        if (!check.require(slip, values[slip] <= values[breakaway], "T_din must not exceed T_max") ||
-            (values[breakaway] > 0.0 && !check.require(stick_speed, values[stick_speed] > 0.0,
-                                                       "it must be > 0 when the body has dry friction (T_max > 0)")))
-            return false;
-        params.dry_friction[k] = DryFrictionParameters{values[slip], values[breakaway], values[stick_speed], values[damping]};
+        if (!read_dry_friction(check, vars.dry_friction, params.dry_friction[k])) return false;
     }
-    params.energy_accounting = flags[vb_energy_accounting];
     params.multibody.d_ab = read_vector(values, kBasePointB);
     params.multibody.gravity = values[vr_g];
     prepare_multibody(params.multibody);
+    return true;
+}
 
+// The motors (current_limiter.hpp, voltage_clamp.hpp) and the gears (gear_backlash.hpp).
+bool read_drive_train(Checker& check, ModelParameters& params) {
+    const double (&values)[kRealVariableCount] = check.values;
     struct MotorVariables { RealVariable R, L, k_torque, k_emf, i_L, U_L; };
     const MotorVariables motors[2] = {
         {vr_motor1_R, vr_motor1_L, vr_motor1_k_torque, vr_motor1_k_emf, vr_motor1_i_L, vr_motor1_U_L},
@@ -200,7 +211,11 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         if (!check.require(g.N, values[g.N] != 0.0, "a gear ratio must not be 0")) return false;
         params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], values[g.eta]};
     }
+    return true;
+}
 
+// solver.*: the method (one this binary has), its step limit and substeps.
+bool read_solver(const int (&integers)[kIntegerVariableCount], ModelParameters& params, std::string& error) {
     params.max_steps = integers[vi_solver_max_steps];
     if (integers[vi_solver_method] < 0 || integers[vi_solver_method] >= kIntegrationMethodCount) {
         error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
@@ -221,7 +236,12 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     }
     params.method = integers[vi_solver_method];
     params.substeps = integers[vi_solver_substeps];
+    return true;
+}
 
+// The structural selectors (docs/physics.md section 6).
+bool read_fidelity(const int (&integers)[kIntegerVariableCount], const bool (&flags)[kBooleanVariableCount],
+                   ModelParameters& params, std::string& error) {
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
     const IntegerVariable motor_models[2] = {vi_motor1_model, vi_motor2_model};
     for (int j = 0; j < 2; ++j) {
@@ -241,6 +261,19 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     }
     params.fidelity.dry_friction = flags[vb_dry_friction];
     params.fidelity.fixed_base = flags[vb_base_fixed];
+    return true;
+}
+
+}  // namespace
+
+bool build_model_parameters(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
+                            const bool (&flags)[kBooleanVariableCount], ModelParameters& params, std::string& error) {
+    Checker check{values, error};
+    if (!check_single_variable_rules(check, integers) || !read_bodies(check, params)) return false;
+    params.energy_accounting = flags[vb_energy_accounting];
+    if (!read_drive_train(check, params) || !read_solver(integers, params, error) ||
+        !read_fidelity(integers, flags, params, error))
+        return false;
     params.finalize();
     params.relative_tolerance = values[vr_solver_rtol];
     params.absolute_tolerance = values[vr_solver_atol];
