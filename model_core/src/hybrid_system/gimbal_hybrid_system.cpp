@@ -49,8 +49,7 @@ bool GimbalHybridSystem::at_rest(double time, const double* state) {
 }
 
 bool GimbalHybridSystem::time_dependent() const {
-    return !base_constant_ || (inputs_.voltage_rate[0] != 0.0 && modes_.voltage_clamped[0] == 0) ||
-           (inputs_.voltage_rate[1] != 0.0 && modes_.voltage_clamped[1] == 0);
+    return !base_constant_ || elements_.time_dependent(inputs_, modes_);
 }
 
 const Dynamics& GimbalHybridSystem::dynamics_at(double time, const double* state) {

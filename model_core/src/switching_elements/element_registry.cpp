@@ -56,6 +56,11 @@ void SwitchingElementSet::decide(const SwitchingContext& context, const Modes& p
     for (const DryFrictionElement& element : friction_) element.decide_torque(context, previous, modes, crossings);
 }
 
+bool SwitchingElementSet::time_dependent(const StepInputs& inputs, const Modes& modes) const {
+    return std::any_of(elements_.begin(), elements_.end(),
+                       [&](const SwitchingElement* element) { return element->time_dependent(inputs, modes); });
+}
+
 int SwitchingElementSet::count_changes(const Modes& before, const Modes& after, EventCounters& counters) const {
     int changes = 0;
     for (const SwitchingElement* element : elements_) {

@@ -42,6 +42,9 @@ public:
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                 const int* crossings, const std::function<void()>& refresh) const;
 
+    // Whether any element's guards move with time alone (SwitchingElement::time_dependent).
+    bool time_dependent(const StepInputs& inputs, const Modes& modes) const;
+
     // The number of elements whose mode differs between the two, each counted in its kind's counter.
     int count_changes(const Modes& before, const Modes& after, EventCounters& counters) const;
     // "gear1 backlash: gap -> +eta stop; ..." for the elements whose mode differs.

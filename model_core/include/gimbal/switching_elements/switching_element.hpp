@@ -50,6 +50,13 @@ public:
     virtual void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                         const int* crossings) const = 0;
 
+    // Whether the dynamics under this element's mode move with time alone (a ramped input not yet
+    // clamped): the Rosenbrock methods then need the right-hand side's time derivative.
+    virtual bool time_dependent(const StepInputs& inputs, const Modes& modes) const {
+        (void)inputs, (void)modes;
+        return false;
+    }
+
     // Whether this element's mode differs between the two; if so, counted in its kind's counter.
     virtual bool changed(const Modes& before, const Modes& after) const = 0;
     virtual void count_change(EventCounters& counters) const { (void)counters; }

@@ -31,6 +31,10 @@ public:
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                 const int* crossings) const override;
+    // A ramp not yet clamped moves the applied voltage with time.
+    bool time_dependent(const StepInputs& inputs, const Modes& modes) const override {
+        return inputs.voltage_rate[axis_] != 0.0 && modes.voltage_clamped[axis_] == 0;
+    }
     bool changed(const Modes& before, const Modes& after) const override {
         return before.voltage_clamped[axis_] != after.voltage_clamped[axis_];
     }
