@@ -1,4 +1,4 @@
-// The specialised rigid-body dynamics (model_core/src/rigid_body.cpp, base_kinematics.cpp) against the
+// The specialised rigid-body dynamics (model_core/src/multibody/rigid_body.cpp, base_kinematics.cpp) against the
 // generic implementation they replaced, kept here verbatim as the reference: random full inertia
 // tensors, centres of mass anywhere, random base motion and gravity, rotors with and without the
 // axial symmetry that lets the fast code skip their trigonometry. Also solve_mass_matrix against LLT.
