@@ -9,17 +9,6 @@ const char* limit_name(int side) { return side > 0 ? "held at +i_L" : (side < 0 
 
 }  // namespace
 
-void add_motor_force_derivatives(const ModelParameters& params, const Modes& modes, int axis, Mat4x12& force) {
-    if (modes.motor_limited[axis] != 0) return;
-    const MotorParameters& motor = params.motor[axis];
-    const int rotor = rotor_index(axis);
-    if (params.layout.current_slot[axis] >= 0) {
-        force(rotor, kCurrentColumn + axis) += motor.torque_constant;
-    } else {
-        force(rotor, kRateColumn + rotor) -= motor.torque_constant * motor.back_emf_constant / motor.resistance;
-    }
-}
-
 bool current_state_row(const ModelParameters& params, const Modes& modes, int axis, const Mat4& T, Row12& row) {
     if (params.layout.current_slot[axis] < 0 || modes.motor_limited[axis] != 0) return false;
     const MotorParameters& motor = params.motor[axis];

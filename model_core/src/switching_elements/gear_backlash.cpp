@@ -9,29 +9,6 @@ const char* contact_name(int side) { return side > 0 ? "+eta stop" : (side < 0 ?
 
 }  // namespace
 
-void add_gear_force_derivatives(const ModelParameters& params, const Modes& modes, int axis, Mat4x12& force) {
-    const GearParameters& gear = params.gear[axis];
-    const int rotor = rotor_index(axis), load = load_index(axis);
-    const GearModel model = params.fidelity.gear[axis];
-    const int contact = modes.gear_contact[axis];
-    double stiffness = 0.0, damping = 0.0, backlash = 0.0;  // d T_E / d(theta_d, dtheta_d, theta_b)
-    if (model == GearModel::compliant || (model == GearModel::backlash && gear.half_backlash == 0.0)) {
-        stiffness = gear.stiffness, damping = gear.damping;
-    } else if (model == GearModel::backlash && contact != 0) {
-        stiffness = gear.stiffness;
-        damping = dead_zone_gear(gear) ? 0.0 : gear.damping;
-        backlash = dead_zone_gear(gear) ? 0.0 : -gear.stiffness;
-    }
-    Row12 torque = Row12::Zero();
-    torque(rotor) = stiffness / gear.ratio;
-    torque(load) = -stiffness;
-    torque(kRateColumn + rotor) = damping / gear.ratio;
-    torque(kRateColumn + load) = -damping;
-    torque(kBacklashColumn + axis) = backlash;
-    force.row(load) += torque;
-    force.row(rotor) -= torque / gear.ratio;
-}
-
 bool backlash_state_row(const ModelParameters& params, const Modes& modes, int axis, const Mat4& T, Row12& row) {
     const GearParameters& gear = params.gear[axis];
     if (params.layout.backlash_slot[axis] < 0 || modes.gear_contact[axis] != 0 || gear.half_backlash <= 0.0)

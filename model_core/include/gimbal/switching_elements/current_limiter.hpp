@@ -41,7 +41,16 @@ inline double motor_circuit(const ModelParameters& params, const StepInputs& inp
 
 // Jacobian pass: the motor torque's derivatives on the rotor's row of `force` (through the current
 // state, or for a quasi-static motor the back-emf damping); none while the limiter holds i.
-void add_motor_force_derivatives(const ModelParameters& params, const Modes& modes, int axis, Mat4x12& force);
+inline void add_motor_force_derivatives(const ModelParameters& params, const Modes& modes, int axis, Mat4x12& force) {
+    if (modes.motor_limited[axis] != 0) return;
+    const MotorParameters& motor = params.motor[axis];
+    const int rotor = rotor_index(axis);
+    if (params.layout.current_slot[axis] >= 0) {
+        force(rotor, kCurrentColumn + axis) += motor.torque_constant;
+    } else {
+        force(rotor, kRateColumn + rotor) -= motor.torque_constant * motor.back_emf_constant / motor.resistance;
+    }
+}
 
 // The row of d(di/dt)/d(state) of a free inductive circuit (q_full = T q_padded); false otherwise.
 bool current_state_row(const ModelParameters& params, const Modes& modes, int axis, const Mat4& T, Row12& row);

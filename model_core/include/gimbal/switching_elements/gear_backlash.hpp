@@ -61,7 +61,28 @@ inline double gear_coupling(const ModelParameters& params, const Modes& modes, i
 
 // Jacobian pass: d T_E / d(state) under the contact mode, added to the load's row of `force` and, as
 // -T_E / N, to the rotor's (full coordinates, columns of JacobianColumn).
-void add_gear_force_derivatives(const ModelParameters& params, const Modes& modes, int axis, Mat4x12& force);
+inline void add_gear_force_derivatives(const ModelParameters& params, const Modes& modes, int axis, Mat4x12& force) {
+    const GearParameters& gear = params.gear[axis];
+    const int rotor = rotor_index(axis), load = load_index(axis);
+    const GearModel model = params.fidelity.gear[axis];
+    const int contact = modes.gear_contact[axis];
+    double stiffness = 0.0, damping = 0.0, backlash = 0.0;  // d T_E / d(theta_d, dtheta_d, theta_b)
+    if (model == GearModel::compliant || (model == GearModel::backlash && gear.half_backlash == 0.0)) {
+        stiffness = gear.stiffness, damping = gear.damping;
+    } else if (model == GearModel::backlash && contact != 0) {
+        stiffness = gear.stiffness;
+        damping = dead_zone_gear(gear) ? 0.0 : gear.damping;
+        backlash = dead_zone_gear(gear) ? 0.0 : -gear.stiffness;
+    }
+    Row12 torque = Row12::Zero();
+    torque(rotor) = stiffness / gear.ratio;
+    torque(load) = -stiffness;
+    torque(kRateColumn + rotor) = damping / gear.ratio;
+    torque(kRateColumn + load) = -damping;
+    torque(kBacklashColumn + axis) = backlash;
+    force.row(load) += torque;
+    force.row(rotor) -= torque / gear.ratio;
+}
 
 // The row of d(dtheta_b/dt)/d(state) in the gap (q_full = T q_padded); false when theta_b has no
 // dynamics of its own (no backlash state, at a stop, or eta = 0).
