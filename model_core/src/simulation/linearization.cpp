@@ -46,15 +46,8 @@ double difference_step(double value) {
     return std::cbrt(std::numeric_limits<double>::epsilon()) * std::max(1.0, std::fabs(value));
 }
 
-}  // namespace
-
-void linearize(const ModelParameters& params, const StepInputs& given_inputs, const Modes& modes, double time,
-               const double* state, LinearModel& out) {
-    const StateLayout& layout = params.layout;
-    const int n = layout.energy_slot >= 0 ? layout.energy_slot : layout.size;
-    out = LinearModel();
-    out.state_count = n;
-    out.modes = modes;
+// The output each state slot carries (the state's name in the linear model).
+void name_states(const StateLayout& layout, LinearModel& out) {
     for (int body = 0; body < 4; ++body) {
         if (!layout.independent(body)) continue;
         out.state_variable[layout.angle_slot[body]] = static_cast<RealVariable>(kLinearFirstOutput + body);
@@ -65,30 +58,13 @@ void linearize(const ModelParameters& params, const StepInputs& given_inputs, co
         if (layout.backlash_slot[axis] >= 0)
             out.state_variable[layout.backlash_slot[axis]] = axis == 0 ? vr_theta_b1 : vr_theta_b2;
     }
+}
 
-    StepInputs inputs = given_inputs;
-    inputs.step_start_time = time;
-    inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;
-    // A held voltage at or beyond its clamp does not respond to a small change (at the limit itself,
-    // not to an increase: a saturated controller sits exactly there): its column is 0 and the mode
-    // says clamped, on the side of the limit.
-    double voltage_passes[2];
-    for (int axis = 0; axis < 2; ++axis) {
-        const double commanded = inputs.commanded_voltage[axis], limit = params.motor[axis].voltage_limit;
-        inputs.voltage[axis] = clamp_voltage(params.motor[axis], commanded);
-        const bool clamped = std::fabs(commanded) >= limit;
-        voltage_passes[axis] = clamped ? 0.0 : 1.0;
-        if (clamped) out.modes.voltage_clamped[axis] = commanded > 0.0 ? 1 : -1;
-    }
-
-    const BaseKinematics base = base_kinematics_at(params, inputs, time);
-    Dynamics dynamics;
-    evaluate_dynamics(params, inputs, base, time, state, modes, dynamics);
-    double jacobian[kMaxStateSize * kMaxStateSize];
-    evaluate_jacobian(params, modes, base, dynamics, jacobian);
-    for (int row = 0; row < n; ++row)
-        for (int col = 0; col < n; ++col) out.A[row][col] = jacobian[col * layout.size + row];
-
+// B and D by central differences of the rates and the outputs in each input; a voltage held at its
+// clamp passes nothing (voltage_passes[axis] = 0).
+void input_columns(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
+                   const double* state, const double (&voltage_passes)[2], LinearModel& out) {
+    const int n = out.state_count;
     double plus[kMaxStateSize], minus[kMaxStateSize];
     double y_plus[kLinearOutputCount], y_minus[kLinearOutputCount];
     for (int k = 0; k < kLinearInputCount; ++k) {
@@ -105,10 +81,15 @@ void linearize(const ModelParameters& params, const StepInputs& given_inputs, co
         for (int row = 0; row < n; ++row) out.B[row][k] = (plus[row] - minus[row]) * scale;
         for (int row = 0; row < kLinearOutputCount; ++row) out.D[row][k] = (y_plus[row] - y_minus[row]) * scale;
     }
+}
 
+// C by central differences of the outputs in each state.
+void state_output_columns(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
+                          const double* state, LinearModel& out) {
+    double y_plus[kLinearOutputCount], y_minus[kLinearOutputCount];
     double shifted[kMaxStateSize];
-    std::copy(state, state + layout.size, shifted);
-    for (int col = 0; col < n; ++col) {
+    std::copy(state, state + params.layout.size, shifted);
+    for (int col = 0; col < out.state_count; ++col) {
         const double step = difference_step(state[col]);
         shifted[col] = state[col] + step;
         output_values(params, inputs, modes, time, shifted, y_plus);
@@ -117,6 +98,43 @@ void linearize(const ModelParameters& params, const StepInputs& given_inputs, co
         shifted[col] = state[col];
         for (int row = 0; row < kLinearOutputCount; ++row) out.C[row][col] = (y_plus[row] - y_minus[row]) / (2.0 * step);
     }
+}
+
+}  // namespace
+
+void linearize(const ModelParameters& params, const StepInputs& given_inputs, const Modes& modes, double time,
+               const double* state, LinearModel& out) {
+    const StateLayout& layout = params.layout;
+    const int n = layout.energy_slot >= 0 ? layout.energy_slot : layout.size;
+    out = LinearModel();
+    out.state_count = n;
+    out.modes = modes;
+    name_states(layout, out);
+
+    StepInputs inputs = given_inputs;
+    inputs.step_start_time = time;
+    inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;
+    // A held voltage at or beyond its clamp does not respond to a small change (voltage_clamp.hpp,
+    // held_clamp_side): its column is 0 and the mode says clamped, on the side of the limit.
+    double voltage_passes[2];
+    for (int axis = 0; axis < 2; ++axis) {
+        const double commanded = inputs.commanded_voltage[axis];
+        inputs.voltage[axis] = clamp_voltage(params.motor[axis], commanded);
+        const int side = held_clamp_side(params.motor[axis], commanded);
+        voltage_passes[axis] = side != 0 ? 0.0 : 1.0;
+        if (side != 0) out.modes.voltage_clamped[axis] = side;
+    }
+
+    const BaseKinematics base = base_kinematics_at(params, inputs, time);
+    Dynamics dynamics;
+    evaluate_dynamics(params, inputs, base, time, state, modes, dynamics);
+    double jacobian[kMaxStateSize * kMaxStateSize];
+    evaluate_jacobian(params, modes, base, dynamics, jacobian);
+    for (int row = 0; row < n; ++row)
+        for (int col = 0; col < n; ++col) out.A[row][col] = jacobian[col * layout.size + row];
+
+    input_columns(params, inputs, modes, time, state, voltage_passes, out);
+    state_output_columns(params, inputs, modes, time, state, out);
 }
 
 }  // namespace gimbal

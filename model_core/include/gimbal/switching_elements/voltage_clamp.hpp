@@ -7,6 +7,8 @@
 //   guards: 2 (indicators 4-7)                            counter: none (counted in the total only)
 #pragma once
 
+#include <cmath>
+
 #include "gimbal/switching_elements/switching_element.hpp"
 
 namespace gimbal {
@@ -22,6 +24,14 @@ inline double applied_voltage(const ModelParameters& params, const StepInputs& i
     if (inputs.voltage_rate[axis] == 0.0) return inputs.voltage[axis];
     if (modes.voltage_clamped[axis] != 0) return modes.voltage_clamped[axis] * params.motor[axis].voltage_limit;
     return ramped_voltage(inputs, axis, time);
+}
+
+// The linear model's view of a held voltage: at or beyond its clamp (at the limit itself, not only
+// beyond: a saturated controller sits exactly there) it does not respond to a small change. The side
+// of the limit, or 0 when the voltage passes.
+inline int held_clamp_side(const MotorParameters& motor, double commanded_voltage) {
+    if (!(std::fabs(commanded_voltage) >= motor.voltage_limit)) return 0;  // NaN passes, as before
+    return commanded_voltage > 0.0 ? 1 : -1;
 }
 
 class VoltageClampElement final : public SwitchingElement {
