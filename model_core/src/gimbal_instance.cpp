@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "gimbal/parameter_validation.hpp"
+#include "gimbal/snapshot.hpp"
 #include "gimbal/variable_groups.hpp"
 
 namespace gimbal {
@@ -34,93 +35,26 @@ bool continues(const StepInputs& running, const StepInputs& next, double time) {
     return true;
 }
 
+// A base motion as the 15 numbers of a snapshot: attitude, rate, acceleration, v_a, a_a.
+void write_base_motion(const BaseMotion& base, double* values) {
+    const Vec3* parts[5] = {&base.attitude, &base.attitude_rate, &base.attitude_accel, &base.velocity_a,
+                            &base.acceleration_a};
+    for (int p = 0; p < 5; ++p)
+        for (int k = 0; k < 3; ++k) values[3 * p + k] = (*parts[p])[k];
+}
+
+BaseMotion read_base_motion(const double* values) {
+    BaseMotion base;
+    Vec3* parts[5] = {&base.attitude, &base.attitude_rate, &base.attitude_accel, &base.velocity_a,
+                      &base.acceleration_a};
+    for (int p = 0; p < 5; ++p)
+        for (int k = 0; k < 3; ++k) (*parts[p])[k] = values[3 * p + k];
+    return base;
+}
+
 bool same_base_motion(const BaseMotion& a, const BaseMotion& b) {
     return a.attitude == b.attitude && a.attitude_rate == b.attitude_rate && a.attitude_accel == b.attitude_accel &&
            a.velocity_a == b.velocity_a && a.acceleration_a == b.acceleration_a;
-}
-
-constexpr std::uint32_t kSnapshotMagic = 0x47324158;  // "G2AX"
-constexpr std::uint32_t kSnapshotVersion = 7;
-
-// Plain integers and doubles only, flags as bytes: any byte pattern decodes without undefined
-// behaviour, and check_snapshot() decides whether it is a state this model can be in.
-struct Snapshot {
-    std::uint32_t magic;
-    std::uint32_t version;
-    double reals[kRealVariableCount];
-    std::int32_t integers[kIntegerVariableCount];
-    std::uint8_t booleans[kBooleanVariableCount];
-    std::uint8_t initialized;
-    std::uint8_t integrator_running;
-    std::uint8_t at_rest;
-    std::uint8_t rtol_set;
-    std::uint8_t master_tolerance_defined;
-    double master_tolerance;
-    double time;
-    double clock;  // model time: the instance's own sum of steps since the start
-    double state[kMaxStateSize];
-    Modes modes;
-    EventCounters counters;
-    IntegratorStatistics statistics;
-    double voltage[2];
-    double commanded_voltage[2];
-    double voltage_rate[2];
-    double pending_voltage_rate[2];
-    double base[15];  // attitude, rate, accel, v_a, a_a at the arc start
-    double arc_start_time;  // model time
-    double epoch;
-    IntegratorMemory integrator_memory;
-    // The continuous-time interface's event memory.
-    std::uint8_t continuous_time;
-    std::uint8_t decided_here;
-    std::int8_t decided_side[GimbalHybridSystem::kIndicatorCount];
-    double reference_guards[GimbalHybridSystem::kIndicatorCount];
-    double last_event_time;
-    double dwell_until;
-    std::int32_t rapid_events;
-    std::int64_t zeno_holds;
-};
-static_assert(std::is_trivially_copyable<Snapshot>::value, "snapshots are copied as bytes");
-static_assert(sizeof(int) == sizeof(std::int32_t), "Integer variables are stored as int");
-
-// Counters beyond this are not the product of any run (2^53 steps would take centuries).
-constexpr double kMaxCount = 9007199254740992.0;
-
-// Collects the first reason a snapshot is refused.
-struct SnapshotCheck {
-    std::string reason;
-    bool ok() const { return reason.empty(); }
-    void fail(const std::string& why) {
-        if (reason.empty()) reason = why;
-    }
-    void finite(const char* field, const double* values, std::size_t count) {
-        for (std::size_t k = 0; k < count && ok(); ++k)
-            if (!std::isfinite(values[k])) fail(std::string(field) + "[" + std::to_string(k) + "] is not finite");
-    }
-    void flag(const char* field, std::uint8_t value) {
-        if (value > 1) fail(std::string(field) + " = " + std::to_string(value) + " is not a boolean");
-    }
-    void count(const char* field, std::int64_t value) {
-        if (value < 0 || static_cast<double>(value) > kMaxCount)
-            fail(std::string(field) + " = " + std::to_string(value) + " is not a count");
-    }
-    void within(const char* field, std::int64_t value, std::int64_t low, std::int64_t high) {
-        if (value < low || value > high)
-            fail(std::string(field) + " = " + std::to_string(value) + " lies outside [" + std::to_string(low) + ", " +
-                 std::to_string(high) + "]");
-    }
-};
-
-// The model a snapshot's values define, validated as at initialization.
-bool snapshot_parameters(const Snapshot& snap, ModelParameters& params, std::string& error) {
-    double reals[kRealVariableCount];
-    int integers[kIntegerVariableCount];
-    bool booleans[kBooleanVariableCount];
-    std::copy(snap.reals, snap.reals + kRealVariableCount, reals);
-    std::copy(snap.integers, snap.integers + kIntegerVariableCount, integers);
-    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans[vr] = snap.booleans[vr] != 0;
-    return build_model_parameters(reals, integers, booleans, params, error) &&
-           validate_start_state(reals, params, error);
 }
 
 // The hybrid system keeps a reference to the instance's parameters, so new ones go in place before
@@ -547,13 +481,11 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     return GIMBAL_OK;
 }
 
-std::size_t GimbalInstance::snapshot_size() { return sizeof(Snapshot); }
+std::size_t GimbalInstance::snapshot_size() { return snapshot_bytes(); }
 
 void GimbalInstance::save(void* buffer) {
-    Snapshot snap;
-    std::memset(static_cast<void*>(&snap), 0, sizeof snap);  // no stray padding bytes in a serialized state
-    snap.magic = kSnapshotMagic;
-    snap.version = kSnapshotVersion;
+    SnapshotContent snap;
+    std::memset(static_cast<void*>(&snap), 0, sizeof snap);
     std::copy(reals_, reals_ + kRealVariableCount, snap.reals);
     std::copy(integers_, integers_ + kIntegerVariableCount, snap.integers);
     for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) snap.booleans[vr] = booleans_[vr] ? 1 : 0;
@@ -576,181 +508,68 @@ void GimbalInstance::save(void* buffer) {
     snap.dwell_until = chattering_.dwell_until;
     snap.rapid_events = chattering_.rapid_events;
     snap.zeno_holds = zeno_holds_;
-    if (snap.initialized) {
-        snap.modes = system_->modes();
-        snap.counters = system_->counters();
-        snap.statistics = integrator_->statistics();
-        const StepInputs& in = system_->inputs();
-        for (int axis = 0; axis < 2; ++axis) {
-            snap.voltage[axis] = in.voltage[axis];
-            snap.commanded_voltage[axis] = in.commanded_voltage[axis];
-            snap.voltage_rate[axis] = in.voltage_rate[axis];
-        }
-        const Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel,
-                                &in.base.velocity_a, &in.base.acceleration_a};
-        for (int p = 0; p < 5; ++p)
-            for (int k = 0; k < 3; ++k) snap.base[3 * p + k] = (*parts[p])[k];
-        snap.arc_start_time = in.step_start_time;
-        snap.at_rest = at_rest_;
-        if (integrator_->resumable()) {
-            // The one-step methods carry only their step-size controller: the snapshot holds it, and a
-            // restored copy continues exactly as this instance does.
-            snap.integrator_running = integrator_running_;
-            snap.integrator_memory = integrator_->memory();
-        } else {
-            // A multistep method's history does not fit in a snapshot: end the integration segment here,
-            // so that this instance and a restored copy both restart the integrator at the next step.
-            const IntegratorStatistics totals = integrator_->statistics();
-            create_integrator();
-            integrator_->set_statistics(totals);
-            snap.integrator_running = false;
-        }
+    if (snap.initialized) save_run(snap);
+    encode_snapshot(snap, buffer);
+}
+
+// The parts of a snapshot only an initialized instance has: modes, counters, the running inputs and
+// the integrator.
+void GimbalInstance::save_run(SnapshotContent& snap) {
+    snap.modes = system_->modes();
+    snap.counters = system_->counters();
+    snap.statistics = integrator_->statistics();
+    const StepInputs& in = system_->inputs();
+    for (int axis = 0; axis < 2; ++axis) {
+        snap.voltage[axis] = in.voltage[axis];
+        snap.commanded_voltage[axis] = in.commanded_voltage[axis];
+        snap.voltage_rate[axis] = in.voltage_rate[axis];
     }
-    std::memcpy(buffer, &snap, sizeof snap);
+    write_base_motion(in.base, snap.base);
+    snap.arc_start_time = in.step_start_time;
+    snap.at_rest = at_rest_;
+    if (integrator_->resumable()) {
+        // The one-step methods carry only their step-size controller: the snapshot holds it, and a
+        // restored copy continues exactly as this instance does.
+        snap.integrator_running = integrator_running_;
+        snap.integrator_memory = integrator_->memory();
+    } else {
+        // A multistep method's history does not fit in a snapshot: end the integration segment here,
+        // so that this instance and a restored copy both restart the integrator at the next step.
+        const IntegratorStatistics totals = integrator_->statistics();
+        create_integrator();
+        integrator_->set_statistics(totals);
+        snap.integrator_running = false;
+    }
+}
+
+GimbalStatus GimbalInstance::read_snapshot(const void* buffer, SnapshotContent& snap) const {
+    const bool format_ok = decode_snapshot(buffer, snap);
+    const std::string reason = check_snapshot_content(snap, format_ok, continuous_time_);
+    if (!reason.empty()) return refuse(GIMBAL_ERROR, "the FMU state is refused: " + reason);
+    return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::check_snapshot(const void* buffer, bool& initialized) const {
-    Snapshot snap;
-    std::memcpy(&snap, buffer, sizeof snap);
-    SnapshotCheck check;
-    if (snap.magic != kSnapshotMagic || snap.version != kSnapshotVersion)
-        check.fail("it was not saved by this version of Gimbal2Axis (snapshot format " +
-                   std::to_string(kSnapshotVersion) + ")");
-    check.finite("Real variable", snap.reals, kRealVariableCount);
-    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) check.flag(kBooleanVariables[vr].name, snap.booleans[vr]);
-    check.flag("initialized", snap.initialized);
-    check.flag("integrator_running", snap.integrator_running);
-    check.flag("at_rest", snap.at_rest);
-    check.flag("rtol_set", snap.rtol_set);
-    check.flag("master_tolerance_defined", snap.master_tolerance_defined);
-    check.finite("master tolerance", &snap.master_tolerance, 1);
-    check.finite("time", &snap.time, 1);
-    check.finite("clock", &snap.clock, 1);
-    check.finite("epoch", &snap.epoch, 1);
-    check.finite("state", snap.state, kMaxStateSize);
-    check.finite("pending voltage rate", snap.pending_voltage_rate, 2);
-    check.flag("continuous_time", snap.continuous_time);
-    check.flag("decided_here", snap.decided_here);
-    if (check.ok() && (snap.continuous_time != 0) != continuous_time_)
-        check.fail(std::string("it was saved by an instance of the ") +
-                   (snap.continuous_time ? "continuous-time (Model Exchange)" : "Co-Simulation") + " interface");
-    for (int k = 0; k < kIndicatorCount; ++k) check.within("decided side", snap.decided_side[k], -1, 1);
-    check.finite("reference guards", snap.reference_guards, kIndicatorCount);
-    check.finite("last event time", &snap.last_event_time, 1);
-    check.finite("end of the chattering hold", &snap.dwell_until, 1);
-    check.count("rapid events", snap.rapid_events);
-    check.count("chattering holds", snap.zeno_holds);
-    const IntegerVariable mode_outputs[] = {vi_gear1_contact, vi_gear2_contact, vi_motor1_limited, vi_motor2_limited};
-    for (IntegerVariable vi : mode_outputs) check.within(kIntegerVariables[vi].name, snap.integers[vi], -1, 1);
-    const IntegerVariable friction_outputs[] = {vi_body1_stick_slip, vi_rotor1_stick_slip, vi_body2_stick_slip,
-                                                vi_rotor2_stick_slip};
-    for (IntegerVariable vi : friction_outputs) check.within(kIntegerVariables[vi].name, snap.integers[vi], -2, 2);
-    for (IntegerVariable vi : kEventCounters) check.count(kIntegerVariables[vi].name, snap.integers[vi]);
-    const IntegerVariable solver_outputs[] = {vi_solver_states, vi_solver_steps, vi_solver_rhs_evaluations,
-                                              vi_solver_jacobian_evaluations, vi_solver_method_switches};
-    for (IntegerVariable vi : solver_outputs) check.count(kIntegerVariables[vi].name, snap.integers[vi]);
-    if (check.ok() && snap.initialized) {
-        check.finite("voltage", snap.voltage, 2);
-        check.finite("commanded voltage", snap.commanded_voltage, 2);
-        check.finite("voltage rate", snap.voltage_rate, 2);
-        check.finite("base motion", snap.base, 15);
-        check.finite("arc start time", &snap.arc_start_time, 1);
-        if (!(snap.time >= snap.epoch) || !(snap.clock >= 0.0)) check.fail("the time lies before the start of the run");
-        const Modes& modes = snap.modes;
-        for (int axis = 0; axis < 2; ++axis) {
-            check.within("gear contact mode", modes.gear_contact[axis], -1, 1);
-            check.within("current limiter mode", modes.motor_limited[axis], -1, 1);
-            check.within("voltage clamp mode", modes.voltage_clamped[axis], -1, 1);
-        }
-        for (int body = 0; body < 4; ++body)
-            check.within("friction mode", static_cast<long>(modes.friction[body]),
-                         static_cast<long>(FrictionMode::none), static_cast<long>(FrictionMode::at_max_negative));
-        const EventCounters& c = snap.counters;
-        const std::int64_t counters[] = {c.total, c.backlash[0], c.backlash[1], c.current_limit[0], c.current_limit[1],
-                                 c.stick_slip};
-        for (std::int64_t value : counters) check.count("event counter", value);
-        check.finite("last event time", &c.last_event_time, 1);
-        const IntegratorStatistics& st = snap.statistics;
-        const std::int64_t statistics[] = {st.steps, st.rhs_evaluations, st.jacobian_evaluations, st.events, st.zeno_holds,
-                                   st.method_switches, st.rejected_steps};
-        for (std::int64_t value : statistics) check.count("integrator statistic", value);
-        const IntegratorMemory& m = snap.integrator_memory;
-        const double memory_reals[] = {m.step_size, m.previous_error, m.chattering.last_event_time,
-                                       m.chattering.dwell_until, m.accuracy_step, m.accuracy_time,
-                                       m.explicit_step, m.stable_product, m.jump_time, m.jump_step};
-        check.finite("integrator memory", memory_reals, 10);
-        if (!(m.step_size >= 0.0)) check.fail("the saved step size is negative");
-        if (!(m.accuracy_step >= 0.0) || !(m.explicit_step >= 0.0) || !(m.stable_product >= 0.0))
-            check.fail("a saved step of the switch rule is negative");
-        if (!(m.jump_step >= 0.0) || m.steps_since_jump < -1) check.fail("the saved input jump is invalid");
-        if (!(m.previous_error > 0.0)) check.fail("the saved error estimate is not positive");
-        check.flag("stiff", static_cast<std::uint8_t>(m.stiff < 0 || m.stiff > 1 ? 2 : m.stiff));
-        check.flag("last_step_rejected",
-                   static_cast<std::uint8_t>(m.last_step_rejected < 0 || m.last_step_rejected > 1 ? 2 : m.last_step_rejected));
-        check.count("stiff votes", m.stiff_votes);
-        check.count("non-stiff votes", m.nonstiff_votes);
-        check.count("rapid events", m.chattering.rapid_events);
-    }
-    if (check.ok() && snap.initialized) {
-        // The parameters must be valid, and the modes possible for the elements they define.
-        ModelParameters params;
-        std::string error;
-        if (!snapshot_parameters(snap, params, error)) check.fail(error);
-        for (int axis = 0; axis < 2 && check.ok(); ++axis) {
-            if (params.fidelity.gear[axis] != GearModel::backlash && snap.modes.gear_contact[axis] != 0)
-                check.fail("gear " + std::to_string(axis + 1) + " has no backlash but a contact mode");
-        }
-        for (int body = 0; body < 4 && check.ok(); ++body) {
-            if (!params.fidelity.dry_friction && snap.modes.friction[body] != FrictionMode::none)
-                check.fail("a friction mode is set but dry friction is off");
-        }
-        for (int k = params.layout.size; k < kMaxStateSize && check.ok(); ++k)
-            if (snap.state[k] != 0.0) check.fail("the state has values beyond the model's " +
-                                                 std::to_string(params.layout.size) + " states");
-    }
-    if (!check.ok()) return refuse(GIMBAL_ERROR, "the FMU state is refused: " + check.reason);
+    SnapshotContent snap;
+    const GimbalStatus status = read_snapshot(buffer, snap);
+    if (status != GIMBAL_OK) return status;
     initialized = snap.initialized != 0;
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::restore(const void* buffer) {
-    bool initialized = false;
-    const GimbalStatus checked = check_snapshot(buffer, initialized);
+    SnapshotContent snap;
+    const GimbalStatus checked = read_snapshot(buffer, snap);
     if (checked != GIMBAL_OK) return checked;
-    Snapshot snap;
-    std::memcpy(&snap, buffer, sizeof snap);
+    const bool initialized = snap.initialized != 0;
 
     // Everything is built aside first: a refusal (or running out of memory) leaves the instance as it was.
-    ModelParameters params;
     std::unique_ptr<GimbalHybridSystem> system;
     std::unique_ptr<HybridIntegrator> integrator;
     ParameterSwap swap(params_, params_);
     if (initialized) {
-        std::string error;
-        if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, error);
-        params_ = params;
-        system = std::make_unique<GimbalHybridSystem>(params_);
-        system->hold_inputs_at_any_time(continuous_time_);
-        StepInputs in;
-        for (int axis = 0; axis < 2; ++axis) {
-            in.voltage[axis] = snap.voltage[axis];
-            in.commanded_voltage[axis] = snap.commanded_voltage[axis];
-            in.voltage_rate[axis] = snap.voltage_rate[axis];
-        }
-        Vec3* parts[5] = {&in.base.attitude, &in.base.attitude_rate, &in.base.attitude_accel, &in.base.velocity_a,
-                          &in.base.acceleration_a};
-        for (int p = 0; p < 5; ++p)
-            for (int k = 0; k < 3; ++k) (*parts[p])[k] = snap.base[3 * p + k];
-        in.step_start_time = snap.arc_start_time;
-        system->set_inputs(in);
-        system->restore(snap.modes, snap.counters);
-        integrator = make_integrator(*system, params_);
-        if (snap.integrator_running && integrator->resumable() &&
-            !integrator->resume(snap.clock, snap.state, snap.integrator_memory)) {
-            return refuse(GIMBAL_ERROR, "the integrator cannot continue from the saved state (" +
-                                            last_integrator_error_ + ")");
-        }
-        integrator->set_statistics(snap.statistics);
+        const GimbalStatus built = rebuild_run(snap, system, integrator);
+        if (built != GIMBAL_OK) return built;
     }
 
     std::copy(snap.reals, snap.reals + kRealVariableCount, reals_);
@@ -780,6 +599,36 @@ GimbalStatus GimbalInstance::restore(const void* buffer) {
     if (initialized) map_integrated_states();
     system_ = std::move(system);
     integrator_ = std::move(integrator);
+    return GIMBAL_OK;
+}
+
+// The hybrid system and the integrator of a checked snapshot's run, its parameters put in place (the
+// caller's ParameterSwap puts the previous ones back unless it commits).
+GimbalStatus GimbalInstance::rebuild_run(const SnapshotContent& snap, std::unique_ptr<GimbalHybridSystem>& system,
+                                         std::unique_ptr<HybridIntegrator>& integrator) {
+    ModelParameters params;
+    std::string error;
+    if (!snapshot_parameters(snap, params, error)) return refuse(GIMBAL_ERROR, error);
+    params_ = params;
+    system = std::make_unique<GimbalHybridSystem>(params_);
+    system->hold_inputs_at_any_time(continuous_time_);
+    StepInputs in;
+    for (int axis = 0; axis < 2; ++axis) {
+        in.voltage[axis] = snap.voltage[axis];
+        in.commanded_voltage[axis] = snap.commanded_voltage[axis];
+        in.voltage_rate[axis] = snap.voltage_rate[axis];
+    }
+    in.base = read_base_motion(snap.base);
+    in.step_start_time = snap.arc_start_time;
+    system->set_inputs(in);
+    system->restore(snap.modes, snap.counters);
+    integrator = make_integrator(*system, params_);
+    if (snap.integrator_running && integrator->resumable() &&
+        !integrator->resume(snap.clock, snap.state, snap.integrator_memory)) {
+        return refuse(GIMBAL_ERROR, "the integrator cannot continue from the saved state (" +
+                                        last_integrator_error_ + ")");
+    }
+    integrator->set_statistics(snap.statistics);
     return GIMBAL_OK;
 }
 

@@ -20,6 +20,8 @@
 
 namespace gimbal {
 
+struct SnapshotContent;  // gimbal/snapshot.hpp
+
 class GimbalInstance {
 public:
     using Logger = std::function<void(GimbalStatus, const char* category, const std::string& message)>;
@@ -99,6 +101,12 @@ public:
                                         std::size_t known_count, const double* seed, double* result);
 
 private:
+    // The snapshot (gimbal/snapshot.hpp walks its table of fields): what only an initialized instance
+    // saves, a snapshot decoded and checked, and the run it describes rebuilt aside.
+    void save_run(SnapshotContent& snap);
+    GimbalStatus read_snapshot(const void* buffer, SnapshotContent& snap) const;
+    GimbalStatus rebuild_run(const SnapshotContent& snap, std::unique_ptr<GimbalHybridSystem>& system,
+                             std::unique_ptr<HybridIntegrator>& integrator);
     StepInputs read_step_inputs(double step_start) const;
     bool build_parameters(ModelParameters& params, std::string& error) const;
     void load_start_state();
