@@ -1,5 +1,7 @@
 #include "fmu_state.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -45,6 +47,32 @@ const char* fmu_state_integrity_problem(const unsigned char* bytes, size_t size,
         return "it was saved by an FMU with another GUID";
     if (header.checksum != fmu_state_checksum(bytes, size)) return "its checksum does not match: the bytes were altered";
     return NULL;
+}
+
+const char* fmu_state_header_problem(const StateHeader* header, const FmuStateRules* rules, int model_exchange) {
+    const int32_t state = header->state;
+    const int recorded = rules->last_status_max >= 0;
+    if ((state & rules->saveable_states) == 0 || (state & (state - 1)) != 0)
+        return "its instance state is not one an FMU state can be taken in";
+    if (header->stop_time_defined != 0 && header->stop_time_defined != 1) return "its stop-time flag is not a boolean";
+    if (recorded && (header->last_step_status < 0 || header->last_step_status > rules->last_status_max))
+        return "its last step status is not an fmi2Status";
+    if (!isfinite(header->time) || !isfinite(header->stop_time) || (recorded && !isfinite(header->last_successful_time)))
+        return "its times are not finite";
+    if (rules->stop_time_bounds_time && header->stop_time_defined && header->time > header->stop_time)
+        return "its time lies beyond its stop time";
+    if ((state & rules->model_exchange_states) && !model_exchange) return "it was saved by a Model Exchange instance";
+    if ((state & rules->cosimulation_states) && model_exchange) return "it was saved by a Co-Simulation instance";
+    return NULL;
+}
+
+const char* fmu_state_model_problem(const StateHeader* header, const FmuStateRules* rules, int initialized,
+                                    char* text, size_t text_size) {
+    const int running = (header->state & rules->initialized_states) != 0;
+    if (running == (initialized != 0)) return NULL;
+    snprintf(text, text_size, "its instance state '%s' contradicts its %s model", rules->state_name(header->state),
+             initialized ? "initialized" : "uninitialized");
+    return text;
 }
 
 long fmu_states_find(const FmuStateRegistry* registry, const void* record) {
