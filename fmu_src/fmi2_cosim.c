@@ -517,11 +517,7 @@ static fmi2Status impl_GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
         }
     }
     StateHeader header;
-    memset(&header, 0, sizeof header);
-    header.magic = STATE_MAGIC;
-    header.format_version = STATE_FORMAT_VERSION;
-    header.size = state_record_size();
-    strncpy(header.guid, GIMBAL_GUID, sizeof header.guid - 1);
+    fmu_state_header_init(&header, STATE_MAGIC, state_record_size(), GIMBAL_GUID);
     header.state = (int32_t)instance->state;
     header.time = instance->time;
     header.stop_time = instance->stop_time;
@@ -605,9 +601,7 @@ static fmi2Status impl_SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate,
                     size, state_record_size());
         return fmi2Error;
     }
-    memcpy(serializedState, record, state_record_size());
-    const uint64_t checksum = fmu_state_checksum((const unsigned char*)serializedState, state_record_size());
-    memcpy(serializedState + offsetof(StateHeader, checksum), &checksum, sizeof checksum);
+    fmu_state_serialize(record, state_record_size(), (unsigned char*)serializedState);
     return fmi2OK;
 }
 

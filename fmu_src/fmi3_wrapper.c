@@ -480,11 +480,7 @@ static fmi3Status get_fmu_state(Instance3* i, fmi3FMUState* out) {
         }
     }
     StateHeader header;
-    memset(&header, 0, sizeof header);
-    header.magic = STATE_MAGIC_FMI3;
-    header.format_version = STATE_FORMAT_VERSION;
-    header.size = record_size();
-    strncpy(header.guid, GIMBAL_GUID, sizeof header.guid - 1);
+    fmu_state_header_init(&header, STATE_MAGIC_FMI3, record_size(), GIMBAL_GUID);
     header.state = (int32_t)i->state;
     header.time = i->time;
     header.stop_time = i->stop_time;
@@ -545,9 +541,7 @@ static fmi3Status serialize(Instance3* i, fmi3FMUState state, fmi3Byte bytes[], 
         say(i, fmi3Error, "logStatusError", "%s: size %zu is below the %zu bytes needed", f, size, record_size());
         return fmi3Error;
     }
-    memcpy(bytes, record, record_size());
-    const uint64_t checksum = fmu_state_checksum(bytes, record_size());
-    memcpy(bytes + offsetof(StateHeader, checksum), &checksum, sizeof checksum);
+    fmu_state_serialize(record, record_size(), bytes);
     return fmi3OK;
 }
 

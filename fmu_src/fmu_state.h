@@ -33,6 +33,12 @@ typedef struct {
  * finalizer), so any change confined to one word - every single-bit flip - changes the result. */
 uint64_t fmu_state_checksum(const unsigned char* record, size_t size);
 
+/* A header with the record's identity (magic, format, size, GUID) and every other field zero. */
+void fmu_state_header_init(StateHeader* header, uint32_t magic, size_t record_size, const char* guid);
+
+/* A record's serialized bytes: a copy with its checksum filled in. */
+void fmu_state_serialize(const unsigned char* record, size_t record_size, unsigned char* bytes);
+
 /* NULL when the bytes are a record of this FMU (size, magic, format, GUID and checksum), otherwise
  * what is wrong with them. */
 const char* fmu_state_integrity_problem(const unsigned char* bytes, size_t size, size_t expected_size,
