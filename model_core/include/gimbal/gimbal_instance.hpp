@@ -131,6 +131,7 @@ private:
     // The parts of a step: its checks, its inputs, its end, its outputs' check (inline, defined in
     // simulation/instance_step.cpp, the only place they are called).
     inline GimbalStatus check_step(double step_size);
+    GimbalStatus check_real_time_resolution(double step_size);
     inline GimbalStatus take_step_inputs(double step_start, bool& resting);
     inline void end_step_at(double step_end, double reached_model_time, bool ended_early);
     inline GimbalStatus check_published_outputs(double current_time, const StepStart& start);

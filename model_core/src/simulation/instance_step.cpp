@@ -76,6 +76,11 @@ GIMBAL_HOT_PART GimbalStatus GimbalInstance::check_step(double step_size) {
     const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) return base_status;
     if (params_.method != static_cast<int>(IntegrationMethod::real_time)) return GIMBAL_OK;
+    return check_real_time_resolution(step_size);
+}
+
+// Out of line: its message buffer stays out of integrate_step's frame.
+GimbalStatus GimbalInstance::check_real_time_resolution(double step_size) {
     std::string why;
     if (real_time_resolution_ok(params_, system_->dynamics_at(clock_, state_), step_size, why)) return GIMBAL_OK;
     return refuse(GIMBAL_ERROR, why);
