@@ -718,6 +718,78 @@ bool OneStepIntegrator::move_to_step_end() {
            reselect_after_dwell();
 }
 
+bool OneStepIntegrator::refuse_failed_substep(int substeps) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "the real-time method's step from t = " << t_ << " to " << t_new_
+      << " failed (a state or right-hand side not finite, or a singular iteration matrix): "
+      << "solver.substeps = " << substeps << " is too few for this model";
+    error_sink_(s.str());
+    return false;
+}
+
+bool OneStepIntegrator::refuse_mode_change_bound(double end_time) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "more than " << settings_.mode_changes_per_step << " mode changes in the communication step "
+      << "ending at t = " << end_time << " (the real-time method's bound: its work per step is "
+      << "fixed, and switching later is not safe at a stiff contact); raise solver.substeps, or "
+      << "model the gear without backlash if the scene does not need it";
+    error_sink_(s.str());
+    return false;
+}
+
+// The chattering guard's hold ends at a step end, so that the modes are re-selected on time: t_new_
+// is moved back to it if it lies within the step (and not within `smallest` of its start).
+GIMBAL_HOT_PART bool OneStepIntegrator::cut_at_hold_end(double smallest) {
+    const double hold_end = memory_.chattering.dwell_until;
+    if (!(t_ < hold_end && hold_end < t_new_ && hold_end - t_ > smallest)) return false;
+    t_new_ = hold_end;
+    return true;
+}
+
+// Whether a chattering hold ended at the current point (the modes are then re-selected).
+GIMBAL_HOT_PART bool OneStepIntegrator::hold_ended() const {
+    return memory_.chattering.dwell_until > -1e300 && t_ >= memory_.chattering.dwell_until;
+}
+
+// RODAS4 over [t_, t_new_] with a fresh Jacobian, accepted whatever its error estimate; false (reported)
+// when it cannot be taken.
+GIMBAL_HOT_PART bool OneStepIntegrator::fixed_rosenbrock_step(int substeps) {
+    if (!jacobian_at(t_, y_) || !time_derivative_at_current_point()) {
+        error_sink_("the Jacobian or the right-hand side is not finite at t = " + std::to_string(t_));
+        return false;
+    }
+    if (rosenbrock_step(t_new_ - t_, t_new_) != StepResult::accepted) return refuse_failed_substep(substeps);
+    ++totals_.steps;
+    return true;
+}
+
+// One substep of the real-time method toward grid_end: shorter where a chattering hold ends, or where
+// a mode change is located inside it (a shorter one then finishes it).
+GIMBAL_HOT_PART OneStepIntegrator::Substep OneStepIntegrator::real_time_substep(double grid_end, double end_time, int substeps,
+                                                                std::int64_t& changes_here) {
+    if (hold_ended() && !reselect_after_dwell()) return Substep::failed;
+    const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
+    const double remaining = grid_end - t_;
+    if (remaining <= smallest) return creep_to(grid_end) ? Substep::grid_reached : Substep::failed;
+    t_new_ = grid_end;
+    cut_at_hold_end(smallest);
+    if (!fixed_rosenbrock_step(substeps)) return Substep::failed;
+    bool event_found = false;
+    const std::int64_t events_before = totals_.events;
+    if (!handle_events(event_found)) return Substep::failed;
+    changes_here += totals_.events - events_before;
+    if (settings_.mode_changes_per_step > 0 && changes_here > settings_.mode_changes_per_step) {
+        refuse_mode_change_bound(end_time);
+        return Substep::failed;
+    }
+    if (event_found)
+        return stop_at_mode_change_ && totals_.events > events_before && t_ < end_time ? Substep::stopped
+                                                                                       : Substep::taken;
+    return move_to_step_end() ? Substep::taken : Substep::failed;
+}
+
 bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
     // The grid is fixed by the communication step alone: a mode change located inside a substep ends
     // that step early, and a shorter one finishes it, so the work per communication step is bounded by
@@ -726,60 +798,108 @@ bool OneStepIntegrator::advance_fixed_substeps(double end_time, double* state) {
     const int substeps = std::max(1, settings_.substeps);
     const double grid_step = (end_time - start) / substeps;
     std::int64_t changes_here = 0;
-    for (int k = 1; k <= substeps; ++k) {
+    bool stopped = false;
+    for (int k = 1; k <= substeps && !stopped; ++k) {
         const double grid_end = k == substeps ? end_time : start + k * grid_step;
         while (t_ < grid_end) {
-            if (memory_.chattering.dwell_until > -1e300 && t_ >= memory_.chattering.dwell_until && !reselect_after_dwell())
-                return false;
-            const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
-            const double remaining = grid_end - t_;
-            if (remaining <= smallest) {
-                if (!creep_to(grid_end)) return false;
-                break;
-            }
-            t_new_ = grid_end;
-            if (t_ < memory_.chattering.dwell_until && memory_.chattering.dwell_until < t_new_ &&
-                memory_.chattering.dwell_until - t_ > smallest)
-                t_new_ = memory_.chattering.dwell_until;
-            if (!jacobian_at(t_, y_) || !time_derivative_at_current_point()) {
-                error_sink_("the Jacobian or the right-hand side is not finite at t = " + std::to_string(t_));
-                return false;
-            }
-            if (rosenbrock_step(t_new_ - t_, t_new_) != StepResult::accepted) {
-                std::ostringstream s;
-                s.precision(17);
-                s << "the real-time method's step from t = " << t_ << " to " << t_new_
-                  << " failed (a state or right-hand side not finite, or a singular iteration matrix): "
-                  << "solver.substeps = " << substeps << " is too few for this model";
-                error_sink_(s.str());
-                return false;
-            }
-            ++totals_.steps;
-            bool event_found = false;
-            const std::int64_t events_before = totals_.events;
-            if (!handle_events(event_found)) return false;
-            changes_here += totals_.events - events_before;
-            if (settings_.mode_changes_per_step > 0 && changes_here > settings_.mode_changes_per_step) {
-                std::ostringstream s;
-                s.precision(17);
-                s << "more than " << settings_.mode_changes_per_step << " mode changes in the communication step "
-                  << "ending at t = " << end_time << " (the real-time method's bound: its work per step is "
-                  << "fixed, and switching later is not safe at a stiff contact); raise solver.substeps, or "
-                  << "model the gear without backlash if the scene does not need it";
-                error_sink_(s.str());
-                return false;
-            }
-            if (event_found) {
-                if (stop_at_mode_change_ && totals_.events > events_before && t_ < end_time) {
-                    for (int i = 0; i < size_; ++i) state[i] = y_[i];
-                    return true;
-                }
-                continue;
-            }
-            if (!move_to_step_end()) return false;
+            const Substep outcome = real_time_substep(grid_end, end_time, substeps, changes_here);
+            if (outcome == Substep::failed) return false;
+            stopped = outcome == Substep::stopped;
+            if (stopped || outcome == Substep::grid_reached) break;
         }
     }
     for (int i = 0; i < size_; ++i) state[i] = y_[i];
+    return true;
+}
+
+
+bool OneStepIntegrator::refuse_step_limit(std::int64_t events_here) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "more than solver.max_steps = " << settings_.max_steps << " internal steps (" << events_here
+      << " mode changes) before t = " << t_ << ": the inputs or parameters drive switching faster than "
+      << "the model can follow";
+    error_sink_(s.str());
+    return false;
+}
+
+// The next step toward end_time from the controller's proposal; sets t_new_.
+GIMBAL_HOT_PART OneStepIntegrator::StepPlan OneStepIntegrator::plan_step(double end_time) {
+    StepPlan plan;
+    if (memory_.step_size <= 0.0) memory_.step_size = initial_step(end_time);
+    double h = memory_.step_size;
+    if (settings_.max_step > 0.0) h = std::min(h, settings_.max_step);
+    const double remaining = end_time - t_;
+    // Equal steps to the end of the communication step, each at most 10 % longer than proposed (the
+    // controller's safety factor absorbs that): a proposal just short of a divisor of the
+    // communication step would otherwise cost a whole extra step.
+    const double steps_left = std::max(1.0, std::ceil(remaining / h - kStretch));
+    bool last = false;
+    if (steps_left <= 1.0) {
+        h = remaining, last = true;
+    } else {
+        h = remaining / steps_left;
+    }
+    const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
+    if (remaining <= smallest) {
+        plan.kind = StepPlan::creep;
+        return plan;
+    }
+    if (h <= smallest) {
+        std::ostringstream s;
+        s.precision(17);
+        s << "the step size fell to " << h << " at t = " << t_ << " (a right-hand side that is not finite, or "
+          << "an accuracy the tolerances cannot reach)";
+        error_sink_(s.str());
+        plan.kind = StepPlan::failed;
+        return plan;
+    }
+    t_new_ = last ? end_time : t_ + h;
+    plan.cut_short = cut_at_hold_end(smallest) || last;
+    plan.h = t_new_ - t_;
+    return plan;
+}
+
+// One attempt over h to t_new_ by the method in force (RODAS4 with a current Jacobian while stiff).
+// False when the Jacobian or the time derivative cannot be had.
+GIMBAL_HOT_PART bool OneStepIntegrator::attempt_step(double h, StepResult& result) {
+    if (memory_.stiff && !jacobian_current_) {
+        if (!jacobian_at(t_, y_)) {
+            error_sink_("the Jacobian is not finite");
+            return false;
+        }
+        if (!time_derivative_at_current_point()) {
+            error_sink_("the right-hand side is not finite just after t");
+            return false;
+        }
+        jacobian_current_ = true;  // until the point or the modes change (a rejected step keeps it)
+    }
+    result = memory_.stiff ? rosenbrock_step(h, t_new_) : dormand_prince_step(h, t_new_);
+    return true;
+}
+
+// An accepted step: the controller's next proposal, the mode changes within it, and its end as the
+// current point. `stop`: the integration stops at the mode change found (early return).
+GIMBAL_HOT_PART bool OneStepIntegrator::accept_step(const StepPlan& plan, double end_time, std::int64_t& events_here, bool& stop) {
+    ++totals_.steps;
+    jacobian_current_ = false;
+    // A step cut short to land on end_time or on the end of a hold says nothing against the longer
+    // step proposed before it.
+    memory_.step_size =
+        plan.cut_short ? std::max(proposal_, std::min(memory_.step_size, proposal_ * kMaxGrowth)) : proposal_;
+    bool event_found = false;
+    const std::int64_t events_before = totals_.events;
+    if (!handle_events(event_found)) return false;
+    events_here += totals_.events - events_before;
+    if (event_found) {
+        stop = stop_at_mode_change_ && totals_.events > events_before && t_ < end_time;
+        return true;
+    }
+    if (!move_to_step_end()) return false;
+    // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
+    // input jump it takes a few short steps, at which any method would be stable.
+    if (memory_.stiff) vote_on_stiffness_rosenbrock(plan.h);
+    else vote_on_stiffness_explicit(plan.h, true);
     return true;
 }
 
@@ -787,91 +907,24 @@ bool OneStepIntegrator::advance_steps(double end_time, double* state) {
     long attempts = 0;
     std::int64_t events_here = 0;
     while (t_ < end_time) {
-        if (memory_.chattering.dwell_until > -1e300 && t_ >= memory_.chattering.dwell_until && !reselect_after_dwell()) return false;
-        if (++attempts > settings_.max_steps) {
-            std::ostringstream s;
-            s.precision(17);
-            s << "more than solver.max_steps = " << settings_.max_steps << " internal steps (" << events_here
-              << " mode changes) before t = " << t_ << ": the inputs or parameters drive switching faster than "
-              << "the model can follow";
-            error_sink_(s.str());
-            return false;
-        }
-        if (memory_.step_size <= 0.0) memory_.step_size = initial_step(end_time);
-        double h = memory_.step_size;
-        if (settings_.max_step > 0.0) h = std::min(h, settings_.max_step);
-        const double remaining = end_time - t_;
-        // Equal steps to the end of the communication step, each at most 10 % longer than proposed (the
-        // controller's safety factor absorbs that): a proposal just short of a divisor of the
-        // communication step would otherwise cost a whole extra step.
-        const double steps_left = std::max(1.0, std::ceil(remaining / h - kStretch));
-        bool last = false;
-        if (steps_left <= 1.0) {
-            h = remaining, last = true;
-        } else {
-            h = remaining / steps_left;
-        }
-        const double smallest = 16.0 * kEpsilon * std::max(1.0, std::fabs(t_));
-        if (remaining <= smallest) {
+        if (hold_ended() && !reselect_after_dwell()) return false;
+        if (++attempts > settings_.max_steps) return refuse_step_limit(events_here);
+        const StepPlan plan = plan_step(end_time);
+        if (plan.kind == StepPlan::failed) return false;
+        if (plan.kind == StepPlan::creep) {
             if (!creep_to(end_time)) return false;
             break;
         }
-        if (h <= smallest) {
-            std::ostringstream s;
-            s.precision(17);
-            s << "the step size fell to " << h << " at t = " << t_ << " (a right-hand side that is not finite, or "
-              << "an accuracy the tolerances cannot reach)";
-            error_sink_(s.str());
-            return false;
-        }
-        t_new_ = last ? end_time : t_ + h;
-        // The chattering guard's hold ends at a step end, so that the modes are re-selected on time.
-        bool cut_short = last;
-        if (t_ < memory_.chattering.dwell_until && memory_.chattering.dwell_until < t_new_ && memory_.chattering.dwell_until - t_ > smallest)
-            t_new_ = memory_.chattering.dwell_until, last = false, cut_short = true;
-        h = t_new_ - t_;
-
         StepResult result;
-        if (memory_.stiff && !jacobian_current_) {
-            if (!jacobian_at(t_, y_)) {
-                error_sink_("the Jacobian is not finite");
-                return false;
-            }
-            if (!time_derivative_at_current_point()) {
-                error_sink_("the right-hand side is not finite just after t");
-                return false;
-            }
-            jacobian_current_ = true;  // until the point or the modes change (a rejected step keeps it)
-        }
-        if (memory_.stiff) {
-            result = rosenbrock_step(h, t_new_);
-        } else {
-            result = dormand_prince_step(h, t_new_);
-        }
+        if (!attempt_step(plan.h, result)) return false;
         if (result == StepResult::rejected) {
             ++totals_.rejected_steps;
-            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit(h, false);
+            if (!memory_.stiff && std::isfinite(stiffness_estimate_)) vote_on_stiffness_explicit(plan.h, false);
             continue;
         }
-        ++totals_.steps;
-        jacobian_current_ = false;
-        // A step cut short to land on end_time or on the end of a hold says nothing against the longer
-        // step proposed before it.
-        memory_.step_size =
-            cut_short ? std::max(proposal_, std::min(memory_.step_size, proposal_ * kMaxGrowth)) : proposal_;
-        bool event_found = false;
-        const std::int64_t events_before = totals_.events;
-        if (!handle_events(event_found)) return false;
-        events_here += totals_.events - events_before;
-        if (event_found) {
-            if (stop_at_mode_change_ && totals_.events > events_before && t_ < end_time) break;
-            continue;
-        }
-        if (!move_to_step_end()) return false;
-        // Judged at the step the Rosenbrock method proposes next, not the one just taken: right after an
-        // input jump it takes a few short steps, at which any method would be stable.
-        if (memory_.stiff) vote_on_stiffness_rosenbrock(h);
-        else vote_on_stiffness_explicit(h, true);
+        bool stop = false;
+        if (!accept_step(plan, end_time, events_here, stop)) return false;
+        if (stop) break;
     }
     for (int k = 0; k < size_; ++k) state[k] = y_[k];
     return true;

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "gimbal/hybrid_system/event_handling.hpp"
+#include "gimbal/hot_path.hpp"
 #include "gimbal/integrators/integrator.hpp"
 #include "iteration_matrix.hpp"
 
@@ -46,6 +47,25 @@ private:
     enum class StepResult { accepted, rejected, failed };
 
     bool advance_steps(double end_time, double* state);
+    // The parts of an adaptive step (advance_steps): its size, the attempt, what follows acceptance
+    // (inline: defined with GIMBAL_HOT_PART in one_step_integrator.cpp, the only place they are called).
+    struct StepPlan {
+        enum Kind { step, creep, failed } kind = step;  // creep: a few ulp left; failed: reported
+        double h = 0.0;
+        bool cut_short = false;  // shorter than proposed (the end of the communication step or of a hold)
+    };
+    inline StepPlan plan_step(double end_time);
+    inline bool attempt_step(double h, StepResult& result);
+    inline bool accept_step(const StepPlan& plan, double end_time, std::int64_t& events_here, bool& stop);
+    inline bool hold_ended() const;
+    inline bool cut_at_hold_end(double smallest);
+    inline bool fixed_rosenbrock_step(int substeps);
+    bool refuse_step_limit(std::int64_t events_here);
+    // The real-time method's substep (advance_fixed_substeps) and refusals.
+    enum class Substep { taken, grid_reached, stopped, failed };
+    inline Substep real_time_substep(double grid_end, double end_time, int substeps, std::int64_t& changes_here);
+    bool refuse_failed_substep(int substeps);
+    bool refuse_mode_change_bound(double end_time);
     // The real-time method: RODAS4 over a fixed grid of equal substeps, every step accepted.
     bool advance_fixed_substeps(double end_time, double* state);
     bool real_time() const { return settings_.method == IntegrationMethod::real_time; }

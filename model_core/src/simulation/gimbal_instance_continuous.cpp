@@ -16,6 +16,7 @@
 
 #include "gimbal/hybrid_system/event_handling.hpp"
 #include "gimbal/simulation/gimbal_instance.hpp"
+#include "gimbal/simulation/instance_outputs.hpp"
 
 namespace gimbal {
 namespace {
@@ -29,43 +30,6 @@ bool crossed(double before, double after) {
 constexpr double kDepartureLookahead = 1e-12;
 
 }  // namespace
-
-void GimbalInstance::full_state_vector(const Dynamics& d, double* states) const {
-    const StateLayout& layout = params_.layout;
-    for (int body = 0; body < 4; ++body) {
-        states[body] = d.full.angle[body];
-        states[kRates + body] = d.full.rate[body];
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-        states[kCurrents + axis] = d.full.current[axis];
-        states[kBacklash + axis] = d.full.backlash[axis];
-    }
-    for (int k = 0; k < kEnergyFlowCount; ++k)
-        states[kStateSize + k] = layout.energy_slot >= 0 ? state_[layout.energy_slot + k] : 0.0;
-}
-
-void GimbalInstance::full_state_derivative(const Dynamics& d, const double* derivative, double* out) const {
-    const StateLayout& layout = params_.layout;
-    for (int body = 0; body < 4; ++body) {
-        out[body] = d.full.rate[body];
-        out[kRates + body] = d.full_acceleration[body];
-    }
-    for (int axis = 0; axis < 2; ++axis) {
-        const int slot = layout.current_slot[axis];
-        if (slot >= 0) {
-            out[kCurrents + axis] = derivative[slot];
-        } else if (system_->modes().motor_limited[axis] != 0) {
-            out[kCurrents + axis] = 0.0;
-        } else {
-            // A quasi-static motor's current (u - k_e w) / R moves with its rotor's speed (u is held).
-            const MotorParameters& motor = params_.motor[axis];
-            out[kCurrents + axis] = -motor.back_emf_constant * d.full_acceleration[rotor_index(axis)] / motor.resistance;
-        }
-        out[kBacklash + axis] = layout.backlash_slot[axis] >= 0 ? derivative[layout.backlash_slot[axis]] : 0.0;
-    }
-    for (int k = 0; k < kEnergyFlowCount; ++k)
-        out[kStateSize + k] = layout.energy_slot >= 0 ? derivative[layout.energy_slot + k] : 0.0;
-}
 
 void GimbalInstance::map_integrated_states() {
     const StateLayout& layout = params_.layout;
@@ -134,7 +98,7 @@ GimbalStatus GimbalInstance::set_continuous_states(const double* states) {
 
 void GimbalInstance::get_continuous_states(double* states) {
     refresh_held_inputs();
-    full_state_vector(system_->dynamics_at(clock_, state_), states);
+    full_state_vector(params_, system_->dynamics_at(clock_, state_), state_, states);
 }
 
 void GimbalInstance::get_nominal_states(double* nominals) const {
@@ -167,7 +131,7 @@ GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
           << ": the states or inputs set lie beyond what the model can represent";
         return refuse(GIMBAL_ERROR, s.str());
     }
-    full_state_derivative(dynamics, integrated, derivatives);
+    full_state_derivative(params_, system_->modes(), dynamics, integrated, derivatives);
     return GIMBAL_OK;
 }
 
@@ -201,6 +165,30 @@ GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
     return GIMBAL_OK;
 }
 
+// The guards left exactly on zero, settled as the integrators settle them after a located event;
+// what they settle to is where the next crossing is measured from. Returns the mode changes made.
+int GimbalInstance::settle_guards(double now, int n, const int* directions, const HybridIntegrator::MessageSink& sink) {
+    double derivative[kMaxStateSize];
+    double raw[kIndicatorCount];
+    int settled_changes = 0;
+    const double lookahead = kDepartureLookahead * std::max(1.0, std::fabs(now));
+    const bool evaluated = guard_settling_.settle(
+        now, state_, params_.layout.size, n, lookahead, directions, derivative, reference_guards_, settled_changes,
+        [this](double t, const double* x, double* dx) { return system_->derivative(t, x, dx); },
+        [this, n, &raw](double t, const double* x, double* g) {
+            system_->event_functions(t, x, g);
+            if (g == reference_guards_) std::copy(g, g + n, raw);
+            return true;
+        },
+        [this, now, &sink](const int* settle_directions) {
+            return switch_modes(*system_, now, state_, settle_directions, event_settings_, sink, time_);
+        });
+    for (int k = 0; k < n; ++k)
+        decided_side_[k] = static_cast<std::int8_t>(evaluated && raw[k] == 0.0 ? (reference_guards_[k] > 0.0) - (reference_guards_[k] < 0.0) : 0);
+    // A failed evaluation (non-finite derivatives) is reported by the next fmi2GetDerivatives.
+    return settled_changes;
+}
+
 GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     update = DiscreteUpdate{};
     refresh_held_inputs();
@@ -230,28 +218,7 @@ GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     std::copy(state_, state_ + kMaxStateSize, before);
     const HybridIntegrator::MessageSink sink = [this](const std::string& message) { log_event(message); };
     int changes = switch_modes(*system_, now, state_, directions, event_settings_, sink, time_);
-
-    // The guards left exactly on zero, settled as the integrators settle them after a located event;
-    // what they settle to is where the next crossing is measured from.
-    double derivative[kMaxStateSize];
-    double raw[kIndicatorCount];
-    int settled_changes = 0;
-    const double lookahead = kDepartureLookahead * std::max(1.0, std::fabs(now));
-    const bool evaluated = guard_settling_.settle(
-        now, state_, params_.layout.size, n, lookahead, directions, derivative, reference_guards_, settled_changes,
-        [this](double t, const double* x, double* dx) { return system_->derivative(t, x, dx); },
-        [this, n, &raw](double t, const double* x, double* g) {
-            system_->event_functions(t, x, g);
-            if (g == reference_guards_) std::copy(g, g + n, raw);
-            return true;
-        },
-        [this, now, &sink](const int* settle_directions) {
-            return switch_modes(*system_, now, state_, settle_directions, event_settings_, sink, time_);
-        });
-    changes += settled_changes;
-    for (int k = 0; k < n; ++k)
-        decided_side_[k] = static_cast<std::int8_t>(evaluated && raw[k] == 0.0 ? (reference_guards_[k] > 0.0) - (reference_guards_[k] < 0.0) : 0);
-    // A failed evaluation (non-finite derivatives) is reported by the next fmi2GetDerivatives.
+    changes += settle_guards(now, n, directions, sink);
 
     if (changes > 0 && record_mode_change(chattering_, event_settings_, now, 0.0, sink, epoch_)) ++zeno_holds_;
     update.mode_changes = changes;
@@ -263,13 +230,10 @@ GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     return GIMBAL_OK;
 }
 
-GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, std::size_t unknown_count,
-                                                    const unsigned* knowns, std::size_t known_count, const double* seed,
-                                                    double* result) {
-    // What each known and unknown is: a state (its index among the 17) or an input; a derivative (its
-    // index) or an output.
-    double state_seed[kStateCount] = {};
-    std::vector<std::pair<unsigned, double>> input_seed;
+// The knowns of a directional derivative: a state's seed goes to its index among the 17, an input's
+// to the list of inputs moved (refused: anything else).
+GimbalStatus GimbalInstance::seed_knowns(const unsigned* knowns, std::size_t known_count, const double* seed,
+                                         double* state_seed, std::vector<std::pair<unsigned, double>>& input_seed) const {
     for (std::size_t j = 0; j < known_count; ++j) {
         const unsigned vr = knowns[j];
         const auto state = std::find(kContinuousStates, kContinuousStates + kStateCount, vr);
@@ -283,10 +247,14 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
                                             " is neither a continuous state nor an input");
         }
     }
-    // The row of the analytic Jacobian that answers each unknown, or -1: the derivatives of the states
-    // this fidelity integrates, but for the energy accumulators (their rows are not in the Jacobian).
-    std::vector<int> jacobian_row(unknown_count, -1);
-    bool all_rows_analytic = true;
+    return GIMBAL_OK;
+}
+
+// The row of the analytic Jacobian that answers each unknown, or -1: the derivatives of the states
+// this fidelity integrates, but for the energy accumulators (their rows are not in the Jacobian).
+GimbalStatus GimbalInstance::jacobian_rows(const unsigned* unknowns, std::size_t unknown_count,
+                                           std::vector<int>& jacobian_row, bool& all_rows_analytic) const {
+    all_rows_analytic = true;
     for (std::size_t i = 0; i < unknown_count; ++i) {
         const unsigned vr = unknowns[i];
         const auto derivative = std::find(kStateDerivatives, kStateDerivatives + kStateCount, vr);
@@ -302,11 +270,13 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
         }
         all_rows_analytic &= jacobian_row[i] >= 0;
     }
-    std::fill(result, result + unknown_count, 0.0);
-    refresh_held_inputs();
+    return GIMBAL_OK;
+}
 
-    // The state part of the derivatives' rows from the Jacobian the implicit integrators use (analytic
-    // where the model is stiff); everything else by a central difference within the modes in force.
+// The state part of the derivatives' rows from the Jacobian the implicit integrators use (analytic
+// where the model is stiff), into result; `used` says whether there was any.
+GimbalStatus GimbalInstance::jacobian_part(const std::vector<int>& jacobian_row, const double* state_seed,
+                                           double* result, bool& used) {
     const int n = params_.layout.size;
     double jacobian[kMaxStateSize * kMaxStateSize];
     double slot_seed[kMaxStateSize] = {};
@@ -315,26 +285,48 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
         slot_seed[integrated_slot_[k]] = state_seed[integrated_state_[k]];
         any_state_seed |= state_seed[integrated_state_[k]] != 0.0;
     }
-    const bool use_jacobian = any_state_seed && std::any_of(jacobian_row.begin(), jacobian_row.end(), [](int r) { return r >= 0; });
-    if (use_jacobian) {
-        system_->jacobian(clock_, state_, jacobian);
-        for (std::size_t i = 0; i < unknown_count; ++i) {
-            if (jacobian_row[i] < 0) continue;
-            double sum = 0.0;
-            for (int column = 0; column < n; ++column) sum += jacobian[jacobian_row[i] + column * n] * slot_seed[column];
-            if (!std::isfinite(sum)) {
-                std::ostringstream s;
-                s.precision(17);
-                s << "the Jacobian is not finite at t = " << time_
-                  << ": the states or inputs set lie beyond what the model can represent";
-                return refuse(GIMBAL_ERROR, s.str());
-            }
-            result[i] = sum;
+    used = any_state_seed && std::any_of(jacobian_row.begin(), jacobian_row.end(), [](int r) { return r >= 0; });
+    if (!used) return GIMBAL_OK;
+    system_->jacobian(clock_, state_, jacobian);
+    for (std::size_t i = 0; i < jacobian_row.size(); ++i) {
+        if (jacobian_row[i] < 0) continue;
+        double sum = 0.0;
+        for (int column = 0; column < n; ++column) sum += jacobian[jacobian_row[i] + column * n] * slot_seed[column];
+        if (!std::isfinite(sum)) {
+            std::ostringstream s;
+            s.precision(17);
+            s << "the Jacobian is not finite at t = " << time_
+              << ": the states or inputs set lie beyond what the model can represent";
+            return refuse(GIMBAL_ERROR, s.str());
         }
+        result[i] = sum;
     }
+    return GIMBAL_OK;
+}
+
+GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, std::size_t unknown_count,
+                                                    const unsigned* knowns, std::size_t known_count, const double* seed,
+                                                    double* result) {
+    // What each known and unknown is: a state (its index among the 17) or an input; a derivative (its
+    // index) or an output.
+    double state_seed[kStateCount] = {};
+    std::vector<std::pair<unsigned, double>> input_seed;
+    GimbalStatus status = seed_knowns(knowns, known_count, seed, state_seed, input_seed);
+    if (status != GIMBAL_OK) return status;
+    std::vector<int> jacobian_row(unknown_count, -1);
+    bool all_rows_analytic = true;
+    status = jacobian_rows(unknowns, unknown_count, jacobian_row, all_rows_analytic);
+    if (status != GIMBAL_OK) return status;
+    std::fill(result, result + unknown_count, 0.0);
+    refresh_held_inputs();
+
+    // The state part of the derivatives' rows from the Jacobian; everything else by a central
+    // difference within the modes in force.
+    bool use_jacobian = false;
+    status = jacobian_part(jacobian_row, state_seed, result, use_jacobian);
+    if (status != GIMBAL_OK) return status;
     // The rest: the input part of the analytic rows, and the whole of the other unknowns.
     std::vector<double> difference[2] = {std::vector<double>(unknown_count), std::vector<double>(unknown_count)};
-    GimbalStatus status = GIMBAL_OK;
     if (!all_rows_analytic || !use_jacobian) {
         status = central_difference(unknowns, unknown_count, state_seed, input_seed, difference[0].data());
         if (status != GIMBAL_OK) return status;
@@ -351,14 +343,10 @@ GimbalStatus GimbalInstance::directional_derivative(const unsigned* unknowns, st
     return GIMBAL_OK;
 }
 
-GimbalStatus GimbalInstance::central_difference(const unsigned* unknowns, std::size_t unknown_count,
-                                                const double* state_seed,
-                                                const std::vector<std::pair<unsigned, double>>& input_seed,
-                                                double* result) {
-    std::fill(result, result + unknown_count, 0.0);
-    // Two evaluations whatever the number of knowns and unknowns. The step is the cube root of the
-    // rounding error relative to the values moved, the balance of truncation and rounding of a central
-    // difference.
+// The step of a central difference: the cube root of the rounding error relative to the values
+// moved, the balance of truncation and rounding. False when nothing is moved.
+bool GimbalInstance::difference_step(const double* state_seed,
+                                     const std::vector<std::pair<unsigned, double>>& input_seed, double& step) {
     double states[kStateCount];
     get_continuous_states(states);
     double size = 0.0, scale = 1.0;
@@ -366,8 +354,19 @@ GimbalStatus GimbalInstance::central_difference(const unsigned* unknowns, std::s
         if (state_seed[k] != 0.0) size = std::max(size, std::fabs(state_seed[k])), scale = std::max(scale, std::fabs(states[k]));
     for (const auto& [vr, value] : input_seed)
         if (value != 0.0) size = std::max(size, std::fabs(value)), scale = std::max(scale, std::fabs(reals_[vr]));
-    if (size == 0.0) return GIMBAL_OK;
-    const double step = 6e-6 * scale / size;
+    if (size == 0.0) return false;
+    step = 6e-6 * scale / size;
+    return true;
+}
+
+GimbalStatus GimbalInstance::central_difference(const unsigned* unknowns, std::size_t unknown_count,
+                                                const double* state_seed,
+                                                const std::vector<std::pair<unsigned, double>>& input_seed,
+                                                double* result) {
+    std::fill(result, result + unknown_count, 0.0);
+    // Two evaluations whatever the number of knowns and unknowns.
+    double step = 0.0;
+    if (!difference_step(state_seed, input_seed, step)) return GIMBAL_OK;
 
     double saved_state[kMaxStateSize];
     std::copy(state_, state_ + kMaxStateSize, saved_state);
@@ -410,7 +409,7 @@ GimbalStatus GimbalInstance::publish_continuous_time_outputs() {
     std::copy(reals_, reals_ + kRealVariableCount, reals);
     std::copy(integers_, integers_ + kIntegerVariableCount, integers);
     publish_outputs();
-    clamp_published_to_bounds();
+    clamp_published_to_bounds(params_, reals_);
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
         if (std::isfinite(reals_[vr])) continue;
         std::ostringstream s;
@@ -423,17 +422,6 @@ GimbalStatus GimbalInstance::publish_continuous_time_outputs() {
     }
     outputs_stale_ = false;
     return GIMBAL_OK;
-}
-
-void GimbalInstance::clamp_published_to_bounds() {
-    // Between a host's step that overshoots a stop or a limit and the event update that projects the
-    // state back, the outputs already show the physical values.
-    const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
-    for (int axis = 0; axis < 2; ++axis) {
-        const double limit = params_.motor[axis].current_limit, eta = params_.gear[axis].half_backlash;
-        reals_[currents[axis]] = std::clamp(reals_[currents[axis]], -limit, limit);
-        reals_[backlash[axis]] = std::clamp(reals_[backlash[axis]], -eta, eta);
-    }
 }
 
 }  // namespace gimbal

@@ -13,12 +13,16 @@
 #include "gimbal/gimbal_c_api.h"
 #include "gimbal/hybrid_system/event_handling.hpp"
 #include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
+#include "gimbal/simulation/instance_outputs.hpp"
 #include "gimbal/integrators/integrator.hpp"
 #include "gimbal/simulation/linearization.hpp"
+#include "gimbal/simulation/step_checks.hpp"
 #include "gimbal/model/variable_groups.hpp"
 #include "gimbal/model/variables.hpp"
 
 namespace gimbal {
+
+struct SnapshotContent;  // gimbal/simulation/snapshot.hpp
 
 class GimbalInstance {
 public:
@@ -60,8 +64,8 @@ public:
     // arc, a voltage ramp), so that the next step continues the same problem.
     GimbalStatus do_step_until_mode_change(double current_time, double step_size, double& reached);
     // Work of one fmi2DoStep, in right-hand-side evaluations, beyond which the step is reported
-    // (about 25 ms of CPU at the measured 230 ns per evaluation: 5,000 times the default scene's).
-    static constexpr long kStepWorkBudget = 100000;
+    // (simulation/step_checks.hpp).
+    static constexpr long kStepWorkBudget = gimbal::kStepWorkBudget;
     double time() const { return time_; }
     bool initialized() const { return system_ != nullptr && integrator_ != nullptr; }
     // The continuous model linearized at the current time and state, with the inputs as last set.
@@ -99,11 +103,16 @@ public:
                                         std::size_t known_count, const double* seed, double* result);
 
 private:
+    // The snapshot (gimbal/simulation/snapshot.hpp walks its table of fields): what only an initialized instance
+    // saves, a snapshot decoded and checked, and the run it describes rebuilt aside.
+    void save_run(SnapshotContent& snap);
+    GimbalStatus read_snapshot(const void* buffer, SnapshotContent& snap) const;
+    GimbalStatus rebuild_run(const SnapshotContent& snap, std::unique_ptr<GimbalHybridSystem>& system,
+                             std::unique_ptr<HybridIntegrator>& integrator);
     StepInputs read_step_inputs(double step_start) const;
     bool build_parameters(ModelParameters& params, std::string& error) const;
     void load_start_state();
     GimbalStatus check_fixed_base() const;
-    GimbalStatus check_real_time_resolution(double step_size);
     std::unique_ptr<HybridIntegrator> make_integrator(GimbalHybridSystem& system, const ModelParameters& params);
     void create_integrator();
     // What a failed or interrupted step returns to.
@@ -119,27 +128,44 @@ private:
         double clock;
     };
     GimbalStatus integrate_step(double current_time, double step_size, StepStart& start, double* early = nullptr);
+    // The parts of a step: its checks, its inputs, its end, its outputs' check (inline, defined in
+    // simulation/instance_step.cpp, the only place they are called).
+    inline GimbalStatus check_step(double step_size);
+    GimbalStatus check_real_time_resolution(double step_size);
+    inline GimbalStatus take_step_inputs(double step_start, bool& resting);
+    inline void end_step_at(double step_end, double reached_model_time, bool ended_early);
+    inline GimbalStatus check_published_outputs(double current_time, const StepStart& start);
     GimbalStatus advance_step(double current_time, double step_size, double* early, double& reached);
     void roll_back(const StepStart& start);
     GimbalStatus report_step_work(double step_size, const IntegratorStatistics& before, const EventCounters& events_before);
     void apply_master_tolerance();
     // Before initialization ends, calculated outputs follow from the start values on request.
     GimbalStatus preview_outputs(const char* name);
-    void publish_outputs();
+    void publish_outputs() {
+        gimbal::publish_outputs(OutputPoint{params_, *system_, *integrator_, state_, clock_, epoch_, zeno_holds_},
+                                reals_, integers_);
+    }
     GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
-    // Continuous-time interface: the 17 states and their derivatives from the integrated ones (a state a
-    // reduced fidelity does not integrate is computed from the others).
-    void full_state_vector(const Dynamics& dynamics, double* states) const;
-    void full_state_derivative(const Dynamics& dynamics, const double* derivative, double* out) const;
     // Which of the 17 states this fidelity integrates, and where (set with the parameters).
     void map_integrated_states();
     // Pushes inputs set since the last evaluation into the hybrid system.
     void refresh_held_inputs();
     void log_event(const std::string& message) const { logger_(GIMBAL_OK, "logEvents", message); }
-    void clamp_published_to_bounds();
     // The outputs at the point the host set; refused (and the last good ones kept) where the states or
     // inputs set make one of them non-finite.
     GimbalStatus publish_continuous_time_outputs();
+    // update_discrete_states' settling of the guards left exactly on zero; the mode changes it made.
+    int settle_guards(double now, int n, const int* directions, const HybridIntegrator::MessageSink& sink);
+    // The parts of directional_derivative: the knowns' seeds, the unknowns' Jacobian rows, the part the
+    // Jacobian answers.
+    GimbalStatus seed_knowns(const unsigned* knowns, std::size_t known_count, const double* seed, double* state_seed,
+                             std::vector<std::pair<unsigned, double>>& input_seed) const;
+    GimbalStatus jacobian_rows(const unsigned* unknowns, std::size_t unknown_count, std::vector<int>& jacobian_row,
+                               bool& all_rows_analytic) const;
+    GimbalStatus jacobian_part(const std::vector<int>& jacobian_row, const double* state_seed, double* result,
+                               bool& used);
+    bool difference_step(const double* state_seed, const std::vector<std::pair<unsigned, double>>& input_seed,
+                         double& step);
     // d(unknowns)/d(states, inputs) . seed by one central difference (two evaluations), the point restored.
     GimbalStatus central_difference(const unsigned* unknowns, std::size_t unknown_count, const double* state_seed,
                                     const std::vector<std::pair<unsigned, double>>& input_seed, double* result);
@@ -169,7 +195,7 @@ private:
     bool master_tolerance_defined_ = false;
     double master_tolerance_ = 0.0;
     bool rtol_set_ = false;            // solver.rtol set by the user: the master's tolerance does not apply
-    std::int64_t steps_over_budget_ = 0;
+    StepWorkMonitor step_work_;
 
     // Continuous-time interface state (saved with an FMU state).
     bool continuous_time_ = false;
