@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "gimbal/gimbal_hybrid_system.hpp"
-#include "gimbal/parameter_validation.hpp"
+#include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
+#include "gimbal/simulation/parameter_validation.hpp"
 
 using namespace gimbal;
 

@@ -26,9 +26,9 @@
 #include <vector>
 
 #include "fmi2Functions.h"
-#include "gimbal/gimbal_hybrid_system.hpp"
-#include "gimbal/parameter_validation.hpp"
-#include "gimbal/variable_groups.hpp"
+#include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
+#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/model/variable_groups.hpp"
 
 using namespace gimbal;
 

@@ -473,36 +473,28 @@ static unsigned char* own_state(Instance* instance, Function function, const voi
     return (unsigned char*)state;
 }
 
-static int is_single_state(int32_t state) {
-    return (state & FMU_STATE_STATES) != 0 && (state & (state - 1)) == 0;
-}
+static const char* state_name_of(int32_t state) { return state_name((InstanceState)state); }
+
+static const FmuStateRules kStateRules = {
+    FMU_STATE_STATES, RUNNING_STATES | STATE_TERMINATED, fmi2Pending, 1, 0, 0, state_name_of,
+};
 
 /* The wrapper's fields of a record, range-checked, and the core's snapshot checked by the core; a
  * record that could not have been saved by this FMU is refused with the reason. */
 static int valid_state_content(Instance* instance, Function function, const unsigned char* record) {
     StateHeader header;
     memcpy(&header, record, sizeof header);
-    const char* problem = NULL;
-    if (!is_single_state(header.state)) problem = "its instance state is not one an FMU state can be taken in";
-    else if (header.stop_time_defined != 0 && header.stop_time_defined != 1) problem = "its stop-time flag is not a boolean";
-    else if (header.last_step_status < fmi2OK || header.last_step_status > fmi2Pending) problem = "its last step status is not an fmi2Status";
-    else if (!isfinite(header.time) || !isfinite(header.stop_time) || !isfinite(header.last_successful_time))
-        problem = "its times are not finite";
-    else if (header.stop_time_defined && header.time > header.stop_time) problem = "its time lies beyond its stop time";
+    char text[160];
+    const char* problem = fmu_state_header_problem(&header, &kStateRules, instance->type == fmi2ModelExchange);
+    if (problem == NULL) {
+        int initialized = 0;
+        if (from_core(gimbal_core_check_snapshot(instance->core, record + sizeof header, &initialized)) > fmi2Warning)
+            return 0;
+        problem = fmu_state_model_problem(&header, &kStateRules, initialized, text, sizeof text);
+    }
     if (problem != NULL) {
         log_message(instance, fmi2Error, "logStatusError", "%s: the FMU state is refused: %s", kFunctions[function].name,
                     problem);
-        return 0;
-    }
-    int initialized = 0;
-    if (from_core(gimbal_core_check_snapshot(instance->core, record + sizeof header,
-                                             &initialized)) > fmi2Warning)
-        return 0;
-    const int running = (header.state & (RUNNING_STATES | STATE_TERMINATED)) != 0;
-    if (running != initialized) {
-        log_message(instance, fmi2Error, "logStatusError",
-                    "%s: the FMU state is refused: its instance state '%s' contradicts its %s model", kFunctions[function].name,
-                    state_name((InstanceState)header.state), initialized ? "initialized" : "uninitialized");
         return 0;
     }
     return 1;
@@ -525,11 +517,7 @@ static fmi2Status impl_GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
         }
     }
     StateHeader header;
-    memset(&header, 0, sizeof header);
-    header.magic = STATE_MAGIC;
-    header.format_version = STATE_FORMAT_VERSION;
-    header.size = state_record_size();
-    strncpy(header.guid, GIMBAL_GUID, sizeof header.guid - 1);
+    fmu_state_header_init(&header, STATE_MAGIC, state_record_size(), GIMBAL_GUID);
     header.state = (int32_t)instance->state;
     header.time = instance->time;
     header.stop_time = instance->stop_time;
@@ -613,9 +601,7 @@ static fmi2Status impl_SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate,
                     size, state_record_size());
         return fmi2Error;
     }
-    memcpy(serializedState, record, state_record_size());
-    const uint64_t checksum = fmu_state_checksum((const unsigned char*)serializedState, state_record_size());
-    memcpy(serializedState + offsetof(StateHeader, checksum), &checksum, sizeof checksum);
+    fmu_state_serialize(record, state_record_size(), (unsigned char*)serializedState);
     return fmi2OK;
 }
 

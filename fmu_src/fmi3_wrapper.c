@@ -442,25 +442,25 @@ static unsigned char* own_state(Instance3* i, const char* f, const void* state) 
     return (unsigned char*)state;
 }
 
+static const char* state_name_of(int32_t state) { return state_name((State3)state); }
+
+/* FMI 3.0's header records no step status; the interface an instance serves shows in its state. */
+static const FmuStateRules kStateRules = {
+    S_FMU_STATE, S_RUNNING | S_TERMINATED, -1, 0, S_CONTINUOUS_TIME, S_STEP | S_STEP_DISCARDED, state_name_of,
+};
+
 static int valid_record(Instance3* i, const char* f, const unsigned char* record) {
     StateHeader header;
     memcpy(&header, record, sizeof header);
-    const int single = (header.state & S_FMU_STATE) != 0 && (header.state & (header.state - 1)) == 0;
-    const char* problem = NULL;
-    if (!single) problem = "its instance state is not one an FMU state can be taken in";
-    else if (header.stop_time_defined != 0 && header.stop_time_defined != 1) problem = "its stop-time flag is not a boolean";
-    else if (!isfinite(header.time) || !isfinite(header.stop_time)) problem = "its times are not finite";
-    else if ((header.state & S_CONTINUOUS_TIME) && !i->model_exchange) problem = "it was saved by a Model Exchange instance";
-    else if ((header.state & (S_STEP | S_STEP_DISCARDED)) && i->model_exchange) problem = "it was saved by a Co-Simulation instance";
+    char text[160];
+    const char* problem = fmu_state_header_problem(&header, &kStateRules, i->model_exchange);
+    if (problem == NULL) {
+        int initialized = 0;
+        if (from_core(gimbal_core_check_snapshot(i->core, record + sizeof header, &initialized)) > fmi3Warning) return 0;
+        problem = fmu_state_model_problem(&header, &kStateRules, initialized, text, sizeof text);
+    }
     if (problem != NULL) {
         say(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: %s", f, problem);
-        return 0;
-    }
-    int initialized = 0;
-    if (from_core(gimbal_core_check_snapshot(i->core, record + sizeof header, &initialized)) > fmi3Warning) return 0;
-    if (((header.state & (S_RUNNING | S_TERMINATED)) != 0) != (initialized != 0)) {
-        say(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: its instance state '%s' contradicts its %s model", f,
-            state_name((State3)header.state), initialized ? "initialized" : "uninitialized");
         return 0;
     }
     return 1;
@@ -480,11 +480,7 @@ static fmi3Status get_fmu_state(Instance3* i, fmi3FMUState* out) {
         }
     }
     StateHeader header;
-    memset(&header, 0, sizeof header);
-    header.magic = STATE_MAGIC_FMI3;
-    header.format_version = STATE_FORMAT_VERSION;
-    header.size = record_size();
-    strncpy(header.guid, GIMBAL_GUID, sizeof header.guid - 1);
+    fmu_state_header_init(&header, STATE_MAGIC_FMI3, record_size(), GIMBAL_GUID);
     header.state = (int32_t)i->state;
     header.time = i->time;
     header.stop_time = i->stop_time;
@@ -545,9 +541,7 @@ static fmi3Status serialize(Instance3* i, fmi3FMUState state, fmi3Byte bytes[], 
         say(i, fmi3Error, "logStatusError", "%s: size %zu is below the %zu bytes needed", f, size, record_size());
         return fmi3Error;
     }
-    memcpy(bytes, record, record_size());
-    const uint64_t checksum = fmu_state_checksum(bytes, record_size());
-    memcpy(bytes + offsetof(StateHeader, checksum), &checksum, sizeof checksum);
+    fmu_state_serialize(record, record_size(), bytes);
     return fmi3OK;
 }
 

@@ -2,8 +2,8 @@
 # modelDescription.xml's <SourceFiles> and every header they include, found by the compiler itself
 # (-M) rather than by a list that could go stale. Each file lands at its path relative to the include
 # root it was found under, so the one include path a builder gives, sources/ itself, finds them all:
-#   model_core/src/*, fmu_src/*, the generated gimbal_guid.h  -> sources/
-#   model_core/include/gimbal/*                               -> sources/gimbal/
+#   model_core/src/<layer>/*, fmu_src/*, gimbal_guid.h (generated) -> sources/<layer>/, sources/
+#   model_core/include/gimbal/[<layer>/]*                        -> sources/gimbal/[<layer>/]
 #   Eigen's headers (from the system's Eigen, MPL2)           -> sources/Eigen/
 # The FMI headers are not copied (the standard leaves them to the importer), nor system headers.
 # Eigen's CPU back ends (Eigen/src/Core/arch) are copied whole: -M sees only this machine's, and

@@ -2,10 +2,10 @@
 #include <cmath>
 
 #include "check.hpp"
-#include "gimbal/base_kinematics.hpp"
-#include "gimbal/drive_train.hpp"
-#include "gimbal/gimbal_hybrid_system.hpp"
-#include "gimbal/gimbal_model.hpp"
+#include "gimbal/multibody/base_kinematics.hpp"
+#include "gimbal/multibody/drive_train.hpp"
+#include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
+#include "gimbal/model/gimbal_model.hpp"
 
 #include <Eigen/Dense>
 

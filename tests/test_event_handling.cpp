@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "check.hpp"
-#include "gimbal/event_handling.hpp"
+#include "gimbal/hybrid_system/event_handling.hpp"
 
 using namespace gimbal;
 

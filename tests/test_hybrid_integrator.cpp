@@ -4,7 +4,7 @@
 #include <string>
 
 #include "check.hpp"
-#include "gimbal/integrator.hpp"
+#include "gimbal/integrators/integrator.hpp"
 
 using namespace gimbal;
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "check.hpp"
-#include "one_step_integrator.hpp"
+#include "integrators/one_step_integrator.hpp"
 
 using namespace gimbal;
 

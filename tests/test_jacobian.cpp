@@ -7,8 +7,8 @@
 #include <string>
 
 #include "check.hpp"
-#include "gimbal/gimbal_model.hpp"
-#include "gimbal/parameter_validation.hpp"
+#include "gimbal/model/gimbal_model.hpp"
+#include "gimbal/simulation/parameter_validation.hpp"
 
 #include <Eigen/Dense>
 

@@ -5,9 +5,9 @@
 #include <string>
 
 #include "check.hpp"
-#include "one_step_integrator.hpp"
-#include "iteration_matrix.hpp"
-#include "small_lu.hpp"
+#include "integrators/one_step_integrator.hpp"
+#include "integrators/iteration_matrix.hpp"
+#include "integrators/small_lu.hpp"
 
 #include <random>
 #include <Eigen/Dense>

@@ -1,4 +1,4 @@
-// The specialised rigid-body dynamics (model_core/src/rigid_body.cpp, base_kinematics.cpp) against the
+// The specialised rigid-body dynamics (model_core/src/multibody/rigid_body.cpp, base_kinematics.cpp) against the
 // generic implementation they replaced, kept here verbatim as the reference: random full inertia
 // tensors, centres of mass anywhere, random base motion and gravity, rotors with and without the
 // axial symmetry that lets the fast code skip their trigonometry. Also solve_mass_matrix against LLT.
@@ -15,8 +15,8 @@
 #include <random>
 #include <utility>
 
-#include "gimbal/base_kinematics.hpp"
-#include "gimbal/rigid_body.hpp"
+#include "gimbal/multibody/base_kinematics.hpp"
+#include "gimbal/multibody/rigid_body.hpp"
 
 // ---------------------------------------------------------------------------------------------------
 // Reference: the generic implementation as it was before the specialisation (rotation matrices built

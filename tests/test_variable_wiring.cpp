@@ -18,10 +18,10 @@
 #include <vector>
 
 #include "check.hpp"
-#include "gimbal/gimbal_hybrid_system.hpp"
-#include "gimbal/gimbal_instance.hpp"
-#include "gimbal/integrator.hpp"
-#include "gimbal/parameter_validation.hpp"
+#include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
+#include "gimbal/simulation/gimbal_instance.hpp"
+#include "gimbal/integrators/integrator.hpp"
+#include "gimbal/simulation/parameter_validation.hpp"
 
 using namespace gimbal;
 

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "gimbal/gimbal_c_api.h"
-#include "gimbal/variable_groups.hpp"
-#include "gimbal/variables.hpp"
+#include "gimbal/model/variable_groups.hpp"
+#include "gimbal/model/variables.hpp"
 
 namespace {
 

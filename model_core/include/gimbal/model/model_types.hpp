@@ -1,0 +1,145 @@
+// The model's types: the constant model (parameters, fidelity, state layout), the discrete modes
+// (one slot per switching element), the inputs over a step, and the dynamics at one instant. Below
+// the switching elements (switching_elements/) and the dynamics that assemble them (gimbal_model.hpp).
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "gimbal/multibody/drive_train.hpp"
+#include "gimbal/multibody/rigid_body.hpp"
+
+namespace gimbal {
+
+// Layout of the full state vector (docs/physics.md section 3.3). Reduced fidelities drop entries: see StateLayout.
+enum StateIndex : int {
+    kAngles = 0,      // alpha, alpha_m, beta, beta_m
+    kRates = 4,       // their time derivatives
+    kCurrents = 8,    // i_R1, i_R2
+    kBacklash = 10,   // theta_b1, theta_b2
+    kStateSize = 12,
+    kEnergyFlowCount = 5,  // electrical in, resistive, viscous, shaft damping, dry friction
+    kMaxStateSize = kStateSize + kEnergyFlowCount
+};
+
+enum EnergyFlow : int { kElectricalIn = 0, kResistive, kViscous, kShaftDamping, kDryFriction };
+
+// "Model only what a scene needs" (docs/physics.md section 6): each reduction removes states.
+enum class GearModel : int { rigid = 0, compliant = 1, backlash = 2 };
+enum class MotorModel : int { quasi_static = 0, inductive = 1 };
+
+struct Fidelity {
+    GearModel gear[2] = {GearModel::backlash, GearModel::backlash};
+    MotorModel motor[2] = {MotorModel::inductive, MotorModel::inductive};
+    bool dry_friction = true;
+    bool fixed_base = false;
+};
+
+// Rotor coordinate of axis j in q order (alpha_m, beta_m) and its load coordinate (alpha, beta).
+constexpr int rotor_index(int axis) { return axis == 0 ? 1 : 3; }
+constexpr int load_index(int axis) { return axis == 0 ? 0 : 2; }
+
+// Where each quantity lives in the integrated state vector; -1 when the fidelity removed it.
+// Coordinates are "padded": a rigid axis's rotor keeps its index 0..3 in the equations of motion
+// but has no state (q_m = N q_l).
+struct StateLayout {
+    int angle_slot[4];
+    int rate_slot[4];
+    int current_slot[2];
+    int backlash_slot[2];
+    int energy_slot;  // first of kEnergyFlowCount, or -1
+    int size;
+    bool canonical;   // every quantity present, in StateIndex order (full fidelity): no slot lookups
+
+    static StateLayout from(const Fidelity& fidelity, bool energy_accounting);
+    bool independent(int body) const { return angle_slot[body] >= 0; }
+};
+
+struct ModelParameters {
+    MultibodyModel multibody;
+    MotorParameters motor[2];
+    GearParameters gear[2];
+    double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
+    DryFrictionParameters dry_friction[4];      // per body, as given
+    Fidelity fidelity;
+    bool energy_accounting = false;
+    double relative_tolerance = 1e-6;
+    double absolute_tolerance = 1e-8;
+    long max_steps = 100000;  // per communication step
+    int method = 0;           // IntegrationMethod
+    int substeps = 1;         // real-time method: equal substeps per communication step
+
+    // Derived by finalize(): the layout, dry friction per padded coordinate (a rigid axis merges its
+    // rotor's friction into the load's), and the share of a merged element attributed to the rotor.
+    StateLayout layout;
+    DryFrictionParameters coordinate_friction[4];
+    double rotor_friction_share[2] = {0, 0};
+    void finalize();
+    int state_size() const { return layout.size; }
+};
+
+// Dry friction regime of one coordinate. |qd| < w_min is the low-speed (stick candidate) region.
+enum class FrictionMode : std::int8_t {
+    none,               // coordinate without dry friction
+    slip_positive,      // qd >= w_min: T_as = -T_din
+    slip_negative,      // qd <= -w_min: T_as = +T_din
+    hold,               // low speed, T_as = -T_outros - c_num qd within +-T_max (stuck)
+    at_max_positive,    // low speed, T_as = +T_max (break-away, or the hold torque clipped)
+    at_max_negative,    // low speed, T_as = -T_max
+};
+
+inline bool low_speed(FrictionMode mode) {
+    return mode == FrictionMode::hold || mode == FrictionMode::at_max_positive || mode == FrictionMode::at_max_negative;
+}
+
+// Discrete state: constant between events, so that the right-hand side is smooth within a mode.
+struct Modes {
+    int gear_contact[2] = {0, 0};    // -1 at -eta, 0 in the gap (or no backlash), +1 at +eta
+    int motor_limited[2] = {0, 0};   // -1 held at -i_L, 0 free, +1 held at +i_L
+    int voltage_clamped[2] = {0, 0}; // a ramped voltage held at -U_L / +U_L (0: follows the ramp)
+    FrictionMode friction[4] = {FrictionMode::none, FrictionMode::none, FrictionMode::none, FrictionMode::none};
+};
+
+// Inputs over one communication step: voltages held (or, when the master gives their derivatives,
+// ramped), base motion at constant acceleration from the step start.
+struct StepInputs {
+    double voltage[2] = {0, 0};            // commanded at the step start, clamped to +-U_L
+    double commanded_voltage[2] = {0, 0};  // as set, unclamped
+    double voltage_rate[2] = {0, 0};       // fmi2SetRealInputDerivatives, order 1
+    BaseMotion base;                       // at the step start
+    double step_start_time = 0.0;
+};
+
+// The state in full form, whatever the fidelity.
+struct FullState {
+    Vec4 angle, rate;
+    double current[2];   // the armature current (algebraic for a quasi-static motor, held at +-i_L when limited)
+    double backlash[2];  // 0 without backlash
+};
+
+// Everything the right-hand side, the event functions and the outputs need, at one (t, x, modes).
+struct Dynamics {
+    FullState full;
+    Vec4 acceleration;              // padded coordinates (0 for a rigid axis's rotor)
+    Vec4 full_acceleration;         // all four bodies
+    double current_rate[2];
+    double backlash_rate[2];
+    double free_backlash_rate[2];   // X of (2.81)
+    double deflection[2];
+    double deflection_rate[2];
+    double shaft_torque[2];
+    double steady_current[2];       // (u - k_emf w) / R
+    Vec4 friction_torque;           // T_as per padded coordinate
+    Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
+    double voltage[2];              // applied
+    Mat4 reduced_mass;              // padded coordinates
+};
+
+// Derivatives of the full generalized forces (or accelerations) with respect to the full state:
+// columns q (0-3), qd (4-7), currents (8-9), theta_b (10-11), whatever the fidelity.
+using Mat4x12 = Eigen::Matrix<double, 4, 12>;
+using Row12 = Eigen::Matrix<double, 1, 12>;
+enum JacobianColumn : int { kAngleColumn = 0, kRateColumn = 4, kCurrentColumn = 8, kBacklashColumn = 10 };
+
+}  // namespace gimbal

@@ -1,0 +1,219 @@
+// One simulation instance: the variable values, the constant model built from them, the state, the
+// hybrid system and its integrator (Pinocchio-style split: ModelParameters is constant during a run,
+// the rest is per-run data).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gimbal/gimbal_c_api.h"
+#include "gimbal/hybrid_system/event_handling.hpp"
+#include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
+#include "gimbal/simulation/instance_outputs.hpp"
+#include "gimbal/integrators/integrator.hpp"
+#include "gimbal/simulation/linearization.hpp"
+#include "gimbal/simulation/step_checks.hpp"
+#include "gimbal/model/variable_groups.hpp"
+#include "gimbal/model/variables.hpp"
+
+namespace gimbal {
+
+struct SnapshotContent;  // gimbal/simulation/snapshot.hpp
+
+class GimbalInstance {
+public:
+    using Logger = std::function<void(GimbalStatus, const char* category, const std::string& message)>;
+
+    using LogFilter = std::function<bool(const char* category)>;
+
+    GimbalInstance(Logger logger, LogFilter filter);
+    GimbalInstance(const GimbalInstance&) = delete;
+    GimbalInstance& operator=(const GimbalInstance&) = delete;
+
+    void reset();
+    GimbalStatus set_real(unsigned vr, double value);
+    GimbalStatus get_real(unsigned vr, double& value);
+    GimbalStatus set_integer(unsigned vr, int value);
+    GimbalStatus get_integer(unsigned vr, int& value);
+    GimbalStatus set_boolean(unsigned vr, bool value);
+    GimbalStatus get_boolean(unsigned vr, bool& value) const;
+    // fmi2SetupExperiment's tolerance: becomes solver.rtol at initialization unless solver.rtol was set.
+    void set_master_tolerance(bool defined, double tolerance);
+    GimbalStatus initialize(double start_time);
+    // fmi2SetRealInputDerivatives: the voltages may ramp over the next step (order 1 only).
+    // All or nothing.
+    GimbalStatus set_reals(const unsigned* vr, std::size_t count, const double* values);
+    GimbalStatus set_input_derivative(unsigned vr, int order, double value);
+
+    // Everything a rollback needs, as plain bytes (fmi2GetFMUstate / serialization). Saving ends the
+    // current integration segment: the next step restarts the integrator, so that a rollback to this
+    // point replays bit for bit.
+    // A snapshot from elsewhere (a deserialized blob) is range-checked field by field: restore()
+    // refuses a bad one with the reason and leaves the instance as it was.
+    static std::size_t snapshot_size();
+    void save(void* buffer);
+    GimbalStatus check_snapshot(const void* buffer, bool& initialized) const;
+    GimbalStatus restore(const void* buffer);
+    GimbalStatus do_step(double current_time, double step_size);
+    // A step that may end early, right after the first mode change (FMI 3.0's early return): *reached
+    // is the time it ended at. The inputs are then left as the step carried them there (the carrier's
+    // arc, a voltage ramp), so that the next step continues the same problem.
+    GimbalStatus do_step_until_mode_change(double current_time, double step_size, double& reached);
+    // Work of one fmi2DoStep, in right-hand-side evaluations, beyond which the step is reported
+    // (simulation/step_checks.hpp).
+    static constexpr long kStepWorkBudget = gimbal::kStepWorkBudget;
+    double time() const { return time_; }
+    bool initialized() const { return system_ != nullptr && integrator_ != nullptr; }
+    // The continuous model linearized at the current time and state, with the inputs as last set.
+    GimbalStatus linearize(LinearModel& model);
+
+    // ---- The continuous-time interface (Model Exchange; gimbal_instance_continuous.cpp) ----
+    // The host integrates: it sets the time, the states and the inputs, reads derivatives and event
+    // indicators, and calls update_discrete_states() where an indicator crossed zero (or an input
+    // jumped, or the time event it was given came). Chosen once, before initialization.
+    void use_continuous_time_interface() { continuous_time_ = true; }
+    bool continuous_time_interface() const { return continuous_time_; }
+    static constexpr int kStateCount = kContinuousStateCount;
+    static constexpr int kIndicatorCount = GimbalHybridSystem::kIndicatorCount;
+    struct DiscreteUpdate {
+        bool states_changed = false;      // a transition moved the state (onto a stop, a limit)
+        bool next_time_defined = false;   // the chattering guard holds the modes until next_time
+        double next_time = 0.0;
+        int mode_changes = 0;
+    };
+    GimbalStatus set_time(double time);
+    GimbalStatus set_continuous_states(const double* states);
+    void get_continuous_states(double* states);
+    void get_nominal_states(double* nominals) const;
+    GimbalStatus get_derivatives(double* derivatives);
+    GimbalStatus get_event_indicators(double* indicators);
+    // Before initialization ends: the states and indicators at the start values (the FMU's part of
+    // initialization mode), computed as the outputs are previewed then.
+    GimbalStatus preview_continuous(double* states, double* indicators);
+    GimbalStatus update_discrete_states(DiscreteUpdate& update);
+    // d(unknowns)/d(knowns) . seed at the current point, within the modes in force: unknowns are state
+    // derivatives or outputs, knowns continuous states or inputs (Real value references). The
+    // derivatives' dependence on the integrated states comes from the analytic Jacobian, the rest from
+    // central differences.
+    GimbalStatus directional_derivative(const unsigned* unknowns, std::size_t unknown_count, const unsigned* knowns,
+                                        std::size_t known_count, const double* seed, double* result);
+
+private:
+    // The snapshot (gimbal/simulation/snapshot.hpp walks its table of fields): what only an initialized instance
+    // saves, a snapshot decoded and checked, and the run it describes rebuilt aside.
+    void save_run(SnapshotContent& snap);
+    GimbalStatus read_snapshot(const void* buffer, SnapshotContent& snap) const;
+    GimbalStatus rebuild_run(const SnapshotContent& snap, std::unique_ptr<GimbalHybridSystem>& system,
+                             std::unique_ptr<HybridIntegrator>& integrator);
+    StepInputs read_step_inputs(double step_start) const;
+    bool build_parameters(ModelParameters& params, std::string& error) const;
+    void load_start_state();
+    GimbalStatus check_fixed_base() const;
+    std::unique_ptr<HybridIntegrator> make_integrator(GimbalHybridSystem& system, const ModelParameters& params);
+    void create_integrator();
+    // What a failed or interrupted step returns to.
+    struct StepStart {
+        double state[kMaxStateSize];
+        Modes modes;
+        EventCounters counters;
+        IntegratorStatistics work;
+        double reals[kRealVariableCount];  // the published values, once the step is about to change them
+        int integers[kIntegerVariableCount];
+        bool outputs_saved = false;
+        double time;
+        double clock;
+    };
+    GimbalStatus integrate_step(double current_time, double step_size, StepStart& start, double* early = nullptr);
+    // The parts of a step: its checks, its inputs, its end, its outputs' check (inline, defined in
+    // simulation/instance_step.cpp, the only place they are called).
+    inline GimbalStatus check_step(double step_size);
+    GimbalStatus check_real_time_resolution(double step_size);
+    inline GimbalStatus take_step_inputs(double step_start, bool& resting);
+    inline void end_step_at(double step_end, double reached_model_time, bool ended_early);
+    inline GimbalStatus check_published_outputs(double current_time, const StepStart& start);
+    GimbalStatus advance_step(double current_time, double step_size, double* early, double& reached);
+    void roll_back(const StepStart& start);
+    GimbalStatus report_step_work(double step_size, const IntegratorStatistics& before, const EventCounters& events_before);
+    void apply_master_tolerance();
+    // Before initialization ends, calculated outputs follow from the start values on request.
+    GimbalStatus preview_outputs(const char* name);
+    void publish_outputs() {
+        gimbal::publish_outputs(OutputPoint{params_, *system_, *integrator_, state_, clock_, epoch_, zeno_holds_},
+                                reals_, integers_);
+    }
+    GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
+    // Which of the 17 states this fidelity integrates, and where (set with the parameters).
+    void map_integrated_states();
+    // Pushes inputs set since the last evaluation into the hybrid system.
+    void refresh_held_inputs();
+    void log_event(const std::string& message) const { logger_(GIMBAL_OK, "logEvents", message); }
+    // The outputs at the point the host set; refused (and the last good ones kept) where the states or
+    // inputs set make one of them non-finite.
+    GimbalStatus publish_continuous_time_outputs();
+    // update_discrete_states' settling of the guards left exactly on zero; the mode changes it made.
+    int settle_guards(double now, int n, const int* directions, const HybridIntegrator::MessageSink& sink);
+    // The parts of directional_derivative: the knowns' seeds, the unknowns' Jacobian rows, the part the
+    // Jacobian answers.
+    GimbalStatus seed_knowns(const unsigned* knowns, std::size_t known_count, const double* seed, double* state_seed,
+                             std::vector<std::pair<unsigned, double>>& input_seed) const;
+    GimbalStatus jacobian_rows(const unsigned* unknowns, std::size_t unknown_count, std::vector<int>& jacobian_row,
+                               bool& all_rows_analytic) const;
+    GimbalStatus jacobian_part(const std::vector<int>& jacobian_row, const double* state_seed, double* result,
+                               bool& used);
+    bool difference_step(const double* state_seed, const std::vector<std::pair<unsigned, double>>& input_seed,
+                         double& step);
+    // d(unknowns)/d(states, inputs) . seed by one central difference (two evaluations), the point restored.
+    GimbalStatus central_difference(const unsigned* unknowns, std::size_t unknown_count, const double* state_seed,
+                                    const std::vector<std::pair<unsigned, double>>& input_seed, double* result);
+
+    Logger logger_;
+    LogFilter log_filter_;
+    double reals_[kRealVariableCount];
+    int integers_[kIntegerVariableCount];
+    bool booleans_[kBooleanVariableCount];
+    ModelParameters params_;
+    double state_[kMaxStateSize];
+    std::unique_ptr<GimbalHybridSystem> system_;
+    std::unique_ptr<HybridIntegrator> integrator_;
+    bool integrator_running_ = false;  // false: the next step must restart the integrator
+    bool preview_current_ = false;
+    bool at_rest_ = false;             // exact equilibrium under the running inputs: steps need no integration
+    std::string last_integrator_error_;
+    double voltage_rate_[2] = {0.0, 0.0};  // for the next step only
+    double time_ = 0.0;  // the host's time of the current point: epoch_ + clock_
+    // The model runs on its own clock, the time since initialization: results do not depend on where
+    // the host's clock starts, and event times keep their resolution at large start times. A step
+    // advances it by communicationStepSize (never by differences of the host's times, which lose the
+    // step's low bits at a large start time); in the continuous-time interface the host owns time and
+    // clock_ is its time less the start.
+    double epoch_ = 0.0;
+    double clock_ = 0.0;
+    bool master_tolerance_defined_ = false;
+    double master_tolerance_ = 0.0;
+    bool rtol_set_ = false;            // solver.rtol set by the user: the master's tolerance does not apply
+    StepWorkMonitor step_work_;
+
+    // Continuous-time interface state (saved with an FMU state).
+    bool continuous_time_ = false;
+    bool inputs_stale_ = true;     // an input was set since the hybrid system last took them
+    bool outputs_stale_ = true;    // time, state or inputs changed since outputs were published
+    bool decided_here_ = false;    // update_discrete_states ran at this very point: a repeat changes nothing
+    double reference_guards_[kIndicatorCount] = {};  // guards as decided at the last update (crossings are
+                                                     // measured against them)
+    std::int8_t decided_side_[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
+    ChatteringMemory chattering_;      // model times
+    GuardSettling guard_settling_;
+    double preview_states_[kContinuousStateCount] = {};      // at the start values, before initialization
+    double preview_indicators_[GimbalHybridSystem::kIndicatorCount] = {};
+    int integrated_count_ = 0;
+    int integrated_state_[kContinuousStateCount] = {};  // index among the 17 states
+    int integrated_slot_[kContinuousStateCount] = {};   // its slot in state_
+    IntegratorSettings event_settings_;  // the chattering guard's limits, and whether events are logged
+    std::int64_t zeno_holds_ = 0;
+};
+
+}  // namespace gimbal

@@ -1,0 +1,41 @@
+// The continuous model linearized at one point, within the modes in force there:
+//   d(dx)/dt = A dx + B du,   dy = C dx + D du.
+// A is the right-hand side's Jacobian (evaluate_jacobian, the one the implicit methods use); B, C and D
+// are central differences of the right-hand side and of the outputs, which are cheap and smooth
+// within a mode. Control design starts from these matrices (docs/linearization.md).
+#pragma once
+
+#include "gimbal/model/gimbal_model.hpp"
+#include "gimbal/model/variables.hpp"
+
+namespace gimbal {
+
+// u: the FMU's Real inputs in value-reference order (voltages, base attitude, its rates and
+// accelerations, point a's velocity and acceleration). y: the outputs a control loop uses (angles,
+// rates, currents, backlash positions, shaft torques, payload angular velocity).
+constexpr RealVariable kLinearFirstInput = vr_u_R1;
+constexpr int kLinearInputCount = vr_base_a_a_3 - vr_u_R1 + 1;
+constexpr RealVariable kLinearFirstOutput = vr_alpha;
+constexpr int kLinearOutputCount = vr_los_omega_3 - vr_alpha + 1;
+
+struct LinearModel {
+    // The integrated states without the energy accumulators (they feed nothing back), each named by
+    // the output variable that carries it.
+    int state_count = 0;
+    RealVariable state_variable[kStateSize] = {};
+    // Row-major with the maximal sizes as leading dimensions; only state_count rows/columns are used.
+    double A[kStateSize][kStateSize] = {};
+    double B[kStateSize][kLinearInputCount] = {};
+    double C[kLinearOutputCount][kStateSize] = {};
+    double D[kLinearOutputCount][kLinearInputCount] = {};
+    // In force at the point: the model holds until one of them switches. voltage_clamped also marks a
+    // held voltage at or beyond +-U_L (the core's own mode covers ramps only).
+    Modes modes;
+};
+
+// `inputs` as a step starting at `time` would hold them (voltage ramps are ignored: they last one
+// step). `modes` must be those the hybrid system selects at (time, state, inputs).
+void linearize(const ModelParameters& params, const StepInputs& inputs, const Modes& modes, double time,
+               const double* state, LinearModel& out);
+
+}  // namespace gimbal

@@ -1,0 +1,90 @@
+// What every switching element is (docs/physics.md section 5): one unit with its name, its guard
+// functions and the rule that re-selects its mode where a guard crosses zero (in the spirit of Drake's
+// witness functions with their reset maps). Each element's module (gear_backlash, voltage_clamp,
+// current_limiter, dry_friction) derives from SwitchingElement and also holds the element's force and
+// Jacobian contributions, which the dynamics (model/gimbal_model.hpp) call in one pass per element.
+// Which elements a model has, their guards' places and their decision order: element_registry.hpp.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "gimbal/model/model_types.hpp"
+
+namespace gimbal {
+
+// Mode changes so far, by kind (the FMU's event counters).
+struct EventCounters {
+    std::int64_t total = 0;
+    std::int64_t backlash[2] = {0, 0};
+    std::int64_t current_limit[2] = {0, 0};
+    std::int64_t stick_slip = 0;
+    double last_event_time = 0.0;
+};
+
+// What guards and rules see at one instant: the constant model, the step inputs, and the dynamics
+// evaluated at (time, state) under the modes being decided.
+struct SwitchingContext {
+    const ModelParameters& params;
+    const StepInputs& inputs;
+    const Dynamics& dynamics;
+    double time;
+};
+
+class SwitchingElement {
+public:
+    SwitchingElement(std::string name, int first_guard) : name_(std::move(name)), first_guard_(first_guard) {}
+    virtual ~SwitchingElement() = default;
+
+    const std::string& name() const { return name_; }
+    int first_guard() const { return first_guard_; }
+    virtual int guard_count() const = 0;
+
+    // The guard functions under the current modes, written to values[first_guard() ...]; slots the
+    // current mode does not use hold 1 (they never cross).
+    virtual void guards(const SwitchingContext& context, const Modes& modes, double* values) const = 0;
+
+    // Re-selects this element's mode in `modes` (holding the previous modes' values on entry).
+    // `crossings[first_guard() + k]` is +1 / -1 when guard k has just crossed zero upward / downward, 0
+    // otherwise; nullptr after an input change. May project the state onto the new mode's constraint.
+    virtual void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
+                        const int* crossings) const = 0;
+
+    // Whether the dynamics under this element's mode move with time alone (a ramped input not yet
+    // clamped): the Rosenbrock methods then need the right-hand side's time derivative.
+    virtual bool time_dependent(const StepInputs& inputs, const Modes& modes) const {
+        (void)inputs, (void)modes;
+        return false;
+    }
+
+    // Whether this element's mode differs between the two; if so, counted in its kind's counter.
+    virtual bool changed(const Modes& before, const Modes& after) const = 0;
+    virtual void count_change(EventCounters& counters) const { (void)counters; }
+    // "gap -> +eta stop" when this element's mode differs between the two, else empty.
+    virtual std::string describe(const Modes& before, const Modes& after) const = 0;
+
+protected:
+    // The sign of guard k at a decision: right after a located crossing the guard may sit exactly on
+    // zero or a rounding error short of it, and the crossing's direction decides.
+    int side(double value, const int* crossings, int guard) const;
+    int crossing(const int* crossings, int guard) const {
+        return crossings != nullptr && guard >= 0 ? crossings[first_guard_ + guard] : 0;
+    }
+
+private:
+    std::string name_;
+    int first_guard_;
+};
+
+namespace switching {
+
+inline int sign(double value) { return value > 0.0 ? 1 : (value < 0.0 ? -1 : 0); }
+
+// Contact rule of (2.81) at one side, shared by the limiter: at the stop, and not pulled back.
+int select_contact(bool at_plus_stop, bool at_minus_stop, int pull_sign, int current);
+
+// "from -> to".
+std::string transition(const char* from, const char* to);
+
+}  // namespace switching
+}  // namespace gimbal
