@@ -72,7 +72,7 @@ package_marker="$venv/.package-installed"
 if ! "$venv/bin/python" -I -c "import importlib.util as u, sys
 sys.exit(not (u.find_spec('scene_lib') and u.find_spec('sweep_lib')))" >/dev/null 2>&1 ||
    [ "$repo/pyproject.toml" -nt "$package_marker" ] || [ "$repo/requirements-run.txt" -nt "$package_marker" ] ||
-   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/scripts/scene_lib/native" -newer "$package_marker" 2>/dev/null)" ] ||
+   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/gimbal2axis/native" -newer "$package_marker" 2>/dev/null)" ] ||
    [ "$repo/CMakeLists.txt" -nt "$package_marker" ] ||   # the package's version is the CMake project's
    ! ls "$repo"/scripts/scene_lib/_native*.so >/dev/null 2>&1; then
   echo "[setup] installing the project's Python package (scene_lib, sweep_lib, their C kernels) into .venv, editable"
