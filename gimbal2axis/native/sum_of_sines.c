@@ -11,6 +11,8 @@ void gimbal_sum_of_sines_weights(long components, const double* amplitude, const
     }
 }
 
+long gimbal_sum_of_sines_rotation_doubles(long components) { return 2 * GIMBAL_SUM_OF_SINES_BLOCK * components; }
+
 void gimbal_sum_of_sines_rotation(double h, long components, const double* omega, double* rotation) {
     const long block = GIMBAL_SUM_OF_SINES_BLOCK;
     double* rotation_cos = rotation;
@@ -60,7 +62,7 @@ void gimbal_sum_of_sines_rows(long first, long count, double t0, double h, long 
 
 int gimbal_sum_of_sines(long rows, double t0, double h, long components, const double* omega, const double* phase,
                         const double* weights, double* value, double* rate, double* acceleration) {
-    double* rotation = malloc(sizeof(double) * 2 * GIMBAL_SUM_OF_SINES_BLOCK * (size_t)(components > 0 ? components : 1));
+    double* rotation = malloc(sizeof(double) * (size_t)gimbal_sum_of_sines_rotation_doubles(components > 0 ? components : 1));
     if (rotation == NULL) return -1;
     gimbal_sum_of_sines_rotation(h, components, omega, rotation);
     gimbal_sum_of_sines_rows(0, rows, t0, h, components, omega, phase, weights, rotation, value, rate, acceleration);

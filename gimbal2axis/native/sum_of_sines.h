@@ -21,7 +21,10 @@ extern "C" {
 /* The weights of value, rate and acceleration per component, 3 x components: A, A w, -A w^2. */
 void gimbal_sum_of_sines_weights(long components, const double* amplitude, const double* omega, double* weights);
 
-/* The rotation table of a grid of step h: 2 x BLOCK x components doubles into `rotation`. */
+/* How many doubles the rotation table of `components` sinusoids takes: 2 x BLOCK x components. */
+long gimbal_sum_of_sines_rotation_doubles(long components);
+
+/* The rotation table of a grid of step h into `rotation` (gimbal_sum_of_sines_rotation_doubles). */
 void gimbal_sum_of_sines_rotation(double h, long components, const double* omega, double* rotation);
 
 /* Rows first .. first + count - 1 of the grid (value[0] is row `first`), with the grid's rotation table. */
