@@ -48,8 +48,7 @@ class Controller:
         self.voltage = tuple(voltage)
         self.u_limit = tuple(u_limit)
         self.reference = (math.nan, math.nan)   # last set points, for the record
-        if self.kind != "python":
-            self._setup_kernel()
+        self._setup_kernel()
 
     def _setup_kernel(self) -> None:
         """The kernel's struct of this controller (kind, limits, constant voltages) and the buffers
@@ -343,6 +342,9 @@ class UserController(Controller):
                                  "reset(context) and step(t, measurements)")
         self.delay_steps = int(spec.get("delay_steps", 1))
         self.batch = getattr(cls, "batch", False) is True
+
+    def _setup_kernel(self) -> None:
+        """None: the user's class computes the voltages, in Python."""
 
     def start(self, step_size: float, scene_name: str) -> None:
         self.user.reset(ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name))
