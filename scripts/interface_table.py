@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Print the FMU's variables as Markdown tables (from modelDescription.xml), for the README."""
+"""Print the FMU's variables as Markdown tables (from modelDescription.xml), for docs/interface.md."""
 import sys
 
 from fmpy import read_model_description

@@ -5,7 +5,7 @@ Runs the scene on the FMU (no files written), takes one recorded signal from --f
 transient) to the end, and times its upward crossings of its mean over that window, each by linear
 interpolation between samples: frequency = (crossings - 1) / (time of the last - time of the first).
 As a cross-check it also prints the peak of the signal's spectrum (Hann window; resolution 1 / window
-length). The limit-cycle frequency in README.md is what this prints for the default scene.
+length). The limit-cycle frequency in docs/scenes.md is what this prints for the default scene.
 
 Usage: limit_cycle_frequency.py [scene.toml] [--fmu build/Gimbal2Axis.fmu] [--signal alpha] [--from-s 1]
 """

@@ -1,8 +1,8 @@
 """An independent Python implementation of the FMU's 12-state model for high-accuracy reference runs.
 
 The rigid-body part comes from the symbolic Lagrangian (tests/symbolic), the drive train is written
-from MODEL.md section 3 (linear gear spring-damper, RL motor, viscous friction), and the co-simulation
-semantics from INTERFACE.md (voltages held, base motion at constant acceleration over each step).
+from docs/physics.md section 4 (linear gear spring-damper, RL motor, viscous friction), and the co-simulation
+semantics of docs/model_overview.md ("Step semantics") (voltages held, base motion at constant acceleration over each step).
 """
 from __future__ import annotations
 

@@ -77,7 +77,7 @@ def test_dry_friction_off_equals_frictionless_parameters(gimbal_fmu):
 
 
 def test_rigid_axis_merges_rotor_and_load_friction(gimbal_fmu):
-    """MODEL.md section 5: T_max = T_max_load + N T_max_rotor on the load axis. A load torque just below
+    """docs/physics.md section 6 (a rigid axis with dry friction on both sides): T_max = T_max_load + N T_max_rotor on the load axis. A load torque just below
     that holds the axis; just above it breaks away."""
     N, t_max_rotor, t_max_load = 60.0, 0.0025, 0.05
     held_limit = t_max_load + N * t_max_rotor

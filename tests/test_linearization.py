@@ -74,7 +74,7 @@ def start(fmu, slave, values):
 
 def chain_matrix(inputs):
     """d(u)/dt within a step: the base angles move with their rates, the rates with the accelerations,
-    point a's velocity with its acceleration (INTERFACE.md's within-step semantics); voltages are held."""
+    point a's velocity with its acceleration (the within-step semantics of docs/model_overview.md); voltages are held."""
     M = np.zeros((len(inputs), len(inputs)))
     for k, name in enumerate(inputs):
         for low, high in (("", "_dot"), ("_dot", "_ddot")):

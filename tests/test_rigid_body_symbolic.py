@@ -1,4 +1,4 @@
-"""The C++ rigid-body core (J, f of MODEL.md section 2) against an independent symbolic
+"""The C++ rigid-body core (J, f of docs/physics.md section 3) against an independent symbolic
 Lagrange derivation (tests/symbolic/lagrange_reference.py), plus physics checks that hold
 independently of any reference.
 
@@ -307,7 +307,7 @@ def test_reference_satisfies_lagrange_by_finite_differences():
 
 def _energy_drift(mass_matrix_and_bias, seed, T=2.0):
     """Integrate J qdd = f on a fixed (tilted, v_a = 0) base with Xi = 0 and return the largest
-    relative change of K + U (K, U from the reference energy, i.e. MODEL.md's formulas)."""
+    relative change of K + U (K, U from the reference energy, i.e. docs/physics.md section 3.2)."""
     rng = np.random.default_rng(seed)
     params = ref.random_params(rng)
     q0, qd0 = ref.random_state(rng)
@@ -387,7 +387,7 @@ def test_reference_mass_matrix_symmetric_positive_definite(reference):
 
 def test_core_conserves_energy_on_fixed_base(core):
     """Physics check of the core on its own: the motion its J and f predict on a fixed base
-    keeps K + U constant (MODEL.md's energies)."""
+    keeps K + U constant (the energies of docs/physics.md section 3.2)."""
     for seed in (1, 2):
         drift = _energy_drift(core, seed)
         assert drift < 1e-9, f"seed {seed}: relative energy drift {drift:.3e}"

@@ -1,6 +1,6 @@
 """What the scene runner tells its user: one-line errors instead of tracebacks, warnings for scenes
 that run but probably not as meant, results named after the scene file, plots that hide no sample,
-help texts, and the README's limit-cycle figure against the script that measures it."""
+help texts, and the limit-cycle figure of docs/scenes.md against the script that measures it."""
 import math
 import pathlib
 import re
@@ -310,20 +310,20 @@ def test_help_is_whole_sentences_without_internal_jargon():
     assert not re.search(r"issue \d|seed's|section \d", text)
 
 
-def test_the_scenes_section_of_the_readme_speaks_to_users():
-    readme = (REPO / "README.md").read_text()
-    section = readme[readme.index("### Scenes"):readme.index("### Sweeps")]
+def test_the_scenes_page_speaks_to_users():
+    page = (REPO / "docs" / "scenes.md").read_text()
+    section = page[page.index("## Scenes"):page.index("## Your own controller")]
     assert not re.search(r"issue \d|seed's|section \d", section)
     assert "named after the scene file" in section
 
 
-def test_the_readme_limit_cycle_frequency_is_what_the_script_prints(fmu_path):
+def test_the_documented_limit_cycle_frequency_is_what_the_script_prints(fmu_path):
     script = runpy.run_path(str(REPO / "scripts" / "limit_cycle_frequency.py"))   # its functions, not its main
     measured = script["measure"](REPO / "scenes" / "backlash_limit_cycle.toml", fmu_path)
     printed = script["describe"](measured)
     frequency = re.search(r"oscillates at (\d+\.\d) Hz", printed).group(1)
     assert abs(measured["spectral_peak"] - measured["frequency"]) <= measured["resolution"]
-    readme = (REPO / "README.md").read_text()
-    row = next(line for line in readme.splitlines() if line.startswith("| `backlash_limit_cycle`"))
+    page = (REPO / "docs" / "scenes.md").read_text()
+    row = next(line for line in page.splitlines() if line.startswith("| `backlash_limit_cycle`"))
     assert f"{frequency} Hz limit cycle (`scripts/limit_cycle_frequency.py`)" in row
-    assert f"oscillates at {frequency} Hz" in readme
+    assert f"oscillates at {frequency} Hz" in page

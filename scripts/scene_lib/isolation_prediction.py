@@ -195,6 +195,9 @@ def rest_problems(signals: dict) -> list[str]:
 
 def sample_plant(model, h: float) -> SampledPlant:
     """Exact discretization over a step with inputs polynomial (degree 2) in the time s into the step."""
+    # Not python-control's c2d: its holds (zoh, foh, tustin, ...) do not include the FMU's in-step
+    # carrier extrapolation (angle, rate and acceleration from the step start: a degree-2 polynomial),
+    # which is what makes this prediction hold up to the Nyquist frequency.
     from scipy.linalg import expm
 
     n = len(model.states)

@@ -184,33 +184,30 @@ class LinearModel:
         return np.linalg.eigvals(self.A)
 
     def frequency_response(self, frequencies_hz, input: str, output: str) -> np.ndarray:
-        """G(j w) = C (j w I - A)^-1 B + D from one input to one output, at each frequency (complex)."""
+        """G(j w) = C (j w I - A)^-1 B + D from one input to one output, at each frequency (complex),
+        evaluated by python-control."""
+        import control
+
         i, o = self.inputs.index(input), self.outputs.index(output)
-        n = len(self.states)
-        out = []
-        for f in np.atleast_1d(np.asarray(frequencies_hz, float)):
-            x = np.linalg.solve(2j * math.pi * f * np.eye(n) - self.A, self.B[:, i])
-            out.append(self.C[o] @ x + self.D[o, i])
-        return np.array(out)
+        path = control.ss(self.A, self.B[:, [i]], self.C[[o]], self.D[[o]][:, [i]])
+        w = 2 * math.pi * np.atleast_1d(np.asarray(frequencies_hz, float))
+        return np.asarray(path(1j * w), complex).reshape(-1)
 
     def held_frequency_response(self, frequencies_hz, input: str, output: str, step: float) -> np.ndarray:
         """What a sine dwell of the sampled plant measures: the input held over steps of `step` s (zero-order
         hold), the output sampled at the step ends, and the input's continuous-time fundamental taken as the
         reference (scene_lib.frequency_response.zoh_fundamental). It differs from frequency_response by the
         aliases of the staircase's harmonics, which matter as f approaches 1 / (2 step)."""
-        from scipy.linalg import expm
+        import control
 
         i, o = self.inputs.index(input), self.outputs.index(output)
-        n = len(self.states)
-        block = np.zeros((n + 1, n + 1))
-        block[:n, :n], block[:n, n] = self.A * step, self.B[:, i] * step
-        transition = expm(block)
-        Phi, Gamma = transition[:n, :n], transition[:n, n]
+        # Zero-order-hold discretization over one step (python-control's c2d); the output published at
+        # t_k holds the input of the step before, so D enters as D / z, not as the sampled system's D.
+        held = control.c2d(control.ss(self.A, self.B[:, [i]], self.C[[o]], np.zeros((1, 1))), step, method="zoh")
         out = []
         for f in np.atleast_1d(np.asarray(frequencies_hz, float)):
             z = np.exp(2j * math.pi * f * step)
-            # x_k+1 = Phi x_k + Gamma u_k; the output published at t_k holds the input of the step before
-            samples = self.C[o] @ np.linalg.solve(z * np.eye(n) - Phi, Gamma) + self.D[o, i] / z
+            samples = complex(np.asarray(held(z)).reshape(-1)[0]) + self.D[o, i] / z
             half = math.pi * f * step
             hold = complex(math.cos(half), -math.sin(half)) * math.sin(half) / half
             out.append(samples / hold)

@@ -1,7 +1,7 @@
-"""Independent symbolic reference for the rigid-body dynamics of MODEL.md sections 1-2.
+"""Independent symbolic reference for the rigid-body dynamics of docs/physics.md sections 1-3.
 
 The kinetic energy K and the potential energy U of the four moving bodies (azimuth housing 1,
-rotor R1, elevation payload 2, rotor R2) are built with SymPy literally as MODEL.md writes them,
+rotor R1, elevation payload 2, rotor R2) are built with SymPy literally as docs/physics.md sections 1-3 write them,
 and Lagrange's equations are formed by differentiating L = K - U:
 
     d/dt (dL/dqd) - dL/dq = Xi
@@ -88,12 +88,12 @@ class _Symbols:
 
 
 def _inertia_matrix(Ixx, Iyy, Izz, Ixy, Ixz, Iyz):
-    # MODEL.md: the product of inertia is the tensor element itself.
+    # docs/physics.md section 3.2: the product of inertia is the tensor element itself.
     return sp.Matrix([[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz, Izz]])
 
 
 def build_energies(S: _Symbols):
-    """Return (K, U) as SymPy expressions, built literally from MODEL.md sections 1-2."""
+    """Return (K, U) as SymPy expressions, built literally from docs/physics.md sections 1-3."""
     alpha, alpha_m, beta, beta_m = S.q
     dalpha, dalpha_m, dbeta, dbeta_m = S.qd
     delta, psi, gamma = S.att
