@@ -5,8 +5,9 @@
  *
  * Called once per communication point with the measurements at t_k (after the sensors) and the set
  * points; returns the voltages (u_R1, u_R2), saturated at +-u_limit like a DAC. Axis 0 is the azimuth
- * (alpha, motor 1), axis 1 the elevation (beta, motor 2). The arithmetic is the Python loop's of
- * before, operation for operation (build with -ffp-contract=off), so results keep their bits. */
+ * (alpha, motor 1), axis 1 the elevation (beta, motor 2). Every operation and its order is fixed
+ * (Python's min/max semantics, sums in order; built with -ffp-contract=off): results keep the bits
+ * they were recorded with (tests/golden), whichever loop runs them. */
 #ifndef GIMBAL_KERNEL_CONTROLLERS_H
 #define GIMBAL_KERNEL_CONTROLLERS_H
 
