@@ -1,7 +1,8 @@
 """What pyproject.toml cannot say: the version, which is CMakeLists.txt's project(VERSION) (one number
-for the FMU, the package and the README), and the package's C kernels, one extension
-(gimbal2axis.native._native) built from gimbal2axis/native/*.c and used through ctypes
-(gimbal2axis/native/__init__.py): the compiled communication loop and the base motion's sums of sinusoids."""
+for the FMU, the package and the README), and the C kernel, one extension (gimbal2axis.native._native)
+built from gimbal2axis/native/*.c and used through ctypes (gimbal2axis/native/__init__.py): the
+built-in controllers, the sensors, the sums of sinusoids of the base motions and the compiled
+communication loop."""
 import pathlib
 import re
 import sys
@@ -17,10 +18,12 @@ def cmake_project_version() -> str:
     return match.group(1)
 
 
-# Contracting a*b + c into one fused multiply-add would round differently from Python, whose loop
-# the compiled one must reproduce bit for bit (MSVC does not contract by default).
+# Contracting a*b + c into one fused multiply-add would round differently from the arithmetic the
+# results were recorded with (MSVC does not contract by default).
 flags = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off"]
-sources = [f"gimbal2axis/native/{name}.c" for name in ("module", "master_loop", "sum_of_sines")]
+# The kernel's sources (the CMake build compiles the same files, minus the module, for the drivers:
+# gimbal2axis/native/kernel.cmake).
+sources = sorted(str(path) for path in pathlib.Path("gimbal2axis/native").glob("*.c"))
 
 setup(version=cmake_project_version(),
       ext_modules=[Extension("gimbal2axis.native._native", sources, extra_compile_args=flags)])

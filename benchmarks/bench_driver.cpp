@@ -30,7 +30,9 @@
 #include <string>
 #include <vector>
 
+#include "controllers.h"
 #include "fmi2Functions.h"
+#include "sum_of_sines.h"
 
 // ------------------------------------------------------------------------------------------------
 // Heap allocation counting (interposition of the C allocator)
@@ -319,20 +321,20 @@ void check(fmi2Status status, const char* what) {
 
 // ------------------------------------------------------------------------------------------------
 // Sea-state base motion: per axis q(t) = sum_i A_i sin(w_i t + phi_i), rates and accelerations
-// exact. The terms advance by an exact rotation per communication step (6 flops per term instead of
-// a sin and a cos) and are recomputed from t every 1024 steps, so rounding does not accumulate.
+// exact. The sums are the C kernel's (gimbal2axis/native/sum_of_sines.h), the scene runner's: rows
+// are evaluated a block at a time, when the step reaches the next block.
 // ------------------------------------------------------------------------------------------------
 struct SeaState {
     static constexpr int kTerms = 10;
     static constexpr int kAxes = 4;  // pitch delta, yaw psi, roll gamma, heave z
-    struct Term {
-        double A, w, phi;
-        double s, c;    // sin, cos of w t + phi at the current time
-        double cs, sn;  // cos(w h), sin(w h)
-    };
-    Term terms[kAxes][kTerms];
+    static constexpr long kBlock = GIMBAL_SUM_OF_SINES_BLOCK;
+    double amplitude[kAxes][kTerms], omega[kAxes][kTerms], phase[kAxes][kTerms];
+    double weights[kAxes][3 * kTerms];
+    double rotation[kAxes][2 * kBlock * kTerms];
+    double value[kAxes][kBlock], rate[kAxes][kBlock], acceleration[kAxes][kBlock];
     double h = 1e-3;
     long k = 0;
+    long block_first = -1;  // the first row of the block in value, rate, acceleration (-1: none yet)
 
     // Significant amplitudes (2 sigma) [rad, rad, rad, m] and a JONSWAP-like spectrum about the
     // peak period: a moderate sea, the ship heading into it.
@@ -346,75 +348,46 @@ struct SeaState {
             const double lo = 0.5 * wp, hi = 3.0 * wp, dw = (hi - lo) / kTerms;
             double total = 0.0;
             for (int i = 0; i < kTerms; ++i) {
-                Term& term = terms[a][i];
-                term.w = lo + (i + rng.uniform()) * dw;
-                term.phi = 2.0 * M_PI * rng.uniform();
-                const double r = wp / term.w;
-                const double shape = std::pow(term.w, -5.0) * std::exp(-1.25 * r * r * r * r) *
-                                     std::pow(3.3, std::exp(-std::pow(term.w - wp, 2) / (2.0 * 0.08 * 0.08 * wp * wp)));
-                term.A = shape * dw;  // variance share, normalized below
-                total += term.A;
+                const double w = omega[a][i] = lo + (i + rng.uniform()) * dw;
+                phase[a][i] = 2.0 * M_PI * rng.uniform();
+                const double r = wp / w;
+                const double shape = std::pow(w, -5.0) * std::exp(-1.25 * r * r * r * r) *
+                                     std::pow(3.3, std::exp(-std::pow(w - wp, 2) / (2.0 * 0.08 * 0.08 * wp * wp)));
+                amplitude[a][i] = shape * dw;  // variance share, normalized below
+                total += amplitude[a][i];
             }
             const double sigma = significant[a] / 2.0;
-            for (int i = 0; i < kTerms; ++i) terms[a][i].A = std::sqrt(2.0 * terms[a][i].A / total) * sigma;
-            for (int i = 0; i < kTerms; ++i) {
-                terms[a][i].cs = std::cos(terms[a][i].w * h);
-                terms[a][i].sn = std::sin(terms[a][i].w * h);
-            }
+            for (int i = 0; i < kTerms; ++i) amplitude[a][i] = std::sqrt(2.0 * amplitude[a][i] / total) * sigma;
+            gimbal_sum_of_sines_weights(kTerms, amplitude[a], omega[a], weights[a]);
+            gimbal_sum_of_sines_rotation(h, kTerms, omega[a], rotation[a]);
         }
         reset(0);
     }
 
-    void reset(long step_index) {
-        k = step_index;
-        const double t = k * h;
-        for (auto& axis : terms)
-            for (Term& term : axis) {
-                term.s = std::sin(term.w * t + term.phi);
-                term.c = std::cos(term.w * t + term.phi);
-            }
-    }
+    void reset(long step_index) { k = step_index; }
+    void advance() { ++k; }
 
-    void advance() {
-        if (((k + 1) & 1023) == 0) {
-            reset(k + 1);
-            return;
+    // The 15 base inputs at t_k in the order delta, psi, gamma, *_dot, *_ddot, v_a[1..3], a_a[1..3].
+    void inputs(double out[15]) {
+        const long first = k - k % kBlock;
+        if (first != block_first) {
+            for (int a = 0; a < kAxes; ++a)
+                gimbal_sum_of_sines_rows(first, kBlock, 0.0, h, kTerms, omega[a], phase[a], weights[a], rotation[a],
+                                         value[a], rate[a], acceleration[a]);
+            block_first = first;
         }
-        ++k;
-        for (auto& axis : terms)
-            for (Term& term : axis) {
-                const double s = term.s * term.cs + term.c * term.sn;
-                const double c = term.c * term.cs - term.s * term.sn;
-                term.s = s;
-                term.c = c;
-            }
-    }
-
-    // The 15 base inputs in the order delta, psi, gamma, *_dot, *_ddot, v_a[1..3], a_a[1..3].
-    void inputs(double out[15]) const {
-        double q[kAxes], qd[kAxes], qdd[kAxes];
-        for (int a = 0; a < kAxes; ++a) {
-            double x = 0.0, v = 0.0, acc = 0.0;
-            for (const Term& term : terms[a]) {
-                x += term.A * term.s;
-                v += term.A * term.w * term.c;
-                acc -= term.A * term.w * term.w * term.s;
-            }
-            q[a] = x;
-            qd[a] = v;
-            qdd[a] = acc;
-        }
+        const long m = k - first;
         for (int a = 0; a < 3; ++a) {
-            out[a] = q[a];
-            out[3 + a] = qd[a];
-            out[6 + a] = qdd[a];
+            out[a] = value[a][m];
+            out[3 + a] = rate[a][m];
+            out[6 + a] = acceleration[a][m];
         }
         out[9] = 0.0;
         out[10] = 0.0;
-        out[11] = qd[3];  // heave velocity of point a
+        out[11] = rate[3][m];  // heave velocity of point a
         out[12] = 0.0;
         out[13] = 0.0;
-        out[14] = qdd[3];
+        out[14] = acceleration[3][m];
     }
 };
 
@@ -446,23 +419,33 @@ void gimbal_angles_for(const double target[3], double delta, double psi, double 
     alpha += 2.0 * M_PI * std::round((alpha_near - alpha) / (2.0 * M_PI));
 }
 
-// PD on each axis about the IK set points, with the payload gyro as the rate signal:
-// elevation rate = los.omega[1], azimuth rate = los.omega[3] / cos(beta) (secant correction).
+// PD on each axis about the IK set points, with the payload gyro as the rate signal: the kernel's
+// PID (gimbal2axis/native/controllers.h, the scene runner's) with kp and k_gyro only. Its rates:
+// elevation = los.omega[1], azimuth = los.omega[3] / cos(beta) (secant correction).
 struct Controller {
-    double kp[2] = {300.0, 640.0};  // V/rad
-    double kd[2] = {6.0, 12.0};     // V.s/rad
-    double u_limit[2] = {24.0, 24.0};
+    static constexpr double kp[2] = {300.0, 640.0};  // V/rad
+    static constexpr double kd[2] = {6.0, 12.0};     // V.s/rad, on the gyro rates
     double target[3];
+    GimbalController pid;
 
-    void compute(double alpha, double beta, const double gyro[3], const double base[15], double u[2]) const {
-        double r_alpha, r_beta;
-        gimbal_angles_for(target, base[0], base[1], base[2], alpha, r_alpha, r_beta);
-        const double w_az = gyro[2] / std::max(std::cos(beta), 0.2);
-        const double w_el = gyro[0];
-        const double v1 = kp[0] * (r_alpha - alpha) - kd[0] * w_az;
-        const double v2 = kp[1] * (r_beta - beta) - kd[1] * w_el;
-        u[0] = std::min(std::max(v1, -u_limit[0]), u_limit[0]);
-        u[1] = std::min(std::max(v2, -u_limit[1]), u_limit[1]);
+    // Gains, the voltage limits (the motors' U_L: the output saturates there) and a state at rest.
+    void setup(const double u_limit[2]) {
+        std::memset(&pid, 0, sizeof pid);
+        pid.kind = gimbal_controller_kind("pid");
+        for (int i = 0; i < 2; ++i) {
+            pid.u_limit[i] = u_limit[i];
+            GimbalAxisPid& axis = pid.axis[i];
+            axis.kp = kp[i];
+            axis.k_gyro = kd[i];
+            axis.u_limit = axis.i_limit = u_limit[i];
+        }
+    }
+
+    void compute(long k, double h, double alpha, double beta, const double gyro[3], const double base[15], double u[2]) {
+        double set_point[4] = {0.0, 0.0, 0.0, 0.0}, reference[2];
+        gimbal_angles_for(target, base[0], base[1], base[2], alpha, set_point[0], set_point[1]);
+        const double measured[5] = {alpha, beta, gyro[0], gyro[1], gyro[2]};
+        gimbal_controller_step(&pid, k, h, measured, set_point, u, reference);
     }
 };
 
@@ -860,8 +843,8 @@ struct Run {
         // Stop time with half a step of slack: the accumulated time may pass n * h by rounding.
         check(fmi.setup_experiment(component, fmi2False, 0.0, 0.0, fmi2True, (n + 0.5) * h), "fmi2SetupExperiment");
         check(fmi.enter_initialization_mode(component), "fmi2EnterInitializationMode");
-        controller.u_limit[0] = get_real("motor1.U_L");
-        controller.u_limit[1] = get_real("motor2.U_L");
+        const double u_limit[2] = {get_real("motor1.U_L"), get_real("motor2.U_L")};
+        controller.setup(u_limit);
         const double N1 = get_real("gear1.N"), N2 = get_real("gear2.N");
         // Start on target with relaxed gears (rotor angle = N times the load's), at rest on the base.
         set_real("alpha", alpha0);
@@ -888,6 +871,19 @@ struct Run {
         if (record) trajectory.reserve(static_cast<size_t>(n + 1) * 6);
         double y[5];
         double u_next[2] = {0.0, 0.0};  // computed at t_k, applied over [t_{k+1}, t_{k+2}]
+        // The master's work at communication point `step` once the outputs are in y: the controller's
+        // command (applied one step later), the base inputs and the previous command to the FMU.
+        const auto command = [&](long step) {
+            sea.inputs(base);
+            double u[2];
+            controller.compute(step, h, y[0], y[1], y + 2, base, u);
+            in[0] = u_next[0];
+            in[1] = u_next[1];
+            std::memcpy(in + 2, base, sizeof base);
+            u_next[0] = u[0];
+            u_next[1] = u[1];
+            check(fmi.set_real(component, in_vr, 17, in), "fmi2SetReal inputs");
+        };
         backtrace(reinterpret_cast<void**>(y), 1);  // loads libgcc's unwinder now, not inside a measured step
 
         const double wall0 = clock_seconds(CLOCK_MONOTONIC), cpu0 = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
@@ -914,15 +910,7 @@ struct Run {
         for (; k < n; ++k, t += h) {
             check(fmi.get_real(component, out_vr, 5, y), "fmi2GetReal outputs");
             if (record) trajectory.insert(trajectory.end(), {t, y[0], y[1], y[2], y[3], y[4]});
-            sea.inputs(base);
-            double u[2];
-            controller.compute(y[0], y[1], y + 2, base, u);
-            in[0] = u_next[0];
-            in[1] = u_next[1];
-            std::memcpy(in + 2, base, sizeof base);
-            u_next[0] = u[0];
-            u_next[1] = u[1];
-            check(fmi.set_real(component, in_vr, 17, in), "fmi2SetReal inputs");
+            command(k);
 
             const uint64_t before = g_alloc.allocations, bytes_before = g_alloc.bytes;
             g_current_time = t;
@@ -1012,20 +1000,13 @@ struct Run {
             // The master's own share: the same loop (outputs, sea state, controller, inputs) without
             // doStep, on the final state. The FMU's share is cpu - master_cpu.
             sea.reset(0);
+            controller.setup(u_limit);
             u_next[0] = u_next[1] = 0.0;
             const double m0 = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
             for (long j = 0; j < k; ++j) {
                 check(fmi.get_real(component, out_vr, 5, y), "fmi2GetReal outputs");
                 if (record) trajectory[static_cast<size_t>(j) * 6] = j * h;  // same memory traffic
-                sea.inputs(base);
-                double u[2];
-                controller.compute(y[0], y[1], y + 2, base, u);
-                in[0] = u_next[0];
-                in[1] = u_next[1];
-                std::memcpy(in + 2, base, sizeof base);
-                u_next[0] = u[0];
-                u_next[1] = u[1];
-                check(fmi.set_real(component, in_vr, 17, in), "fmi2SetReal inputs");
+                command(j);
                 sea.advance();
             }
             report.master_cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - m0;

@@ -72,7 +72,7 @@ package_marker="$venv/.package-installed"
 if ! "$venv/bin/python" -I -c "import importlib.util as u, sys
 sys.exit(not u.find_spec('gimbal2axis'))" >/dev/null 2>&1 || [ ! -x "$venv/bin/gimbal2axis" ] ||
    [ "$repo/pyproject.toml" -nt "$package_marker" ] || [ "$repo/requirements-run.txt" -nt "$package_marker" ] ||
-   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/gimbal2axis/native" -name '*.c' -newer "$package_marker" 2>/dev/null)" ] ||
+   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/gimbal2axis/native" -newer "$package_marker" 2>/dev/null)" ] ||
    [ "$repo/CMakeLists.txt" -nt "$package_marker" ] ||   # the package's version is the CMake project's
    ! ls "$repo"/gimbal2axis/native/_native*.so >/dev/null 2>&1; then
   echo "[setup] installing the project's Python package (gimbal2axis, its command and C kernels) into .venv, editable"

@@ -11,9 +11,12 @@
  *
  * The scene: 3 s in steps of 1 ms at the default parameters (full fidelity, backlash in both gears),
  * the carrier rolling, pitching, yawing and heaving (sinusoids with their exact derivatives, set at
- * each step start), and a PD loop in this driver that slews the gimbal to fixed angles (0.1 rad
- * azimuth, -0.05 rad elevation) against that motion: the voltages saturate at first and the current
- * limiters and backlash stops switch. Every 10th step writes a CSV row of outputs and voltages.
+ * each step start; the scene runner's sums of sinusoids, gimbal2axis/native/sum_of_sines.h), and a PD
+ * loop that slews the gimbal to fixed angles (0.1 rad azimuth, -0.05 rad elevation) against that
+ * motion with the payload gyro as its rate signal (the scene runner's PID,
+ * gimbal2axis/native/controllers.h, with kp and k_gyro): the voltages saturate at first and the
+ * current limiters and backlash stops switch. Every 10th step writes a CSV row of outputs and
+ * voltages.
  *
  * Then, in the same process (one Wine start), each REFUSED_METHOD is set as solver.method on a fresh
  * instance, and the status of fmi2ExitInitializationMode is printed ("refusal: solver.method = M
@@ -47,8 +50,10 @@ static void* find_symbol(Library library, const char* name) { return dlsym(libra
 static void close_library(Library library) { dlclose(library); }
 #endif
 
+#include "controllers.h"
 #include "fmi2Functions.h"
 #include "fmi3Functions.h"
+#include "sum_of_sines.h"
 
 /* Value references: the position in the FMU's variable tables (the same tables it is built from). */
 enum {
@@ -231,25 +236,40 @@ static void free_instance(const Api* api, void* c) {
         api->free_instance(c);
 }
 
-/* The carrier's motion at time t: attitude, rates, accelerations (pitch delta, yaw psi, roll gamma)
- * and the velocity and acceleration of point a (heave along z). */
-static void base_motion(double t, double values[15]) {
-    static const double amplitude[3] = {0.03, 0.015, 0.08}; /* rad: pitch, yaw, roll */
-    static const double frequency[3] = {0.9, 0.5, 0.7};     /* rad/s */
-    static const double phase[3] = {0.5, 1.0, 0.0};
-    for (int k = 0; k < 3; ++k) {
-        const double a = amplitude[k], w = frequency[k] * 2.0 * 3.14159265358979323846, p = w * t + phase[k];
-        values[k] = a * sin(p);
-        values[3 + k] = a * w * cos(p);
-        values[6 + k] = -a * w * w * sin(p);
+/* The carrier's motion at t_k = k h, k = 0 .. steps: attitude, rates, accelerations (pitch delta, yaw
+ * psi, roll gamma; one sinusoid each) and the velocity and acceleration of point a (cruising along y,
+ * heaving along z), row k of a (steps + 1) x 15 table. 0 when out of memory. */
+enum { BASE_AXES = 4 }; /* pitch, yaw, roll, heave */
+static double* base_motion(long steps, double h) {
+    static const double amplitude[BASE_AXES] = {0.03, 0.015, 0.08, 0.5}; /* rad: pitch, yaw, roll; m: heave */
+    static const double phase[BASE_AXES] = {0.5, 1.0, 0.0, 0.0};
+    const double omega[BASE_AXES] = {0.9 * 2.0 * 3.14159265358979323846, 0.5 * 2.0 * 3.14159265358979323846,
+                                      0.7 * 2.0 * 3.14159265358979323846, 2.0 * 3.14159265358979323846 / 8.0};
+    const long rows = steps + 1;
+    double* table = calloc((size_t)rows * 15, sizeof(double));
+    double* sums = malloc((size_t)rows * 3 * sizeof(double));
+    int ok = table != NULL && sums != NULL;
+    for (int axis = 0; ok && axis < BASE_AXES; ++axis) {
+        double weights[3];
+        gimbal_sum_of_sines_weights(1, &amplitude[axis], &omega[axis], weights);
+        ok = gimbal_sum_of_sines(rows, 0.0, h, 1, &omega[axis], &phase[axis], weights, sums, sums + rows,
+                                 sums + 2 * rows) == 0;
+        /* attitude axes: the angle and its derivatives; heave: the velocity and acceleration of point a */
+        const int value_column = axis < 3 ? axis : -1, rate_column = axis < 3 ? 3 + axis : 11,
+                  acceleration_column = axis < 3 ? 6 + axis : 14;
+        for (long k = 0; ok && k < rows; ++k) {
+            if (value_column >= 0) table[15 * k + value_column] = sums[k];
+            table[15 * k + rate_column] = sums[rows + k];
+            table[15 * k + acceleration_column] = sums[2 * rows + k];
+        }
     }
-    const double heave = 0.5, w = 2.0 * 3.14159265358979323846 / 8.0;
-    values[9] = 0.0;
-    values[10] = 6.0; /* cruising: constant velocity along y */
-    values[11] = heave * w * cos(w * t);
-    values[12] = 0.0;
-    values[13] = 0.0;
-    values[14] = -heave * w * w * sin(w * t);
+    for (long k = 0; ok && k < rows; ++k) table[15 * k + 10] = 6.0; /* cruising: constant velocity along y */
+    free(sums);
+    if (!ok) {
+        free(table);
+        return NULL;
+    }
+    return table;
 }
 
 static const unsigned kBaseInputs[15] = {
@@ -263,7 +283,7 @@ static const unsigned kOutputs[] = {
 static const char* const kOutputNames =
     "alpha,alpha_m,beta,beta_m,alpha_dot,alpha_m_dot,beta_dot,beta_m_dot,i_R1,i_R2,theta_b1,theta_b2,T_E1,T_E2,"
     "los.omega[1],los.omega[2],los.omega[3]";
-enum { OUTPUT_COUNT = sizeof kOutputs / sizeof kOutputs[0] };
+enum { OUTPUT_COUNT = sizeof kOutputs / sizeof kOutputs[0], GYRO_COLUMN = OUTPUT_COUNT - 3 /* los.omega[1..3] */ };
 static const unsigned kCounters[] = {VI_events_total, VI_solver_steps};
 
 static int run_scene(const Api* api, const char* guid, const char* csv_path) {
@@ -275,21 +295,32 @@ static int run_scene(const Api* api, const char* guid, const char* csv_path) {
         free_instance(api, c);
         return 0;
     }
-    const double h = 1e-3, alpha_ref = 0.1, beta_ref = -0.05, kp = 400.0, kd = 8.0;
+    const double h = 1e-3;
     const int steps = 3000, every = 10;
-    double base[15], y[OUTPUT_COUNT], u[2] = {0.0, 0.0};
+    double y[OUTPUT_COUNT], u[2] = {0.0, 0.0};
     int counters[2], status = 0;
-    int ok = enter_initialization(api, c, steps * h);
-    base_motion(0.0, base);
+    /* PD: kp on the encoder angles, k_gyro on the gyro rates; no limit here (the motors' own clamp). */
+    GimbalController pd;
+    memset(&pd, 0, sizeof pd);
+    pd.kind = gimbal_controller_kind("pid");
+    for (int axis = 0; axis < 2; ++axis) {
+        pd.axis[axis].kp = 400.0;
+        pd.axis[axis].k_gyro = 8.0;
+        pd.axis[axis].u_limit = pd.axis[axis].i_limit = pd.u_limit[axis] = HUGE_VAL;
+    }
+    const double set_point[4] = {0.1, -0.05, 0.0, 0.0}; /* rad: azimuth, elevation; at rest */
+    double* base = base_motion(steps, h);
+    int ok = base != NULL && enter_initialization(api, c, steps * h);
     ok = ok && set_reals(api, c, kBaseInputs, 15, base) && exit_initialization(api, c, &status);
     fprintf(csv, "time,%s,u_R1,u_R2,events.total,solver.steps\n", kOutputNames);
     for (int k = 0; ok && k <= steps; ++k) {
         const double t = k * h;
         ok = get_reals(api, c, kOutputs, OUTPUT_COUNT, y) && get_integers(api, c, kCounters, 2, counters);
         if (!ok) break;
-        /* PD on the encoder angles and the joint rates, the new voltages applied over this step. */
-        u[0] = kp * (alpha_ref - y[0]) - kd * y[4];
-        u[1] = kp * (beta_ref - y[2]) - kd * y[6];
+        /* the new voltages applied over this step */
+        const double measured[5] = {y[0], y[2], y[GYRO_COLUMN], y[GYRO_COLUMN + 1], y[GYRO_COLUMN + 2]};
+        double reference[2];
+        gimbal_controller_step(&pd, k, h, measured, set_point, u, reference);
         if (k % every == 0) {
             fprintf(csv, "%.17g", t);
             for (int j = 0; j < OUTPUT_COUNT; ++j) fprintf(csv, ",%.17g", y[j]);
@@ -297,11 +328,12 @@ static int run_scene(const Api* api, const char* guid, const char* csv_path) {
         }
         if (k == steps) break;
         const unsigned voltages[2] = {VR_u_R1, VR_u_R2};
-        base_motion(t, base);
-        ok = set_reals(api, c, voltages, 2, u) && set_reals(api, c, kBaseInputs, 15, base) && do_step(api, c, t, h);
+        ok = set_reals(api, c, voltages, 2, u) && set_reals(api, c, kBaseInputs, 15, base + 15 * k) &&
+             do_step(api, c, t, h);
     }
     if (ok) terminate(api, c);
     free_instance(api, c);
+    free(base);
     fclose(csv);
     if (!ok) fprintf(stderr, "fmu_scene_driver: the scene failed (see the FMU's messages above)\n");
     return ok;

@@ -1,6 +1,11 @@
-"""The compiled communication loop (gimbal2axis/native/master_loop.c) against the Python loop: for every
-built-in controller, sensor model and delay, the two runs must agree to the bit in every recorded
-signal; and a failing FMU call must stop both with the same message."""
+"""The compiled communication loop (gimbal2axis/native/master_loop.c) against the Python loop
+(master.step_loop): for every built-in controller, sensor model and delay, the two runs must agree
+to the bit in every recorded signal; and a failing FMU call must stop both with the same message.
+
+Both loops call the kernel's controllers and sensors (the Python one through ctypes), so what this
+compares is the loops themselves: the records, the set point rows, the delay and zero-order hold, the
+state carried from step to step, the failure handling. The controllers' and sensors' equations are
+checked against independent references in tests/test_kernel.py."""
 import pathlib
 
 import numpy as np

@@ -1,20 +1,20 @@
-/* The base motion's sums of sinusoids on a uniform time grid, with their first two derivatives:
- *     q(t_k) = sum_j A_j sin(w_j t_k + phi_j),  q' = sum_j A_j w_j cos(...),  q'' = -sum_j A_j w_j^2 sin(...)
- * for t_k = t0 + k h. Per block of `block` rows, sin and cos of each component at the block's start
- * (libm), turned to the rows inside it by the rotation (cos, sin)(w_j m h), m < block (tabulated once):
- * a few multiply-adds per component and row instead of a sin and a cos. Blocks start at multiples
- * of `block` rows from t0, so a row's value depends only on its index: a shortened run gives the
- * same bits as the full one. The sums run over j in order (no reassociation: -ffp-contract=off and
- * no -ffast-math), so the bits do not depend on threads or on how many rows are asked for.
- *
- * rotation: 2 * block * components doubles of scratch (the caller's).
- * weights: value, rate and acceleration weights per component (A, A w, -A w^2), 3 * components.
- */
-#include <math.h>
+#include "sum_of_sines.h"
 
-void gimbal_sum_of_sines(long rows, double t0, double h, long components, const double* omega, const double* phase,
-                         const double* weights, long block, double* rotation, double* value, double* rate,
-                         double* acceleration) {
+#include <math.h>
+#include <stdlib.h>
+
+void gimbal_sum_of_sines_weights(long components, const double* amplitude, const double* omega, double* weights) {
+    for (long j = 0; j < components; ++j) {
+        weights[j] = amplitude[j];
+        weights[components + j] = amplitude[j] * omega[j];
+        weights[2 * components + j] = -amplitude[j] * (omega[j] * omega[j]);
+    }
+}
+
+long gimbal_sum_of_sines_rotation_doubles(long components) { return 2 * GIMBAL_SUM_OF_SINES_BLOCK * components; }
+
+void gimbal_sum_of_sines_rotation(double h, long components, const double* omega, double* rotation) {
+    const long block = GIMBAL_SUM_OF_SINES_BLOCK;
     double* rotation_cos = rotation;
     double* rotation_sin = rotation + block * components;
     for (long j = 0; j < components; ++j)
@@ -23,24 +23,49 @@ void gimbal_sum_of_sines(long rows, double t0, double h, long components, const 
             rotation_cos[j * block + m] = cos(angle);
             rotation_sin[j * block + m] = sin(angle);
         }
+}
+
+void gimbal_sum_of_sines_rows(long first, long count, double t0, double h, long components, const double* omega,
+                              const double* phase, const double* weights, const double* rotation, double* value,
+                              double* rate, double* acceleration) {
+    const long block = GIMBAL_SUM_OF_SINES_BLOCK;
+    const double* rotation_cos = rotation;
+    const double* rotation_sin = rotation + block * components;
     const double* value_weight = weights;
     const double* rate_weight = weights + components;
     const double* acceleration_weight = weights + 2 * components;
-    for (long first = 0; first < rows; first += block) {
-        const double start = t0 + (double)first * h;
-        const long count = rows - first < block ? rows - first : block;
-        for (long m = 0; m < count; ++m) value[first + m] = rate[first + m] = acceleration[first + m] = 0.0;
+    const long end = first + count;
+    for (long row = first; row < end;) {
+        const long block_start = row - row % block;
+        const long stop = block_start + block < end ? block_start + block : end;
+        const double start = t0 + (double)block_start * h;
+        double* q = value + (row - first);
+        double* q_dot = rate + (row - first);
+        double* q_ddot = acceleration + (row - first);
+        for (long r = 0; r < stop - row; ++r) q[r] = q_dot[r] = q_ddot[r] = 0.0;
         for (long j = 0; j < components; ++j) {
             const double argument = omega[j] * start + phase[j];
             const double start_sin = sin(argument), start_cos = cos(argument);
-            for (long m = 0; m < count; ++m) {
-                const double c = rotation_cos[j * block + m], s = rotation_sin[j * block + m];
-                const double row_sin = start_sin * c + start_cos * s;
-                const double row_cos = start_cos * c - start_sin * s;
-                value[first + m] += value_weight[j] * row_sin;
-                rate[first + m] += rate_weight[j] * row_cos;
-                acceleration[first + m] += acceleration_weight[j] * row_sin;
+            const double* c = rotation_cos + j * block + (row - block_start);
+            const double* s = rotation_sin + j * block + (row - block_start);
+            for (long r = 0; r < stop - row; ++r) {
+                const double row_sin = start_sin * c[r] + start_cos * s[r];
+                const double row_cos = start_cos * c[r] - start_sin * s[r];
+                q[r] += value_weight[j] * row_sin;
+                q_dot[r] += rate_weight[j] * row_cos;
+                q_ddot[r] += acceleration_weight[j] * row_sin;
             }
         }
+        row = stop;
     }
+}
+
+int gimbal_sum_of_sines(long rows, double t0, double h, long components, const double* omega, const double* phase,
+                        const double* weights, double* value, double* rate, double* acceleration) {
+    double* rotation = malloc(sizeof(double) * (size_t)gimbal_sum_of_sines_rotation_doubles(components > 0 ? components : 1));
+    if (rotation == NULL) return -1;
+    gimbal_sum_of_sines_rotation(h, components, omega, rotation);
+    gimbal_sum_of_sines_rows(0, rows, t0, h, components, omega, phase, weights, rotation, value, rate, acceleration);
+    free(rotation);
+    return 0;
 }

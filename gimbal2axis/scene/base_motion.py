@@ -59,57 +59,41 @@ class _SumOfSines(BaseMotion):
         self.offsets = offsets        # angle axis index -> offset [rad]
         self.velocity = np.asarray(velocity, dtype=float)
 
-    # Rows of a uniform time grid evaluated per block: sin and cos of every component at the block's
-    # start, rotated to the rows inside it by exp(i w m h) (tabulated once per run). In C
-    # (native/sum_of_sines.c) when the package's kernels are built, else with numpy; both within
-    # 1e-13 of sin and cos of every entry (tested); the C kernel's bits do not depend on threads or on
-    # how many rows are asked for.
-    _BLOCK = 128
-    _CHUNK_ROWS = 8192   # bounds the memory of a long run's (rows x components) arrays (numpy)
+    # A uniform time grid is the C kernel's (gimbal2axis/native/sum_of_sines.c: blockwise, its bits
+    # independent of threads and of how many rows are asked for); other times (a single instant,
+    # an irregular grid) are evaluated directly here, sin and cos of every entry.
+    _CHUNK_ROWS = 8192   # bounds the memory of the direct evaluation's (rows x components) arrays
 
     @classmethod
     def _eval(cls, terms, t):
         """sum_i A_i sin(w_i t + phi_i) and its first two time derivatives, at the times t."""
-        amplitude, omega, phase = terms
-        weights = (amplitude, amplitude * omega, -amplitude * omega**2)
+        kernel = native.kernel()
+        amplitude, omega, phase = (np.ascontiguousarray(x, dtype=float) for x in terms)
+        count = len(omega)
+        weights = np.empty(3 * count)
+        kernel.gimbal_sum_of_sines_weights(count, amplitude.ctypes.data, omega.ctypes.data, weights.ctypes.data)
         n = len(t)
         step = t[1] - t[0] if n > 1 else 0.0
         # Every uniform grid, however short: a row's value then depends only on its index and the step
         # (blocks start at fixed multiples), so a shortened run gives the same bits as the full one.
-        uniform = n > 1 and step > 0 and np.array_equal(t, t[0] + np.arange(n) * step)
-        kernels = native.library()
-        if uniform and kernels is not None:
-            return cls._eval_compiled(kernels, weights, omega, phase, float(t[0]), float(step), n)
-        results = [np.empty(n) for _ in weights]
-        rotation = np.exp(1j * np.outer(np.arange(cls._BLOCK) * step, omega)) if uniform else None
+        if n > 1 and step > 0 and np.array_equal(t, t[0] + np.arange(n) * step):
+            results = [np.empty(n) for _ in range(3)]
+            if kernel.gimbal_sum_of_sines(n, float(t[0]), float(step), count, omega.ctypes.data, phase.ctypes.data,
+                                          weights.ctypes.data, *(r.ctypes.data for r in results)) != 0:
+                raise MemoryError("the sum of sinusoids' rotation table")
+            return tuple(results)
+        weights = weights.reshape(3, count)
+        results = [np.empty(n) for _ in range(3)]
         for first in range(0, n, cls._CHUNK_ROWS):
             rows = slice(first, min(first + cls._CHUNK_ROWS, n))
-            if uniform:
-                count = rows.stop - rows.start
-                blocks = -(-count // cls._BLOCK)
-                starts = t[0] + (first + np.arange(blocks) * cls._BLOCK) * step
-                at_starts = np.exp(1j * (np.outer(starts, omega) + phase))
-                z = (at_starts[:, None, :] * rotation[None, :, :]).reshape(blocks * cls._BLOCK, -1)[:count]
-                s, c = z.imag, z.real
-            else:
-                arg = np.outer(t[rows], omega) + phase
-                s, c = np.sin(arg), np.cos(arg)
+            arg = np.outer(t[rows], omega) + phase
+            s, c = np.sin(arg), np.cos(arg)
             # Not `s @ amplitude`: a BLAS matrix-vector product sums in an order that depends on its
             # thread count (Dask workers run BLAS single-threaded), so a case would give other bits on a
             # worker than in a serial sweep. einsum's own loop sums the same way everywhere.
             results[0][rows] = np.einsum("ij,j->i", s, weights[0])
             results[1][rows] = np.einsum("ij,j->i", c, weights[1])
             results[2][rows] = np.einsum("ij,j->i", s, weights[2])
-        return tuple(results)
-
-    @classmethod
-    def _eval_compiled(cls, kernels, weights, omega, phase, t0: float, step: float, n: int):
-        omega, phase = np.ascontiguousarray(omega, dtype=float), np.ascontiguousarray(phase, dtype=float)
-        stacked = np.ascontiguousarray(np.concatenate(weights), dtype=float)
-        rotation = np.empty(2 * cls._BLOCK * len(omega))
-        results = [np.empty(n) for _ in weights]
-        kernels.gimbal_sum_of_sines(n, t0, step, len(omega), omega.ctypes.data, phase.ctypes.data, stacked.ctypes.data,
-                                    cls._BLOCK, rotation.ctypes.data, *(r.ctypes.data for r in results))
         return tuple(results)
 
     def sample(self, t):

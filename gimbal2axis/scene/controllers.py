@@ -11,9 +11,14 @@ set points by inverse kinematics of the line-of-sight target for the measured ba
 Rate signals: the payload gyro los.omega (frame 2) gives the inertial rate about the elevation
 axis, w[1], and the cross-elevation rate w[3]; w[3] / cos(beta) is the azimuth rate that moves
 the line of sight (secant correction). On a fixed base these equal beta_dot and alpha_dot.
+
+The built-in controllers' arithmetic is the C kernel's (gimbal2axis/native/controllers.c), one
+implementation for the Python loop (through ctypes, here) and the compiled loop: each object keeps
+its state in the kernel's struct (`state`), which the compiled loop copies.
 """
 from __future__ import annotations
 
+import ctypes
 import importlib
 import importlib.util
 import inspect
@@ -22,6 +27,7 @@ import pathlib
 import sys
 
 from . import geometry
+from .. import native
 from ..errors import SceneError, check_keys, number
 from .references import Reference
 from .setpoints import plan_set_points
@@ -43,6 +49,31 @@ class Controller:
         self.voltage = tuple(voltage)
         self.u_limit = tuple(u_limit)
         self.reference = (math.nan, math.nan)   # last set points, for the record
+        self._setup_kernel()
+
+    def _setup_kernel(self) -> None:
+        """The kernel's struct of this controller (kind, limits, constant voltages) and the buffers
+        a step passes it: measured (alpha, beta, gyro), set point, voltages, reference."""
+        kernel = native.kernel()
+        self.state = native.struct("GimbalController")()
+        self.state.kind = kernel.gimbal_controller_kind(self.kind.encode())
+        self.state.voltage[:] = self.voltage
+        self.state.u_limit[:] = self.u_limit
+        self._buffer = (ctypes.c_double * 13)()
+        address, size = ctypes.addressof(self._buffer), ctypes.sizeof(ctypes.c_double)
+        self._measured, self._set_point, self._u, self._reference = (address + i * size for i in (0, 5, 9, 11))
+
+    def _step(self, step: int, h: float, alpha: float, beta: float, gyro, set_point=None) -> tuple:
+        """The kernel's controller at communication point `step`; set_point (r1, r2, r1_dot, r2_dot),
+        or None for the prepared set points of that step."""
+        buffer = self._buffer
+        buffer[0], buffer[1], buffer[2:5] = alpha, beta, gyro
+        if set_point is not None:
+            buffer[5:9] = set_point
+        native.kernel().gimbal_controller_step(ctypes.addressof(self.state), step, h, self._measured,
+                                               None if set_point is None else self._set_point, self._u,
+                                               self._reference)
+        return buffer[9], buffer[10]
 
     def start(self, step_size: float, scene_name: str) -> None:
         """Called by the master before every run (the built-in controllers need nothing)."""
@@ -53,7 +84,7 @@ class Controller:
 
     def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude, base_rates,
                  step: int | None = None) -> tuple:
-        return self.voltage
+        return self._step(step or 0, h, alpha, beta, gyro)
 
     def clamp(self, u: float, axis: int) -> float:
         limit = self.u_limit[axis]
@@ -64,11 +95,21 @@ class _ReferenceMixin:
     set_points = None   # SetPoints of the run, once prepared
 
     def prepare(self, times, h, attitude, rates) -> None:
-        self.set_points = plan_set_points(self.refs, self.target, times, h, attitude, rates)
+        points = self.set_points = plan_set_points(self.refs, self.target, times, h, attitude, rates)
+        kernel_points = self.state.set_points
+        kernel_points.values, kernel_points.rates = points.values.ctypes.data, points.rates.ctypes.data
+        kernel_points.unwrap[:] = points.unwrap
 
-    def _prepared_references(self, step: int, alpha: float, beta: float):
-        points = self.set_points
-        return points.at(step, 0, alpha), points.at(step, 1, beta), points.rate_rows[step]
+    def _step_with_references(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step) -> tuple:
+        """The kernel's step with the prepared set points of `step`, or, called outside a run (no
+        step, or not prepared), with set points computed here from the references."""
+        if step is None or self.set_points is None:
+            set_point = self._references(t, alpha, base_attitude, base_rates, h)
+            u = self._step(step or 0, h, alpha, beta, gyro, set_point)
+        else:
+            u = self._step(step, h, alpha, beta, gyro)
+        self.reference = (self._buffer[11], self._buffer[12])
+        return u
 
     def _setup_references(self, spec: dict, target):
         self.target = target
@@ -106,7 +147,8 @@ class _ReferenceMixin:
 
 
 class AxisPID:
-    """u = kp e + ki int(e) + kd de/dt - k_gyro w + k_ff r_dot, e = reference - encoder angle, de/dt a
+    """The gains of one axis of the PID (the kernel's GimbalAxisPid computes it, with its state):
+    u = kp e + ki int(e) + kd de/dt - k_gyro w + k_ff r_dot, e = reference - encoder angle, de/dt a
     backward difference through a first-order filter (time constant d_filter_s), w the gyro rate
     about the axis, r_dot the rate of the reference relative to the base (feed-forward: k_ff = N k_emf
     cancels the motor's back-emf). Anti-windup: the integral stops while the output is saturated in the direction of e,
@@ -119,23 +161,11 @@ class AxisPID:
         self.tau = number(f"{where}.d_filter_s", spec.get("d_filter_s", 0.0))
         self.i_limit = number(f"{where}.i_limit_V", spec["i_limit_V"]) if "i_limit_V" in spec else u_limit
         self.u_limit = u_limit
-        self.integral = 0.0
-        self.e_prev = None
-        self.d = 0.0
-        self.saturated = 0
 
-    def __call__(self, e: float, rate: float, h: float, ref_rate: float = 0.0) -> float:
-        if self.e_prev is not None:
-            raw = (e - self.e_prev) / h
-            self.d += (h / (self.tau + h)) * (raw - self.d)
-        self.e_prev = e
-        if self.ki != 0.0 and not (self.saturated * e > 0):
-            self.integral += e * h
-            if abs(self.ki * self.integral) > self.i_limit:
-                self.integral = math.copysign(self.i_limit / abs(self.ki), self.integral)
-        u = self.kp * e + self.ki * self.integral + self.kd * self.d - self.k_gyro * rate + self.k_ff * ref_rate
-        self.saturated = 1 if u > self.u_limit else -1 if u < -self.u_limit else 0
-        return min(max(u, -self.u_limit), self.u_limit)
+    def to_kernel(self, axis) -> None:
+        """Writes the gains into the kernel's GimbalAxisPid `axis` (its state starts at rest)."""
+        axis.kp, axis.ki, axis.kd, axis.k_gyro, axis.k_ff = self.kp, self.ki, self.kd, self.k_gyro, self.k_ff
+        axis.d_filter_s, axis.i_limit, axis.u_limit = self.tau, self.i_limit, self.u_limit
 
 
 class PID(_ReferenceMixin, Controller):
@@ -144,22 +174,18 @@ class PID(_ReferenceMixin, Controller):
     def __init__(self, spec: dict, target, u_limit):
         super().__init__(u_limit=u_limit)
         self.axes = [AxisPID(f"controller.{axis}", spec.get(axis, {}), u_limit[i]) for i, axis in enumerate(AXES)]
+        for axis, kernel_axis in zip(self.axes, self.state.axis):
+            axis.to_kernel(kernel_axis)
         self._setup_references(spec, target)
 
     def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
-        if step is None or self.set_points is None:
-            r1, r2, r1_dot, r2_dot = self._references(t, alpha, base_attitude, base_rates, h)
-        else:
-            r1, r2, (r1_dot, r2_dot) = self._prepared_references(step, alpha, beta)
-        self.reference = (r1, r2)
-        w_az, w_el = gyro_axis_rates(gyro, beta)
-        return self.axes[0](r1 - alpha, w_az, h, r1_dot), self.axes[1](r2 - beta, w_el, h, r2_dot)
+        return self._step_with_references(t, h, alpha, beta, gyro, base_attitude, base_rates, step)
 
 
 class StateFeedback(_ReferenceMixin, Controller):
     """u = -K x + ki * int(reference - angle), x = [alpha - alpha_ref, beta - beta_ref, w_az, w_el],
     K a 2x4 matrix [V/rad, V s/rad]; rates from the gyro (rate_source = "gyro") or from backward
-    differences of the encoder angles ("encoder")."""
+    differences of the encoder angles ("encoder"). Computed by the kernel (GimbalController)."""
     kind = "state_feedback"
 
     def __init__(self, spec: dict, target, u_limit):
@@ -175,29 +201,12 @@ class StateFeedback(_ReferenceMixin, Controller):
         self.rate_source = spec.get("rate_source", "gyro")
         if self.rate_source not in ("gyro", "encoder"):
             raise SceneError("[controller] rate_source must be 'gyro' or 'encoder'")
-        self.integral = [0.0, 0.0]
-        self.prev = None
+        self.state.gain[:] = self.K[0] + self.K[1]
+        self.state.state_ki[:] = self.ki
+        self.state.rate_from_encoder = self.rate_source == "encoder"
 
     def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
-        if step is None or self.set_points is None:
-            r1, r2 = self._references(t, alpha, base_attitude)
-        else:
-            r1, r2, _ = self._prepared_references(step, alpha, beta)
-        self.reference = (r1, r2)
-        if self.rate_source == "gyro":
-            w_az, w_el = gyro_axis_rates(gyro, beta)
-        else:
-            w_az, w_el = (0.0, 0.0) if self.prev is None else ((alpha - self.prev[0]) / h, (beta - self.prev[1]) / h)
-            self.prev = (alpha, beta)
-        x = (alpha - r1, beta - r2, w_az, w_el)
-        u = []
-        for i in range(2):
-            v = -sum(k * xi for k, xi in zip(self.K[i], x)) + self.ki[i] * self.integral[i]
-            limited = self.clamp(v, i)
-            if self.ki[i] != 0.0 and limited == v:      # anti-windup: integrate only when unsaturated
-                self.integral[i] += -x[i] * h
-            u.append(limited)
-        return tuple(u)
+        return self._step_with_references(t, h, alpha, beta, gyro, base_attitude, base_rates, step)
 
 
 class Replay(Controller):
@@ -210,12 +219,7 @@ class Replay(Controller):
 
         super().__init__(u_limit=u_limit)
         self.voltages = np.ascontiguousarray(voltages, dtype=float)
-        self.rows = None
-
-    def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
-        if self.rows is None:
-            self.rows = [tuple(row) for row in self.voltages.tolist()]
-        return self.rows[step]
+        self.state.replayed = self.voltages.ctypes.data
 
 
 class Measurements:
@@ -339,6 +343,9 @@ class UserController(Controller):
                                  "reset(context) and step(t, measurements)")
         self.delay_steps = int(spec.get("delay_steps", 1))
         self.batch = getattr(cls, "batch", False) is True
+
+    def _setup_kernel(self) -> None:
+        """None: the user's class computes the voltages, in Python."""
 
     def start(self, step_size: float, scene_name: str) -> None:
         self.user.reset(ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name))

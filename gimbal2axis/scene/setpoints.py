@@ -5,9 +5,9 @@ loop and vectorised over it: by inverse kinematics of the target for the measure
 Per axis: the set point at t_k and its rate. For a target, the rate is the derivative of the inverse
 kinematics along the measured base rates (a difference over 1e-6 s of attitude); for the other
 references, the difference quotient over one step. The azimuth to a target is stored as its
-principal value: each step takes the 2 pi branch nearest the measured azimuth (`at`), so a gimbal
-that has turned a full circle keeps tracking without a jump. Python loop and compiled loop read the
-same arrays, with the same arithmetic.
+principal value: each step takes the 2 pi branch nearest the measured azimuth (the kernel's
+controllers.c, for both loops), so a gimbal that has turned a full circle keeps tracking without a
+jump.
 """
 from __future__ import annotations
 
@@ -41,27 +41,6 @@ class SetPoints:
         self.values = np.ascontiguousarray(values, dtype=float)
         self.rates = np.ascontiguousarray(rates, dtype=float)
         self.unwrap = tuple(bool(u) for u in unwrap)
-        self._rows = self._rate_rows = None
-
-    # The Python loop reads Python floats (they cost less per step than numpy rows); the compiled
-    # loop reads the arrays, so the lists are made only when asked for.
-    @property
-    def rows(self) -> list:
-        if self._rows is None:
-            self._rows = self.values.tolist()
-        return self._rows
-
-    @property
-    def rate_rows(self) -> list:
-        if self._rate_rows is None:
-            self._rate_rows = self.rates.tolist()
-        return self._rate_rows
-
-    def at(self, k: int, axis: int, measured: float) -> float:
-        principal = self.rows[k][axis]
-        if not self.unwrap[axis]:
-            return principal
-        return principal + TWO_PI * round((measured - principal) / TWO_PI)
 
 
 def plan_set_points(references: list, target, times: np.ndarray, h: float, attitude: np.ndarray,

@@ -1,7 +1,7 @@
 /* Analysis entries into the dynamics core, built as libgimbal_probe.so beside the FMU (never part of
  * it: the FMU exports only fmi2*).
- * - The linearization of the continuous model (docs/linearization.md), which scripts/linearize.py
- *   and scene_lib.linearization use.
+ * - The linearization of the continuous model (docs/linearization.md), which `gimbal2axis linearize`
+ *   and gimbal2axis.analysis.linearization use.
  * - J(q) and f(q, qd, base motion) of the rigid-body equations, which the tests compare with an
  *   independent symbolic derivation. */
 #ifndef GIMBAL_PROBE_API_H
