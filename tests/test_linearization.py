@@ -326,3 +326,29 @@ def test_a_running_instance_is_linearized_where_it_is_and_left_undisturbed(gimba
     for name in "ABCD":
         expected, got = getattr(direct, name), getattr(model, name)
         assert np.allclose(got, expected, rtol=1e-7, atol=1e-9 * np.max(np.abs(expected))), name
+
+
+def test_the_linear_model_struct_is_built_from_the_library_and_checked_against_its_size(probe_lib_path):
+    """The binding asks the library for GimbalLinearModel's dimensions and size; a library whose struct
+    does not match what the fields make is refused by name, not read at the wrong offsets."""
+    import ctypes
+
+    from gimbal2axis.analysis import linearization
+    from gimbal2axis.errors import SceneError
+
+    library = ctypes.CDLL(str(probe_lib_path))
+    struct_type, dimensions = linearization._linear_model_struct(library)
+    assert dimensions == (12, 17, 17)
+
+    class OtherVersion:
+        """The real library, except that it reports one state more."""
+        def __init__(self, real):
+            self.gimbal_probe_linear_model_layout = self
+            self._real = real.gimbal_probe_linear_model_layout
+
+        def __call__(self, states, inputs, outputs, size):
+            self._real(states, inputs, outputs, size)
+            ctypes.cast(states, ctypes.POINTER(ctypes.c_int))[0] += 1
+
+    with pytest.raises(SceneError, match="GimbalLinearModel has .* bytes"):
+        linearization._linear_model_struct(OtherVersion(library))

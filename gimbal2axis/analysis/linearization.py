@@ -34,9 +34,7 @@ from ..locations import probe_library_path
 
 REAL, INTEGER, BOOLEAN = 0, 1, 2
 INPUT_CAUSALITY = 1
-MAX_STATES, INPUTS, OUTPUTS = 12, 17, 17
-SERIALIZED_HEADER_BYTES = 128   # fmu_src/fmu_state.h: the wrapper's header before the core's snapshot
-SERIALIZED_MAGIC = 0x46535441   # its first field, STATE_MAGIC ("FSTA"); then the format version and the size
+SERIALIZED_MAGIC = 0x46535441   # the first field of the wrapper's FMU-state header ("FSTA"); then the format version and the size
 FRICTION_MODES = ["none", "slipping +", "slipping -", "stuck", "at break-away +", "at break-away -"]
 
 
@@ -44,20 +42,35 @@ class _Setting(ctypes.Structure):
     _fields_ = [("type", ctypes.c_int), ("vr", ctypes.c_uint), ("value", ctypes.c_double)]
 
 
-class _LinearModel(ctypes.Structure):
-    _fields_ = [("state_count", ctypes.c_int),
-                ("state_vr", ctypes.c_uint * MAX_STATES),
-                ("input_vr", ctypes.c_uint * INPUTS),
-                ("output_vr", ctypes.c_uint * OUTPUTS),
-                ("A", ctypes.c_double * (MAX_STATES * MAX_STATES)),
-                ("B", ctypes.c_double * (MAX_STATES * INPUTS)),
-                ("C", ctypes.c_double * (OUTPUTS * MAX_STATES)),
-                ("D", ctypes.c_double * (OUTPUTS * INPUTS)),
-                ("gear_contact", ctypes.c_int * 2),
-                ("motor_limited", ctypes.c_int * 2),
-                ("voltage_clamped", ctypes.c_int * 2),
-                ("friction", ctypes.c_int * 4),
-                ("time", ctypes.c_double)]
+def _linear_model_struct(lib):
+    """The ctypes view of GimbalLinearModel, its dimensions asked from the library (not copied here) and
+    its size checked against the library's sizeof."""
+    lib.gimbal_probe_linear_model_layout.restype = None
+    lib.gimbal_probe_linear_model_layout.argtypes = [ctypes.POINTER(ctypes.c_int)] * 3 + [ctypes.POINTER(ctypes.c_size_t)]
+    max_states, inputs, outputs, size = ctypes.c_int(), ctypes.c_int(), ctypes.c_int(), ctypes.c_size_t()
+    lib.gimbal_probe_linear_model_layout(ctypes.byref(max_states), ctypes.byref(inputs), ctypes.byref(outputs),
+                                         ctypes.byref(size))
+    n, m, p = max_states.value, inputs.value, outputs.value
+
+    class LinearModelStruct(ctypes.Structure):
+        _fields_ = [("state_count", ctypes.c_int),
+                    ("state_vr", ctypes.c_uint * n),
+                    ("input_vr", ctypes.c_uint * m),
+                    ("output_vr", ctypes.c_uint * p),
+                    ("A", ctypes.c_double * (n * n)),
+                    ("B", ctypes.c_double * (n * m)),
+                    ("C", ctypes.c_double * (p * n)),
+                    ("D", ctypes.c_double * (p * m)),
+                    ("gear_contact", ctypes.c_int * 2),
+                    ("motor_limited", ctypes.c_int * 2),
+                    ("voltage_clamped", ctypes.c_int * 2),
+                    ("friction", ctypes.c_int * 4),
+                    ("time", ctypes.c_double)]
+
+    if ctypes.sizeof(LinearModelStruct) != size.value:
+        raise SceneError(f"the probe library's GimbalLinearModel has {size.value} bytes where its fields as read here "
+                         f"make {ctypes.sizeof(LinearModelStruct)}: gimbal2axis and the library come from different versions")
+    return LinearModelStruct, (n, m, p)
 
 
 class Probe:
@@ -70,9 +83,10 @@ class Probe:
         lib.gimbal_probe_variable.argtypes = [ctypes.c_int, ctypes.c_uint, ctypes.POINTER(ctypes.c_char_p),
                                               ctypes.POINTER(ctypes.c_int)]
         lib.gimbal_probe_snapshot_size.restype = ctypes.c_size_t
+        self._model_struct, self.dimensions = _linear_model_struct(lib)
         lib.gimbal_probe_linearize.restype = ctypes.c_int
         lib.gimbal_probe_linearize.argtypes = [ctypes.POINTER(_Setting), ctypes.c_size_t, ctypes.c_void_p,
-                                               ctypes.c_size_t, ctypes.POINTER(_LinearModel), ctypes.c_char_p,
+                                               ctypes.c_size_t, ctypes.POINTER(self._model_struct), ctypes.c_char_p,
                                                ctypes.c_size_t]
         self._lib = lib
         self.variables: dict[str, tuple[int, int, int]] = {}   # name -> (type, vr, causality)
@@ -111,17 +125,18 @@ class Probe:
                 raise SceneError(f"linearize: the snapshot has {len(snapshot)} bytes where {self.path} expects "
                                  f"{self.snapshot_size}: the FMU and the probe library come from different builds")
             buffer = ctypes.create_string_buffer(bytes(snapshot), len(snapshot))
-        model = _LinearModel()
+        model = self._model_struct()
         message = ctypes.create_string_buffer(1024)
         status = self._lib.gimbal_probe_linearize(settings, len(values), buffer, len(snapshot or b""),
                                                   ctypes.byref(model), message, len(message))
         if status != 0:
             raise SceneError(f"linearize: {message.value.decode(errors='replace')}")
         n = model.state_count
-        A = np.ctypeslib.as_array(model.A).reshape(MAX_STATES, MAX_STATES)[:n, :n].copy()
-        B = np.ctypeslib.as_array(model.B).reshape(MAX_STATES, INPUTS)[:n].copy()
-        C = np.ctypeslib.as_array(model.C).reshape(OUTPUTS, MAX_STATES)[:, :n].copy()
-        D = np.ctypeslib.as_array(model.D).reshape(OUTPUTS, INPUTS).copy()
+        max_states, input_count, output_count = self.dimensions
+        A = np.ctypeslib.as_array(model.A).reshape(max_states, max_states)[:n, :n].copy()
+        B = np.ctypeslib.as_array(model.B).reshape(max_states, input_count)[:n].copy()
+        C = np.ctypeslib.as_array(model.C).reshape(output_count, max_states)[:, :n].copy()
+        D = np.ctypeslib.as_array(model.D).reshape(output_count, input_count).copy()
         modes = {}
         for axis in (0, 1):
             modes[f"gear{axis + 1}.contact"] = int(model.gear_contact[axis])
@@ -131,8 +146,8 @@ class Probe:
             modes[f"{name}.friction"] = FRICTION_MODES[model.friction[body]]
         return LinearModel(A=A, B=B, C=C, D=D,
                            states=[self.real_names[model.state_vr[k]] for k in range(n)],
-                           inputs=[self.real_names[model.input_vr[k]] for k in range(INPUTS)],
-                           outputs=[self.real_names[model.output_vr[k]] for k in range(OUTPUTS)],
+                           inputs=[self.real_names[model.input_vr[k]] for k in range(input_count)],
+                           outputs=[self.real_names[model.output_vr[k]] for k in range(output_count)],
                            modes=modes, time=float(model.time),
                            point={name: float(value) for name, value in values.items()})
 
@@ -288,8 +303,11 @@ def linearize_instance(fmu, slave, inputs: dict | None = None, build_dir: str | 
     if magic != SERIALIZED_MAGIC or recorded_size != len(serialized):
         raise SceneError(f"linearize: {fmu.path} handed out an FMU state that does not start like one of this "
                          f"project's FMUs (magic {magic:#x}, recorded size {recorded_size})")
-    if len(serialized) != SERIALIZED_HEADER_BYTES + probe.snapshot_size:
-        raise SceneError(f"linearize: {fmu.path} serializes {len(serialized)} bytes where {probe.path} expects "
-                         f"{SERIALIZED_HEADER_BYTES + probe.snapshot_size}: they come from different builds")
-    model = probe.linearize(inputs, snapshot=serialized[SERIALIZED_HEADER_BYTES:])
+    # The core's snapshot is the tail of the record; the wrapper's header before it is whatever the rest is
+    # (its size is the wrapper's, not copied here). The core checks the snapshot's own format and size.
+    header_bytes = len(serialized) - probe.snapshot_size
+    if header_bytes < struct.calcsize("<IIQ"):
+        raise SceneError(f"linearize: {fmu.path} serializes {len(serialized)} bytes, too few for the "
+                         f"{probe.snapshot_size}-byte model state {probe.path} expects: they come from different builds")
+    model = probe.linearize(inputs, snapshot=serialized[header_bytes:])
     return model

@@ -42,6 +42,10 @@ int gimbal_probe_variable(int type, unsigned vr, const char** name, int* causali
  * then these bytes). */
 size_t gimbal_probe_snapshot_size(void);
 
+/* The dimensions of GimbalLinearModel (gimbal_c_api.h) and its size in bytes, so that a binding builds
+ * its view of the struct from the library instead of copying the numbers. */
+void gimbal_probe_linear_model_layout(int* max_states, int* inputs, int* outputs, size_t* size);
+
 typedef struct GimbalProbeSetting {
     int type; /* GimbalType */
     unsigned vr;

@@ -53,6 +53,13 @@ extern "C" int gimbal_probe_variable(int type, unsigned vr, const char** name, i
 
 extern "C" size_t gimbal_probe_snapshot_size(void) { return gimbal_core_snapshot_size(); }
 
+extern "C" void gimbal_probe_linear_model_layout(int* max_states, int* inputs, int* outputs, size_t* size) {
+    if (max_states != nullptr) *max_states = GIMBAL_LINEAR_MAX_STATES;
+    if (inputs != nullptr) *inputs = GIMBAL_LINEAR_INPUTS;
+    if (outputs != nullptr) *outputs = GIMBAL_LINEAR_OUTPUTS;
+    if (size != nullptr) *size = sizeof(GimbalLinearModel);
+}
+
 extern "C" int gimbal_probe_linearize(const GimbalProbeSetting* settings, size_t setting_count, const void* snapshot,
                                       size_t snapshot_size, GimbalLinearModel* model, char* message,
                                       size_t message_size) {
