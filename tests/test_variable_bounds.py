@@ -129,3 +129,16 @@ def test_enumeration_items_are_the_accepted_values(gimbal_fmu, name):
         log = []
         assert _exit_initialization(gimbal_fmu, {name: value}, log) == ERROR, (name, value)
         assert any(level == ERROR and name in text for level, _, text in log), log
+
+
+def test_an_enumeration_refusal_lists_the_items_of_the_model_description(gimbal_fmu):
+    """The refusal of a value outside an Enumeration is made from the same table as modelDescription.xml's
+    items: every item, by value and name, the start value marked as the default."""
+    for name in ("gear1.model", "motor2.model", "solver.method"):
+        v = gimbal_fmu.variable(name)
+        log = []
+        assert _exit_initialization(gimbal_fmu, {name: 99}, log) == ERROR
+        text = next(text for level, _, text in log if level == ERROR and name in text)
+        for item in v.declaredType.items:
+            default = ", the default" if int(item.value) == int(v.start) else ""
+            assert f"{item.value} ({item.name}{default})" in text, (item.name, text)

@@ -72,11 +72,12 @@ namespace enumeration {
 
 struct Item {
     const char* type;
+    const char* name;
     int value;
 };
 constexpr Item kItems[] = {
 #define TYPE(id, description)
-#define ITEM(type, item, value, description) {#type, value},
+#define ITEM(type, item, value, description) {#type, #item, value},
 #include "gimbal/enumeration_types.def"
 #undef ITEM
 #undef TYPE
@@ -118,6 +119,30 @@ static_assert(variable_table::joins(variable_table::kInteger[vi_gear1_model].dec
                   variable_table::joins(variable_table::kInteger[vi_motor2_model].declared_type, "MotorModel", "") &&
                   variable_table::joins(variable_table::kInteger[vi_solver_method].declared_type, "IntegrationMethod", ""),
               "the structural selectors are declared with the Enumeration types they are validated against");
+
+// An Enumeration-typed parameter takes exactly its type's items; the refusal lists them (the start
+// value marked as the default), so a new item needs no new message.
+bool is_item(const char* type, int value) {
+    for (const Item& item : kItems)
+        if (variable_table::joins(item.type, type, "") && item.value == value) return true;
+    return false;
+}
+
+bool within_items(IntegerVariable vi, int value, std::string& error) {
+    const VariableInfo& v = kIntegerVariables[vi];
+    if (is_item(v.declared_type, value)) return true;
+    std::ostringstream s;
+    s << v.name << " = " << value << " is invalid: it must be an item of " << v.declared_type << ":";
+    const char* separator = " ";
+    for (const Item& item : kItems) {
+        if (!variable_table::joins(item.type, v.declared_type, "")) continue;
+        s << separator << item.value << " (" << item.name
+          << (item.value == static_cast<int>(v.start) ? ", the default)" : ")");
+        separator = ", ";
+    }
+    error = s.str();
+    return false;
+}
 }  // namespace enumeration
 
 bool build_inertia(Checker& check, const BodyParameterVariables& body, Mat3& inertia) {
@@ -153,9 +178,11 @@ bool check_single_variable_rules(Checker& check, const int (&integers)[kIntegerV
             return false;
     }
     for (unsigned vi = 0; vi < kIntegerVariableCount; ++vi) {
-        if (kIntegerVariables[vi].causality == Causality::parameter &&
-            kIntegerVariables[vi].declared_type[0] == '\0' &&
-            !integer_within_declared_bounds(static_cast<IntegerVariable>(vi), integers[vi], check.error))
+        if (kIntegerVariables[vi].causality != Causality::parameter) continue;
+        const IntegerVariable variable = static_cast<IntegerVariable>(vi);
+        const bool enumeration_typed = kIntegerVariables[vi].declared_type[0] != '\0';
+        if (enumeration_typed ? !enumeration::within_items(variable, integers[vi], check.error)
+                              : !integer_within_declared_bounds(variable, integers[vi], check.error))
             return false;
     }
     return true;
@@ -214,18 +241,10 @@ bool read_drive_train(Checker& check, ModelParameters& params) {
     return true;
 }
 
-// solver.*: the method (one this binary has), its step limit and substeps.
+// solver.*: the method (its range checked from the table; here: one this binary has), its step limit and
+// substeps.
 bool read_solver(const int (&integers)[kIntegerVariableCount], ModelParameters& params, std::string& error) {
     params.max_steps = integers[vi_solver_max_steps];
-    if (integers[vi_solver_method] < 0 || integers[vi_solver_method] >= kIntegrationMethodCount) {
-        error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
-                " is invalid: it must be 4 (automatic: Dormand-Prince 5(4), RODAS4 while stiff; the default), "
-                "5 (Dormand-Prince 5(4) only), 6 (RODAS4 only), 7 (real time: RODAS4 in fixed substeps), or a "
-                "SUNDIALS reference method: 0 (CVODE BDF, "
-                "analytic Jacobian), 1 (CVODE BDF, difference quotients), 2 (CVODE Adams) or 3 (ARKODE explicit "
-                "Runge-Kutta)";
-        return false;
-    }
     if (!kSundialsAvailable && is_sundials_method(static_cast<IntegrationMethod>(integers[vi_solver_method]))) {
         error = "solver.method = " + std::to_string(integers[vi_solver_method]) +
                 " is not available in this binary: it was built without SUNDIALS (as the FMU's win64 binary and "
@@ -240,28 +259,18 @@ bool read_solver(const int (&integers)[kIntegerVariableCount], ModelParameters& 
 }
 
 // The structural selectors (docs/physics.md section 6).
-bool read_fidelity(const int (&integers)[kIntegerVariableCount], const bool (&flags)[kBooleanVariableCount],
-                   ModelParameters& params, std::string& error) {
+// Their values were checked against their Enumeration items with the other single-variable rules.
+void read_fidelity(const int (&integers)[kIntegerVariableCount], const bool (&flags)[kBooleanVariableCount],
+                   ModelParameters& params) {
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
     const IntegerVariable motor_models[2] = {vi_motor1_model, vi_motor2_model};
     for (int j = 0; j < 2; ++j) {
         const int gear_model = integers[gear_models[j]], motor_model = integers[motor_models[j]];
-        if (gear_model < 0 || gear_model > 2) {
-            error = std::string(kIntegerVariables[gear_models[j]].name) + " = " + std::to_string(gear_model) +
-                    " is invalid: it must be 0 (rigid), 1 (compliant) or 2 (compliant with backlash)";
-            return false;
-        }
-        if (motor_model < 0 || motor_model > 1) {
-            error = std::string(kIntegerVariables[motor_models[j]].name) + " = " + std::to_string(motor_model) +
-                    " is invalid: it must be 0 (quasi-static) or 1 (with inductance)";
-            return false;
-        }
         params.fidelity.gear[j] = static_cast<GearModel>(gear_model);
         params.fidelity.motor[j] = static_cast<MotorModel>(motor_model);
     }
     params.fidelity.dry_friction = flags[vb_dry_friction];
     params.fidelity.fixed_base = flags[vb_base_fixed];
-    return true;
 }
 
 }  // namespace
@@ -271,9 +280,8 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     Checker check{values, error};
     if (!check_single_variable_rules(check, integers) || !read_bodies(check, params)) return false;
     params.energy_accounting = flags[vb_energy_accounting];
-    if (!read_drive_train(check, params) || !read_solver(integers, params, error) ||
-        !read_fidelity(integers, flags, params, error))
-        return false;
+    if (!read_drive_train(check, params) || !read_solver(integers, params, error)) return false;
+    read_fidelity(integers, flags, params);
     params.finalize();
     params.relative_tolerance = values[vr_solver_rtol];
     params.absolute_tolerance = values[vr_solver_atol];
