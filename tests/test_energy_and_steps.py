@@ -9,7 +9,7 @@ output as a float: the Integer event counters stay integers here, and inputs are
 """
 import numpy as np
 
-from gimbal2axis.fmu import STATES
+from expected_names import STATES
 
 STORED = ["energy.kinetic", "energy.potential", "energy.spring", "energy.magnetic"]
 DISSIPATED = ["energy.resistive", "energy.viscous", "energy.shaft_damping", "energy.dry_friction"]

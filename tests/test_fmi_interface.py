@@ -6,7 +6,9 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2DoStepStatus
 
-from gimbal2axis.fmu import STATES, simulate
+from gimbal2axis.fmu import simulate
+
+from expected_names import STATES
 
 OUTPUTS = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
 START = {"beta": 0.3, "beta_m": 18.0, "solver.rtol": 1e-8, "solver.atol": 1e-10}
@@ -226,3 +228,9 @@ def test_calls_in_the_wrong_state_are_refused_and_named(gimbal_fmu):
         gimbal_fmu.get_values(slave, ["alpha"])
     finally:
         slave.freeInstance()
+
+
+def test_the_package_reads_the_states_from_the_model_description(gimbal_fmu):
+    """gimbal2axis takes the states from the model description (outputs with initial="exact"), not from
+    a list of its own: they are the 12 states of docs/physics.md section 3.3, in that order."""
+    assert gimbal_fmu.states == STATES

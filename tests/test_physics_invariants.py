@@ -1,7 +1,9 @@
 """Physical invariants of the integrated FMU: energy, Galilean invariance, convergence."""
 import numpy as np
 
-from gimbal2axis.fmu import STATES, simulate
+from gimbal2axis.fmu import simulate
+
+from expected_names import STATES
 
 CONSERVATIVE = {
     # Fixed base, no friction, no damping, motors that exert no torque: only gravity and gear springs act

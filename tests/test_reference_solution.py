@@ -1,7 +1,9 @@
 """A closed-loop scene on a moving base against an independent high-accuracy solution."""
 import numpy as np
 
-from gimbal2axis.fmu import STATES, simulate
+from gimbal2axis.fmu import simulate
+
+from expected_names import STATES
 from reference_model import ReferenceModel
 
 STEP = 2e-3

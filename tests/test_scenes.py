@@ -70,7 +70,6 @@ def test_scene_errors_name_the_culprit(tmp_path, fmu):
         'name = "x"\nstop_time = 0.01\nstep_size = 1e-3\n[base_motion]\ntype = "sinusoids"\nroll = {amplitude_deg = 1}\n':
             "period_s",
         'name = "x"\nstop_time = 0.01\nstep_size = 1e-3\n[fidelity]\n"gear3.model" = 0\n': "gear3.model",
-        'name = "x"\nstop_time = 0.01\nstep_size = 1e-3\n[initial]\nomega = 1.0\n': "not a state",
         'name = "x"\nstop_time = 0.01\nstep_size = 1e-3\n[fidelity]\n"base.fixed" = true\n[base_motion]\n'
         'type = "sinusoids"\nroll = {amplitude_deg = 1, period_s = 5}\n': "base.fixed = true needs a fixed base",
     }
@@ -79,6 +78,10 @@ def test_scene_errors_name_the_culprit(tmp_path, fmu):
             load_scene(write_scene(tmp_path, text))
     path = write_scene(tmp_path, 'name = "x"\nstop_time = 0.01\nstep_size = 1e-3\n[parameters]\n"solver.max_steps" = 1.5\n')
     with pytest.raises(SceneError, match="Integer"):
+        check_against_fmu(load_scene(path), fmu)
+    # the states are the FMU's (its model description's outputs with initial="exact"), so checked against it
+    path = write_scene(tmp_path, 'name = "x"\nstop_time = 0.01\nstep_size = 1e-3\n[initial]\nomega = 1.0\n')
+    with pytest.raises(SceneError, match=r"\[initial\]: 'omega' is not a state \(states: \['alpha'"):
         check_against_fmu(load_scene(path), fmu)
 
 

@@ -135,7 +135,6 @@ def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_
     (start_on_target angles): the steady state is not the start state, since the elevation holds its
     gravity torque with a steady current and a deflected gear (about 1 V in the ship scene), and the
     linearization at 0 V misses the coupling that torque adds (1 % in los.omega[3] under roll)."""
-    from ..fmu import STATES
     from ..master.master import run
     from ..scene.scene import start_values
 
@@ -157,7 +156,7 @@ def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_
                              f"(is the loop unstable with these gains?)")
     values = start_values(at_rest, fmu, np.zeros(15))
     values.update(merged)
-    values.update({name: float(signals[name][-1]) for name in STATES + VOLTAGES if name in signals})
+    values.update({name: float(signals[name][-1]) for name in fmu.states + VOLTAGES if name in signals})
     return values
 
 

@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import SceneError
 from ..fmu import FMU
 from ..locations import fmu_path
-from ..master import REAL_OUTPUTS, run
+from ..master import real_outputs, run
 from ..scene import load_scene
 from ..scene.controllers import Replay
 from .defaults import scene_file
@@ -49,7 +49,7 @@ def loop_cpu(scene, fmu, compiled: bool, controller=None):
 
 
 def same_outputs(a, b, fmu) -> bool:
-    return all(np.array_equal(a.signals[name], b.signals[name]) for name in REAL_OUTPUTS if fmu.has(name))
+    return all(np.array_equal(a.signals[name], b.signals[name]) for name in real_outputs(fmu))
 
 
 def measure(scene, fmu, repeat: int) -> dict:

@@ -14,9 +14,16 @@ import numpy as np
 
 from ..errors import SceneError
 
+# The structural switches a scene's [fidelity] table takes: the scene format's vocabulary, checked when
+# a scene file is loaded (before any FMU is opened); check_against_fmu then checks each against the
+# model description. The states, by contrast, are read from the model description (FMU.states).
 FIDELITY = ["gear1.model", "gear2.model", "motor1.model", "motor2.model", "dry_friction", "base.fixed"]
-STATES = ["alpha", "alpha_m", "beta", "beta_m", "alpha_dot", "alpha_m_dot", "beta_dot", "beta_m_dot",
-          "i_R1", "i_R2", "theta_b1", "theta_b2"]
+
+
+def state_names(model_description) -> list[str]:
+    """The model's states, in the model description's order: the outputs with initial="exact", whose
+    start values set the initial state (the core holds that rule: kStartState in variable_groups.hpp)."""
+    return [v.name for v in model_description.modelVariables if v.causality == "output" and v.initial == "exact"]
 
 _CASTS = {"Real": float, "Integer": int, "Boolean": bool}   # the types set and read by name
 
@@ -50,6 +57,7 @@ class FMU:
     files on exit (or call close()).
 
     variables      {name: fmpy ModelVariable} of the model description (`model_description`)
+    states         the names of the states (outputs with initial="exact"), in the description's order
     vr(name)       the value reference; variable(name) the ModelVariable; has(name), start(name)
     check(...)     validates scene values (names, causalities, types) before a run
     set_values(slave, {name: value})   Real, Integer (and Enumeration) and Boolean, each with the setter of its type
@@ -67,6 +75,7 @@ class FMU:
             raise SceneError(f"{self.path}: no such FMU (build it: cmake --build build, or bash scripts/setup.sh)")
         self.model_description = read_model_description(str(self.path))
         self.variables = {v.name: v for v in self.model_description.modelVariables}
+        self.states = state_names(self.model_description)
         self.unzipdir = extract(str(self.path), unzipdir=tempfile.mkdtemp(prefix="gimbal_fmu_", dir=workdir))
 
     def close(self) -> None:
@@ -186,7 +195,7 @@ InputFunction = Callable[[float, dict], dict]
 
 
 def simulate(fmu: FMU, stop_time: float, step_size: float, start_values: dict | None = None,
-             inputs: InputFunction | None = None, outputs: Iterable[str] = STATES,
+             inputs: InputFunction | None = None, outputs: Iterable[str] | None = None,
              instance_name: str = "instance") -> dict:
     """Runs one simulation with fixed communication steps on a fresh instance; returns
     {'time': array, name: array, ...} sampled at every communication point.
@@ -195,7 +204,7 @@ def simulate(fmu: FMU, stop_time: float, step_size: float, start_values: dict | 
 
     `inputs(t, latest_outputs)` returns the input values to hold over the step starting at t.
     """
-    outputs = list(outputs)
+    outputs = list(fmu.states if outputs is None else outputs)
     slave = fmu.instantiate(instance_name)
     try:
         slave.setupExperiment(startTime=0.0)

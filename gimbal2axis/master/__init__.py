@@ -2,8 +2,8 @@
 voltages' delay (master.py, with the compiled loop of compiled_loop.py for the built-in controllers),
 many user-controller scenes stepped together (lockstep.py), a run's signals and metrics (results.py),
 its plots (plotting.py), and a scene file run to its CSV and PNG (scene_files.py)."""
-from .master import REAL_OUTPUTS, Plan, run
+from .master import Plan, real_outputs, run
 from .results import RunResult
 from .scene_files import run_scene_file
 
-__all__ = ["REAL_OUTPUTS", "Plan", "RunResult", "run", "run_scene_file"]
+__all__ = ["Plan", "RunResult", "real_outputs", "run", "run_scene_file"]

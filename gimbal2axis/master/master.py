@@ -19,7 +19,7 @@ import numpy as np
 from . import compiled_loop
 from ..scene.base_motion import INPUTS as BASE_INPUTS
 from ..errors import SceneError
-from ..fmu import FMU, STATES
+from ..fmu import FMU
 from ..progress import Progress
 from .results import RunResult
 from ..scene.scene import Scene, check_against_fmu, parameter_value, start_values
@@ -45,7 +45,13 @@ class RawCalls:
             ("fmi2DoStep", slave.dll))
 
 
-REAL_OUTPUTS = STATES + ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
+# Recorded besides the states (FMU.states, from the model description).
+OTHER_REAL_OUTPUTS = ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega[3]"]
+
+
+def real_outputs(fmu: FMU) -> list[str]:
+    """The Real outputs a run records: the FMU's states, then the gear torques and the payload gyro."""
+    return fmu.states + [name for name in OTHER_REAL_OUTPUTS if fmu.has(name)]
 MODE_OUTPUTS = ["gear1.contact", "gear2.contact", "motor1.limited", "motor2.limited", "body1.stick_slip",
                 "rotor1.stick_slip", "body2.stick_slip", "rotor2.stick_slip", "events.total"]
 
@@ -73,7 +79,7 @@ class Plan:
         self.measured_attitude = self.sensors.prepare(self.base[:, :3])
         self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
 
-        self.real_names = [name for name in REAL_OUTPUTS if fmu.has(name)]
+        self.real_names = real_outputs(fmu)
         self.mode_names = [name for name in MODE_OUTPUTS
                            if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
         for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]"):

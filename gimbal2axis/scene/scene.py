@@ -40,7 +40,7 @@ from . import geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
 from ..errors import SceneError, SceneWarning, check_keys, number, positive
-from ..fmu import FIDELITY, FMU, STATES
+from ..fmu import FIDELITY, FMU
 from .sensors import Sensors
 
 TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", "fidelity", "parameters",
@@ -171,9 +171,7 @@ def _validate(scene: Scene) -> None:
     unknown = set(scene.fidelity) - set(FIDELITY)
     if unknown:
         raise SceneError(f"[fidelity]: unknown switch(es) {sorted(unknown)}; known: {FIDELITY}")
-    for name, value in scene.initial.items():
-        if name not in STATES:
-            raise SceneError(f"[initial]: '{name}' is not a state (states: {STATES})")
+    for name, value in scene.initial.items():   # whether each is a state: check_against_fmu
         number(f"initial.{name}", value)
     overlap = sorted(set(scene.fidelity) & set(scene.parameters))
     if overlap:
@@ -288,6 +286,9 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
     try:
         fmu.check("fidelity", scene.fidelity, {"parameter", "structuralParameter"})
         fmu.check("parameters", scene.parameters, {"parameter", "structuralParameter"})
+        for name in scene.initial:
+            if name not in fmu.states:
+                raise SceneError(f"[initial]: '{name}' is not a state (states: {fmu.states})")
         fmu.check("initial", scene.initial, {"output", "local"})
         names = {n for names in scene.plot.values() for n in names}
         for name in names:

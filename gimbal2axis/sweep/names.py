@@ -13,7 +13,7 @@ import difflib
 
 from ..scene import base_motion, controllers, references, sensors
 from ..errors import SceneError
-from ..fmu import FIDELITY, STATES
+from ..fmu import FIDELITY
 from ..scene.scene import check_against_fmu
 
 from .spec import FLAT_SECTIONS, NESTED_SECTIONS, SweepError, apply_case, parse_name
@@ -52,7 +52,7 @@ def valid_names(scene, fmu) -> list[str]:
     names += parameters
     names += [f"parameters.{p}" for p in parameters if p not in FIDELITY]
     names += [f"fidelity.{f}" for f in FIDELITY]
-    names += [f"initial.{s}" for s in STATES]
+    names += [f"initial.{s}" for s in fmu.states]
     for section, attr in NESTED_SECTIONS.items():
         names += _leaf_paths(getattr(scene, attr) or {}, section)
     names += [f"controller.{k}" for k in sorted(controllers.CONTROLLER_KEYS - LIST_KEYS - {"options"})
@@ -112,14 +112,14 @@ def resolve_names(sweep, scene, fmu) -> tuple[dict, list[str]]:
             continue
         v = fmu.variables.get(variable)
         if section == "initial":
-            if variable not in STATES:
-                problems.append(f"'{name}': '{variable}' is not a state of the FMU (states: {', '.join(STATES)})"
+            if variable not in fmu.states:
+                problems.append(f"'{name}': '{variable}' is not a state of the FMU (states: {', '.join(fmu.states)})"
                                 + did_you_mean(name, candidates))
         elif v is None:
             problems.append(f"'{name}': '{variable}' is not a variable of {fmu.path.name}"
                             + did_you_mean(name, candidates))
         elif v.causality not in PARAMETER_CAUSALITIES:
-            hint = f"; its start value is swept as 'initial.{variable}'" if variable in STATES else ""
+            hint = f"; its start value is swept as 'initial.{variable}'" if variable in fmu.states else ""
             what = f"'{name}'" if name == variable else f"'{name}': '{variable}'"
             problems.append(f"{what} is not a parameter of the FMU (causality {v.causality}){hint}")
         elif section == "fidelity" and variable not in FIDELITY:
