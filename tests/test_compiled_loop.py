@@ -19,6 +19,11 @@ from gimbal2axis.master import compiled_loop
 SCENES = REPO / "scenes"
 NOISY_SENSORS = {"encoder_resolution_deg": 0.001, "gyro_noise_deg_s": 0.02, "imu_attitude_noise_deg": 0.01, "seed": 3}
 SINE = {"type": "sine", "offset_deg": 2.0, "amplitude_deg": 3.0, "frequency_hz": 2.0}
+DATASHEET_GYRO = {"angle_random_walk_deg_rt_h": 0.5, "bias_instability_deg_h": 20.0, "bias_correlation_time_s": 50.0,
+                  "rate_random_walk_deg_h_rt_h": 30.0, "bias_deg_h": [10.0, -5.0, 3.0], "scale_factor_error_ppm": 800.0,
+                  "misalignment_mrad": [1.0, -0.5, 0.3, 2.0, -1.0, 0.5], "bandwidth_hz": 150.0, "damping": 0.6,
+                  "quantization_deg_s": 0.002, "delay_samples": 2}
+EVERY_SENSOR_TERM = {**NOISY_SENSORS, "encoder_offset_deg": [0.01, -0.02], "gyro": DATASHEET_GYRO}
 PID_WITH_EVERY_TERM = {
     "type": "pid", "delay_steps": 2,
     "azimuth": {"kp": 300.0, "ki": 3000.0, "kd": 2.0, "d_filter_s": 0.002, "i_limit_V": 3.0, "k_gyro": 4.0,
@@ -43,6 +48,13 @@ def variant(name: str):
     pointing = load_scene(SCENES / "pointing_step.toml")
     if name == "ship_with_noisy_sensors":
         return ship.with_changes(sensors_spec=NOISY_SENSORS), 1.0
+    if name == "ship_with_every_sensor_term":
+        return ship.with_changes(sensors_spec=EVERY_SENSOR_TERM), 1.0
+    if name == "ship_indirect_with_every_sensor_term_and_encoder_differences":
+        return ship.with_changes(sensors_spec={**EVERY_SENSOR_TERM, "stabilization": "indirect",
+                                               "joint_rate": "encoder_difference"}), 1.0
+    if name == "ship_indirect_with_a_tachometer":
+        return ship.with_changes(sensors_spec={**EVERY_SENSOR_TERM, "stabilization": "indirect"}), 1.0
     if name == "ship_undelayed":
         return ship.with_changes(controller_spec={**ship.controller_spec, "delay_steps": 0}), 0.5
     if name == "state_feedback_encoder_rates_on_the_ship":
@@ -58,7 +70,8 @@ def variant(name: str):
 
 
 VARIANTS = sorted(p.name for p in SCENES.glob("*.toml")) + [
-    "ship_with_noisy_sensors", "ship_undelayed", "state_feedback_encoder_rates_on_the_ship",
+    "ship_with_noisy_sensors", "ship_with_every_sensor_term",
+    "ship_indirect_with_every_sensor_term_and_encoder_differences", "ship_indirect_with_a_tachometer", "ship_undelayed", "state_feedback_encoder_rates_on_the_ship",
     "pid_with_every_term_saturating", "constant_voltages"]
 
 

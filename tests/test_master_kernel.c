@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "controllers.h"
+#include "gyro.h"
 #include "sensors.h"
 #include "sum_of_sines.h"
 
@@ -67,12 +68,78 @@ static void state_feedback_by_hand(void) {
 
 static void sensors_by_hand(void) {
     const double noise[6] = {0.0, 0.0, 0.0, 0.125, -0.5, 1.0};
-    const GimbalSensors sensors = {0.5, noise};
-    double measured[5] = {0.75, 0.25, 1.0, 2.0, 3.0};
+    GimbalSensors sensors = {0};
+    sensors.encoder_resolution = 0.5, sensors.gyro_noise = noise;
+    double measured[7] = {0.75, 0.25, 1.0, 2.0, 3.0, 7.0, 7.0};
     gimbal_sensors_measure(&sensors, 1, measured);
     /* 1.5 and 0.5 resolution steps round to the even neighbours 2 and 0 */
     CHECK(measured[0] == 1.0 && measured[1] == 0.0);
     CHECK(measured[2] == 1.125 && measured[3] == 1.5 && measured[4] == 4.0);
+    /* an encoder offset is added before the quantization: 0.75 + 0.5 = 1.25 -> 1.0 (even), 0.25 - 0.5 -> -0.0 */
+    sensors.encoder_offset[0] = 0.5, sensors.encoder_offset[1] = -0.5, sensors.gyro_noise = NULL;
+    double offset[7] = {0.75, 0.25, 1.0, 2.0, 3.0, 0.0, 0.0};
+    gimbal_sensors_measure(&sensors, 0, offset);
+    CHECK(offset[0] == 1.0 && offset[1] == -0.0 && offset[2] == 1.0 && offset[4] == 3.0);
+}
+
+/* Indirect: a carrier turning at 1 rad/s about z0, the azimuth turned by pi/2 and the elevation by
+ * pi/2 with joint rates 2 and 3: w1 = Rz(pi/2)^T [0, 0, 1] + [0, 0, 2] = [0, 0, 3];
+ * w2 = Rx(pi/2)^T [0, 0, 3] + [3, 0, 0] = [3, 3, 0] (Rx(b)^T maps z1 to +y2 when b = pi/2). */
+static void indirect_by_hand(void) {
+    const double carrier[6] = {0.0, 0.0, 1.0, 1.0, 0.0, 0.0};
+    GimbalSensors sensors = {0};
+    sensors.indirect = 1, sensors.carrier_rate = carrier, sensors.h = 0.5;
+    const double half_pi = 1.5707963267948966;
+    double measured[7] = {half_pi, half_pi, 9.0, 9.0, 9.0, 2.0, 3.0};
+    gimbal_sensors_measure(&sensors, 0, measured);
+    CHECK(fabs(measured[2] - 3.0) < 1e-15 && fabs(measured[3] - 3.0) < 1e-15 && fabs(measured[4]) < 1e-15);
+    /* row 1: the carrier turns about x0 at 1 rad/s; at a = b = 0 and no joint motion w2 = [1, 0, 0] */
+    double level[7] = {0.0, 0.0, 9.0, 9.0, 9.0, 0.0, 0.0};
+    gimbal_sensors_measure(&sensors, 1, level);
+    CHECK(level[2] == 1.0 && level[3] == 0.0 && level[4] == 0.0);
+    /* joint rates from the encoders: 0 at the first sample, then backward differences over h */
+    sensors.joint_rate_from_encoders = 1;
+    double first[7] = {0.0, 0.0, 9.0, 9.0, 9.0, 5.0, 5.0}, second[7] = {0.25, 0.5, 9.0, 9.0, 9.0, 5.0, 5.0};
+    gimbal_sensors_measure(&sensors, 0, first);
+    CHECK(fabs(first[2]) < 1e-15 && fabs(first[3]) < 1e-15 && fabs(first[4] - 1.0) < 1e-15);
+    gimbal_sensors_measure(&sensors, 1, second);
+    /* a' = 0.5, b' = 1: w1 = Rz(0.25)^T [1, 0, 0] + [0, 0, 0.5], w2 = Rx(0.5)^T w1 + [1, 0, 0] */
+    const double w1x = cos(0.25), w1y = -sin(0.25), w1z = 0.5;
+    CHECK(fabs(second[2] - (w1x + 1.0)) < 1e-15);
+    CHECK(fabs(second[3] - (cos(0.5) * w1y + sin(0.5) * w1z)) < 1e-15);
+    CHECK(fabs(second[4] - (-sin(0.5) * w1y + cos(0.5) * w1z)) < 1e-15);
+}
+
+/* The gyro's deterministic terms by hand: axes matrix, error table, quantization, delay line. */
+static void gyro_by_hand(void) {
+    GimbalGyro gyro = {0};
+    gyro.enabled = 1;
+    const double axes[9] = {1.5, 0.25, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0};
+    for (int i = 0; i < 9; ++i) gyro.axes[i] = axes[i];
+    const double error[12] = {0.125, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    gyro.error = error, gyro.quantum = 0.25, gyro.delay = 2;
+    const double rates[9] = {1.0, 2.0, 3.0, 2.0, 0.0, 1.0, 0.0, 0.0, 0.0};
+    double out[9];
+    gimbal_gyro_series(&gyro, 3, rates, out);
+    /* sample 0: [1.5 + 0.5 + 0.125, 2, -3] -> quantized [2.0 (2.125 -> 8.5 quanta -> 8), 2, -3]; held
+     * through the delay line for samples 1 and 2 (the line starts full of the first sample) */
+    for (int k = 0; k < 3; ++k) CHECK(out[3 * k] == 2.0 && out[3 * k + 1] == 2.0 && out[3 * k + 2] == -3.0);
+    double more[3], zero[3] = {0.0, 0.0, 0.0};
+    gimbal_gyro_measure(&gyro, 3, zero, more);   /* sample 1's value comes out: [3, 0, -1] */
+    CHECK(more[0] == 3.0 && more[1] == 0.0 && more[2] == -1.0);
+    /* a filter of unit DC gain starts settled: a constant rate comes out unchanged */
+    GimbalGyro filtered = {0};
+    filtered.enabled = 1, filtered.filtered = 1;
+    filtered.axes[0] = filtered.axes[4] = filtered.axes[8] = 1.0;
+    const double a[4] = {0.5, 0.25, -0.25, 0.5}, b[2] = {0.25, 0.75}, c[2] = {1.0, 0.0};
+    for (int i = 0; i < 4; ++i) filtered.filter_a[i] = a[i];
+    filtered.filter_b[0] = b[0], filtered.filter_b[1] = b[1], filtered.filter_c[0] = c[0], filtered.filter_c[1] = c[1];
+    /* (I - A)^-1 B for this A, B: [[0.5, -0.25], [0.25, 0.5]]^-1 [0.25, 0.75] = [1, 1] (c x = 1) */
+    filtered.filter_settled[0] = 1.0, filtered.filter_settled[1] = 1.0;
+    const double steady[6] = {2.0, -4.0, 0.5, 2.0, -4.0, 0.5};
+    double steady_out[6];
+    gimbal_gyro_series(&filtered, 2, steady, steady_out);
+    for (int i = 0; i < 6; ++i) CHECK(steady_out[i] == steady[i]);
 }
 
 static void sums_of_sines(void) {
@@ -109,6 +176,8 @@ int main(void) {
     pid_by_hand();
     state_feedback_by_hand();
     sensors_by_hand();
+    indirect_by_hand();
+    gyro_by_hand();
     sums_of_sines();
     if (failures == 0) printf("master kernel: all checks passed\n");
     return failures == 0 ? 0 : 1;

@@ -45,6 +45,7 @@ class CompiledLoop:
         m.h, m.n, m.delay = plan.h, plan.n, plan.delay
         m.i_alpha, m.i_beta = plan.i_alpha, plan.i_beta
         m.i_gyro[:] = plan.i_gyro
+        m.i_alpha_dot, m.i_beta_dot = plan.i_joint_rates
         m.sensors = plan.sensors.state
         # A copy: the run leaves the controller object's own state as it was (as before the run).
         m.controller = plan.controller.state

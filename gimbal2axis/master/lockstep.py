@@ -224,7 +224,8 @@ def _run(cases: list) -> None:
               case.real_stride, case.get_integer, case.mode_refs, case.mode_count, case.mode_row, case.mode_stride,
               case.set_real, case.input_refs, case.input_count, case.input_row, case.input_stride, case.do_step,
               case.plan.rec_real, case.plan.inputs, None if case.plan.sensors.ideal else case.plan.sensors.measure,
-              case.plan.i_alpha, case.plan.i_beta, case.plan.i_gyro, case.attitude_rows, case.rate_rows,
+              case.plan.i_alpha, case.plan.i_beta, case.plan.i_gyro, case.plan.i_joint_rates, case.attitude_rows,
+              case.rate_rows,
               case.plan.u_cmd, case.plan.refs, case.u_limit[0], case.u_limit[1], rows[case.position])
              for case in alive]
     isfinite, array, Measurements = math.isfinite, np.array, controllers.Measurements
@@ -234,7 +235,7 @@ def _run(cases: list) -> None:
         for slot in slots:
             (case, plan, component, get_real, real_refs, real_count, real_row, real_stride, get_integer, mode_refs,
              mode_count, mode_row, mode_stride, _, _, _, _, _, _, rec_real, _, measure, i_alpha, i_beta, (g1, g2, g3),
-             attitude_rows, rate_rows, _, _, _, _, row) = slot
+             (i_alpha_dot, i_beta_dot), attitude_rows, rate_rows, _, _, _, _, row) = slot
             plan.k = k
             if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
                 case.fail(FMUCallFailed("fmi2GetReal"))
@@ -248,7 +249,8 @@ def _run(cases: list) -> None:
             if measure is None:
                 row[0], row[1], row[2] = y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]]
             else:
-                row[0], row[1], row[2] = measure(k, y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]])
+                row[0], row[1], row[2] = measure(k, y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]], y[i_alpha_dot],
+                                                 y[i_beta_dot])
             row[3], row[4] = attitude_rows[k], rate_rows[k]
         if failed:
             slots = [slot for slot in slots if slot not in failed]
@@ -264,7 +266,7 @@ def _run(cases: list) -> None:
         failed = []
         for slot in slots:
             (case, plan, component, _, _, _, _, _, _, _, _, _, _, set_real, input_refs, input_count, input_row,
-             input_stride, do_step, _, inputs, _, _, _, _, _, _, u_cmd, refs, limit1, limit2, _) = slot
+             input_stride, do_step, _, inputs, _, _, _, _, _, _, _, u_cmd, refs, limit1, limit2, _) = slot
             position = case.position
             u1, u2 = voltages[position]
             if not (isfinite(u1) and isfinite(u2)):

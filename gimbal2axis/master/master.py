@@ -76,19 +76,20 @@ class Plan:
         self.delay = scene.delay_steps
         # What the IMU measures (the sensors' noise of the whole run drawn here), and from it the
         # built-in controllers' set points of the whole run.
-        self.measured_attitude = self.sensors.prepare(self.base[:, :3])
+        self.measured_attitude = self.sensors.prepare(self.base, self.h)
         self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
 
         self.real_names = real_outputs(fmu)
         self.mode_names = [name for name in MODE_OUTPUTS
                            if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
-        for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]"):
+        for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]", "alpha_dot", "beta_dot"):
             if needed not in self.real_names:
                 raise SceneError(f"{fmu.path} has no output '{needed}', which the sensors need")
         self.real_vrs = [fmu.vr(name) for name in self.real_names]
         self.mode_vrs = [fmu.vr(name) for name in self.mode_names]
         self.i_alpha, self.i_beta = self.real_names.index("alpha"), self.real_names.index("beta")
         self.i_gyro = [self.real_names.index(f"los.omega[{j}]") for j in (1, 2, 3)]
+        self.i_joint_rates = [self.real_names.index(name) for name in ("alpha_dot", "beta_dot")]
         self.input_vrs = [fmu.vr("u_R1"), fmu.vr("u_R2")] + ([] if self.motion.fixed else
                                                               [fmu.vr(b) for b in BASE_INPUTS])
 
@@ -128,7 +129,7 @@ def step_loop(slave, plan: Plan, bar: Progress) -> None:
     h, n, delay = plan.h, plan.n, plan.delay
     # Python floats: reading them per step costs less than indexing numpy rows
     attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
-    i_alpha, i_beta, i_gyro = plan.i_alpha, plan.i_beta, plan.i_gyro
+    i_alpha, i_beta, i_gyro, (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, plan.i_joint_rates
     u_cmd, refs = plan.u_cmd, plan.refs
     zero = (0.0, 0.0)
     for k in range(n + 1):
@@ -139,7 +140,7 @@ def step_loop(slave, plan: Plan, bar: Progress) -> None:
         if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
             raise FMUCallFailed("fmi2GetInteger")
         y = rec_real[k].tolist()
-        alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro])
+        alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro], y[i_alpha_dot], y[i_beta_dot])
         u = controller(t, h, alpha, beta, gyro, attitude_rows[k], rate_rows[k], step=k)
         u_cmd.append(u)
         refs.append(controller.reference)

@@ -47,6 +47,8 @@ def _declare(loaded) -> None:
         "gimbal_controller_kind": ([text], integer),
         "gimbal_controller_step": ([pointer, long, double, pointer, pointer, pointer, pointer], None),
         "gimbal_sensors_measure": ([pointer, long, pointer], None),
+        "gimbal_gyro_measure": ([pointer, long, pointer, pointer], None),
+        "gimbal_gyro_series": ([pointer, long, pointer, pointer], None),
         "gimbal_sum_of_sines_weights": ([long, pointer, pointer, pointer], None),
         "gimbal_sum_of_sines": ([long, double, double, long] + [pointer] * 6, integer),
         "gimbal_layout_field_count": ([], long),

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "controllers.h"
+#include "gyro.h"
 #include "master_loop.h"
 #include "sensors.h"
 
@@ -24,6 +25,9 @@ typedef struct {
     {GIMBAL_NAME(STRUCTURE), #name, (long)offsetof(STRUCTURE, name), #kind, count},
 
 static const Field kFields[] = {
+#define STRUCTURE GimbalGyro
+    GIMBAL_GYRO_FIELDS(FIELD_ROW, ARRAY_ROW)
+#undef STRUCTURE
 #define STRUCTURE GimbalSensors
     GIMBAL_SENSORS_FIELDS(FIELD_ROW, ARRAY_ROW)
 #undef STRUCTURE
@@ -44,7 +48,8 @@ static const Field kFields[] = {
 static const struct {
     const char* structure;
     long size;
-} kSizes[] = {{"GimbalSensors", sizeof(GimbalSensors)},
+} kSizes[] = {{"GimbalGyro", sizeof(GimbalGyro)},
+              {"GimbalSensors", sizeof(GimbalSensors)},
               {"GimbalAxisPid", sizeof(GimbalAxisPid)},
               {"GimbalSetPoints", sizeof(GimbalSetPoints)},
               {"GimbalController", sizeof(GimbalController)},

@@ -15,7 +15,8 @@ int gimbal_master_loop(GimbalMasterLoop* m, long first, long last) {
         if (m->mode_count &&
             m->get_integer(m->component, m->mode_vrs, (size_t)m->mode_count, m->rec_mode + k * m->mode_count) > 1)
             return m->failed_call = kFailedGetInteger;
-        double measured[5] = {y[m->i_alpha], y[m->i_beta], y[m->i_gyro[0]], y[m->i_gyro[1]], y[m->i_gyro[2]]};
+        double measured[7] = {y[m->i_alpha],   y[m->i_beta],      y[m->i_gyro[0]],  y[m->i_gyro[1]],
+                              y[m->i_gyro[2]], y[m->i_alpha_dot], y[m->i_beta_dot]};
         gimbal_sensors_measure(&m->sensors, k, measured);
         double* u = m->u_cmd + 2 * k;
         gimbal_controller_step(&m->controller, k, m->h, measured, NULL, u, m->refs + 2 * k);

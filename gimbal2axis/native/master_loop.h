@@ -36,6 +36,7 @@ typedef int (*GimbalDoStepCall)(void* component, double t, double h, int no_set_
     FIELD(double, h, double) FIELD(long, n, long) FIELD(long, delay, long)                                 \
     /* columns of rec_real the sensors read */                                                            \
     FIELD(long, i_alpha, long) FIELD(long, i_beta, long) ARRAY(long, i_gyro, long, 3)                      \
+    FIELD(long, i_alpha_dot, long) FIELD(long, i_beta_dot, long)                                           \
     FIELD(GimbalSensors, sensors, GimbalSensors) FIELD(GimbalController, controller, GimbalController)     \
     /* where it stopped: the step, and the call that failed (gimbal_master_loop_call_name) */             \
     FIELD(long, failed_step, long) FIELD(int, failed_call, int)
