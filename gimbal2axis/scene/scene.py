@@ -15,7 +15,7 @@ file's name), description, stop_time [s], step_size [s] (communication step), ou
                   hold (geometry.py); start_on_target = true starts the gimbal pointing at it
   [controller]    type = "none" | "pid" | "state_feedback" | "python", delay_steps (default 1)
                   (controllers.py)
-  [sensors]       encoder quantization, gyro and IMU noise (sensors.py; default ideal)
+  [sensors]       encoders, a datasheet gyro, direct or indirect stabilization, IMU noise (sensors.py)
   [requirements]  los_rms_max_mrad, los_final_max_mrad, from_s: line-of-sight bounds the run must meet
   [test]          stop_time: the shortened end time the test suite runs the scene to
   [plot]          optional: panel name = [recorded signal names], replaces the default panels

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import difflib
 
-from ..scene import base_motion, controllers, references, sensors
+from ..scene import base_motion, controllers, gyro, references, sensors
 from ..errors import SceneError
 from ..fmu import FIDELITY
 from ..scene.scene import check_against_fmu
@@ -63,7 +63,9 @@ def valid_names(scene, fmu) -> list[str]:
     for axis in controllers.AXES:
         names += [f"controller.{axis}.{k}" for k in sorted(controllers.PID_KEYS) if k != "reference"]
         names += _reference_keys(f"controller.{axis}")
-    names += [f"sensors.{k}" for k in sorted(sensors.KEYS)]
+    names += [f"sensors.{k}" for k in sorted(sensors.KEYS - {"gyro", "encoder_offset_deg"})]
+    names += [f"sensors.encoder_offset_deg.{i}" for i in range(2)]
+    names += [f"sensors.gyro.{k}" for k in sorted(gyro.GYRO_KEYS)]
     names += [f"target.{k}" for k in sorted(TARGET_KEYS)]
     names += [f"base_motion.{k}" for k in sorted(BASE_MOTION_KEYS)]
     names += [f"base_motion.velocity_m_s.{i}" for i in range(3)]
