@@ -1,14 +1,15 @@
-"""gimbal2axis: run scenes, sweeps, linearizations, frequency responses and the master's benchmark on
-the Gimbal2Axis FMU. `gimbal2axis COMMAND --help` says more about each."""
+"""gimbal2axis: run scenes, sweeps, linearizations, frequency responses, comparison reports and the
+master's benchmark on the Gimbal2Axis FMU. `gimbal2axis COMMAND --help` says more about each."""
 from __future__ import annotations
 
 import argparse
 import sys
 
-from . import bench, freqresp, linearize, run, sweep
+from . import bench, freqresp, linearize, report, run, sweep
 
 PROG = "gimbal2axis"
-SUBCOMMANDS = {"run": run, "sweep": sweep, "linearize": linearize, "freqresp": freqresp, "bench": bench}
+SUBCOMMANDS = {"run": run, "sweep": sweep, "linearize": linearize, "freqresp": freqresp, "report": report,
+               "bench": bench}
 EXIT_USAGE = 2
 
 
