@@ -75,27 +75,29 @@ class RunResult:
         return {"final": float(e[-1]), "rms": float(np.sqrt(np.mean(e[window] ** 2))),
                 "max": float(np.max(e[window])), "from_s": start, "rms_all": float(np.sqrt(np.mean(e ** 2)))}
 
-    def metrics_window(self) -> np.ndarray:
-        """The samples los_metrics takes: from the requirements window's start, the whole run when
-        the run ends before it."""
-        window = self.signals["time"] >= self.window_start() - 1e-12
+    def metrics_window(self, from_s: float | None = None) -> np.ndarray:
+        """The samples los_metrics takes: from `from_s` (default the requirements window's start), the
+        whole run when the run ends before it."""
+        start = self.window_start() if from_s is None else from_s
+        window = self.signals["time"] >= start - 1e-12
         return window if window.any() else np.ones_like(window)
 
-    def los_spectra(self) -> dict:
+    def los_spectra(self, from_s: float | None = None) -> dict:
         """{cross-elevation error, elevation error: spectra.Spectrum} over the metrics window (empty
         without a target or with fewer than 2 samples there)."""
-        if not hasattr(self, "_los_spectra"):
-            window = self.metrics_window()
-            self._los_spectra = {} if not self.has_target or window.sum() < 2 else {
+        cache = self.__dict__.setdefault("_los_spectra", {})
+        if from_s not in cache:
+            window = self.metrics_window(from_s)
+            cache[from_s] = {} if not self.has_target or window.sum() < 2 else {
                 name: spectra.psd(self.derived[name][window], 1.0 / self.scene.step_size,
                                   self.scene.analysis.psd_resolution_hz) for name in AXIS_ERRORS}
-        return self._los_spectra
+        return cache[from_s]
 
-    def band_rms(self) -> dict:
+    def band_rms(self, from_s: float | None = None) -> dict:
         """{band name: RMS [rad] of the line-of-sight error in the band, both axes combined
         (root-sum-square of the cross-elevation and elevation band RMS)} for the scene's
         [analysis.bands]; nan when there is no spectrum."""
-        found = self.los_spectra()
+        found = self.los_spectra(from_s)
         return {name: math.hypot(*(sp.band_rms(lo, hi) for sp in found.values())) if found else math.nan
                 for name, (lo, hi) in self.scene.analysis.bands.items()}
 
