@@ -146,3 +146,23 @@ def test_a_sweep_of_a_scene_with_bands_has_a_column_per_band(tmp_path, fmu_path)
         assert 0 < combined <= row["los_rms_mrad"] * 1.05   # the spread, without the mean
     with open(outcome.csv) as f:
         assert "los_band_low_rms_mrad" in next(csv.reader(f))
+
+
+def test_the_sea_estimate_is_put_on_the_dwell_scale_by_the_pointing_geometry(tmp_path, ship_run):
+    from gimbal2axis.analysis.frequency_response import read_sea_estimate
+    from gimbal2axis.cli.freqresp import dwell_scale
+
+    # on the ship's target (azimuth 30 deg, elevation 5 deg) a roll about y0 lies sin 30 deg along the
+    # elevation axis and cos 30 deg sin 5 deg along the cross-elevation one
+    scale = dwell_scale(load_scene(SHIP), "roll")
+    assert scale["elevation"] == pytest.approx(0.5) and scale["cross_elevation"] == pytest.approx(
+        math.cos(math.radians(30)) * math.sin(math.radians(5)))
+    path = tmp_path / "iso.csv"
+    assert ship_run.write_isolation_csv(path)
+    plain = read_sea_estimate(path, 0.01, 100.0)
+    scaled = read_sea_estimate(path, 0.01, 100.0, scale)
+    assert [c[0].split(":")[1].split("/")[0].strip() for c in plain] == ["los.omega[1]", "los.omega[3]"]
+    assert np.allclose(scaled[0][2], plain[0][2] * 0.5) and plain[0][1].min() > 0
+    with pytest.raises(ValueError, match="not an isolation CSV"):
+        (tmp_path / "other.csv").write_text("# x\na,b\n1,2\n")
+        read_sea_estimate(tmp_path / "other.csv", 0.1, 1.0)
