@@ -397,14 +397,46 @@ def curves(rows: list[dict]) -> dict:
 GAIN_RANGE_DB = 120.0   # the gain axis spans at most this far below the largest gain; lower points sit on its floor
 
 
-def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None) -> None:
+def read_sea_estimate(path, f_min: float, f_max: float, scale: dict | None = None) -> list:
+    """The isolation a sea-state run estimated (`gimbal2axis run` writes <scene>_isolation.csv) as
+    overlay curves for plot_bode: (label, frequency, gain, coherence) per payload axis, between f_min
+    and f_max. `scale` {axis name: factor} puts a per-axis ratio on the dwell's scale (the dwell divides
+    by the carrier's rate about one carrier axis, the sea estimate by its rate about the payload axis)."""
+    import pathlib
+
+    path = pathlib.Path(path)
+    try:
+        data = np.genfromtxt(path, delimiter=",", names=True, skip_header=1)
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"--sea-estimate {path}: cannot read it ({exc})") from None
+    if data.dtype.names is None or "frequency_hz" not in data.dtype.names:
+        raise ValueError(f"--sea-estimate {path}: not an isolation CSV of gimbal2axis run (no frequency_hz column)")
+    f = np.atleast_1d(data["frequency_hz"])
+    keep = (f >= f_min) & (f <= f_max) & (f > 0)
+    curves = []
+    for axis, output in (("elevation", "los.omega[1]"), ("cross_elevation", "los.omega[3]")):
+        if f"{axis}_gain" not in data.dtype.names:
+            continue
+        factor = (scale or {}).get(axis, 1.0)
+        label = f"sea-state run: {output} / carrier rate about payload axis" + (
+            f" x {factor:.3g} (dwell's scale)" if factor != 1.0 else "")
+        curves.append((label, f[keep], np.atleast_1d(data[f"{axis}_gain"])[keep] * factor,
+                       np.atleast_1d(data[f"{axis}_coherence"])[keep]))
+    if not curves:
+        raise ValueError(f"--sea-estimate {path}: no elevation_gain or cross_elevation_gain column")
+    return curves
+
+
+def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None, sea: list | None = None) -> None:
     """Gain (dB), phase (deg, unwrapped along each curve) and coherence against frequency, every point
     marked, each curve with its own marker and line style (coinciding curves stay visible). The phase and
     coherence axes are autoscaled to every value. The gain axis spans at most GAIN_RANGE_DB below the
     largest gain: a lower gain (a load that does not move at all gives -200 dB or less) or a gain of exactly 0
     is drawn on the floor as a downward triangle and counted in the legend; its value is in the CSV.
     `lines` (linear_lines) are drawn as thin continuous lines under the points; the linear model's rows
-    among `rows` are then not drawn again as points."""
+    among `rows` are then not drawn again as points. `sea` (read_sea_estimate): the isolation estimated
+    from a sea-state run, thin grey lines in the gain panel and its magnitude-squared coherence in the
+    third."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -417,6 +449,8 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
     finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
     for _, _, G, *_ in lines or []:
         finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
+    for _, _, gain, _ in sea or []:   # the sea's bins set the gain axis too: none is put on a floor it did not need
+        finite_gains += [20 * math.log10(g) for g in gain if np.isfinite(g) and g > 0]
     top = max(finite_gains) if finite_gains else 0.0
     floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
     for index, line in enumerate(lines or []):
@@ -451,6 +485,16 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
             unwrapped = np.degrees(np.unwrap(np.radians(p[finite])))
             ax_p.semilogx(f[finite], unwrapped, **kw)
         ax_c.semilogx(f, c, **kw)
+    for index, (label, f, gain, coherence) in enumerate(sea or []):
+        color = ["0.45", "0.7"][index % 2]
+        with np.errstate(divide="ignore"):
+            db = 20 * np.log10(gain)
+        low = ~(np.isfinite(db) & (db >= floor))
+        ax_g.semilogx(f, np.where(low, floor, db), "-", color=color, lw=0.8,
+                      label=label + (f" ({low.sum()} bins below {floor:.0f} dB: on the floor)" if low.any() else ""))
+        ax_c.semilogx(f, coherence, "-", color=color, lw=0.8, label=f"{label.split(':')[0]}: magnitude-squared coherence")
+    if sea:
+        ax_c.legend(fontsize=7)
     ax_g.set_ylabel("gain [dB]")
     ax_p.set_ylabel("phase [deg] (unwrapped)")
     ax_c.set_ylabel("power fraction at the fundamental")

@@ -107,6 +107,26 @@ def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
             None)
 
 
+CARRIER_AXES = {"roll": (0.0, 1.0, 0.0), "pitch": (1.0, 0.0, 0.0), "yaw": (0.0, 0.0, 1.0)}   # in frame 0, level
+
+
+def dwell_scale(scene, axis: str) -> dict:
+    """{payload axis: |component of the dwell's carrier axis along it|} with the gimbal on the scene's
+    target on a level carrier: the dwell's ratio (LOS rate / carrier rate about one carrier axis) is the
+    per-payload-axis ratio times this, while the axes do not couple."""
+    import numpy as np
+
+    from ..scene import geometry
+
+    if scene.target is None:
+        raise SceneError("--sea-estimate needs a scene with a [target] (the gimbal's pointing sets the scale)")
+    alpha, beta = geometry.gimbal_angles_for(scene.target, 0.0, 0.0, 0.0)
+    carrier_axis = np.array(CARRIER_AXES[axis])
+    to_payload = (geometry.rz(alpha) @ geometry.rx(beta)).T   # frame 0 -> frame 2
+    components = to_payload @ carrier_axis
+    return {"elevation": abs(components[0]), "cross_elevation": abs(components[2])}
+
+
 def measured_margins(rows: list[dict]) -> list[str]:
     """A line per simulated curve: the margins of its loop_gain points (interpolated between the dwell's
     frequencies, so only as fine as its grid; a point of low coherence may place a crossing anywhere)."""
@@ -158,6 +178,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     parser.add_argument("--out", default="results", help="directory of the CSV and PNG (default results/ in the "
                                                          "current directory)")
+    parser.add_argument("--sea-estimate", default=None, metavar="CSV",
+                        help="isolation: draw the isolation estimated from a sea-state run (<scene>_isolation.csv "
+                             "of gimbal2axis run) over the dwell, put on the dwell's scale by the projection of "
+                             "the --axis carrier axis on each payload axis at the scene's target (docs/jitter.md)")
     parser.add_argument("--name", default=None, help="file name stem (default frequency_response_<mode>_<axis>)")
 
 
@@ -190,6 +214,11 @@ def execute(args) -> int:
             excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
             outputs = None
         excitation = excitations[0]
+        sea = None
+        if args.sea_estimate:
+            if excitation.kind != "base":
+                raise SceneError("--sea-estimate goes with freqresp isolation (a carrier rate as the input)")
+            sea = fr.read_sea_estimate(args.sea_estimate, args.fmin, args.fmax, dwell_scale(scene, axis))
         variants = []
         if not args.linear_only:
             variants.append(("full model", None))
@@ -241,7 +270,7 @@ def execute(args) -> int:
         shown_outputs = (fr.LOOP_GAIN, fr.SENSITIVITY)
         plotted_rows = [r for r in rows if r["output"] in shown_outputs]
         plotted_lines = lines and [line for line in lines if line[0].rsplit(": ", 1)[-1] in shown_outputs]
-    fr.plot_bode(plotted_rows, png_path, title, plotted_lines)
+    fr.plot_bode(plotted_rows, png_path, title, plotted_lines, sea)
     if excitation.kind == "injection":
         for line in measured_margins(rows):
             print(line)

@@ -21,9 +21,9 @@ ROUND_OFF_MRAD = 1e-9
 
 def signal_unit(name: str) -> tuple[float, str]:
     """(scale, unit) a signal is plotted in."""
-    if name in ("los_error", "alpha_error", "beta_error") or name.startswith("theta_b"):
+    if name in ("los_error", "alpha_error", "beta_error", "los_error_xel", "los_error_el") or name.startswith("theta_b"):
         return 1e3, "mrad"
-    if name.endswith("_dot") or name.startswith("los.omega"):
+    if name.endswith("_dot") or name.startswith("los.omega") or name.startswith("base.omega2"):
         return DEG, "deg/s"
     if name.endswith("_ddot"):
         return DEG, "deg/s2"
@@ -60,7 +60,8 @@ def default_panels(result) -> dict:
 LABELS = {"alpha": "alpha (azimuth)", "beta": "beta (elevation)", "alpha_ref": "alpha set point",
           "beta_ref": "beta set point", "los.omega[1]": "gyro x (elevation)", "los.omega[3]": "gyro z (cross-elev.)",
           "u_R1": "u_R1 applied", "u_R2": "u_R2 applied", "base.delta": "pitch delta", "base.psi": "yaw psi",
-          "base.gamma": "roll gamma", "los_error": "LOS error"}
+          "base.gamma": "roll gamma", "los_error": "LOS error",
+          "los_error_xel": "LOS error, cross-elevation", "los_error_el": "LOS error, elevation"}
 
 
 def draw_los_error(ax, result, t: np.ndarray, values: np.ndarray) -> None:
@@ -113,7 +114,7 @@ def figure(result, limits: dict | None = None):
             scale, unit = signal_unit(name)
             units.add(unit)
             style = "--" if name.endswith("_ref") else "-"
-            values = np.asarray(s[name], dtype=float) * scale
+            values = np.asarray(result.signal(name), dtype=float) * scale
             if name == "los_error" and result.has_target:
                 draw_los_error(ax, result, t, values)
             else:
@@ -143,3 +144,87 @@ def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
         fig.savefig(path, dpi=100)
     finally:
         plt.close(fig)
+
+
+def spectrum_figure(result):
+    """The line-of-sight error in the frequency domain (spectra.py, docs/jitter.md), drawn beside the
+    time plot: per axis the Welch PSD [mrad^2/Hz] and the cumulative RMS [mrad] on log-log axes, the
+    scene's bands marked; on a moving base also the isolation estimated from the run (|H1| of the gyro
+    against the carrier's rate about the same payload axis) and its coherence. None without a target.
+    The 0-Hz bin has no place on a log axis: its value is in the legend (and the CSV), and it is in
+    every cumulative RMS. The y limits are matplotlib's from every drawn value: nothing is clipped."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    found = result.los_spectra()
+    if not found:
+        return None
+    isolation = result.isolation_estimates()
+    rows = 2 + (2 if isolation else 0)
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(10, 2.6 * rows + 0.8), squeeze=False)
+    axes = axes[:, 0]
+    for index, (name, spectrum) in enumerate(found.items()):
+        f, psd = spectrum.frequency, spectrum.psd * 1e6
+        label = (f"{LOS_AXIS_LABELS[name]} (mean {spectrum.mean * 1e3:.3g} mrad removed; "
+                 f"0-Hz bin {psd[0]:.3g} mrad^2/Hz)")
+        shown = (f > 0) & (psd > 0)
+        hidden = int((f > 0).sum() - shown.sum())
+        if hidden:
+            label += f"; {hidden} bins of exactly 0 not drawn"
+        axes[0].loglog(f[shown], psd[shown], lw=0.9, color=f"C{index}", label=label)
+        cumulative = spectrum.cumulative_rms() * 1e3
+        axes[1].loglog(f[f > 0], cumulative[f > 0], lw=1.1, color=f"C{index}",
+                       label=f"{LOS_AXIS_LABELS[name]}: total {cumulative[-1]:.3g} mrad RMS")
+    spectrum = next(iter(found.values()))
+    t = result.signals["time"][result.metrics_window()]
+    axes[0].set_title(f"Welch: {spectrum.resolution:g} Hz resolution, Hann window, 50 % overlap, "
+                      f"{spectrum.segments} segment(s) over [{t[0]:g}, {t[-1]:g}] s", fontsize="small")
+    axes[0].set_ylabel("LOS error PSD\n[mrad^2/Hz]", fontsize="small")
+    axes[1].set_ylabel("cumulative RMS\n[mrad]", fontsize="small")
+    rms = result.band_rms()
+    for k, (band, (lo, hi)) in enumerate(result.scene.analysis.bands.items()):
+        for ax in axes[:2]:
+            ax.axvspan(max(lo, spectrum.resolution / 2), hi, color=f"C{k % 10}", alpha=0.07)
+        axes[1].text(math.sqrt(max(lo, spectrum.resolution) * hi), 1.0, f"{band}\n{rms[band] * 1e3:.3g} mrad",
+                     transform=axes[1].get_xaxis_transform(), ha="center", va="top", fontsize="x-small")
+    if isolation:
+        for index, (i, estimate) in enumerate(isolation.items()):
+            f = estimate.frequency
+            gain = np.abs(estimate.response)
+            shown = (f > 0) & np.isfinite(gain) & (gain > 0)
+            axes[2].loglog(f[shown], gain[shown], lw=0.9, color=f"C{index + 2}",
+                           label=f"los.omega[{i}] / carrier rate about payload axis {i} ({ISOLATION_LABELS[i]})")
+            axes[3].semilogx(f[f > 0], estimate.coherence[f > 0], lw=0.9, color=f"C{index + 2}",
+                             label=f"{ISOLATION_LABELS[i]}")
+        axes[3].axhline(1.0 / max(estimate.segments, 1), color="gray", lw=0.7, ls=":",
+                        label=f"1/segments = {1.0 / max(estimate.segments, 1):.2g} (no relation reads about this)")
+        axes[2].set_title(f"isolation from this run: H1 estimate, {estimate.resolution:g} Hz resolution, "
+                          f"{estimate.segments} segment(s)", fontsize="small")
+        axes[2].set_ylabel("|H1| LOS rate /\ncarrier rate", fontsize="small")
+        axes[3].set_ylabel("coherence", fontsize="small")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0, fontsize="x-small")
+    axes[-1].set_xlabel("frequency [Hz]")
+    fig.suptitle(f"{result.scene.title}: line-of-sight error in the frequency domain", fontsize="medium")
+    fig.tight_layout()
+    return fig
+
+
+LOS_AXIS_LABELS = {"los_error_xel": "cross-elevation", "los_error_el": "elevation"}
+ISOLATION_LABELS = {1: "elevation", 3: "cross-elevation"}
+
+
+def plot_spectrum(result, path: pathlib.Path) -> bool:
+    """Writes the PNG of `spectrum_figure(result)`; False (nothing written) without a target."""
+    fig = spectrum_figure(result)
+    if fig is None:
+        return False
+    import matplotlib.pyplot as plt
+    try:
+        fig.savefig(path, dpi=100)
+    finally:
+        plt.close(fig)
+    return True

@@ -1,4 +1,6 @@
-"""A run's record: derived line-of-sight signals, metrics, requirement checks, CSV and summary line."""
+"""A run's record: derived line-of-sight signals, metrics, requirement checks, CSV and summary line;
+the line-of-sight error's spectrum per axis and the isolation estimated from a moving base
+(spectra.py, docs/jitter.md)."""
 from __future__ import annotations
 
 import math
@@ -7,6 +9,15 @@ import pathlib
 import numpy as np
 
 from ..scene import geometry
+from . import spectra
+
+# Per-axis signed pointing errors (line of sight minus target) [rad]: cross-elevation (the azimuth
+# error times cos of the target's elevation, an angle across the line of sight) and elevation.
+AXIS_ERRORS = {"los_error_xel": "cross-elevation", "los_error_el": "elevation"}
+# The carrier's inertial angular velocity in the payload's frame 2, the input of the isolation estimate
+# whose output is the gyro component about the same axis (los.omega[i]).
+CARRIER_RATES = [f"base.omega2[{i}]" for i in (1, 2, 3)]
+ISOLATION_AXES = {1: "elevation", 3: "cross_elevation"}
 
 
 class RunResult:
@@ -24,6 +35,27 @@ class RunResult:
                                                 math.radians(scene.target_spec["elevation_deg"]))
         else:
             s["los_error"] = np.full_like(s["alpha"], np.nan)
+        # Signals derived for the spectra. Kept apart from `signals` (whose set is the record the golden
+        # digests hold fixed), written to the CSV with them and readable by name through signal().
+        self.derived = {}
+        if self.has_target:
+            self.derived.update(zip(AXIS_ERRORS, geometry.los_axis_errors(
+                s["alpha"], s["beta"], *attitude, math.radians(scene.target_spec["azimuth_deg"]),
+                math.radians(scene.target_spec["elevation_deg"]))))
+        if self.base_moves:
+            rates = (s["base.delta_dot"], s["base.psi_dot"], s["base.gamma_dot"])
+            self.derived.update(zip(CARRIER_RATES, geometry.carrier_rate_in_payload(
+                s["alpha"], s["beta"], s["base.psi"], s["base.gamma"], *rates)))
+
+    @property
+    def base_moves(self) -> bool:
+        s = self.signals
+        return any(np.any(s[f"base.{n}_dot"] != 0) for n in ("delta", "psi", "gamma")) if "base.delta_dot" in s \
+            else False
+
+    def signal(self, name: str) -> np.ndarray:
+        """A recorded or a derived signal by name."""
+        return self.signals[name] if name in self.signals else self.derived[name]
 
     @property
     def has_target(self) -> bool:
@@ -43,6 +75,90 @@ class RunResult:
         return {"final": float(e[-1]), "rms": float(np.sqrt(np.mean(e[window] ** 2))),
                 "max": float(np.max(e[window])), "from_s": start, "rms_all": float(np.sqrt(np.mean(e ** 2)))}
 
+    def metrics_window(self, from_s: float | None = None) -> np.ndarray:
+        """The samples los_metrics takes: from `from_s` (default the requirements window's start), the
+        whole run when the run ends before it."""
+        start = self.window_start() if from_s is None else from_s
+        window = self.signals["time"] >= start - 1e-12
+        return window if window.any() else np.ones_like(window)
+
+    def los_spectra(self, from_s: float | None = None) -> dict:
+        """{cross-elevation error, elevation error: spectra.Spectrum} over the metrics window (empty
+        without a target or with fewer than 2 samples there)."""
+        cache = self.__dict__.setdefault("_los_spectra", {})
+        if from_s not in cache:
+            window = self.metrics_window(from_s)
+            cache[from_s] = {} if not self.has_target or window.sum() < 2 else {
+                name: spectra.psd(self.derived[name][window], 1.0 / self.scene.step_size,
+                                  self.scene.analysis.psd_resolution_hz) for name in AXIS_ERRORS}
+        return cache[from_s]
+
+    def band_rms(self, from_s: float | None = None) -> dict:
+        """{band name: RMS [rad] of the line-of-sight error in the band, both axes combined
+        (root-sum-square of the cross-elevation and elevation band RMS)} for the scene's
+        [analysis.bands]; nan when there is no spectrum."""
+        found = self.los_spectra(from_s)
+        return {name: math.hypot(*(sp.band_rms(lo, hi) for sp in found.values())) if found else math.nan
+                for name, (lo, hi) in self.scene.analysis.bands.items()}
+
+    def isolation_estimates(self) -> dict:
+        """{1: elevation, 3: cross-elevation: spectra.TransferEstimate} of the gyro los.omega[i] against
+        the carrier's rate about the same payload axis, over the metrics window; empty on a still base."""
+        window = self.metrics_window()
+        if not self.base_moves or window.sum() < 2:
+            return {}
+        return {i: spectra.transfer_estimate(self.derived[f"base.omega2[{i}]"][window],
+                                             self.signals[f"los.omega[{i}]"][window], 1.0 / self.scene.step_size,
+                                             self.scene.analysis.isolation_resolution_hz)
+                for i in ISOLATION_AXES}
+
+    def write_psd_csv(self, path: pathlib.Path) -> bool:
+        """<scene>_psd.csv: frequency and, per axis, the PSD [rad^2/Hz] and the cumulative RMS [rad] of the
+        line-of-sight error; a comment line states the estimate. False (nothing written) without one."""
+        found = self.los_spectra()
+        if not found:
+            return False
+        first = next(iter(found.values()))
+        columns, names = [first.frequency], ["frequency_hz"]
+        for name, spectrum in found.items():
+            columns += [spectrum.psd, spectrum.cumulative_rms()]
+            names += [f"psd_{name[len('los_error_'):]}_rad2_per_hz", f"cumulative_rms_{name[len('los_error_'):]}_rad"]
+        t = self.signals["time"][self.metrics_window()]
+        means = ", ".join(f"{AXIS_ERRORS[n]} {sp.mean:.6g} rad" for n, sp in found.items())
+        comment = (f"# Welch PSD of the line-of-sight error (line of sight minus target) over [{t[0]:g}, {t[-1]:g}] s: "
+                   f"Hann window, {spectra.OVERLAP:.0%} overlap, {first.resolution:g} Hz resolution, "
+                   f"{first.segments} segment(s); the mean was removed (static offset: {means})")
+        np.savetxt(path, np.column_stack(columns), delimiter=",", header=comment + "\n" + ",".join(names),
+                   comments="", fmt="%.10g")
+        return True
+
+    def write_isolation_csv(self, path: pathlib.Path) -> bool:
+        """<scene>_isolation.csv: per payload axis the carrier rate's PSD [(rad/s)^2/Hz], the H1 gain and
+        phase of the gyro against it and the coherence. False (nothing written) on a still base."""
+        found = self.isolation_estimates()
+        if not found:
+            return False
+        first = next(iter(found.values()))
+        columns, names = [first.frequency], ["frequency_hz"]
+        for i, estimate in found.items():
+            axis = ISOLATION_AXES[i]
+            carrier = spectra.psd(self.derived[f"base.omega2[{i}]"][self.metrics_window()], 1.0 / self.scene.step_size,
+                                  self.scene.analysis.isolation_resolution_hz).psd   # where the sea has energy
+            with np.errstate(divide="ignore"):
+                gain_db = 20 * np.log10(np.abs(estimate.response))
+            columns += [carrier, np.abs(estimate.response), gain_db, np.degrees(np.angle(estimate.response)),
+                        estimate.coherence]
+            names += [f"{axis}_carrier_psd", f"{axis}_gain", f"{axis}_gain_db", f"{axis}_phase_deg", f"{axis}_coherence"]
+        t = self.signals["time"][self.metrics_window()]
+        comment = (f"# H1 estimate of los.omega[i] against the carrier's inertial rate about the same payload axis "
+                   f"(i = 1 elevation, 3 cross-elevation) over [{t[0]:g}, {t[-1]:g}] s: {spectra.WINDOW} window, "
+                   f"{spectra.OVERLAP:.0%} overlap, {first.resolution:g} Hz resolution, {first.segments} segment(s); "
+                   f"coherence from {first.segments} segments is about {1 / max(first.segments, 1):.2g} where "
+                   f"nothing is related")
+        np.savetxt(path, np.column_stack(columns), delimiter=",", header=comment + "\n" + ",".join(names),
+                   comments="", fmt="%.10g")
+        return True
+
     def requirement_failures(self) -> list[str]:
         """The scene's [requirements] this run does not meet (empty: all met, or none stated). A
         window that starts after the end of a shortened run cannot be judged and is skipped."""
@@ -58,7 +174,7 @@ class RunResult:
         return failures
 
     def csv_columns(self) -> list[str]:
-        return [name for name in self.signals if not name.startswith("_")]
+        return [name for name in self.signals if not name.startswith("_")] + list(self.derived)
 
     def write_csv(self, path: pathlib.Path) -> None:
         """One row per output_interval (SI units: rad, rad/s, V, A, N.m, m); all recorded signals."""
@@ -67,7 +183,7 @@ class RunResult:
         rows = np.arange(0, len(self.signals["time"]), every)
         if rows[-1] != len(self.signals["time"]) - 1:
             rows = np.append(rows, len(self.signals["time"]) - 1)
-        data = np.column_stack([np.asarray(self.signals[n], dtype=float)[rows] for n in names])
+        data = np.column_stack([np.asarray(self.signal(n), dtype=float)[rows] for n in names])
         np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.12g")
 
     def summary(self) -> str:
@@ -82,6 +198,15 @@ class RunResult:
                          f"(max {m['max'] * 1e3:.4g} mrad)")
         else:
             parts.append(f"final alpha {math.degrees(s['alpha'][-1]):.4f} deg, beta {math.degrees(s['beta'][-1]):.4f} deg")
+        bands = self.scene.analysis.bands
+        if self.has_target and bands:
+            spectrum = next(iter(self.los_spectra().values()), None)
+            resolution = f"{spectrum.resolution:g} Hz resolution" if spectrum else "no spectrum"
+            rms = self.band_rms()
+            m = self.los_metrics()
+            window = f" from {m['from_s']:g} s" if m["from_s"] > 0 else ""
+            parts.append(f"LOS RMS by band{window} ({resolution}): " + ", ".join(
+                f"{name} [{lo:g}, {hi:g}) Hz {rms[name] * 1e3:.4g} mrad" for name, (lo, hi) in bands.items()))
         if "events.total" in s:
             parts.append(f"{int(s['events.total'][-1])} events")
         if self.scene.requirements and self.has_target:

@@ -9,8 +9,10 @@ from .master import run
 
 
 def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_time: float | None = None):
-    """Runs one scene file and writes <out>/<scene file's name>.csv and .png; returns (result, csv, png)."""
-    from .plotting import plot
+    """Runs one scene file and writes <out>/<scene file's name>.csv and .png; with a target also
+    <name>_psd.csv and <name>_spectrum.png (the line-of-sight error's spectrum), on a moving base
+    <name>_isolation.csv (the isolation estimated from the run); returns (result, csv, png)."""
+    from .plotting import plot, plot_spectrum
 
     scene = load_scene(scene_path)
     out = pathlib.Path(out_dir)
@@ -27,4 +29,7 @@ def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_t
     csv_path, png_path = out / f"{scene.name}.csv", out / f"{scene.name}.png"
     result.write_csv(csv_path)
     plot(result, png_path, limits)
+    result.write_psd_csv(out / f"{scene.name}_psd.csv")
+    result.write_isolation_csv(out / f"{scene.name}_isolation.csv")
+    plot_spectrum(result, out / f"{scene.name}_spectrum.png")
     return result, csv_path, png_path

@@ -109,3 +109,27 @@ def gimbal_angles_for(target: tuple, delta: float, psi: float, gamma: float, alp
     alpha = math.atan2(-x, y)
     alpha += 2.0 * math.pi * round((alpha_near - alpha) / (2.0 * math.pi))
     return alpha, beta
+
+
+def wrap_angle(angle):
+    """An angle in [-pi, pi)."""
+    return (np.asarray(angle) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def los_axis_errors(alpha, beta, delta, psi, gamma, azimuth, elevation):
+    """Signed pointing errors [rad], line of sight minus target, along the two axes across the line of
+    sight: cross-elevation (the azimuth error, wrapped, times cos of the target's elevation: the angle
+    the azimuth error makes across the line of sight) and elevation. For small errors
+    hypot(cross-elevation, elevation) is los_error."""
+    az, el = los_azimuth_elevation(alpha, beta, delta, psi, gamma)
+    return wrap_angle(az - azimuth) * np.cos(elevation), el - elevation
+
+
+def carrier_rate_in_payload(alpha, beta, psi, gamma, delta_dot, psi_dot, gamma_dot):
+    """The carrier's inertial angular velocity (docs/physics.md (2.13), from the Euler-angle rates)
+    in the payload's frame 2: 2T1 1T0 omega_0 with 1T0 = Rz(alpha)^T, 2T1 = Rx(beta)^T. The payload's
+    own rate (los.omega) is this plus the joints' rates: [beta', alpha' sin(beta), alpha' cos(beta)]."""
+    omega0 = (delta_dot * np.cos(psi) * np.cos(gamma) - psi_dot * np.sin(gamma),
+              -delta_dot * np.sin(psi) + gamma_dot,
+              delta_dot * np.cos(psi) * np.sin(gamma) + psi_dot * np.cos(gamma))
+    return _rot_x(-beta, _rot_z(-alpha, omega0))

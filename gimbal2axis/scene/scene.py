@@ -19,6 +19,8 @@ file's name), description, stop_time [s], step_size [s] (communication step), ou
   [requirements]  los_rms_max_mrad, los_final_max_mrad, from_s: line-of-sight bounds the run must meet
   [test]          stop_time: the shortened end time the test suite runs the scene to
   [plot]          optional: panel name = [recorded signal names], replaces the default panels
+  [analysis]      optional: psd_resolution_hz, isolation_resolution_hz and [analysis.bands] of the
+                  line-of-sight error's spectrum (analysis.py, docs/jitter.md)
 
 Validation has two levels: `load_scene` checks everything a file alone can say; `check_against_fmu`
 checks the FMU variable names, causalities and types (the FMU's model description is the truth).
@@ -36,7 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry
+from . import analysis, geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
 from ..errors import SceneError, SceneWarning, check_keys, number, positive
@@ -44,7 +46,7 @@ from ..fmu import FIDELITY, FMU
 from .sensors import Sensors
 
 TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", "fidelity", "parameters",
-            "initial", "base_motion", "target", "controller", "sensors", "requirements", "test", "plot"}
+            "initial", "base_motion", "target", "controller", "sensors", "requirements", "test", "plot", "analysis"}
 
 
 @dataclass
@@ -66,6 +68,7 @@ class Scene:
     requirements: dict
     test: dict
     plot: dict
+    analysis_spec: dict = field(default_factory=dict)
     raw: dict = field(repr=False, default_factory=dict)
     warnings: list = field(repr=False, default_factory=list)
 
@@ -84,6 +87,11 @@ class Scene:
     @property
     def delay_steps(self) -> int:
         return int(self.controller_spec.get("delay_steps", 1))
+
+    @property
+    def analysis(self) -> analysis.AnalysisSettings:
+        """The [analysis] settings (defaults without the table)."""
+        return analysis.parse(self.analysis_spec, self.step_size)
 
     def base_motion(self):
         return make_base_motion(self.base_motion_spec, self.path.parent)
@@ -152,8 +160,10 @@ def load_scene(path: pathlib.Path | str) -> Scene:
                       initial=_table(raw, "initial", True), base_motion_spec=_table(raw, "base_motion"),
                       target_spec=target, controller_spec=_table(raw, "controller"),
                       sensors_spec=_table(raw, "sensors"), requirements=_table(raw, "requirements"),
-                      test=_table(raw, "test"), plot=_table(raw, "plot"), raw=raw)
+                      test=_table(raw, "test"), plot=_table(raw, "plot"),
+                      analysis_spec=_table(raw, "analysis"), raw=raw)
         _validate(scene)
+        analysis.check_window(scene.analysis, scene.stop_time, float(scene.requirements.get("from_s", 0.0)))
     except SceneError as exc:
         raise SceneError(f"{path}: {exc}") from None
     for message in scene.warnings:
@@ -214,6 +224,9 @@ def _validate(scene: Scene) -> None:
     for panel, names in scene.plot.items():
         if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
             raise SceneError(f"[plot] {panel} must be a list of signal names")
+    settings = scene.analysis
+    if settings.bands and scene.target_spec is None:
+        raise SceneError("[analysis.bands] of the line-of-sight error need a [target]")
 
 
 AXIS_MOTOR = {"azimuth": "u_R1", "elevation": "u_R2"}
@@ -300,7 +313,8 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
 
 
 DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
-                   "los_azimuth", "los_elevation", "heave"} | {f"base.{n}" for n in (
+                   "los_azimuth", "los_elevation", "heave", "los_error_xel", "los_error_el",
+                   "base.omega2[1]", "base.omega2[2]", "base.omega2[3]"} | {f"base.{n}" for n in (
                        "delta", "psi", "gamma", "delta_dot", "psi_dot", "gamma_dot",
                        "delta_ddot", "psi_ddot", "gamma_ddot")}
 

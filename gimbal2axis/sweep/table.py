@@ -12,16 +12,29 @@ LAST = ["seed", "sampling_seed", "status", "los_rms_mrad", "los_peak_mrad", "los
 METRICS = ["los_rms_mrad", "los_peak_mrad", "i_peak_A", "events", "wall_time_s"]
 
 
+def band_metrics(rows: list[dict]) -> list[str]:
+    """The band RMS columns of a scene with [analysis.bands] (los_band_<name>_rms_mrad), in row order."""
+    return list(dict.fromkeys(k for row in rows for k in row if is_band_metric(k)))
+
+
+def is_band_metric(name: str) -> bool:
+    return name.startswith("los_band_") and name.endswith("_rms_mrad")
+
+
 def column_order(rows: list[dict], parameters: list[str]) -> list[str]:
+    """FIRST, the parameters, other columns, LAST, with the band RMS columns (if any) after the other
+    line-of-sight metrics."""
     names = [c for c in FIRST] + [p for p in parameters if p not in FIRST + LAST]
-    seen = set(names) | set(LAST)
+    bands = band_metrics(rows)
+    seen = set(names) | set(LAST) | set(bands)
     extra = []
     for row in rows:
         for key in row:
             if key not in seen:
                 seen.add(key)
                 extra.append(key)
-    return names + extra + LAST
+    at = LAST.index("los_from_s") + 1
+    return names + extra + LAST[:at] + bands + LAST[at:]
 
 
 def _arrow_column(values: list):
@@ -78,6 +91,12 @@ def write(rows: list[dict], parameters: list[str], parquet_path: pathlib.Path, c
 
 LABELS = {"los_rms_mrad": "LOS RMS [mrad]", "los_peak_mrad": "LOS peak [mrad]", "i_peak_A": "peak |i| [A]",
           "events": "events", "wall_time_s": "wall time [s]"}
+
+
+def metric_label(name: str) -> str:
+    if is_band_metric(name):
+        return f"LOS RMS, band {name[len('los_band_'):-len('_rms_mrad')]} [mrad]"
+    return LABELS.get(name, name)
 
 
 def is_seed(name: str) -> bool:
@@ -143,7 +162,7 @@ def summary_figure(rows: list[dict], parameters: list[str], title: str = "", gri
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    metrics = [m for m in METRICS if any(r.get("status") == "ok" and _finite(r.get(m)) for r in rows)]
+    metrics = [m for m in METRICS + band_metrics(rows) if any(r.get("status") == "ok" and _finite(r.get(m)) for r in rows)]
     ok = [r for r in rows if r.get("status") == "ok"]
     failed = [r for r in rows if r.get("status") != "ok"]
     title = title or f"{len(rows)} cases: {len(ok)} ok, {len(failed)} failed"
@@ -188,7 +207,7 @@ def _scatter_panels(plt, rows, ok, failed, numeric, metrics, title):
                 ax.xaxis.set_major_locator(MaxNLocator(nbins=4, integer=seed))
                 ax.xaxis.set_major_formatter(FuncFormatter(lambda v, pos: f"{v:.6g}"))
             if j == 0:
-                ax.set_ylabel(LABELS.get(m, m), fontsize=8)
+                ax.set_ylabel(metric_label(m), fontsize=8)
             if i == len(metrics) - 1:
                 ax.set_xlabel(_wrap(p) + (" (a seed)" if seed else ""), fontsize=8)
             ax.tick_params(labelsize=7)
@@ -241,7 +260,7 @@ def _heat_maps(plt, rows, px, py, metrics, title):
         ax.set_xlabel(_wrap(px, 40), fontsize=8)
         if k % cols == 0:   # the same parameter along every row: once, clear of the colour bars
             ax.set_ylabel(_wrap(py, 30), fontsize=8)
-        label = LABELS.get(m, m)
+        label = metric_label(m)
         bar = fig.colorbar(image, ax=ax)
         bar.set_label(label + (f", median of {samples}" if samples > 1 else ""), fontsize=8)
         bar.ax.tick_params(labelsize=7)

@@ -21,7 +21,8 @@ from ..fmu.worker_cache import dask_worker, loaded_fmu
 
 def metrics(result, from_s: float | None) -> dict:
     """Summary metrics of a run: RMS, peak and final line-of-sight error [mrad] over [from_s, end]
-    (nan without a [target]), peak |current| per motor and overall [A], events, requirements met."""
+    (nan without a [target]), peak |current| per motor and overall [A], events, requirements met, and
+    the band RMS of the scene's [analysis.bands] (band_columns)."""
     s = result.signals
     if from_s is None:
         start = result.window_start()
@@ -34,10 +35,18 @@ def metrics(result, from_s: float | None) -> dict:
     i1, i2 = float(np.max(np.abs(s["i_R1"]))), float(np.max(np.abs(s["i_R2"])))
     failures = result.requirement_failures()
     judged = bool(result.scene.requirements) and result.has_target and result.window_start() < result.stop_time
-    return {"los_rms_mrad": rms, "los_peak_mrad": peak, "los_final_mrad": final, "los_from_s": float(from_s),
-            "i_peak_R1_A": i1, "i_peak_R2_A": i2, "i_peak_A": max(i1, i2),
-            "events": int(s["events.total"][-1]) if "events.total" in s else -1,
-            "requirements_met": (not failures) if judged else None}
+    row = {"los_rms_mrad": rms, "los_peak_mrad": peak, "los_final_mrad": final, "los_from_s": float(from_s),
+           "i_peak_R1_A": i1, "i_peak_R2_A": i2, "i_peak_A": max(i1, i2),
+           "events": int(s["events.total"][-1]) if "events.total" in s else -1,
+           "requirements_met": (not failures) if judged else None}
+    row.update(band_columns(result, from_s))
+    return row
+
+
+def band_columns(result, from_s: float) -> dict:
+    """los_band_<name>_rms_mrad per [analysis.bands] of the scene (none without bands): the band RMS of
+    the line-of-sight error over [from_s, end] (the window of the other LOS metrics), both axes combined."""
+    return {f"los_band_{name}_rms_mrad": value * 1e3 for name, value in result.band_rms(from_s).items()}
 
 
 def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> dict:

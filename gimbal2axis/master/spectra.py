@@ -1,0 +1,127 @@
+"""Spectra of a run's signals: Welch power spectral density, cumulative RMS over frequency, RMS in
+a band, and the H1 transfer estimate with its coherence. Pure functions of numpy arrays.
+
+Conventions (docs/jitter.md):
+
+- One-sided PSD [unit^2/Hz] by Welch's method: Hann window, 50 % overlap, segments of
+  `segment_length(sample_rate, resolution_hz)` samples, so the bins are `resolution` apart (the
+  resolution actually used is sample_rate / segment, returned with the spectrum).
+- The mean over the whole window is removed once, not per segment: a per-segment detrend would
+  throw away the power at periods longer than a segment (a sea's 10-s swell under 2-s segments);
+  kept, it lands in the lowest bins. So the PSD and its cumulative RMS account for the signal's
+  variance (Parseval: sum(PSD) * df = variance, up to the estimate's statistics and the window's
+  half-segment ends), and the mean (a static pointing offset) is reported separately.
+- Integrals are sums over bins times the bin width df (a bin holds the power around its centre);
+  a bin belongs to the band [f_lo, f_hi) when its centre frequency does, and a band reaching the
+  Nyquist frequency also holds the Nyquist bin, so bands that tile [0, Nyquist] tile the spectrum.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+WINDOW = "hann"
+OVERLAP = 0.5
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    frequency: np.ndarray       # Hz, 0 to Nyquist, `resolution` apart
+    psd: np.ndarray             # one-sided power spectral density, unit^2/Hz
+    resolution: float           # Hz, the bin width df
+    segments: int               # segments averaged
+    mean: float                 # the mean removed before the estimate (the static part)
+
+    def cumulative_rms(self) -> np.ndarray:
+        return cumulative_rms(self.psd, self.resolution)
+
+    def band_rms(self, f_lo: float, f_hi: float) -> float:
+        return band_rms(self.frequency, self.psd, self.resolution, f_lo, f_hi)
+
+
+def segment_length(sample_rate: float, resolution_hz: float) -> int:
+    """Samples per Welch segment for bins `resolution_hz` apart (rounded to whole samples)."""
+    if not (sample_rate > 0 and resolution_hz > 0):
+        raise ValueError(f"need a positive sample rate and resolution, got {sample_rate!r}, {resolution_hz!r}")
+    return max(2, int(round(sample_rate / resolution_hz)))
+
+
+def segment_count(samples: int, segment: int) -> int:
+    """Segments Welch averages over `samples` with 50 % overlap."""
+    step = segment - int(segment * OVERLAP)
+    return 0 if samples < segment else 1 + (samples - segment) // step
+
+
+def psd(x, sample_rate: float, resolution_hz: float) -> Spectrum:
+    """One-sided Welch PSD of `x` (module docstring). A signal shorter than one segment is taken as
+    a single segment of its own length: a coarser resolution, which the Spectrum reports."""
+    from scipy import signal
+
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 1 or x.size < 2:
+        raise ValueError(f"need a 1-D signal of at least 2 samples, got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("the signal has non-finite samples")
+    segment = min(segment_length(sample_rate, resolution_hz), x.size)
+    mean = float(np.mean(x))
+    frequency, density = signal.welch(x - mean, fs=sample_rate, window=WINDOW, nperseg=segment,
+                                      noverlap=int(segment * OVERLAP), detrend=False, return_onesided=True,
+                                      scaling="density")
+    return Spectrum(frequency, density, sample_rate / segment, segment_count(x.size, segment), mean)
+
+
+def cumulative_rms(density: np.ndarray, resolution: float) -> np.ndarray:
+    """sqrt of the running integral of the PSD from 0 Hz up to each bin (inclusive): at the top it is
+    the standard deviation."""
+    return np.sqrt(np.cumsum(np.asarray(density, dtype=float)) * resolution)
+
+
+def band_mask(frequency: np.ndarray, f_lo: float, f_hi: float) -> np.ndarray:
+    """The bins of [f_lo, f_hi) (by centre frequency); with the Nyquist bin when f_hi reaches it."""
+    frequency = np.asarray(frequency, dtype=float)
+    mask = (frequency >= f_lo) & (frequency < f_hi)
+    if f_hi >= frequency[-1]:
+        mask |= frequency >= max(f_lo, frequency[-1])
+    return mask
+
+
+def band_rms(frequency: np.ndarray, density: np.ndarray, resolution: float, f_lo: float, f_hi: float) -> float:
+    """RMS of the part of the signal in [f_lo, f_hi): sqrt(sum of the band's PSD bins * df)."""
+    if not f_lo < f_hi:
+        raise ValueError(f"a band needs f_lo < f_hi, got [{f_lo:g}, {f_hi:g})")
+    return float(math.sqrt(np.sum(np.asarray(density)[band_mask(frequency, f_lo, f_hi)]) * resolution))
+
+
+@dataclass(frozen=True)
+class TransferEstimate:
+    frequency: np.ndarray       # Hz
+    response: np.ndarray        # H1 = S_xy / S_xx, complex
+    coherence: np.ndarray       # magnitude-squared coherence, 0..1
+    resolution: float           # Hz
+    segments: int
+
+
+def transfer_estimate(x, y, sample_rate: float, resolution_hz: float) -> TransferEstimate:
+    """The H1 estimate of the transfer from input `x` to output `y`, H1 = S_xy / S_xx (unbiased by
+    noise on the output), and the magnitude-squared coherence |S_xy|^2 / (S_xx S_yy), both by Welch
+    with the PSD's window, overlap and mean removal. Where the input has no power (S_xx = 0) H1 is nan.
+    Coherence from K segments is biased up by about 1/K where there is no relation: trust H1 where the
+    coherence is well above that."""
+    from scipy import signal
+
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.shape != y.shape or x.ndim != 1 or x.size < 2:
+        raise ValueError(f"need two 1-D signals of the same length (>= 2), got {x.shape} and {y.shape}")
+    segment = min(segment_length(sample_rate, resolution_hz), x.size)
+    options = dict(fs=sample_rate, window=WINDOW, nperseg=segment, noverlap=int(segment * OVERLAP), detrend=False)
+    x, y = x - x.mean(), y - y.mean()
+    frequency, s_xx = signal.welch(x, **options)
+    _, s_yy = signal.welch(y, **options)
+    _, s_xy = signal.csd(x, y, **options)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        response = np.where(s_xx > 0, s_xy / s_xx, np.nan)
+        coherence = np.where((s_xx > 0) & (s_yy > 0), np.abs(s_xy) ** 2 / (s_xx * s_yy), np.nan)
+    return TransferEstimate(frequency, response, np.clip(coherence, 0.0, 1.0), sample_rate / segment,
+                            segment_count(x.size, segment))
