@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from ..errors import SceneError, check_keys, positive
 from ..master import run
 from ..scene import load_scene
+from ..scene.gyro import GyroModel
 from ..scene.sensors import SCHEMES, Sensors
 
 KEYS = {"title", "description", "scene", "stop_time", "schemes", "sensors", "analysis", "grades"}
@@ -60,8 +61,9 @@ def _grade_cases(scene, grades: dict, schemes: list, common: dict, analysis: dic
         gyro = {k: v for k, v in table.items() if k != "label"}
         label = str(table.get("label", key))
         for scheme in schemes:
+            GyroModel(gyro, where=f"grades.{key}")   # a wrong datasheet refused by its name in this file
             sensors = {**scene.sensors_spec, **common, "gyro": gyro, "stabilization": scheme}
-            Sensors(sensors)   # refuses a wrong datasheet here, naming the key, before any run
+            Sensors(sensors)   # and the shared sensors, before any run
             changes = {"sensors_spec": sensors}
             if analysis is not None:
                 changes["analysis_spec"] = analysis

@@ -27,12 +27,19 @@ def _figure(results: list, title: str):
     time_rows = math.ceil(count / 2)
     fig, axes = plt.subplots(time_rows + 2, 2, figsize=(12, 3.0 * (time_rows + 2)), squeeze=False)
     fig.suptitle(title)
-    top = max(float(np.max(result.signals["los_error"])) for _, result in results) * 1e3
+    # log above the 1st percentile of the errors, linear below it down to 0 (symlog): the start-up
+    # transient, the jitter and the near-zero samples (a run that starts on target) all stay visible
+    errors = [result.signals["los_error"] * 1e3 for _, result in results]
+    linear_below = max(float(np.percentile(np.concatenate(errors), 1.0)), 1e-12)
+    high = max(float(e.max()) for e in errors)
     for index, (case, result) in enumerate(results):
         ax = axes[index // 2][index % 2]
-        ax.plot(result.signals["time"], result.signals["los_error"] * 1e3, lw=0.6)
-        ax.set_ylim(0.0, top * 1.05)
-        ax.set_title(f"{case.name}: RMS {result.los_metrics()['rms'] * 1e3:.4g} mrad", fontsize=9)
+        ax.plot(result.signals["time"], errors[index], lw=0.5)
+        ax.set_yscale("symlog", linthresh=linear_below)
+        ax.set_ylim(0.0, high * 1.5)
+        ax.axvspan(0.0, result.window_start(), color="0.9", zorder=0, label="before the metrics window")
+        ax.set_title(f"{case.name}: RMS {result.los_metrics()['rms'] * 1e3:.4g} mrad from "
+                     f"{result.window_start():g} s", fontsize=9)
         ax.set_xlabel("time [s]")
         ax.set_ylabel("LOS error [mrad]")
     if count % 2:

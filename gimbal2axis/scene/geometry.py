@@ -125,11 +125,17 @@ def los_axis_errors(alpha, beta, delta, psi, gamma, azimuth, elevation):
     return wrap_angle(az - azimuth) * np.cos(elevation), el - elevation
 
 
+def carrier_rate(psi, gamma, delta_dot, psi_dot, gamma_dot):
+    """The carrier's inertial angular velocity in frame 0 (docs/physics.md (2.13)) from the Euler
+    angles and their rates: GT0 = Rx(delta) Rz(psi) Ry(gamma) gives
+    w0 = Ry(gamma)^T Rz(psi)^T [delta', 0, 0] + Ry(gamma)^T [0, 0, psi'] + [0, gamma', 0]."""
+    return (delta_dot * np.cos(psi) * np.cos(gamma) - psi_dot * np.sin(gamma),
+            -delta_dot * np.sin(psi) + gamma_dot,
+            delta_dot * np.cos(psi) * np.sin(gamma) + psi_dot * np.cos(gamma))
+
+
 def carrier_rate_in_payload(alpha, beta, psi, gamma, delta_dot, psi_dot, gamma_dot):
-    """The carrier's inertial angular velocity (docs/physics.md (2.13), from the Euler-angle rates)
-    in the payload's frame 2: 2T1 1T0 omega_0 with 1T0 = Rz(alpha)^T, 2T1 = Rx(beta)^T. The payload's
-    own rate (los.omega) is this plus the joints' rates: [beta', alpha' sin(beta), alpha' cos(beta)]."""
-    omega0 = (delta_dot * np.cos(psi) * np.cos(gamma) - psi_dot * np.sin(gamma),
-              -delta_dot * np.sin(psi) + gamma_dot,
-              delta_dot * np.cos(psi) * np.sin(gamma) + psi_dot * np.cos(gamma))
-    return _rot_x(-beta, _rot_z(-alpha, omega0))
+    """The carrier's inertial angular velocity in the payload's frame 2: 2T1 1T0 omega_0 with
+    1T0 = Rz(alpha)^T, 2T1 = Rx(beta)^T. The payload's own rate (los.omega) is this plus the joints'
+    rates: [beta', alpha' sin(beta), alpha' cos(beta)]."""
+    return _rot_x(-beta, _rot_z(-alpha, carrier_rate(psi, gamma, delta_dot, psi_dot, gamma_dot)))

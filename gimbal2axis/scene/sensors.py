@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from .. import native
+from . import geometry
 from ..errors import SceneError, check_keys, number
 from .gyro import GyroModel
 
@@ -44,9 +45,8 @@ def _choice(where: str, value, allowed: tuple) -> str:
 
 
 def carrier_rate(base: np.ndarray, h: float | None = None) -> np.ndarray:
-    """The carrier's inertial angular velocity in frame 0 (n x 3, rad/s) from the base motion's
-    columns (delta, psi, gamma, their rates, their accelerations, ...): GT0 = Rx(delta) Rz(psi)
-    Ry(gamma) gives w0 = Ry(gamma)^T Rz(psi)^T [delta', 0, 0] + Ry(gamma)^T [0, 0, psi'] + [0, gamma', 0].
+    """The carrier's inertial angular velocity in frame 0 (n x 3, rad/s; geometry.carrier_rate) from
+    the base motion's columns (delta, psi, gamma, their rates, their accelerations, ...).
 
     With the step h: at communication point k >= 1 the rate of the carrier as the FMU moved it over
     the step before, i.e. the attitude and rates set at t_(k-1) carried to t_k with their constant
@@ -58,11 +58,7 @@ def carrier_rate(base: np.ndarray, h: float | None = None) -> np.ndarray:
         accelerations = base[:-1, 6:9]
         angles[1:] = base[:-1, 0:3] + base[:-1, 3:6] * h + accelerations * (0.5 * h * h)
         rates[1:] = base[:-1, 3:6] + accelerations * h
-    psi, gamma = angles[:, 1], angles[:, 2]
-    pitch_rate, yaw_rate, roll_rate = rates[:, 0], rates[:, 1], rates[:, 2]
-    cy, sy, cr, sr = np.cos(psi), np.sin(psi), np.cos(gamma), np.sin(gamma)
-    return np.column_stack([pitch_rate * cy * cr - yaw_rate * sr, -pitch_rate * sy + roll_rate,
-                            pitch_rate * cy * sr + yaw_rate * cr])
+    return np.column_stack(geometry.carrier_rate(angles[:, 1], angles[:, 2], rates[:, 0], rates[:, 1], rates[:, 2]))
 
 
 class Sensors:
