@@ -1,7 +1,8 @@
 """An independent Python implementation of the FMU's 12-state model for high-accuracy reference runs.
 
 The rigid-body part comes from the symbolic Lagrangian (tests/symbolic), the drive train is written
-from docs/physics.md section 4 (linear gear spring-damper, RL motor, viscous friction), and the co-simulation
+from docs/physics.md section 4 (linear gear spring-damper, RL motor, viscous friction, and the
+disturbances of section 4.5: cable restraints on the joints, cogging on the rotors), and the co-simulation
 semantics of docs/model_overview.md ("Step semantics") (voltages held, base motion at constant acceleration over each step).
 """
 from __future__ import annotations
@@ -31,6 +32,9 @@ class ReferenceModel:
         self.viscous = np.array([v[f"{b}.c_visc"] for b in BODIES])
         self.motor = [{k: v[f"motor{j}.{k}"] for k in ("R", "L", "k_torque", "k_emf", "U_L")} for j in (1, 2)]
         self.gear = [{k: v[f"gear{j}.{k}"] for k in ("N", "k_s", "c_s")} for j in (1, 2)]
+        self.cable = [{k: v.get(f"cable{j}.{k}", 0.0) for k in ("k", "c", "angle_0")} for j in (1, 2)]
+        self.cogging = [dict(T=v.get(f"motor{j}.T_cogging", 0.0), n=v.get(f"motor{j}.cogging_periods", 1),
+                             phase=v.get(f"motor{j}.cogging_phase", 0.0)) for j in (1, 2)]
 
     def derivative(self, x, voltage, base):
         q, qd, current = x[0:4], x[4:8], x[8:10]
@@ -45,6 +49,11 @@ class ReferenceModel:
             shaft_torque = gear["k_s"] * deflection + gear["c_s"] * deflection_rate
             xi[l] += shaft_torque
             xi[r] += motor["k_torque"] * current[j] - shaft_torque / gear["N"]
+            # A cable between the load's joint partners pulls the load angle back to angle_0; cogging
+            # pulls the rotor (angle relative to its stator) towards n q_m + phase = 2 pi k.
+            cable, cogging = self.cable[j], self.cogging[j]
+            xi[l] += -cable["k"] * (q[l] - cable["angle_0"]) - cable["c"] * qd[l]
+            xi[r] += -cogging["T"] * np.sin(cogging["n"] * q[r] + cogging["phase"])
             dx[8 + j] = (voltage[j] - motor["R"] * current[j] - motor["k_emf"] * qd[r]) / motor["L"]
         dx[0:4] = qd
         dx[4:8] = np.linalg.solve(J, xi + f)

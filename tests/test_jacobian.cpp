@@ -1,5 +1,6 @@
 // The Jacobian the implicit methods use against central differences of the right-hand side, for every
-// fidelity and every mode, at random states with a moving carrier, gravity and products of inertia.
+// fidelity and every mode, at random states with a moving carrier, gravity and products of inertia;
+// each case once without and once with the disturbance elements (cable restraints, cogging) on.
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -105,6 +106,7 @@ int main() {
         for (int motor_model = 0; motor_model <= 1; ++motor_model) {
             for (int friction = 0; friction <= 1; ++friction) {
                 for (int fixed_base = 0; fixed_base <= 1; ++fixed_base) {
+                  for (int disturbed = 0; disturbed <= 1; ++disturbed) {
                     Values values;
                     values.integers[vi_gear1_model] = gear_model;
                     values.integers[vi_gear2_model] = gear_model == 0 ? 2 : gear_model;  // mixed fidelities too
@@ -118,12 +120,25 @@ int main() {
                     // Rotors off their axis of symmetry on a moving base; axisymmetric ones (whose angle
                     // the Jacobian then skips) on the fixed base.
                     if (fixed_base == 0) values.reals[vr_rotor1_I_xy] = 1e-6, values.reals[vr_rotor2_d_bf_2] = 0.001;
+                    if (disturbed != 0) {
+                        // Both cables and both cogging torques, in every fidelity: a rigid axis's
+                        // cogging acts through q_m = N q_l, its slope reflected with N^2.
+                        values.reals[vr_cable1_k] = 3.0, values.reals[vr_cable1_c] = 0.02, values.reals[vr_cable1_angle_0] = 0.1;
+                        values.reals[vr_cable2_k] = 1.5, values.reals[vr_cable2_c] = 0.01, values.reals[vr_cable2_angle_0] = -0.2;
+                        values.reals[vr_motor1_T_cogging] = 0.004, values.reals[vr_motor1_cogging_phase] = 0.3;
+                        values.reals[vr_motor2_T_cogging] = 0.003, values.reals[vr_motor2_cogging_phase] = -1.1;
+                        values.integers[vi_motor1_cogging_periods] = 24, values.integers[vi_motor2_cogging_periods] = 18;
+                    }
                     ModelParameters params;
                     std::string error;
                     if (!build_model_parameters(values.reals, values.integers, values.flags, params, error)) {
                         std::fprintf(stderr, "parameters refused: %s\n", error.c_str());
                         ++check::failures;
                         continue;
+                    }
+                    if ((disturbed != 0) != params.disturbances.active) {
+                        std::fprintf(stderr, "the disturbance elements are %s\n", disturbed ? "off" : "on");
+                        ++check::failures;
                     }
                     for (int contact = -1; contact <= 1; ++contact) {
                         for (int limited = -1; limited <= 1; ++limited) {
@@ -140,12 +155,14 @@ int main() {
                                 const std::string label = "gear model " + std::to_string(gear_model) + ", motor model " +
                                                           std::to_string(motor_model) + ", friction " +
                                                           std::to_string(friction) + ", fixed base " +
-                                                          std::to_string(fixed_base) + ", contact " + std::to_string(contact) +
+                                                          std::to_string(fixed_base) + ", disturbances " +
+                                                          std::to_string(disturbed) + ", contact " + std::to_string(contact) +
                                                           ", limited " + std::to_string(limited);
                                 check_case(params, modes, random, label);
                             }
                         }
                     }
+                  }
                 }
             }
         }

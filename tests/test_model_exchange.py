@@ -334,7 +334,15 @@ def test_the_model_description_declares_model_exchange(gimbal_fmu):
     assert {d.variable.name for d in md.derivatives} <= initial_unknowns
 
 
-@pytest.mark.parametrize("point", ["rich", "rigid"])
+# Both cables and both cogging torques on (docs/physics.md section 4.5): their analytic derivatives in
+# the Jacobian, also through a rigid gear's q_m = N q_l.
+DISTURBANCES = {"cable1.k": 3.0, "cable1.c": 0.02, "cable1.angle_0": 0.1,
+                "cable2.k": 1.5, "cable2.c": 0.01, "cable2.angle_0": -0.2,
+                "motor1.T_cogging": 0.004, "motor1.cogging_periods": 24, "motor1.cogging_phase": 0.3,
+                "motor2.T_cogging": 0.003, "motor2.cogging_periods": 18, "motor2.cogging_phase": -1.1}
+
+
+@pytest.mark.parametrize("point", ["rich", "rigid", "rich with disturbances", "rigid with disturbances"])
 def test_directional_derivatives_match_the_linear_model_of_the_core(gimbal_fmu, build_dir, point):
     """d der(x) / d(x, u) and d y / d(x, u) by fmi2GetDirectionalDerivative against A, B, C, D of the
     core's linearization at the same point, column by column. d der(x) / dx is the analytic Jacobian
@@ -343,7 +351,9 @@ def test_directional_derivatives_match_the_linear_model_of_the_core(gimbal_fmu, 
     from gimbal2axis.analysis.linearization import linearize
     from test_linearization import RICH_POINT, RIGID_POINT, split, with_contact
 
-    values = with_contact(gimbal_fmu, RICH_POINT) if point == "rich" else dict(RIGID_POINT)
+    values = with_contact(gimbal_fmu, RICH_POINT) if point.startswith("rich") else dict(RIGID_POINT)
+    if point.endswith("with disturbances"):
+        values.update(DISTURBANCES)
     values = {k: v for k, v in values.items() if not k.startswith("solver.")}
     linear = linearize(values, build_dir)
     start, inputs = split(gimbal_fmu, values)

@@ -327,3 +327,34 @@ def test_the_documented_limit_cycle_frequency_is_what_the_script_prints(fmu_path
     row = next(line for line in page.splitlines() if line.startswith("| `backlash_limit_cycle`"))
     assert f"{frequency} Hz limit cycle (`scripts/limit_cycle_frequency.py`)" in row
     assert f"oscillates at {frequency} Hz" in page
+
+
+# --- [imbalance] ----------------------------------------------------------------------------------------
+
+IMBALANCE = '[imbalance]\npayload_offset_mm = [1.5, -20, 4]\nazimuth_housing_offset_mm = [0, 2, -80]\n'
+
+
+def test_imbalance_in_millimetres_becomes_the_centre_of_mass_parameters_in_metres(tmp_path, fmu_path):
+    from gimbal2axis.scene.scene import check_against_fmu
+
+    scene, found = load_quietly(scene_file(tmp_path, QUIET + IMBALANCE))
+    assert not found
+    expected = {"body2.d_bd[1]": 1.5e-3, "body2.d_bd[2]": -20e-3, "body2.d_bd[3]": 4e-3,
+                "body1.d_bc[1]": 0.0, "body1.d_bc[2]": 2e-3, "body1.d_bc[3]": -80e-3}
+    assert scene.parameters == pytest.approx(expected, rel=1e-15)
+    check_against_fmu(scene, FMU(fmu_path))  # the names are the FMU's own
+
+
+@pytest.mark.parametrize("table, message", [
+    ('[parameters]\n"body2.d_bd[2]" = 0.02\n' + IMBALANCE,
+     r"imbalance.payload_offset_mm and \[parameters\] 'body2.d_bd\[2\]' both set body2.d_bd\[2\]"),
+    ('[parameters]\n"body1.d_bc[3]" = -0.05\n' + IMBALANCE,
+     r"imbalance.azimuth_housing_offset_mm and \[parameters\] 'body1.d_bc\[3\]' both set"),
+    ('[imbalance]\npayload_offset_mm = [1, 2]\n', r"imbalance.payload_offset_mm must be \[x, y, z\] in mm"),
+    ('[imbalance]\npayload_offset_mm = [1, "2", 3]\n', r"imbalance.payload_offset_mm\[1\] must be a finite number"),
+    ('[imbalance]\npayload_offset = [1, 2, 3]\n', r"\[imbalance\]: unknown key\(s\) \['payload_offset'\]"),
+], ids=["payload_twice", "housing_twice", "two_components", "not_a_number", "unknown_key"])
+def test_a_wrong_imbalance_is_refused_in_one_line_naming_it(tmp_path, table, message):
+    with pytest.raises(SceneError, match=message) as refused:
+        load_scene(scene_file(tmp_path, QUIET + table))
+    assert "\n" not in str(refused.value)

@@ -28,6 +28,8 @@ EXPECTED_REAL_BOUNDS = {
     **{f"motor{j}.{p}": (ABOVE_ZERO, None) for j in (1, 2) for p in ("R", "L", "i_L", "U_L")},
     **{f"motor{j}.{p}": (0.0, None) for j in (1, 2) for p in ("k_torque", "k_emf")},
     **{f"gear{j}.{p}": (0.0, None) for j in (1, 2) for p in ("k_s", "c_s", "eta")},
+    **{f"cable{j}.{p}": (0.0, None) for j in (1, 2) for p in ("k", "c")},
+    **{f"motor{j}.T_cogging": (0.0, None) for j in (1, 2)},
     "solver.rtol": (ABOVE_ZERO, math.nextafter(1.0, 0.0)),
     "solver.atol": (ABOVE_ZERO, None),
 }
@@ -81,7 +83,8 @@ def test_declared_bounds_are_the_validation_rules_of_single_variables(gimbal_fmu
             declared[v.name] = (bound, high) if side == "min" else (low, bound)
     assert declared == EXPECTED_REAL_BOUNDS
     integers = {v.name: (v.min, v.max) for v in md.modelVariables if v.type == "Integer" and (v.min or v.max)}
-    assert integers == {"solver.max_steps": ("1", None), "solver.substeps": ("1", "10000")}
+    assert integers == {"solver.max_steps": ("1", None), "solver.substeps": ("1", "10000"),
+                        "motor1.cogging_periods": ("1", None), "motor2.cogging_periods": ("1", None)}
     for v in md.modelVariables:
         if v.causality != "parameter":
             assert v.min is None and v.max is None, f"{v.name}: bounds are declared for parameters only"

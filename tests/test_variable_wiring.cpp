@@ -158,6 +158,23 @@ std::vector<RealParameter> real_parameters() {
         list.push_back({gear + "c_s", ge.c_s, [j](const ModelParameters& m) { return m.gear[j].damping; }});
         list.push_back({gear + "eta", ge.eta, [j](const ModelParameters& m) { return m.gear[j].half_backlash; }});
     }
+    // The disturbance elements (multibody/disturbance_torques.hpp), per axis.
+    struct Disturbance {
+        double k, c, angle_0, T_cogging, cogging_phase;
+    };
+    const Disturbance disturbances[2] = {{2.31, 0.0231, 0.131, 0.00431, 0.331}, {1.42, 0.0142, -0.242, 0.00342, -1.142}};
+    for (int j = 0; j < 2; ++j) {
+        const std::string cable = "cable" + std::to_string(j + 1) + ".", motor = "motor" + std::to_string(j + 1) + ".";
+        const Disturbance& d = disturbances[j];
+        list.push_back({cable + "k", d.k, [j](const ModelParameters& m) { return m.disturbances.cable[j].stiffness; }});
+        list.push_back({cable + "c", d.c, [j](const ModelParameters& m) { return m.disturbances.cable[j].damping; }});
+        list.push_back(
+            {cable + "angle_0", d.angle_0, [j](const ModelParameters& m) { return m.disturbances.cable[j].neutral_angle; }});
+        list.push_back(
+            {motor + "T_cogging", d.T_cogging, [j](const ModelParameters& m) { return m.disturbances.cogging[j].amplitude; }});
+        list.push_back(
+            {motor + "cogging_phase", d.cogging_phase, [j](const ModelParameters& m) { return m.disturbances.cogging[j].phase; }});
+    }
     list.push_back({"solver.rtol", 1.1e-6, [](const ModelParameters& m) { return m.relative_tolerance; }});
     list.push_back({"solver.atol", 1.2e-8, [](const ModelParameters& m) { return m.absolute_tolerance; }});
     return list;
@@ -173,6 +190,8 @@ const std::map<std::string, IntegerField>& integer_parameter_fields() {
         {"solver.method", [](const ModelParameters& m) { return static_cast<long>(m.method); }},
         {"solver.max_steps", [](const ModelParameters& m) { return m.max_steps; }},
         {"solver.substeps", [](const ModelParameters& m) { return static_cast<long>(m.substeps); }},
+        {"motor1.cogging_periods", [](const ModelParameters& m) { return static_cast<long>(m.disturbances.cogging[0].periods); }},
+        {"motor2.cogging_periods", [](const ModelParameters& m) { return static_cast<long>(m.disturbances.cogging[1].periods); }},
     };
     return fields;
 }
@@ -232,9 +251,11 @@ void check_integer_parameters() {
     // every pair differs in one of these two.
     const std::map<std::string, int> settings[2] = {
         {{"gear1.model", 2}, {"gear2.model", 1}, {"motor1.model", 0}, {"motor2.model", 1}, {"solver.method", 6},
-         {"solver.max_steps", 12345}, {"solver.substeps", 3}},
+         {"solver.max_steps", 12345}, {"solver.substeps", 3}, {"motor1.cogging_periods", 24},
+         {"motor2.cogging_periods", 18}},
         {{"gear1.model", 0}, {"gear2.model", 2}, {"motor1.model", 1}, {"motor2.model", 0}, {"solver.method", 2},
-         {"solver.max_steps", 777}, {"solver.substeps", 250}},
+         {"solver.max_steps", 777}, {"solver.substeps", 250}, {"motor1.cogging_periods", 7},
+         {"motor2.cogging_periods", 11}},
     };
     for (const auto& setting : settings) {
         Values values;
@@ -363,6 +384,8 @@ Outputs outputs_by_name(const ModelParameters& params, GimbalHybridSystem& syste
         {"energy.potential", out.potential_energy},
         {"energy.spring", out.spring_energy},
         {"energy.magnetic", out.magnetic_energy},
+        {"energy.cable", out.cable_energy},
+        {"energy.cogging", out.cogging_energy},
         {"energy.electrical_in", flows[kElectricalIn]},
         {"energy.resistive", flows[kResistive]},
         {"energy.viscous", flows[kViscous]},

@@ -8,6 +8,9 @@ file's name), description, stop_time [s], step_size [s] (communication step), ou
   [fidelity]      structural parameters of the FMU (gear1.model, gear2.model, motor1.model,
                   motor2.model, dry_friction, base.fixed); absent = the FMU's defaults (full model)
   [parameters]    any FMU parameter by its name, SI units
+  [imbalance]     payload_offset_mm, azimuth_housing_offset_mm: [x, y, z] in mm, the centre of mass
+                  of the payload from point b in frame 2 (body2.d_bd) and of the azimuth housing in
+                  frame 1 (body1.d_bc); merged into the parameters (one table per parameter)
   [initial]       start values of the FMU's states (alpha, beta_m, i_R1, ...), SI units; a rotor
                   angle/rate not given follows its load through the gear (alpha_m = N1 alpha, ...)
   [base_motion]   type = "fixed" | "sinusoids" | "sea_state" | "recorded" (base_motion.py)
@@ -46,7 +49,12 @@ from ..fmu import FIDELITY, FMU
 from .sensors import Sensors
 
 TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", "fidelity", "parameters",
-            "initial", "base_motion", "target", "controller", "sensors", "requirements", "test", "plot", "analysis"}
+            "imbalance", "initial", "base_motion", "target", "controller", "sensors", "requirements", "test",
+            "plot", "analysis"}
+
+# [imbalance]: a centre-of-mass offset in millimetres -> the FMU's vector parameter (metres, frame of
+# its body; docs/physics.md section 1).
+IMBALANCE = {"payload_offset_mm": "body2.d_bd", "azimuth_housing_offset_mm": "body1.d_bc"}
 
 
 @dataclass
@@ -128,6 +136,26 @@ def _flatten(table: dict, prefix: str = "") -> dict:
     return flat
 
 
+def _imbalance_parameters(table: dict, parameters: dict) -> dict:
+    """The FMU parameters (SI) of an [imbalance] table; a parameter also in [parameters] is refused,
+    since one of the two would win without a word."""
+    check_keys("imbalance", table, set(IMBALANCE))
+    values = {}
+    for key, vector in IMBALANCE.items():
+        if key not in table:
+            continue
+        offset = table[key]
+        if not (isinstance(offset, list) and len(offset) == 3):
+            raise SceneError(f"imbalance.{key} must be [x, y, z] in mm, got {offset!r}")
+        for component, value in enumerate(offset, start=1):
+            name = f"{vector}[{component}]"
+            if name in parameters:
+                raise SceneError(f"imbalance.{key} and [parameters] '{name}' both set {name}: "
+                                 "give the centre of mass in one table only")
+            values[name] = number(f"imbalance.{key}[{component - 1}]", value) / 1000.0
+    return values
+
+
 def load_scene(path: pathlib.Path | str) -> Scene:
     """Reads and validates a scene file (everything but the FMU variable names)."""
     path = pathlib.Path(path)
@@ -153,10 +181,12 @@ def load_scene(path: pathlib.Path | str) -> Scene:
             target = {"azimuth_deg": number("target.azimuth_deg", target.get("azimuth_deg", 0.0)),
                       "elevation_deg": number("target.elevation_deg", target.get("elevation_deg", 0.0)),
                       "start_on_target": bool(target.get("start_on_target", False))}
+        parameters = _table(raw, "parameters", True)
+        parameters.update(_imbalance_parameters(_table(raw, "imbalance"), parameters))
         scene = Scene(path=path, name=path.stem, title=title, description=str(raw.get("description", "")),
                       stop_time=positive("stop_time", raw["stop_time"]), step_size=step,
                       output_interval=positive("output_interval", raw.get("output_interval", step)),
-                      fidelity=_table(raw, "fidelity", True), parameters=_table(raw, "parameters", True),
+                      fidelity=_table(raw, "fidelity", True), parameters=parameters,
                       initial=_table(raw, "initial", True), base_motion_spec=_table(raw, "base_motion"),
                       target_spec=target, controller_spec=_table(raw, "controller"),
                       sensors_spec=_table(raw, "sensors"), requirements=_table(raw, "requirements"),

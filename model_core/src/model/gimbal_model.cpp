@@ -31,6 +31,7 @@ StateLayout StateLayout::from(const Fidelity& fidelity, bool energy_accounting) 
 void ModelParameters::finalize() {
     layout = StateLayout::from(fidelity, energy_accounting);
     assign_coordinate_friction(*this);
+    disturbances.active = disturbances.any_present();
 }
 
 BaseKinematics base_kinematics_at(const ModelParameters& params, const StepInputs& inputs, double time) {
@@ -96,6 +97,19 @@ inline void add_drive_train_forces(const ModelParameters& params, const StepInpu
     force[rotor] += motor_torque - shaft_torque / params.gear[axis].ratio;
 }
 
+// The disturbance elements (disturbance_torques.hpp), each on its own coordinate: the cable of axis j on
+// the load's joint angle, the cogging of motor j on its rotor's angle relative to the stator. The
+// reactions on the inner bodies need no term: the coordinates are relative angles. A rigid axis's rotor
+// angle is N q_l (expand_state), and the reduction below reflects its cogging torque to the load.
+inline void add_disturbance_forces(const DisturbanceParameters& disturbances, const Vec4& q, const Vec4& qd,
+                                   Vec4& force) {
+    for (int axis = 0; axis < 2; ++axis) {
+        const int rotor = rotor_index(axis), load = load_index(axis);
+        force[load] += cable_torque(disturbances.cable[axis], q[load], qd[load]);
+        force[rotor] += cogging_torque(disturbances.cogging[axis], q[rotor]);
+    }
+}
+
 // T^T J T and T^T (force + bias) for each rigid axis, written out: T only adds N times the rotor's
 // row and column to the load's, and the rotor's become the padding identity (a trivial equation).
 inline void reduce_rigid_axes(const ModelParameters& params, Mat4& reduced_mass, Vec4& applied) {
@@ -151,6 +165,7 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     Vec4 force;  // generalized forces on the four bodies, without dry friction
     for (int body = 0; body < 4; ++body) force[body] = -params.viscous_friction[body] * qd[body];
     for (int axis = 0; axis < 2; ++axis) add_drive_train_forces(params, inputs, modes, time, axis, out, force);
+    if (params.disturbances.active) add_disturbance_forces(params.disturbances, q, qd, force);
 
     const bool reduced = params.fidelity.gear[0] == GearModel::rigid || params.fidelity.gear[1] == GearModel::rigid;
     Mat4 mass_matrix;
@@ -215,6 +230,12 @@ bool state_derivative(const ModelParameters& params, const Dynamics& d, double* 
             flow[kViscous] += params.viscous_friction[body] * rate * rate;
             flow[kDryFriction] -= d.friction_torque[body] * rate;
         }
+        // The cable dampers' loss is viscous too: it goes into the same accumulator.
+        if (params.disturbances.active)
+            for (int axis = 0; axis < 2; ++axis) {
+                const double rate = d.full.rate[load_index(axis)];
+                flow[kViscous] += params.disturbances.cable[axis].damping * rate * rate;
+            }
     }
     // x * 0 is NaN exactly when x is not finite: one test instead of one per component.
     double finite_check = 0.0;
@@ -254,6 +275,12 @@ ModelOutputs outputs_from(const ModelParameters& params, const StepInputs& input
     const MultibodyEnergy energy = compute_energy(params.multibody, base, velocity_a, d.full.angle, d.full.rate);
     out.kinetic_energy = energy.kinetic;
     out.potential_energy = energy.potential;
+    if (params.disturbances.active) {
+        for (int axis = 0; axis < 2; ++axis) {
+            out.cable_energy += cable_energy(params.disturbances.cable[axis], d.full.angle[load_index(axis)]);
+            out.cogging_energy += cogging_energy(params.disturbances.cogging[axis], d.full.angle[rotor_index(axis)]);
+        }
+    }
     return out;
 }
 

@@ -1,6 +1,7 @@
 // d(dx/dt)/dx (gimbal_model.hpp, evaluate_jacobian), from the same passes as the dynamics: the
-// drive train's elements (gear_backlash, current_limiter), the multibody terms, the dry friction
-// element's hold torques, and the state rows of the elements with states of their own.
+// drive train's elements (gear_backlash, current_limiter), the disturbance elements (cable, cogging),
+// the multibody terms, the dry friction element's hold torques, and the state rows of the elements
+// with states of their own.
 #include "gimbal/model/gimbal_model.hpp"
 
 #include <algorithm>
@@ -10,15 +11,30 @@
 namespace gimbal {
 namespace {
 
+// The disturbance elements' derivatives (disturbance_torques.hpp): the cable's -k and -c on its joint,
+// the cogging's dT/dq_m on its rotor. Full coordinates: a rigid axis's rotor column reaches the load
+// through the projection to padded coordinates, as its forces do through the reduction.
+void add_disturbance_force_derivatives(const DisturbanceParameters& disturbances, const Vec4& q, Mat4x12& force) {
+    for (int axis = 0; axis < 2; ++axis) {
+        const int rotor = rotor_index(axis), load = load_index(axis);
+        const CableRestraint& cable = disturbances.cable[axis];
+        force(load, kAngleColumn + load) -= cable.stiffness;
+        force(load, kRateColumn + load) -= cable.damping;
+        force(rotor, kAngleColumn + rotor) += cogging_torque_slope(disturbances.cogging[axis], q[rotor]);
+    }
+}
+
 // Derivatives of the full generalized forces of the drive train: viscous friction, then per axis the
-// gear's shaft torque and the motor's torque (the order of the sums is the results' bits).
-Mat4x12 drive_train_force_derivatives(const ModelParameters& params, const Modes& modes) {
+// gear's shaft torque and the motor's torque, then the disturbance elements if any is on (the order of
+// the sums is the results' bits).
+Mat4x12 drive_train_force_derivatives(const ModelParameters& params, const Modes& modes, const Vec4& q) {
     Mat4x12 force = Mat4x12::Zero();
     for (int body = 0; body < 4; ++body) force(body, kRateColumn + body) -= params.viscous_friction[body];
     for (int axis = 0; axis < 2; ++axis) {
         add_gear_force_derivatives(params, modes, axis, force);
         add_motor_force_derivatives(params, modes, axis, force);
     }
+    if (params.disturbances.active) add_disturbance_force_derivatives(params.disturbances, q, force);
     return force;
 }
 
@@ -110,7 +126,7 @@ void write_state_rows(const ModelParameters& params, const Modes& modes, const M
 void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const BaseKinematics& base,
                        const Dynamics& d, double* column_major) {
     // Full coordinates: the switching elements' force derivatives, then the multibody terms.
-    Mat4x12 force = drive_train_force_derivatives(params, modes);
+    Mat4x12 force = drive_train_force_derivatives(params, modes, d.full.angle);
     Mat4 inertia_derivative[4];  // dJ/dq_j, full coordinates
     add_rigid_body_derivatives(params, base, d, force, inertia_derivative);
 

@@ -345,6 +345,20 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     zeno_holds_ = 0;
     publish_outputs();
     outputs_stale_ = false;
+    return check_initial_outputs();
+}
+
+// The start's outputs, like a step's (check_published_outputs): inputs beyond what the model can
+// represent (a carrier rate of 1e300 makes the kinetic energy overflow) are refused, not published.
+GimbalStatus GimbalInstance::check_initial_outputs() {
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
+        if (kRealVariables[vr].causality != Causality::output || std::isfinite(reals_[vr])) continue;
+        std::ostringstream s;
+        s.precision(17);
+        s << kRealVariables[vr].name << " = " << reals_[vr] << " at the start time " << time_
+          << ": an input or parameter lies beyond what the model can represent";
+        return refuse(GIMBAL_ERROR, s.str());
+    }
     return GIMBAL_OK;
 }
 

@@ -54,6 +54,8 @@ void publish_outputs(const OutputPoint& point, double (&reals)[kRealVariableCoun
     reals[vr_energy_potential] = out.potential_energy;
     reals[vr_energy_spring] = out.spring_energy;
     reals[vr_energy_magnetic] = out.magnetic_energy;
+    reals[vr_energy_cable] = out.cable_energy;
+    reals[vr_energy_cogging] = out.cogging_energy;
     const bool accounting = params.layout.energy_slot >= 0;
     const double* flows = point.state + (accounting ? params.layout.energy_slot : 0);
     reals[vr_energy_electrical_in] = accounting ? flows[kElectricalIn] : 0.0;

@@ -241,6 +241,24 @@ bool read_drive_train(Checker& check, ModelParameters& params) {
     return true;
 }
 
+// The cable restraints and the cogging (multibody/disturbance_torques.hpp). Their bounds (k, c,
+// T_cogging >= 0, cogging_periods >= 1) were checked with the other single-variable rules.
+void read_disturbances(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
+                       DisturbanceParameters& disturbances) {
+    struct CableVariables { RealVariable k, c, angle_0; };
+    const CableVariables cables[2] = {{vr_cable1_k, vr_cable1_c, vr_cable1_angle_0},
+                                      {vr_cable2_k, vr_cable2_c, vr_cable2_angle_0}};
+    struct CoggingVariables { RealVariable amplitude; IntegerVariable periods; RealVariable phase; };
+    const CoggingVariables coggings[2] = {{vr_motor1_T_cogging, vi_motor1_cogging_periods, vr_motor1_cogging_phase},
+                                          {vr_motor2_T_cogging, vi_motor2_cogging_periods, vr_motor2_cogging_phase}};
+    for (int j = 0; j < 2; ++j) {
+        const CableVariables& c = cables[j];
+        disturbances.cable[j] = CableRestraint{values[c.k], values[c.c], values[c.angle_0]};
+        const CoggingVariables& g = coggings[j];
+        disturbances.cogging[j] = Cogging{values[g.amplitude], integers[g.periods], values[g.phase]};
+    }
+}
+
 // solver.*: the method (its range checked from the table; here: one this binary has), its step limit and
 // substeps.
 bool read_solver(const int (&integers)[kIntegerVariableCount], ModelParameters& params, std::string& error) {
@@ -281,6 +299,7 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     if (!check_single_variable_rules(check, integers) || !read_bodies(check, params)) return false;
     params.energy_accounting = flags[vb_energy_accounting];
     if (!read_drive_train(check, params) || !read_solver(integers, params, error)) return false;
+    read_disturbances(values, integers, params.disturbances);
     read_fidelity(integers, flags, params);
     params.finalize();
     params.relative_tolerance = values[vr_solver_rtol];

@@ -46,6 +46,8 @@ struct ModelOutputs {
     double potential_energy = 0.0;
     double spring_energy = 0.0;
     double magnetic_energy = 0.0;
+    double cable_energy = 0.0;    // the cable restraints' springs
+    double cogging_energy = 0.0;  // the motors' cogging potentials, 0 at a detent
 };
 
 ModelOutputs evaluate_outputs(const ModelParameters& params, const StepInputs& inputs, const Modes& modes,

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "gimbal/multibody/disturbance_torques.hpp"
 #include "gimbal/multibody/drive_train.hpp"
 #include "gimbal/multibody/rigid_body.hpp"
 
@@ -62,6 +63,7 @@ struct ModelParameters {
     GearParameters gear[2];
     double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
     DryFrictionParameters dry_friction[4];      // per body, as given
+    DisturbanceParameters disturbances;         // cable restraints and cogging; `active` set by finalize()
     Fidelity fidelity;
     bool energy_accounting = false;
     double relative_tolerance = 1e-6;
@@ -71,7 +73,8 @@ struct ModelParameters {
     int substeps = 1;         // real-time method: equal substeps per communication step
 
     // Derived by finalize(): the layout, dry friction per padded coordinate (a rigid axis merges its
-    // rotor's friction into the load's), and the share of a merged element attributed to the rotor.
+    // rotor's friction into the load's), the share of a merged element attributed to the rotor, and
+    // whether any disturbance element is on.
     StateLayout layout;
     DryFrictionParameters coordinate_friction[4];
     double rotor_friction_share[2] = {0, 0};

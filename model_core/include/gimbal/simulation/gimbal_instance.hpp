@@ -135,6 +135,7 @@ private:
     inline GimbalStatus take_step_inputs(double step_start, bool& resting);
     inline void end_step_at(double step_end, double reached_model_time, bool ended_early);
     inline GimbalStatus check_published_outputs(double current_time, const StepStart& start);
+    GimbalStatus check_initial_outputs();
     GimbalStatus advance_step(double current_time, double step_size, double* early, double& reached);
     void roll_back(const StepStart& start);
     GimbalStatus report_step_work(double step_size, const IntegratorStatistics& before, const EventCounters& events_before);
