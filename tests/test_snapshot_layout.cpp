@@ -1,5 +1,5 @@
-// The FMU state's bytes (snapshot format 7) field by field: the table of gimbal/simulation/snapshot.hpp must lay
-// every field where format 7 put it. Format 7 was a C++ struct copied as bytes; that struct is kept
+// The FMU state's bytes (snapshot format 8: format 7's layout over the present variable tables) field by
+// field: the table of gimbal/simulation/snapshot.hpp must lay every field where format 7 put it. Format 7 was a C++ struct copied as bytes; that struct is kept
 // here as the reference (Format7), and every row's offset and size is compared with its member's.
 // Then: content survives encode/decode bit for bit, and single faults are refused naming the field.
 #include <cmath>
@@ -95,7 +95,7 @@ const Place kFormat7[] = {
 };
 
 void test_layout_is_format_7() {
-    CHECK(kSnapshotFormat == 7);
+    CHECK(kSnapshotFormat == 8);
     CHECK(snapshot_bytes() == sizeof(Format7));
     CHECK(GimbalInstance::snapshot_size() == sizeof(Format7));
     const std::size_t rows = sizeof kFormat7 / sizeof kFormat7[0];
@@ -120,7 +120,7 @@ void test_bytes_are_format_7() {
     encode_snapshot(content, bytes.data());
     Format7 legacy;
     std::memcpy(&legacy, bytes.data(), sizeof legacy);
-    CHECK(legacy.magic == kSnapshotMagic && legacy.version == 7);
+    CHECK(legacy.magic == kSnapshotMagic && legacy.version == kSnapshotFormat);
     CHECK(std::memcmp(legacy.reals, content.reals, sizeof legacy.reals) == 0);
     CHECK(std::memcmp(legacy.integers, content.integers, sizeof legacy.integers) == 0);
     CHECK(std::memcmp(legacy.decided_side, content.decided_side, sizeof legacy.decided_side) == 0);
@@ -192,7 +192,7 @@ void test_single_faults_name_the_field() {
         CHECK(reason.compare(0, fault.reason.size(), fault.reason) == 0);
     }
     CHECK(check_snapshot_content(good, false, false) ==
-          "it was not saved by this version of Gimbal2Axis (snapshot format 7)");
+          "it was not saved by this version of Gimbal2Axis (snapshot format 8)");
     // An uninitialized instance's snapshot has no run: its modes are not looked at.
     GimbalInstance fresh([](GimbalStatus, const char*, const std::string&) {}, [](const char*) { return false; });
     fresh.save(bytes.data());

@@ -55,7 +55,9 @@ struct SnapshotContent {
 // Serialized: a 4-byte magic ("G2AX"), the 4-byte format number, then the fields in table order, each
 // at its natural alignment (a row may ask for more), the whole padded to 8 bytes; gaps are zero.
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;
-constexpr std::uint32_t kSnapshotFormat = 7;
+// Format 8: format 7's fields with the longer variable tables of the disturbance elements (cables,
+// cogging): the variable arrays grew, so a format-7 state is refused by its number, not misread.
+constexpr std::uint32_t kSnapshotFormat = 8;
 
 std::size_t snapshot_bytes();
 // The bytes of a content (every gap zero).
