@@ -12,6 +12,20 @@ class SceneWarning(UserWarning):
     """A scene that runs, but probably not as its author meant; the message names the key."""
 
 
+def read_toml(path, error: type = SceneError) -> dict:
+    """The parsed TOML file at `path`; an `error` (the exception type to raise) naming the file when
+    it cannot be read or is not TOML."""
+    import tomllib
+
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except OSError as exc:
+        raise error(f"{path}: {exc.strerror or exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path}: not valid TOML: {exc}") from None
+
+
 def check_keys(where: str, table: dict, allowed: set) -> None:
     unknown = set(table) - set(allowed)
     if unknown:

@@ -121,9 +121,8 @@ def test_a_wrong_sensor_setting_is_refused_by_name(spec, message):
 
 
 @pytest.fixture(scope="module")
-def fmu(fmu_path):
-    with FMU(fmu_path) as loaded:
-        yield loaded
+def fmu(gimbal_fmu):
+    return gimbal_fmu
 
 
 @pytest.fixture(scope="module")

@@ -7,19 +7,17 @@ RMS, total, per axis and per band, and the figure: the error over time of each c
 cumulative RMS per axis), <out>/<name>.png (the figure) and <out>/<name>.csv (the table).
 """
 import pathlib
-import sys
 
-from ..errors import SceneError
 from ..fmu import FMU
 from ..locations import fmu_path
 from ..report import load_comparison, run_comparison, write_page
 from ..report.comparison import table_rows
 from .defaults import scene_file
+from .failures import EXIT_ERROR, run_reporting_failures
 from .run import check_output_directory
 
 SUMMARY = "compare gyro grades and direct/indirect stabilization on a scene: one HTML page"
 PROG = "gimbal2axis report"
-EXIT_ERROR, EXIT_INTERRUPTED = 2, 130
 DEFAULT_COMPARISON = pathlib.Path("reports", "gyro_grades_and_schemes.toml")
 
 
@@ -34,25 +32,18 @@ def add_arguments(parser) -> None:
 
 
 def execute(args) -> int:
-    try:
-        comparison = load_comparison(scene_file(args.comparison, DEFAULT_COMPARISON,
-                                                "the comparison file: gimbal2axis report FILE.toml"))
-        out = pathlib.Path(args.out)
-        check_output_directory(out, comparison.path.stem)
-        with FMU(fmu_path(args.fmu)) as fmu:
-            results = run_comparison(comparison, fmu, progress=not args.quiet)
-        rows = table_rows(results)
-        paths = write_page(comparison, results, rows, out)
-    except SceneError as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
-        return EXIT_ERROR
-    except OSError as exc:
-        where = f"{exc.filename}: " if exc.filename else ""
-        print(f"{PROG}: error: {where}{exc.strerror or exc}", file=sys.stderr)
-        return EXIT_ERROR
-    except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    return run_reporting_failures(PROG, lambda: _report(args))
+
+
+def _report(args) -> int:
+    comparison = load_comparison(scene_file(args.comparison, DEFAULT_COMPARISON,
+                                            "the comparison file: gimbal2axis report FILE.toml"))
+    out = pathlib.Path(args.out)
+    check_output_directory(out, comparison.path.stem)
+    with FMU(fmu_path(args.fmu)) as fmu:
+        results = run_comparison(comparison, fmu, progress=not args.quiet)
+    rows = table_rows(results)
+    paths = write_page(comparison, results, rows, out)
     for row in rows:
         print(f"{row['case']}: LOS error RMS {row['los_rms_mrad']:.4g} mrad, max {row['los_max_mrad']:.4g} mrad")
     print(f"wrote {paths['html']}, {paths['png']} and {paths['csv']}")

@@ -18,10 +18,10 @@ from ..locations import fmu_path
 from ..master import run_scene_file
 from ..scene import load_scene
 from .defaults import scene_file
+from .failures import EXIT_ERROR, run_reporting_failures
 
 SUMMARY = "run a scene file: CSV, plots and a summary line"
 PROG = "gimbal2axis run"
-EXIT_ERROR, EXIT_INTERRUPTED = 2, 130
 DEFAULT_SCENE = pathlib.Path("scenes", "free_swing.toml")   # relative to the current directory
 
 
@@ -86,25 +86,18 @@ def add_arguments(parser) -> None:
 
 def execute(args) -> int:
     warnings.showwarning = show_warning
-    try:
-        scene_path = scene_file(args.scene, DEFAULT_SCENE, "the scene file: gimbal2axis run SCENE.toml")
-        scene = load_scene(scene_path)
-        if args.stop_time is not None:
-            check_stop_time(args.stop_time, scene)
-        fmu = fmu_path(args.fmu)
-        check_output_directory(pathlib.Path(args.out), scene.name)
-        result, csv_path, png_path = run_scene_file(scene_path, fmu, args.out, progress=not args.quiet,
-                                                    stop_time=args.stop_time)
-    except SceneError as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
-        return EXIT_ERROR
-    except OSError as exc:   # writing the results (the directory was writable a moment ago)
-        where = f"{exc.filename}: " if exc.filename else ""
-        print(f"{PROG}: error: {where}{exc.strerror or exc}", file=sys.stderr)
-        return EXIT_ERROR
-    except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    return run_reporting_failures(PROG, lambda: _run(args))
+
+
+def _run(args) -> int:
+    scene_path = scene_file(args.scene, DEFAULT_SCENE, "the scene file: gimbal2axis run SCENE.toml")
+    scene = load_scene(scene_path)
+    if args.stop_time is not None:
+        check_stop_time(args.stop_time, scene)
+    fmu = fmu_path(args.fmu)
+    check_output_directory(pathlib.Path(args.out), scene.name)
+    result, csv_path, png_path = run_scene_file(scene_path, fmu, args.out, progress=not args.quiet,
+                                                stop_time=args.stop_time)
     print(result.summary())
     print(f"wrote {csv_path} and {png_path}")
     return 1 if args.check and result.requirement_failures() else 0

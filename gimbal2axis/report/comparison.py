@@ -19,10 +19,9 @@ from __future__ import annotations
 
 import math
 import pathlib
-import tomllib
 from dataclasses import dataclass
 
-from ..errors import SceneError, check_keys, positive
+from ..errors import SceneError, check_keys, positive, read_toml
 from ..master import run
 from ..scene import load_scene
 from ..scene.gyro import GyroModel
@@ -74,13 +73,7 @@ def _grade_cases(scene, grades: dict, schemes: list, common: dict, analysis: dic
 def load_comparison(path: pathlib.Path | str) -> Comparison:
     """Reads and checks a comparison file; SceneError naming the file and the key otherwise."""
     path = pathlib.Path(path)
-    try:
-        with open(path, "rb") as f:
-            raw = tomllib.load(f)
-    except OSError as exc:
-        raise SceneError(f"{path}: cannot read it: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    raw = read_toml(path)
     try:
         check_keys("comparison", raw, KEYS)
         if "scene" not in raw or "grades" not in raw:

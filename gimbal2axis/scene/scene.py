@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import math
 import pathlib
-import tomllib
 import warnings
 from dataclasses import dataclass, field
 
@@ -44,7 +43,7 @@ import numpy as np
 from . import analysis, geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
-from ..errors import SceneError, SceneWarning, check_keys, number, positive
+from ..errors import SceneError, SceneWarning, check_keys, number, positive, read_toml
 from ..fmu import FIDELITY, FMU
 from .sensors import Sensors
 
@@ -159,13 +158,7 @@ def _imbalance_parameters(table: dict, parameters: dict) -> dict:
 def load_scene(path: pathlib.Path | str) -> Scene:
     """Reads and validates a scene file (everything but the FMU variable names)."""
     path = pathlib.Path(path)
-    try:
-        with open(path, "rb") as f:
-            raw = tomllib.load(f)
-    except OSError as exc:
-        raise SceneError(f"{path}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    raw = read_toml(path)
     try:
         check_keys("top level", raw, TOP_KEYS)
         for key in ("stop_time", "step_size"):

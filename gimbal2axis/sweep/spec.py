@@ -47,13 +47,12 @@ import itertools
 import json
 import math
 import pathlib
-import tomllib
 import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SceneError, positive
+from ..errors import SceneError, positive, read_toml
 from ..scene.scene import Scene
 
 TOP_KEYS = {"name", "description", "cases", "seed", "samples", "stop_time", "metrics_from_s", "grid", "random"}
@@ -212,13 +211,7 @@ def draw(name: str, spec: dict, n: int, seed: int) -> list:
 
 def load_sweep(path: pathlib.Path | str) -> Sweep:
     path = pathlib.Path(path)
-    try:
-        with open(path, "rb") as f:
-            raw = tomllib.load(f)
-    except OSError as exc:
-        raise SweepError(f"{path}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"{path}: not valid TOML: {exc}") from None
+    raw = read_toml(path, SweepError)
     try:
         unknown = set(raw) - TOP_KEYS
         if unknown:
