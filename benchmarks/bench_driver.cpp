@@ -32,6 +32,7 @@
 
 #include "controllers.h"
 #include "fmi2Functions.h"
+#include "set_points.h"
 #include "sum_of_sines.h"
 
 // ------------------------------------------------------------------------------------------------
@@ -392,31 +393,16 @@ struct SeaState {
 };
 
 // ------------------------------------------------------------------------------------------------
-// Line of sight: inverse kinematics of a fixed inertial target (geometry.py's gimbal_angles_for).
-// LOS = y of body 2; in G: GT0 Rz(alpha) Rx(beta) e_y, GT0 = Rx(delta) Rz(psi) Ry(gamma).
+// Line of sight: inverse kinematics of a fixed inertial target, the kernel's (set_points.h, which
+// the scene runner and the controller FMU use), alpha in the turn nearest alpha_near.
 // ------------------------------------------------------------------------------------------------
 void gimbal_angles_for(const double target[3], double delta, double psi, double gamma, double alpha_near,
                        double& alpha, double& beta) {
-    double x = target[0], y = target[1], z = target[2];
-    double c = std::cos(delta), s = std::sin(delta);
-    double y1 = c * y + s * z, z1 = -s * y + c * z;
-    y = y1;
-    z = z1;
-    c = std::cos(psi);
-    s = std::sin(psi);
-    double x1 = c * x + s * y;
-    y1 = -s * x + c * y;
-    x = x1;
-    y = y1;
-    c = std::cos(gamma);
-    s = std::sin(gamma);
-    x1 = c * x - s * z;
-    z1 = s * x + c * z;
-    x = x1;
-    z = z1;
-    beta = std::atan2(z, std::hypot(x, y));
-    alpha = std::atan2(-x, y);
-    alpha += 2.0 * M_PI * std::round((alpha_near - alpha) / (2.0 * M_PI));
+    const double attitude[3] = {delta, psi, gamma};
+    double angles[2];
+    gimbal_target_angles(target, attitude, angles);
+    alpha = gimbal_angle_nearest_turn(angles[0], alpha_near);
+    beta = angles[1];
 }
 
 // PD on each axis about the IK set points, with the payload gyro as the rate signal: the kernel's

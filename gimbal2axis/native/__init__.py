@@ -1,6 +1,6 @@
 """The C kernel (gimbal2axis/native/*.c, built by `pip install -e .` as the extension
-gimbal2axis.native._native), loaded once through ctypes: the built-in controllers (scene/controllers.py),
-the sensors (scene/sensors.py), the sums of sinusoids of the base motions (scene/base_motion.py) and the
+gimbal2axis.native._native), loaded once through ctypes: the built-in controllers (scene/controllers.py)
+and their set points toward a target (scene/setpoints.py), the sensors (scene/sensors.py), the sums of sinusoids of the base motions (scene/base_motion.py) and the
 compiled communication loop (master/compiled_loop.py). The structs they share with Python are built here from the
 kernel's own layout table (`struct`), never copied. `why_not()` says why the kernel is missing."""
 from __future__ import annotations
@@ -46,6 +46,9 @@ def _declare(loaded) -> None:
         "gimbal_master_loop_call_name": ([integer], text),
         "gimbal_controller_kind": ([text], integer),
         "gimbal_controller_step": ([pointer, long, double, pointer, pointer, pointer, pointer], None),
+        "gimbal_target_direction": ([double, double, pointer], None),
+        "gimbal_target_set_points": ([long, pointer, pointer, pointer, pointer, pointer], None),
+        "gimbal_angle_nearest_turn": ([double, double], double),
         "gimbal_sensors_measure": ([pointer, long, pointer], None),
         "gimbal_gyro_measure": ([pointer, long, pointer, pointer], None),
         "gimbal_gyro_series": ([pointer, long, pointer, pointer], None),

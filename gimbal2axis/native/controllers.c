@@ -3,9 +3,9 @@
 #include <math.h>
 #include <string.h>
 
-enum { kNone = 0, kPid = 1, kStateFeedback = 2, kReplay = 3 };
+#include "set_points.h"
 
-static const double kTwoPi = 2.0 * 3.14159265358979311599796346854; /* 2 * math.pi */
+enum { kNone = 0, kPid = 1, kStateFeedback = 2, kReplay = 3 };
 
 /* Python's max(a, b) and min(a, b), whose bits these controllers keep: the first unless the second
    is strictly beyond it. */
@@ -36,8 +36,7 @@ static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double
 
 static double prepared_set_point(const GimbalSetPoints* points, long k, int axis, double measured) {
     const double principal = points->values[2 * k + axis];
-    if (!points->unwrap[axis]) return principal;
-    return principal + kTwoPi * nearbyint((measured - principal) / kTwoPi);
+    return points->unwrap[axis] ? gimbal_angle_nearest_turn(principal, measured) : principal;
 }
 
 static void state_feedback(GimbalController* c, double h, double alpha, double beta, double w_az, double w_el,

@@ -46,6 +46,7 @@ from .controllers import make_controller
 from ..errors import SceneError, SceneWarning, check_keys, number, positive, read_toml
 from ..fmu import FIDELITY, FMU
 from .sensors import Sensors
+from .setpoints import target_direction
 
 TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", "fidelity", "parameters",
             "imbalance", "initial", "base_motion", "target", "controller", "sensors", "requirements", "test",
@@ -85,11 +86,12 @@ class Scene:
 
     @property
     def target(self):
-        """Unit vector of the target in G, or None."""
+        """Unit vector of the target in G, or None: the kernel's (setpoints.target_direction), whose
+        bits the controller FMU computes from the same angles."""
         if self.target_spec is None:
             return None
-        return tuple(float(x) for x in geometry.target_direction(math.radians(self.target_spec["azimuth_deg"]),
-                                                                 math.radians(self.target_spec["elevation_deg"])))
+        return target_direction(math.radians(self.target_spec["azimuth_deg"]),
+                                math.radians(self.target_spec["elevation_deg"]))
 
     @property
     def delay_steps(self) -> int:

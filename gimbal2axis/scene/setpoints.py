@@ -8,15 +8,21 @@ references, the difference quotient over one step. The azimuth to a target is st
 principal value: each step takes the 2 pi branch nearest the measured azimuth (the kernel's
 controllers.c, for both loops), so a gimbal that has turned a full circle keeps tracking without a
 jump.
+
+The target's set points are the C kernel's (gimbal2axis/native/set_points.c), which the controller
+FMU (docs/controller_fmu.md) runs too: libm's sin, cos, atan2 and hypot, where numpy may take SIMD
+routines that round differently in the last bit. `target_angles` stays numpy, vectorised over
+cases, for user controllers.
 """
 from __future__ import annotations
 
-import math
+import ctypes
 
 import numpy as np
 
-TWO_PI = 2.0 * math.pi
-RATE_STEP_S = 1e-6   # the attitude difference for the target's rate
+from .. import native
+
+RATE_STEP_S = 1e-6   # the attitude difference for the target's rate (set_points.h GIMBAL_SET_POINT_RATE_STEP_S)
 
 
 def target_angles(target, delta, psi, gamma):
@@ -31,6 +37,28 @@ def target_angles(target, delta, psi, gamma):
     c, s = np.cos(gamma), np.sin(gamma)
     x, z = c * x - s * z, s * x + c * z
     return np.arctan2(-x, y), np.arctan2(z, np.hypot(x, y))
+
+
+def target_set_points(target, attitude: np.ndarray, rates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's set points toward `target` (a unit vector in G) for every row of the base
+    attitude and its rates ((n + 1) x 3): values (principal alpha, beta) and their rates, (n + 1) x 2."""
+    attitude = np.ascontiguousarray(attitude, dtype=float)
+    rates = np.ascontiguousarray(rates, dtype=float)
+    if attitude.shape != rates.shape or attitude.ndim != 2 or attitude.shape[1] != 3:
+        raise ValueError(f"attitude {attitude.shape} and rates {rates.shape} must both be (n, 3)")
+    direction = np.ascontiguousarray(target, dtype=float)
+    values, value_rates = np.empty((len(attitude), 2)), np.empty((len(attitude), 2))
+    native.kernel().gimbal_target_set_points(len(attitude), direction.ctypes.data, attitude.ctypes.data,
+                                             rates.ctypes.data, values.ctypes.data, value_rates.ctypes.data)
+    return values.T, value_rates.T
+
+
+def target_direction(azimuth: float, elevation: float) -> tuple:
+    """The kernel's unit vector in G of a target at (azimuth, elevation) [rad], as the controller
+    FMU computes it from its parameters target.azimuth and target.elevation."""
+    direction = (ctypes.c_double * 3)()
+    native.kernel().gimbal_target_direction(azimuth, elevation, direction)
+    return tuple(direction)
 
 
 class SetPoints:
@@ -50,13 +78,7 @@ def plan_set_points(references: list, target, times: np.ndarray, h: float, attit
     count = len(times)
     values, value_rates = np.zeros((count, 2)), np.zeros((count, 2))
     if "target" in references:
-        alpha, beta = target_angles(target, attitude[:, 0], attitude[:, 1], attitude[:, 2])
-        ahead = attitude + RATE_STEP_S * rates
-        alpha_ahead, beta_ahead = target_angles(target, ahead[:, 0], ahead[:, 1], ahead[:, 2])
-        turn = alpha_ahead - alpha
-        turn -= TWO_PI * np.round(turn / TWO_PI)
-        target_values = (alpha, beta)
-        target_rates = (turn / RATE_STEP_S, (beta_ahead - beta) / RATE_STEP_S)
+        target_values, target_rates = target_set_points(target, attitude, rates)
     for axis, reference in enumerate(references):
         if reference == "target":
             values[:, axis], value_rates[:, axis] = target_values[axis], target_rates[axis]
