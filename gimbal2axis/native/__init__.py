@@ -1,8 +1,9 @@
 """The C kernel (gimbal2axis/native/*.c, built by `pip install -e .` as the extension
 gimbal2axis.native._native), loaded once through ctypes: the built-in controllers (scene/controllers.py)
-and their set points toward a target (scene/setpoints.py), the sensors (scene/sensors.py), the sums of sinusoids of the base motions (scene/base_motion.py) and the
-compiled communication loop (master/compiled_loop.py). The structs they share with Python are built here from the
-kernel's own layout table (`struct`), never copied. `why_not()` says why the kernel is missing."""
+and their set points toward a target (scene/setpoints.py), the sensors (scene/sensors.py), the sums of
+sinusoids of the base motions and the sea state's components (scene/base_motion.py) and the compiled
+communication loop (master/compiled_loop.py). The structs they share with Python are built here from
+the kernel's own layout table (`struct`), never copied. `why_not()` says why the kernel is missing."""
 from __future__ import annotations
 
 import ctypes
@@ -54,6 +55,10 @@ def _declare(loaded) -> None:
         "gimbal_gyro_series": ([pointer, long, pointer, pointer], None),
         "gimbal_sum_of_sines_weights": ([long, pointer, pointer, pointer], None),
         "gimbal_sum_of_sines": ([long, double, double, long] + [pointer] * 6, integer),
+        "gimbal_pairwise_sum": ([pointer, long], double),
+        "gimbal_random_uniform": ([pointer, long, long, double, double, pointer], None),
+        "gimbal_sea_state_components": ([pointer, long, double, double, double, long, double, double] + [pointer] * 3,
+                                        integer),
         "gimbal_layout_field_count": ([], long),
         "gimbal_layout_field": ([long] + [ctypes.POINTER(text)] * 2 + [ctypes.POINTER(long), ctypes.POINTER(text),
                                                                         ctypes.POINTER(long)], integer),

@@ -3,10 +3,20 @@
 # (the latter also in the win64 cross build). The Python extension compiles the same files
 # (setup.py), with the same -ffp-contract=off: a fused multiply-add would round differently.
 set(_kernel_dir ${CMAKE_CURRENT_LIST_DIR})
+# The sea state (numpy's seeded generator, the JONSWAP components, the sums of sinusoids on a grid):
+# its own library, because the ship-motion FMU (fmu_src/ship_motion/) links it too, to give the
+# scene runner's base inputs bit for bit.
+add_library(gimbal_sea_state_kernel STATIC ${_kernel_dir}/numpy_random.c ${_kernel_dir}/sea_state.c
+            ${_kernel_dir}/sum_of_sines.c)
+target_include_directories(gimbal_sea_state_kernel PUBLIC ${_kernel_dir})
+target_compile_options(gimbal_sea_state_kernel PRIVATE -Wall -Wextra -ffp-contract=off)
+set_target_properties(gimbal_sea_state_kernel PROPERTIES C_VISIBILITY_PRESET hidden)
 add_library(gimbal_master_kernel STATIC ${_kernel_dir}/controllers.c ${_kernel_dir}/set_points.c ${_kernel_dir}/sensors.c ${_kernel_dir}/gyro.c
-            ${_kernel_dir}/sum_of_sines.c ${_kernel_dir}/master_loop.c ${_kernel_dir}/layout.c)
+            ${_kernel_dir}/master_loop.c ${_kernel_dir}/layout.c)
 target_include_directories(gimbal_master_kernel PUBLIC ${_kernel_dir})
 target_compile_options(gimbal_master_kernel PRIVATE -Wall -Wextra -ffp-contract=off)
+target_link_libraries(gimbal_master_kernel PUBLIC gimbal_sea_state_kernel)
 if(NOT WIN32)
+  target_link_libraries(gimbal_sea_state_kernel PUBLIC m)
   target_link_libraries(gimbal_master_kernel PUBLIC m)
 endif()

@@ -131,29 +131,44 @@ class SeaState(_SumOfSines):
     kind = "sea_state"
 
 
-def spectrum_shape(omega: np.ndarray, peak_period: float, gamma: float) -> np.ndarray:
-    """Unnormalized JONSWAP shape (gamma = 1: Pierson-Moskowitz), as a function of omega [rad/s]."""
-    wp = 2.0 * math.pi / peak_period
-    sigma = np.where(omega <= wp, 0.07, 0.09)
-    shape = omega**-5.0 * np.exp(-1.25 * (wp / omega) ** 4)
-    return shape * gamma ** np.exp(-((omega - wp) ** 2) / (2.0 * sigma**2 * wp**2))
+def seed_words(*integers: int) -> np.ndarray:
+    """The entropy of numpy's default_rng([seed, index]) as the uint32 words numpy makes of it: each
+    integer (>= 0) as its base-2**32 digits, least significant first (0 as one word 0), concatenated."""
+    words = []
+    for integer in integers:
+        if integer < 0:
+            raise ValueError(f"a seed must be >= 0, not {integer}")
+        digits = [0] if integer == 0 else []
+        while integer > 0:
+            digits.append(integer & 0xFFFFFFFF)
+            integer >>= 32
+        words.extend(digits)
+    return np.array(words, dtype=np.uint32)
+
+
+_SEA_STATE_REFUSALS = {1: "significant amplitude must be finite and >= 0", 2: "peak period must be finite and > 0",
+                       3: "gamma must be finite and >= 1", 4: "components must be >= 1",
+                       5: "band must satisfy 0 < band[0] < band[1]"}
 
 
 def sea_state_components(significant_amplitude: float, peak_period: float, gamma: float, components: int,
-                         rng: np.random.Generator, band=(0.5, 3.0)):
+                         seed: int, index: int, band=(0.5, 3.0)):
     """Amplitudes, frequencies and phases of a sum of sinusoids whose one-sided spectrum has the
-    JONSWAP shape and whose variance is (significant_amplitude / 2)**2 (significant amplitude =
-    mean of the highest third of the amplitudes = 2 sigma for a narrow-band Gaussian process).
-    Frequencies: one per equal bin of [band[0], band[1]] * omega_peak, at a random place in its bin
-    (so the sum does not repeat); phases uniform; both from `rng` (seeded, reproducible)."""
-    wp = 2.0 * math.pi / peak_period
-    edges = np.linspace(band[0] * wp, band[1] * wp, components + 1)
-    dw = np.diff(edges)
-    omega = edges[:-1] + rng.uniform(0.0, 1.0, components) * dw
-    phase = rng.uniform(0.0, 2.0 * math.pi, components)
-    s = spectrum_shape(omega, peak_period, gamma) * dw
-    sigma = significant_amplitude / 2.0
-    amplitude = np.sqrt(2.0 * s / s.sum()) * sigma   # sum(A^2 / 2) = sigma^2
+    JONSWAP shape (gamma = 1: Pierson-Moskowitz) and whose variance is (significant_amplitude / 2)**2
+    (significant amplitude = mean of the highest third of the amplitudes = 2 sigma for a narrow-band
+    Gaussian process). Frequencies: one per equal bin of [band[0], band[1]] * omega_peak, at a random
+    place in its bin (so the sum does not repeat); phases uniform; both drawn from numpy's
+    default_rng([seed, index]) sequence. Computed by the C kernel (native/sea_state.c), which the
+    ship-motion FMU shares: the same parameters give the same bits in both."""
+    kernel = native.kernel()
+    entropy = seed_words(seed, index)
+    amplitude, omega, phase = (np.empty(components) for _ in range(3))
+    status = kernel.gimbal_sea_state_components(entropy.ctypes.data, len(entropy), float(significant_amplitude),
+                                                float(peak_period), float(gamma), components, float(band[0]),
+                                                float(band[1]), amplitude.ctypes.data, omega.ctypes.data,
+                                                phase.ctypes.data)
+    if status != 0:
+        raise ValueError(f"sea state: {_SEA_STATE_REFUSALS.get(status, f'refused ({status})')}")
     return amplitude, omega, phase
 
 
@@ -330,8 +345,8 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
         seed = spec.get("seed", 1)
         if not isinstance(components, int) or isinstance(components, bool) or components < 1:
             raise SceneError("base_motion.components must be a positive integer")
-        if not isinstance(seed, int) or isinstance(seed, bool):
-            raise SceneError("base_motion.seed must be an integer")
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise SceneError("base_motion.seed must be an integer >= 0")
         angle_terms, translation_terms, offsets = {}, {}, {}
         for index, name in enumerate(["pitch", "yaw", "roll", "surge", "sway", "heave"]):
             if name not in spec:
@@ -349,10 +364,9 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
             gamma = float(item.get("gamma", 3.3))
             if gamma < 1.0:
                 raise SceneError(f"base_motion.{name}.gamma (JONSWAP peak enhancement) must be >= 1 (1 = Pierson-Moskowitz)")
-            rng = np.random.default_rng([seed, index])
             terms = sea_state_components(math.radians(amplitude) if angle else amplitude,
                                          _positive(f"base_motion.{name}.peak_period_s", item["peak_period_s"]),
-                                         gamma, int(item.get("components", components)), rng)
+                                         gamma, int(item.get("components", components)), seed, index)
             if angle:
                 angle_terms[ANGLE_AXES[name]] = terms
             else:

@@ -1,0 +1,595 @@
+/* The ship-motion FMU's FMI 2.0 Co-Simulation interface: the state machine, the checks of every
+ * argument and value, logging, over ship_motion.h. Every exported fmi2* function holds the host's
+ * floating-point environment around its implementation (host_fp_environment.h), as the gimbal's do.
+ *
+ * The clock: row k of the grid at t = startTime + k h, h the first doStep's step size; the motion is
+ * that of the scene runner's grid from t = 0 (the FMU does not depend on the absolute start time).
+ * A doStep with another step size is refused: its outputs would no longer be the grid's rows
+ * (canHandleVariableCommunicationStepSize="false"). */
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "host_fp_environment.h"
+#include "ship_motion.h"
+#include "ship_motion_guid.h"
+#include "ship_motion_variables.h"
+
+typedef enum {
+    STATE_INSTANTIATED = 1 << 0,
+    STATE_INITIALIZATION = 1 << 1,
+    STATE_STEP_COMPLETE = 1 << 2,
+    STATE_TERMINATED = 1 << 3,
+    STATE_ERROR = 1 << 4
+} State;
+
+enum { LOG_STATUS_ERROR, LOG_ALL, LOG_CATEGORY_COUNT };
+static const char* const kLogCategories[LOG_CATEGORY_COUNT] = {"logStatusError", "logAll"};
+
+typedef struct {
+    fmi2CallbackLogger logger;
+    fmi2ComponentEnvironment environment;
+    char* instance_name;
+    int category_enabled[LOG_CATEGORY_COUNT];
+    State state;
+    ShipMotionParameters parameters;
+    ShipMotion motion;
+    int prepared;       /* motion holds the components of `parameters` */
+    double start_time;
+    double step;        /* 0 until the first doStep */
+    long row;           /* the grid row of the current communication point */
+    double outputs[SHIP_MOTION_OUTPUTS];
+    int stop_time_defined;
+    double stop_time;
+    fmi2Status last_step_status;
+} Instance;
+
+static const char* state_name(State state) {
+    switch (state) {
+        case STATE_INSTANTIATED: return "instantiated";
+        case STATE_INITIALIZATION: return "initialization mode";
+        case STATE_STEP_COMPLETE: return "step complete";
+        case STATE_TERMINATED: return "terminated";
+        default: return "error";
+    }
+}
+
+/* Errors are always reported; other messages when the host enabled their category or logAll. */
+static void log_message(const Instance* instance, fmi2Status status, const char* category, const char* format, ...) {
+    if (instance == NULL || instance->logger == NULL) return;
+    int enabled = status == fmi2Error || instance->category_enabled[LOG_ALL];
+    for (int k = 0; k < LOG_CATEGORY_COUNT; ++k)
+        if (strcmp(category, kLogCategories[k]) == 0 && instance->category_enabled[k]) enabled = 1;
+    if (!enabled) return;
+    char text[1024];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(text, sizeof text, format, args);
+    va_end(args);
+    /* The logger treats its message as a format string: escape every '%'. */
+    char escaped[2 * sizeof text];
+    size_t j = 0;
+    for (size_t i = 0; text[i] != '\0' && j + 2 < sizeof escaped; ++i) {
+        if (text[i] == '%') escaped[j++] = '%';
+        escaped[j++] = text[i];
+    }
+    escaped[j] = '\0';
+    instance->logger(instance->environment, instance->instance_name, status, category, escaped);
+}
+
+#define REFUSE(instance, ...)                                                 \
+    do {                                                                      \
+        log_message((instance), fmi2Error, "logStatusError", __VA_ARGS__);    \
+        return fmi2Error;                                                     \
+    } while (0)
+
+/* NULL-safe: is `function` allowed in the instance's state (a bit set of State)? */
+static int allowed(Instance* instance, const char* function, int states) {
+    if (instance == NULL) return 0;
+    if (instance->state & states) return 1;
+    log_message(instance, fmi2Error, "logStatusError", "%s is not allowed in state '%s'", function,
+                state_name(instance->state));
+    return 0;
+}
+
+static int not_null(Instance* instance, const char* function, const void* pointer, const char* argument) {
+    if (pointer != NULL) return 1;
+    log_message(instance, fmi2Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
+    return 0;
+}
+
+static const int kGetStates = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR;
+static const int kSetStates = STATE_INSTANTIATED | STATE_INITIALIZATION;
+static const int kAnyState = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR;
+
+/* The components of the current parameters, and row 0 (the outputs before the first step). */
+static fmi2Status prepare(Instance* instance, const char* function) {
+    if (instance->prepared) return fmi2OK;
+    char message[512];
+    if (ship_motion_check(&instance->parameters, message, sizeof message) != 0)
+        REFUSE(instance, "%s: %s", function, message);
+    if (ship_motion_prepare(&instance->motion, &instance->parameters, 0.0) != 0)
+        REFUSE(instance, "%s: out of memory for the sea state's components", function);
+    instance->prepared = 1;
+    ship_motion_row(&instance->motion, 0, instance->outputs);
+    return fmi2OK;
+}
+
+static void unprepare(Instance* instance) {
+    ship_motion_release(&instance->motion);
+    instance->prepared = 0;
+}
+
+/* ---------------------------------------------------------------- inquiry, logging, lifetime */
+
+static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                                       const fmi2String categories[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetDebugLogging", kAnyState)) return fmi2Error;
+    if (nCategories == 0) {
+        for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
+        return fmi2OK;
+    }
+    if (!not_null(instance, "fmi2SetDebugLogging", categories, "categories")) return fmi2Error;
+    for (size_t i = 0; i < nCategories; ++i) {
+        int index = -1;
+        for (int k = 0; k < LOG_CATEGORY_COUNT; ++k)
+            if (categories[i] != NULL && strcmp(categories[i], kLogCategories[k]) == 0) index = k;
+        if (index < 0)
+            REFUSE(instance, "fmi2SetDebugLogging: unknown log category '%s'", categories[i] != NULL ? categories[i] : "(null)");
+        instance->category_enabled[index] = loggingOn ? 1 : 0;
+    }
+    return fmi2OK;
+}
+
+static void reset_instance(Instance* instance) {
+    unprepare(instance);
+    ship_motion_start_parameters(&instance->parameters);
+    instance->start_time = 0.0;
+    instance->step = 0.0;
+    instance->row = 0;
+    instance->stop_time_defined = 0;
+    instance->stop_time = 0.0;
+    instance->last_step_status = fmi2OK;
+    for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) instance->outputs[k] = 0.0;
+    instance->state = STATE_INSTANTIATED;
+}
+
+static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                                      fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
+                                      fmi2Boolean visible, fmi2Boolean loggingOn) {
+    (void)fmuResourceLocation;
+    (void)visible;
+    if (functions == NULL || functions->logger == NULL) return NULL; /* nowhere to say why */
+    Instance probe;
+    memset(&probe, 0, sizeof probe);
+    probe.logger = functions->logger;
+    probe.environment = functions->componentEnvironment;
+    probe.instance_name = (char*)(instanceName != NULL ? instanceName : "?");
+    if (instanceName == NULL || instanceName[0] == '\0') {
+        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: instanceName must be a non-empty string");
+        return NULL;
+    }
+    if (fmuType != fmi2CoSimulation) {
+        log_message(&probe, fmi2Error, "logStatusError",
+                    "fmi2Instantiate: fmuType = %d: this FMU is Co-Simulation (1) only", (int)fmuType);
+        return NULL;
+    }
+    if (fmuGUID == NULL || strcmp(fmuGUID, SHIP_MOTION_GUID) != 0) {
+        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: GUID '%s' does not match this FMU's '%s'",
+                    fmuGUID != NULL ? fmuGUID : "(null)", SHIP_MOTION_GUID);
+        return NULL;
+    }
+    Instance* instance = (Instance*)calloc(1, sizeof(Instance));
+    char* name = (char*)malloc(strlen(instanceName) + 1);
+    if (instance == NULL || name == NULL) {
+        free(instance);
+        free(name);
+        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
+        return NULL;
+    }
+    strcpy(name, instanceName);
+    instance->logger = functions->logger;
+    instance->environment = functions->componentEnvironment;
+    instance->instance_name = name;
+    for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
+    reset_instance(instance);
+    return instance;
+}
+
+static void impl_FreeInstance(fmi2Component c) {
+    Instance* instance = (Instance*)c;
+    if (instance == NULL) return;
+    unprepare(instance);
+    free(instance->instance_name);
+    free(instance);
+}
+
+/* ---------------------------------------------------------------- initialization and termination */
+
+static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                                       fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    Instance* instance = (Instance*)c;
+    (void)toleranceDefined;
+    (void)tolerance; /* the motion is exact: no tolerance to meet */
+    if (!allowed(instance, "fmi2SetupExperiment", STATE_INSTANTIATED)) return fmi2Error;
+    if (!isfinite(startTime) || (stopTimeDefined && (!isfinite(stopTime) || stopTime < startTime)))
+        REFUSE(instance, "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
+               startTime, stopTime);
+    instance->start_time = startTime;
+    instance->stop_time_defined = stopTimeDefined ? 1 : 0;
+    instance->stop_time = stopTime;
+    return fmi2OK;
+}
+
+static fmi2Status impl_EnterInitializationMode(fmi2Component c) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2EnterInitializationMode", STATE_INSTANTIATED)) return fmi2Error;
+    instance->state = STATE_INITIALIZATION;
+    return fmi2OK;
+}
+
+static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2ExitInitializationMode", STATE_INITIALIZATION)) return fmi2Error;
+    /* Refused parameters leave the instance in initialization mode: the master may correct them. */
+    if (prepare(instance, "fmi2ExitInitializationMode") != fmi2OK) return fmi2Error;
+    instance->row = 0;
+    instance->state = STATE_STEP_COMPLETE;
+    return fmi2OK;
+}
+
+static fmi2Status impl_Terminate(fmi2Component c) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2Terminate", STATE_STEP_COMPLETE | STATE_ERROR)) return fmi2Error;
+    instance->state = STATE_TERMINATED;
+    return fmi2OK;
+}
+
+static fmi2Status impl_Reset(fmi2Component c) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2Reset", kAnyState)) return fmi2Error;
+    reset_instance(instance);
+    return fmi2OK;
+}
+
+/* ---------------------------------------------------------------- values */
+
+static int check_array_arguments(Instance* instance, const char* function, const fmi2ValueReference vr[], size_t nvr,
+                                 const void* value) {
+    return nvr == 0 || (not_null(instance, function, vr, "vr") && not_null(instance, function, value, "value"));
+}
+
+static fmi2Status impl_GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetReal", kGetStates) ||
+        !check_array_arguments(instance, "fmi2GetReal", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (vr[i] >= SHIP_REAL_COUNT) REFUSE(instance, "fmi2GetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
+        if (vr[i] < SHIP_REAL_OUTPUTS) {
+            /* In initialization mode the outputs are row 0 of the parameters as they are now. */
+            if (prepare(instance, "fmi2GetReal") != fmi2OK) return fmi2Error;
+            value[i] = instance->outputs[vr[i]];
+        } else {
+            value[i] = *ship_real_parameter(&instance->parameters, vr[i]);
+        }
+    }
+    return fmi2OK;
+}
+
+static fmi2Status impl_GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetInteger", kGetStates) ||
+        !check_array_arguments(instance, "fmi2GetInteger", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (vr[i] >= SHIP_INTEGER_COUNT)
+            REFUSE(instance, "fmi2GetInteger: value reference %u is not an Integer variable", (unsigned)vr[i]);
+        value[i] = *ship_integer_parameter(&instance->parameters, vr[i]);
+    }
+    return fmi2OK;
+}
+
+/* A value the variable's bounds (and those the XML cannot say: > min, finite) refuse, named; 0 if fine. */
+static int real_refused(Instance* instance, const char* function, fmi2ValueReference vr, double value) {
+    if (vr >= SHIP_REAL_COUNT) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: value reference %u is not a Real variable", function,
+                    (unsigned)vr);
+        return 1;
+    }
+    const ShipRealVariable* variable = &kShipRealVariables[vr];
+    if (variable->causality == SHIP_OUTPUT) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: %s is an output and cannot be set", function, variable->name);
+        return 1;
+    }
+    if (!isfinite(value)) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: %s = %g must be finite", function, variable->name, value);
+        return 1;
+    }
+    if (variable->min_exclusive ? !(value > variable->min) : !(value >= variable->min)) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: %s = %.17g must be %s %g", function, variable->name,
+                    value, variable->min_exclusive ? ">" : ">=", variable->min);
+        return 1;
+    }
+    return 0;
+}
+
+static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetReal", kSetStates) || !check_array_arguments(instance, "fmi2SetReal", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) /* all or nothing: every value checked before any is applied */
+        if (real_refused(instance, "fmi2SetReal", vr[i], value[i])) return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) *ship_real_parameter(&instance->parameters, vr[i]) = value[i];
+    if (nvr > 0) unprepare(instance);
+    return fmi2OK;
+}
+
+static fmi2Status impl_SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetInteger", kSetStates) ||
+        !check_array_arguments(instance, "fmi2SetInteger", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (vr[i] >= SHIP_INTEGER_COUNT)
+            REFUSE(instance, "fmi2SetInteger: value reference %u is not an Integer variable", (unsigned)vr[i]);
+        const ShipIntegerVariable* variable = &kShipIntegerVariables[vr[i]];
+        if (value[i] < variable->min || value[i] > variable->max)
+            REFUSE(instance, "fmi2SetInteger: %s = %d must be in [%d, %d]", variable->name, (int)value[i], variable->min,
+                   variable->max);
+    }
+    for (size_t i = 0; i < nvr; ++i) *ship_integer_parameter(&instance->parameters, vr[i]) = value[i];
+    if (nvr > 0) unprepare(instance);
+    return fmi2OK;
+}
+
+/* The FMU has no Boolean and no String variables. */
+static fmi2Status no_variables(Instance* instance, const char* function, int states, const fmi2ValueReference vr[],
+                               size_t nvr, const void* value, const char* type) {
+    if (!allowed(instance, function, states) || !check_array_arguments(instance, function, vr, nvr, value))
+        return fmi2Error;
+    if (nvr > 0) REFUSE(instance, "%s: value reference %u is not a %s variable (this FMU has none)", function, (unsigned)vr[0], type);
+    return fmi2OK;
+}
+
+/* ---------------------------------------------------------------- stepping */
+
+static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                              fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    Instance* instance = (Instance*)c;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    if (!allowed(instance, "fmi2DoStep", STATE_STEP_COMPLETE)) return fmi2Error;
+    if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
+        REFUSE(instance, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", communicationStepSize);
+    if (instance->step != 0.0 && communicationStepSize != instance->step)
+        REFUSE(instance,
+               "fmi2DoStep: communicationStepSize = %.17g differs from the first step's %.17g: the outputs are the rows "
+               "of one grid (canHandleVariableCommunicationStepSize=\"false\")",
+               communicationStepSize, instance->step);
+    const double step = communicationStepSize;
+    const double time = instance->start_time + (double)instance->row * step;
+    /* Masters keep time as k*h or as a running sum: a mismatch below a millionth of the step is that. */
+    const double tolerance = 1e-12 * fmax(1.0, fabs(time)) + 1e-6 * step;
+    if (!(fabs(currentCommunicationPoint - time) <= tolerance))
+        REFUSE(instance, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
+               currentCommunicationPoint, time);
+    const double end_time = instance->start_time + (double)(instance->row + 1) * step;
+    if (instance->stop_time_defined &&
+        end_time > instance->stop_time + 1e-12 * fmax(1.0, fabs(instance->stop_time)) + 1e-6 * step)
+        REFUSE(instance, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end_time, instance->stop_time);
+    if (instance->row >= LONG_MAX - 1) REFUSE(instance, "fmi2DoStep: the grid's %ld rows are used up", instance->row);
+    if (instance->step == 0.0) {
+        if (ship_motion_set_step(&instance->motion, step) != 0) {
+            instance->state = STATE_ERROR;
+            instance->last_step_status = fmi2Error;
+            REFUSE(instance, "fmi2DoStep: out of memory for the rotation tables of step %g", step);
+        }
+        instance->step = step;
+    }
+    instance->row += 1;
+    ship_motion_row(&instance->motion, instance->row, instance->outputs);
+    instance->last_step_status = fmi2OK;
+    return fmi2OK;
+}
+
+static fmi2Status impl_GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetStatus", STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR) ||
+        !not_null(instance, "fmi2GetStatus", value, "value"))
+        return fmi2Error;
+    if (s != fmi2DoStepStatus) REFUSE(instance, "fmi2GetStatus: status kind %d is not a fmi2Status", (int)s);
+    *value = instance->last_step_status;
+    return fmi2OK;
+}
+
+static fmi2Status impl_GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetRealStatus", STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR) ||
+        !not_null(instance, "fmi2GetRealStatus", value, "value"))
+        return fmi2Error;
+    if (s != fmi2LastSuccessfulTime) REFUSE(instance, "fmi2GetRealStatus: status kind %d is not a Real status", (int)s);
+    *value = instance->start_time + (double)instance->row * instance->step;
+    return fmi2OK;
+}
+
+static fmi2Status impl_GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetBooleanStatus", STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR) ||
+        !not_null(instance, "fmi2GetBooleanStatus", value, "value"))
+        return fmi2Error;
+    if (s != fmi2Terminated) REFUSE(instance, "fmi2GetBooleanStatus: status kind %d has no Boolean value", (int)s);
+    *value = fmi2False; /* the FMU never asks to end the simulation */
+    return fmi2OK;
+}
+
+static fmi2Status impl_GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetStringStatus", STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR) ||
+        !not_null(instance, "fmi2GetStringStatus", value, "value"))
+        return fmi2Error;
+    if (s != fmi2PendingStatus) REFUSE(instance, "fmi2GetStringStatus: status kind %d has no String value", (int)s);
+    *value = ""; /* doStep is synchronous: never pending */
+    return fmi2OK;
+}
+
+/* What the model description says the FMU does not do. */
+static fmi2Status unsupported(fmi2Component c, const char* function, const char* because) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, function, kAnyState)) return fmi2Error;
+    REFUSE(instance, "%s: not supported (%s)", function, because);
+}
+
+/* ---------------------------------------------------------------- the exported functions */
+
+#define IN_FMU_FP_ENVIRONMENT(type, call) \
+    HostFpEnvironment host_environment;   \
+    enter_fmu_fp(&host_environment);      \
+    const type result = call;             \
+    leave_fmu_fp(&host_environment);      \
+    return result
+
+const char* fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char* fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetDebugLogging(c, loggingOn, nCategories, categories));
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Component,
+                          impl_Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation, functions, visible, loggingOn));
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    HostFpEnvironment host_environment;
+    enter_fmu_fp(&host_environment);
+    impl_FreeInstance(c);
+    leave_fmu_fp(&host_environment);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,
+                               fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status,
+                          impl_SetupExperiment(c, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime));
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_EnterInitializationMode(c)); }
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_ExitInitializationMode(c)); }
+fmi2Status fmi2Terminate(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_Terminate(c)); }
+fmi2Status fmi2Reset(fmi2Component c) { IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_Reset(c)); }
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetReal(c, vr, nvr, value));
+}
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetInteger(c, vr, nvr, value));
+}
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2GetBoolean", kGetStates, vr, nvr, value, "Boolean"));
+}
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2GetString", kGetStates, vr, nvr, value, "String"));
+}
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetReal(c, vr, nvr, value));
+}
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetInteger(c, vr, nvr, value));
+}
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2SetBoolean", kSetStates, vr, nvr, value, "Boolean"));
+}
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2SetString", kSetStates, vr, nvr, value, "String"));
+}
+
+static const char kNoState[] = "canGetAndSetFMUstate=\"false\"";
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
+    (void)FMUstate;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2GetFMUstate", kNoState));
+}
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
+    (void)FMUstate;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2SetFMUstate", kNoState));
+}
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
+    (void)FMUstate;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2FreeFMUstate", kNoState));
+}
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size) {
+    (void)FMUstate;
+    (void)size;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2SerializedFMUstateSize", "canSerializeFMUstate=\"false\""));
+}
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
+    (void)FMUstate;
+    (void)serializedState;
+    (void)size;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2SerializeFMUstate", "canSerializeFMUstate=\"false\""));
+}
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate* FMUstate) {
+    (void)serializedState;
+    (void)size;
+    (void)FMUstate;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2DeSerializeFMUstate", "canSerializeFMUstate=\"false\""));
+}
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
+                                        fmi2Real dvUnknown[]) {
+    (void)vUnknown_ref;
+    (void)nUnknown;
+    (void)vKnown_ref;
+    (void)nKnown;
+    (void)dvKnown;
+    (void)dvUnknown;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative=\"false\""));
+}
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[]) {
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2SetRealInputDerivatives", "the FMU has no inputs"));
+}
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[]) {
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2GetRealOutputDerivatives", "maxOutputDerivativeOrder=\"0\""));
+}
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status,
+                          impl_DoStep(c, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint));
+}
+fmi2Status fmi2CancelStep(fmi2Component c) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2CancelStep", "doStep never runs asynchronously"));
+}
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetStatus(c, s, value));
+}
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetRealStatus(c, s, value));
+}
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value) {
+    (void)s;
+    (void)value;
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, unsupported(c, "fmi2GetIntegerStatus", "no status kind has an Integer value"));
+}
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetBooleanStatus(c, s, value));
+}
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value) {
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetStringStatus(c, s, value));
+}
