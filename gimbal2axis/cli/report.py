@@ -2,7 +2,8 @@
 
 Reads a comparison file (reports/*.toml: a scene, gyro datasheets as [grades.<name>] tables, the
 schemes direct and/or indirect, shared [sensors] and [analysis] bands), runs every grade under every
-scheme with the same sea, seed and encoders, and writes <out>/<name>.html (the table of line-of-sight
+scheme with the same sea and encoders (each case `repeats` times, with its sensor noise drawn anew), and
+writes <out>/<name>.html (the table of line-of-sight
 RMS, total, per axis and per band, and the figure: the error over time of each case, the PSD and the
 cumulative RMS per axis), <out>/<name>.png (the figure) and <out>/<name>.csv (the table).
 """
@@ -45,6 +46,8 @@ def _report(args) -> int:
     rows = table_rows(results)
     paths = write_page(comparison, results, rows, out)
     for row in rows:
-        print(f"{row['case']}: LOS error RMS {row['los_rms_mrad']:.4g} mrad, max {row['los_max_mrad']:.4g} mrad")
+        spread = f" +- {row['los_rms_spread_mrad']:.2g}" if row["runs"] > 1 else ""
+        print(f"{row['case']}: LOS error RMS {row['los_rms_mrad']:.4g}{spread} mrad over {row['runs']} run(s), "
+              f"max {row['los_max_mrad']:.4g} mrad")
     print(f"wrote {paths['html']}, {paths['png']} and {paths['csv']}")
     return 0

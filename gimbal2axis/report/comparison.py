@@ -6,6 +6,7 @@ scheme, with the same sea, seed and encoders.
   scene = "../scenes/ship_stabilization.toml"   # relative to this file
   stop_time = 30.0                              # optional: shortens the scene's run
   schemes = ["direct", "indirect"]              # default: both
+  repeats = 5                                   # optional: runs per case, the sensors' seed + 0, 1, ...
   [sensors]                                     # optional: over the scene's [sensors] in every run
   encoder_resolution_deg = 0.0007
   [analysis]                                    # optional: replaces the scene's [analysis]
@@ -21,13 +22,16 @@ import math
 import pathlib
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import SceneError, check_keys, positive, read_toml
 from ..master import run
 from ..scene import load_scene
 from ..scene.gyro import GyroModel
 from ..scene.sensors import SCHEMES, Sensors
 
-KEYS = {"title", "description", "scene", "stop_time", "schemes", "sensors", "analysis", "grades"}
+KEYS = {"title", "description", "scene", "stop_time", "schemes", "repeats", "sensors", "analysis", "grades"}
+MAX_REPEATS = 100
 
 
 @dataclass
@@ -50,6 +54,7 @@ class Comparison:
     scene: object
     stop_time: float
     cases: list
+    repeats: int = 1   # runs per case, each with its own sensor noise (seed + 0, 1, ...)
 
 
 def _grade_cases(scene, grades: dict, schemes: list, common: dict, analysis: dict | None) -> list[Case]:
@@ -96,30 +101,55 @@ def load_comparison(path: pathlib.Path | str) -> Comparison:
         if not isinstance(grades, dict) or not grades:
             raise SceneError("[grades] must hold at least one [grades.<name>] table")
         analysis = raw.get("analysis")
+        repeats = raw.get("repeats", 1)
+        if isinstance(repeats, bool) or not isinstance(repeats, int) or not 1 <= repeats <= MAX_REPEATS:
+            raise SceneError(f"repeats must be an integer in [1, {MAX_REPEATS}], got {repeats!r}")
         cases = _grade_cases(scene, grades, schemes, common, analysis)
         if scene.target_spec is None:
             raise SceneError(f"the scene {scene.path.name} has no [target]: there is no line-of-sight error to compare")
     except SceneError as exc:
         raise SceneError(f"{path}: {exc}") from None
-    return Comparison(path, str(raw.get("title", path.stem)), str(raw.get("description", "")), scene, stop_time, cases)
+    return Comparison(path, str(raw.get("title", path.stem)), str(raw.get("description", "")), scene, stop_time, cases,
+                      repeats)
+
+
+def repeat_scene(case: Case, repeat: int):
+    """The case's scene with its sensors' seed moved on by `repeat` (0: as given)."""
+    if repeat == 0:
+        return case.scene
+    sensors = dict(case.scene.sensors_spec)
+    sensors["seed"] = int(sensors.get("seed", 0)) + repeat
+    return case.scene.with_changes(sensors_spec=sensors)
 
 
 def run_comparison(comparison: Comparison, fmu, progress: bool = True) -> list:
-    """(case, RunResult) of every case, in the file's order."""
-    return [(case, run(case.scene, fmu, stop_time=comparison.stop_time, progress=progress))
-            for case in comparison.cases]
+    """(case, [RunResult of each repeat]) of every case, in the file's order."""
+    return [(case, [run(repeat_scene(case, r), fmu, stop_time=comparison.stop_time, progress=progress)
+                    for r in range(comparison.repeats)]) for case in comparison.cases]
+
+
+def run_metrics(result) -> dict:
+    metrics = result.los_metrics()
+    values = {"los_rms_mrad": metrics["rms"] * 1e3, "los_max_mrad": metrics["max"] * 1e3}
+    for name, spectrum in result.los_spectra().items():
+        values[f"{name}_std_mrad"] = math.sqrt(float(spectrum.psd.sum() * spectrum.resolution)) * 1e3
+        values[f"{name}_mean_mrad"] = spectrum.mean * 1e3
+    values.update({f"band_{band}_mrad": value * 1e3 for band, value in result.band_rms().items()})
+    return values
 
 
 def table_rows(results: list) -> list[dict]:
-    """One row per case: the line-of-sight error's RMS (total, per axis, per band) and maximum, mrad."""
+    """One row per case: the line-of-sight error's RMS (total, per axis, per band) and maximum, mrad,
+    each the mean over the case's repeats; los_rms_spread_mrad is the RMS's standard deviation over
+    them (0 with one run): differences between cases smaller than a few spreads say nothing."""
     rows = []
-    for case, result in results:
-        metrics = result.los_metrics()
-        row = {"case": case.name, "grade": case.label, "scheme": case.scheme,
-               "los_rms_mrad": metrics["rms"] * 1e3, "los_max_mrad": metrics["max"] * 1e3}
-        for name, spectrum in result.los_spectra().items():
-            row[f"{name}_std_mrad"] = math.sqrt(float(spectrum.psd.sum() * spectrum.resolution)) * 1e3
-            row[f"{name}_mean_mrad"] = spectrum.mean * 1e3
-        row.update({f"band_{band}_mrad": value * 1e3 for band, value in result.band_rms().items()})
+    for case, runs in results:
+        per_run = [run_metrics(result) for result in runs]
+        row = {"case": case.name, "grade": case.label, "scheme": case.scheme, "runs": len(runs)}
+        for key in per_run[0]:
+            row[key] = float(np.mean([m[key] for m in per_run]))
+            if key == "los_rms_mrad":
+                spread = float(np.std([m[key] for m in per_run], ddof=1)) if len(per_run) > 1 else 0.0
+                row["los_rms_spread_mrad"] = spread
         rows.append(row)
     return rows

@@ -1,9 +1,10 @@
 """The comparison's page: <out>/<name>.html, one file a person reads (the table, then the figure,
 embedded), with the figure also as <name>.png and the table as <name>.csv.
 
-The figure: the line-of-sight error of each case over time (one panel each, the same axes, so no
-case hides another), then per axis (cross-elevation, elevation) the error's PSD and its cumulative
-RMS over frequency with every case on one axis (log scales spanning the data)."""
+The figure: the line-of-sight error of each case over time (its first run; one panel each, the same
+axes, so no case hides another), then per axis (cross-elevation, elevation) the error's PSD averaged
+over the case's runs and its cumulative RMS over frequency, every case on one axis (log scales
+spanning the data)."""
 from __future__ import annotations
 
 import base64
@@ -18,6 +19,14 @@ import numpy as np
 AXIS_TITLES = {"los_error_xel": "cross-elevation", "los_error_el": "elevation"}
 
 
+def averaged_spectrum(runs: list, axis_name: str):
+    """(frequency, PSD, cumulative RMS) of one axis's error, the PSD averaged over the runs (the
+    same bins: the runs have the same length and resolution)."""
+    spectra = [result.los_spectra()[axis_name] for result in runs]
+    density = np.mean([spectrum.psd for spectrum in spectra], axis=0)
+    return spectra[0].frequency, density, np.sqrt(np.cumsum(density) * spectra[0].resolution)
+
+
 def _figure(results: list, title: str):
     import matplotlib
     matplotlib.use("Agg")
@@ -29,10 +38,11 @@ def _figure(results: list, title: str):
     fig.suptitle(title)
     # log above the 1st percentile of the errors, linear below it down to 0 (symlog): the start-up
     # transient, the jitter and the near-zero samples (a run that starts on target) all stay visible
-    errors = [result.signals["los_error"] * 1e3 for _, result in results]
+    errors = [runs[0].signals["los_error"] * 1e3 for _, runs in results]
     linear_below = max(float(np.percentile(np.concatenate(errors), 1.0)), 1e-12)
     high = max(float(e.max()) for e in errors)
-    for index, (case, result) in enumerate(results):
+    for index, (case, runs) in enumerate(results):
+        result = runs[0]
         ax = axes[index // 2][index % 2]
         ax.plot(result.signals["time"], errors[index], lw=0.5)
         ax.set_yscale("symlog", linthresh=linear_below)
@@ -46,12 +56,11 @@ def _figure(results: list, title: str):
         axes[time_rows - 1][1].axis("off")
     for column, axis_name in enumerate(AXIS_TITLES):
         density_ax, cumulative_ax = axes[time_rows][column], axes[time_rows + 1][column]
-        for case, result in results:
-            spectrum = result.los_spectra()[axis_name]
-            shown = spectrum.frequency > 0   # 0 Hz has no place on a log axis; its power is in the cumulative RMS
-            density_ax.loglog(spectrum.frequency[shown], spectrum.psd[shown] * 1e6, lw=0.8, label=case.name)
-            cumulative_ax.semilogx(spectrum.frequency[shown], spectrum.cumulative_rms()[shown] * 1e3, lw=1.0,
-                                   label=case.name)
+        for case, runs in results:
+            frequency, density, cumulative = averaged_spectrum(runs, axis_name)
+            shown = frequency > 0   # 0 Hz has no place on a log axis; its power is in the cumulative RMS
+            density_ax.loglog(frequency[shown], density[shown] * 1e6, lw=0.8, label=case.name)
+            cumulative_ax.semilogx(frequency[shown], cumulative[shown] * 1e3, lw=1.0, label=case.name)
         density_ax.set_title(f"{AXIS_TITLES[axis_name]} error: PSD", fontsize=9)
         density_ax.set_ylabel("PSD [mrad^2/Hz]")
         cumulative_ax.set_title(f"{AXIS_TITLES[axis_name]} error: cumulative RMS (from 0 Hz)", fontsize=9)
@@ -88,12 +97,15 @@ def write_page(comparison, results: list, rows: list[dict], out: pathlib.Path) -
     import matplotlib.pyplot as plt
     plt.close(figure)
     scene = comparison.scene
-    first = results[0][1]
+    first = results[0][1][0]
     spectrum = next(iter(first.los_spectra().values()))
     notes = (f"Scene {html.escape(scene.path.name)}, {comparison.stop_time:g} s at a {scene.step_size:g} s step; "
              f"metrics from {first.window_start():g} s. PSD: Welch, Hann window, 50 % overlap, "
              f"{spectrum.resolution:.3g} Hz bins, {spectrum.segments} segments; the mean (static offset) is "
-             f"removed first and given in the table. The same sea, seed and encoders in every case.")
+             f"removed first and given in the table. The same sea and encoders in every case; each case runs "
+             f"{comparison.repeats} time(s), its sensors' seed moved on by 1 each time: the table gives the means "
+             f"and the RMS's spread over the runs, the spectra are averaged over them, the time plots show the "
+             f"first run.")
     page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(comparison.title)}</title>"
             "<style>body{font-family:sans-serif;max-width:1250px;margin:auto}table{border-collapse:collapse;"
             "font-size:13px}td,th{border:1px solid #bbb;padding:3px 6px;text-align:right}</style></head><body>"
