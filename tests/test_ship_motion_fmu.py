@@ -18,6 +18,7 @@ from fmpy.validation import validate_fmu
 from gimbal2axis import FMU, load_scene
 from gimbal2axis.errors import read_toml
 from gimbal2axis.scene.base_motion import INPUTS, make_base_motion
+from gimbal2axis.scene.ship_motion_fmu import ship_motion_fmu_parameters
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 SHIP_SCENE = REPO / "scenes" / "ship_stabilization.toml"
@@ -34,23 +35,8 @@ def ship_fmu(build_dir):
 
 
 def parameters_of(base_motion: dict) -> dict:
-    """The FMU's parameters for a scene's [base_motion] table of type sea_state (absent degrees of
-    freedom at rest: significant amplitude 0)."""
-    values = {"seed": base_motion.get("seed", 1)}
-    for dof in DOFS:
-        item = base_motion.get(dof)
-        values[f"{dof}.components"] = (item or {}).get("components", base_motion.get("components", 100))
-        if item is None:
-            values[f"{dof}.significant_amplitude"] = 0.0
-            continue
-        angle = dof in ("pitch", "yaw", "roll")
-        amplitude = float(item["significant_amplitude_deg" if angle else "significant_amplitude_m"])
-        values[f"{dof}.significant_amplitude"] = math.radians(amplitude) if angle else amplitude
-        values[f"{dof}.peak_period"] = float(item["peak_period_s"])
-        values[f"{dof}.gamma"] = float(item.get("gamma", 3.3))
-    for i, v in enumerate(base_motion.get("velocity_m_s", [0.0, 0.0, 0.0]), start=1):
-        values[f"velocity[{i}]"] = float(v)
-    return values
+    """The FMU's parameters for a scene's [base_motion] table of type sea_state."""
+    return ship_motion_fmu_parameters(load_scene(SHIP_SCENE).with_changes(base_motion_spec=base_motion))
 
 
 def run_fmu(fmu, parameters: dict, step: float, steps: int, start_time: float = 0.0) -> np.ndarray:
@@ -180,6 +166,20 @@ def test_a_changed_step_size_is_refused(ship_fmu):
         with pytest.raises(FMICallException):
             slave.doStep(currentCommunicationPoint=0.5, communicationStepSize=0.01)
         assert "does not match the FMU's time" in log[-1].text
+    finally:
+        slave.freeInstance()
+
+
+def test_a_step_a_few_ulps_off_is_the_same_grid_step(ship_fmu):
+    # libcosim passes double(t + h) - double(t) with t, h in integer nanoseconds: h to a few ulps
+    slave, log = instantiate_logged(ship_fmu)
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+        slave.doStep(currentCommunicationPoint=0.01, communicationStepSize=np.nextafter(0.01, 1.0))
+        slave.doStep(currentCommunicationPoint=0.02, communicationStepSize=np.nextafter(0.01, 0.0))
     finally:
         slave.freeInstance()
 

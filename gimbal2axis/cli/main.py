@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from . import bench, freqresp, linearize, report, run, sweep
+from . import bench, freqresp, linearize, report, run, sweep, system
 
 PROG = "gimbal2axis"
 SUBCOMMANDS = {"run": run, "sweep": sweep, "linearize": linearize, "freqresp": freqresp, "report": report,
-               "bench": bench}
+               "system": system, "bench": bench}
 EXIT_USAGE = 2
 
 

@@ -26,6 +26,8 @@ INPUTS = ["base.delta", "base.psi", "base.gamma",
 # scene axis name -> (index of the angle / translation, is an angle)
 ANGLE_AXES = {"pitch": 0, "yaw": 1, "roll": 2}           # delta, psi, gamma
 TRANSLATION_AXES = {"sway": 0, "surge": 1, "heave": 2}   # x_G, y_G, z_G: the bow along y, as roll is about y
+SEA_STATE_DEFAULTS = {"components": 100, "seed": 1}    # of a [base_motion] sea state that does not say
+DEFAULT_GAMMA = 3.3                                     # JONSWAP's mean peak enhancement
 
 
 class BaseMotion:
@@ -341,8 +343,8 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
         return Sinusoids(angle_terms, translation_terms, offsets, _velocity(spec))
     if kind == "sea_state":
         _check_keys("base_motion", spec, {"type", "velocity_m_s", "components", "seed"} | axes)
-        components = spec.get("components", 100)
-        seed = spec.get("seed", 1)
+        components = spec.get("components", SEA_STATE_DEFAULTS["components"])
+        seed = spec.get("seed", SEA_STATE_DEFAULTS["seed"])
         if not isinstance(components, int) or isinstance(components, bool) or components < 1:
             raise SceneError("base_motion.components must be a positive integer")
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
@@ -361,7 +363,7 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
                 if key not in item:
                     raise SceneError(f"base_motion.{name}: missing '{key}'")
             amplitude = float(item[unit])
-            gamma = float(item.get("gamma", 3.3))
+            gamma = float(item.get("gamma", DEFAULT_GAMMA))
             if gamma < 1.0:
                 raise SceneError(f"base_motion.{name}.gamma (JONSWAP peak enhancement) must be >= 1 (1 = Pierson-Moskowitz)")
             terms = sea_state_components(math.radians(amplitude) if angle else amplitude,

@@ -40,6 +40,11 @@ def run_fmpy_ssp(archive: pathlib.Path, component: str, outputs: list, step: flo
     from fmpy.ssp.ssd import read_ssv
 
     parameters = read_ssv(str(archive), resource="resources/parameters.ssv")
+    for parameter in parameters.parameters:
+        # FMPy (0.3) sets a Boolean to `value != 0.0`, and the SSV's value is the text "true" or
+        # "false": both would come out true. Numbers keep its test meaningful.
+        if parameter.type == "Boolean":
+            parameter.value = 1.0 if parameter.value in ("true", "1") else 0.0
     result = simulate_ssp(str(archive), stop_time=stop_time, step_size=step, parameter_set=parameters)
     prefix = f"{component}."
     # FMPy labels a row with the time its step started; its values are those at the step's end

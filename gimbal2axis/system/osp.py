@@ -46,6 +46,25 @@ def _value(value) -> str:
     return f'<Real value="{float(value)!r}"/>'
 
 
+def initial_values(component) -> dict:
+    """The component's start values libcosim can set. libcosim ignores FMI 2.0 Enumeration variables
+    (the gimbal's structural selectors gear<j>.model, motor<j>.model, solver.method): one at its start
+    value is left out, another value refused, since libcosim would run the FMU's default silently."""
+    from fmpy import read_model_description
+
+    variables = {v.name: v for v in read_model_description(str(component.fmu)).modelVariables}
+    values = {}
+    for name, value in component.start_values.items():
+        variable = variables.get(name)
+        if variable is not None and variable.type == "Enumeration":
+            if int(value) != int(variable.start):
+                raise ValueError(f"{component.name}: {name} = {value} cannot be set in libcosim, which ignores FMI 2.0 "
+                                 f"Enumeration variables (its start value {variable.start} would run instead)")
+            continue
+        values[name] = value
+    return values
+
+
 def write_osp(system: System, out: pathlib.Path) -> pathlib.Path:
     """Writes <out>/OspSystemStructure.xml with the FMUs and descriptions beside it; its path."""
     out.mkdir(parents=True, exist_ok=True)
@@ -55,7 +74,7 @@ def write_osp(system: System, out: pathlib.Path) -> pathlib.Path:
         if component.osp_description is not None:
             shutil.copyfile(component.osp_description, out / component.osp_description.name)
         values = "".join(f"\n                <InitialValue variable={quoteattr(name)}>{_value(value)}</InitialValue>"
-                         for name, value in component.start_values.items())
+                         for name, value in initial_values(component).items())
         simulators.append(f'        <Simulator name="{component.name}" source="{component.fmu.name}" '
                           f'stepSize="{system.step!r}">\n            <InitialValues>{values}\n'
                           f'            </InitialValues>\n        </Simulator>')

@@ -1,0 +1,45 @@
+"""Write a scene as a system of FMUs for other co-simulation engines.
+
+The scene's sea state becomes the ship-motion FMU, its built-in controller (with its target and
+sensors) the controller FMU, and with the gimbal FMU they make one system, written as an OSP system
+structure (<out>/osp/OspSystemStructure.xml with the three FMUs and their OSP model descriptions: run
+it with libcosim or the OSP tools) and as an SSP archive (<out>/<scene>.ssp: FMPy, OMSimulator). In
+either engine the voltage computed at t_k acts over [t_k+1, t_k+2], the scene's delay_steps = 1.
+docs/systems.md says what each engine gives and how it differs from `gimbal2axis run`.
+"""
+import pathlib
+
+from ..errors import SceneError
+from ..scene import load_scene
+from ..system.from_scene import ship_system
+from ..system.osp import write_osp
+from ..system.ssp import write_ssp
+from .failures import EXIT_ERROR, run_reporting_failures
+
+SUMMARY = "write a scene as a system of FMUs: OSP system structure (libcosim) and SSP archive"
+PROG = "gimbal2axis system"
+
+
+def add_arguments(parser) -> None:
+    parser.epilog = f"Errors go to stderr, one line. Exit status: 0 done, {EXIT_ERROR} refused or failed."
+    parser.add_argument("scene", help="the scene file (a sea state, a built-in controller, delay_steps = 1)")
+    parser.add_argument("--build-dir", default="build",
+                        help="where the three FMUs were built (default: build/ in the current directory)")
+    parser.add_argument("--out", default="results/systems", help="directory to write into (default: results/systems/)")
+
+
+def _write(args) -> int:
+    scene = load_scene(args.scene)
+    system = ship_system(scene, pathlib.Path(args.build_dir))
+    out = pathlib.Path(args.out)
+    try:
+        structure = write_osp(system, out / "osp")
+    except ValueError as exc:   # what libcosim cannot set
+        raise SceneError(str(exc)) from None
+    archive = write_ssp(system, out / f"{scene.name}.ssp")
+    print(f"wrote {structure} (with the FMUs and their OSP model descriptions) and {archive}")
+    return 0
+
+
+def execute(args) -> int:
+    return run_reporting_failures(PROG, lambda: _write(args))

@@ -1,0 +1,79 @@
+"""A scene with a sea state and a built-in controller as a system of three FMUs: the ship-motion FMU
+(the scene's sea state), the gimbal FMU (the scene's fidelity, parameters and start values, as the
+scene runner sets them) and the controller FMU (the scene's controller, target and sensors), each
+input connected to the output of the same name, and the OSP variable groups connected group to
+group. In an engine that steps every FMU from the values of the communication point before (Jacobi:
+libcosim, FMPy), the voltage computed at t_k acts over [t_k+1, t_k+2]: the scene's delay_steps = 1."""
+from __future__ import annotations
+
+import pathlib
+
+import numpy as np
+
+from ..errors import SceneError
+from ..fmu import FMU
+from ..scene import parameter_value, start_values
+from ..scene.controller_fmu import controller_fmu_parameters
+from ..scene.ship_motion_fmu import ship_motion_fmu_parameters
+from .structure import Component, Connection, System
+
+FMUS = {"ship": "Gimbal2Axis-ShipMotion.fmu", "gimbal": "Gimbal2Axis.fmu", "controller": "Gimbal2Axis-Controller.fmu"}
+CARRIER_GROUPS = ["carrier_attitude", "carrier_attitude_rate", "carrier_attitude_acceleration", "carrier_velocity",
+                  "carrier_acceleration"]
+GROUPS = [("ship", g, "gimbal", g) for g in CARRIER_GROUPS] + \
+    [("ship", g, "controller", g) for g in ("carrier_attitude", "carrier_attitude_rate")] + \
+    [("gimbal", g, "controller", g) for g in ("gimbal_angles", "gimbal_rates", "line_of_sight_rate")] + \
+    [("controller", f"motor{j}_voltage", "gimbal", f"motor{j}_voltage") for j in (1, 2)]
+
+
+def _description(fmu_path: pathlib.Path, fmu: FMU) -> pathlib.Path | None:
+    """<modelName>_OspModelDescription.xml beside the FMU (where the build puts it), if there."""
+    path = fmu_path.parent / f"{fmu.model_description.modelName}_OspModelDescription.xml"
+    return path if path.is_file() else None
+
+
+def _connections(fmus: dict) -> list[Connection]:
+    """Every input of the gimbal and the controller from the output of the same name (the ship's
+    first, then the gimbal's, then the controller's); an input nobody gives is refused."""
+    outputs = {name: [v.name for v in fmu.model_description.modelVariables if v.causality == "output"]
+               for name, fmu in fmus.items()}
+    connections = []
+    for target in ("gimbal", "controller"):
+        for variable in fmus[target].model_description.modelVariables:
+            if variable.causality != "input":
+                continue
+            source = next((s for s in ("ship", "gimbal", "controller") if s != target and variable.name in outputs[s]),
+                          None)
+            if source is None:
+                raise SceneError(f"the system has no output for the {target}'s input {variable.name}")
+            connections.append(Connection(source, variable.name, target, variable.name))
+    return connections
+
+
+def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) -> System:
+    """The system of `scene` with the FMUs of `fmu_dir` (the build directory)."""
+    if scene.delay_steps != 1:
+        raise SceneError(f"a co-simulation engine applies the voltage one step later (delay_steps = 1); the scene "
+                         f"has delay_steps = {scene.delay_steps}")
+    paths = {name: pathlib.Path(fmu_dir) / file for name, file in FMUS.items()}
+    missing = [str(p) for p in paths.values() if not p.is_file()]
+    if missing:
+        raise SceneError(f"missing FMU(s): {', '.join(missing)} (build them: cmake --build build)")
+    fmus = {name: FMU(path) for name, path in paths.items()}
+    try:
+        gimbal = fmus["gimbal"]
+        motion = scene.base_motion()
+        base = motion.sample(np.array([0.0, 1e-6]))
+        gimbal_values = start_values(scene, gimbal, base[0], base[1])
+        u_limit = tuple(float(parameter_value(scene, gimbal, f"motor{j}.U_L")) for j in (1, 2))
+        values = {"ship": ship_motion_fmu_parameters(scene), "gimbal": gimbal_values,
+                  "controller": controller_fmu_parameters(scene, u_limit)}
+        components = [Component(name, paths[name], values[name], _description(paths[name], fmus[name]))
+                      for name in FMUS]
+        connections = _connections(fmus)
+    finally:
+        for fmu in fmus.values():
+            fmu.close()
+    described = all(c.osp_description is not None for c in components)
+    return System(scene.name, scene.step_size, scene.stop_time if stop_time is None else stop_time, components,
+                  connections, GROUPS if described else [])
