@@ -96,7 +96,7 @@ def test_the_command_refuses_in_one_line_and_the_example_file_loads(tmp_path):
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr.count("\n") == 1 and "grades.a.delay_samples must be an integer in [0, 16]" in done.stderr
     example = load_comparison(EXAMPLE)
-    assert len(example.cases) == 4 and example.scene.target_spec is not None
+    assert len(example.cases) == 6 and example.repeats == 5 and example.scene.target_spec is not None
 
 
 def test_the_table_in_the_sensors_page_is_what_the_example_comparison_gives(fmu_path):
