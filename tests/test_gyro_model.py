@@ -3,6 +3,7 @@ gimbal2axis/native/gyro.c, sensors.c): each term against what it must be by defi
 means the model does not use (allantools' Allan deviation, scipy's continuous-time simulation, the
 FMU's own los.omega)."""
 import math
+import pathlib
 
 import allantools
 import numpy as np
@@ -127,7 +128,7 @@ def fmu(gimbal_fmu):
 
 @pytest.fixture(scope="module")
 def ship():
-    return load_scene("scenes/ship_stabilization.toml")
+    return load_scene(pathlib.Path(__file__).resolve().parents[1] / "scenes" / "ship_stabilization.toml")
 
 
 def test_the_carrier_rate_is_the_fmus_kinematics(ship, fmu):
