@@ -403,3 +403,21 @@ def test_a_recording_that_does_not_cover_the_run_is_refused(ship_fmu, tmp_path):
     with pytest.raises(FMICallException):
         run_recorded_fmu(ship_fmu, {"motion": 1, "recording_file": str(late)}, 0.1, 5, log=log)
     assert f"recorded motion {late} covers [0.5, 1.5] s, not t = 0, where the outputs start" in log[-1].text
+
+
+def test_the_reader_has_pythons_doubles_and_line_endings(tmp_path):
+    # At a knot other than the last the spline's value is its sample exactly (d = 0 leaves it), so
+    # there are the reader's doubles: float()'s, for decimal notation however long or small.
+    numbers = ["1e-3", ".5", "7.", "+1.5", "-2.5e+2", "123456789012345678901234567890", "0.1000000000000000055511151231257827",
+               "2.2250738585072011e-308", "4.9e-324", "1e-400", "3.141592653589793238462643383279"]
+    times = [str(k) for k in range(len(numbers))]
+    text = "\ufeff\"time\" , gamma\r\n" + "".join(f"{t}, {n}  # sample\r\n" for t, n in zip(times, numbers)) + \
+        f"{len(numbers)},0\r\n"   # the last knot, whose value the last cubic computes
+    (tmp_path / "motion.csv").write_bytes(text.encode("utf-8"))
+    sampled = Recorded(tmp_path / "motion.csv").sample(np.array([float(t) for t in times]))
+    assert np.array_equal(bits(sampled[:, INPUTS.index("base.gamma")]), bits(np.array([float(n) for n in numbers])))
+    (tmp_path / "old_mac.csv").write_bytes(b"time,gamma\r0,0\r1,1\r2,4\r3,9")
+    assert Recorded(tmp_path / "old_mac.csv").sample(np.array([2.0]))[0, 2] == 4.0   # lines end at "\r" too
+    (tmp_path / "underscore.csv").write_text("time,gamma\n0,0\n1,1_0\n2,4\n3,9\n")
+    with pytest.raises(SceneError, match=r"line 3 \(data row 2\), column 'gamma' is not a number: '1_0'"):
+        Recorded(tmp_path / "underscore.csv")
