@@ -354,10 +354,14 @@ def test_recorded_motion_is_scipys_spline_of_the_columns(tmp_path):
     "time,gamma_dot\n0,0\n0.005,0.001\n0.01,0.002\n0.015,0.003\n",
     "time,gamma\n0,0\n0.005,0.001\n0.005,0.002\n0.015,0.003\n",
     None,
-], ids=["non_numeric_cell", "empty_cell", "unknown_column", "rate_without_angle", "time_not_increasing", "missing"])
+    "a directory",
+], ids=["non_numeric_cell", "empty_cell", "unknown_column", "rate_without_angle", "time_not_increasing", "missing",
+        "directory"])
 def test_a_bad_recording_is_refused_with_the_scene_runners_message(ship_fmu, tmp_path, content):
     path = tmp_path / "motion.csv"
-    if content is not None:
+    if content == "a directory":
+        path.mkdir()
+    elif content is not None:
         path.write_text(content)
     with pytest.raises(SceneError) as refused:
         Recorded(path)

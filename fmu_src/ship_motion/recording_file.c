@@ -94,14 +94,17 @@ char* recording_read(const char* path, size_t* length, char* message, size_t siz
             }
             text = grown;
         }
+        errno = 0;
         const size_t got = fread(text + used, 1, capacity - used, file);
         used += got;
         if (got == 0) break;
     }
     const int failed = ferror(file);
+    const int reason = errno; /* fread's: a directory opens, but cannot be read */
     fclose(file);
     if (failed) {
-        snprintf(message, size, "recorded motion %s: cannot read it (a read error)", path);
+        snprintf(message, size, "recorded motion %s: cannot read it: %s", path,
+                 reason != 0 ? strerror(reason) : "a read error");
         free(text);
         return NULL;
     }
