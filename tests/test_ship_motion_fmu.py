@@ -1,7 +1,10 @@
 """The ship-motion FMU (build/Gimbal2Axis-ShipMotion.fmu, fmu_src/ship_motion/): its outputs are the
 scene runner's base inputs bit for bit (the same C kernel makes the components and sums them on the
 same grid), its rates and accelerations are the derivatives of its attitudes and velocities, a bad
-parameter or step is refused with a message naming it, and it is a valid FMU exporting only fmi2*."""
+parameter or step is refused with a message naming it, and it is a valid FMU exporting only fmi2*.
+With motion = 1 it splines a recorded motion (the C kernel's reader and not-a-knot spline, which the
+scene runner uses too): the same bits as the scene runner's base inputs, the spline scipy's, a bad
+file refused with the Python side's message."""
 import math
 import os
 import pathlib
@@ -14,11 +17,12 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
+from scipy.interpolate import CubicSpline
 
-from gimbal2axis import FMU, load_scene
-from gimbal2axis.errors import read_toml
-from gimbal2axis.scene.base_motion import INPUTS, make_base_motion
-from gimbal2axis.scene.ship_motion_fmu import ship_motion_fmu_parameters
+from gimbal2axis import FMU, load_scene, native
+from gimbal2axis.errors import SceneError, read_toml
+from gimbal2axis.scene.base_motion import INPUTS, Recorded, make_base_motion
+from gimbal2axis.scene.ship_motion_fmu import recording_parameters, ship_motion_fmu_parameters
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 SHIP_SCENE = REPO / "scenes" / "ship_stabilization.toml"
@@ -218,3 +222,206 @@ def test_shared_object_exports_only_fmi2_and_links_only_libc(build_dir):
     ldd = subprocess.run(["ldd", str(so)], capture_output=True, text=True, check=True).stdout
     allowed = re.compile(r"^(linux-vdso\.so\.1|libc\.so\.6|libm\.so\.6|/lib64/ld-linux-x86-64\.so\.2)$")
     assert [line.split()[0] for line in ldd.splitlines() if line.strip() and not allowed.match(line.split()[0])] == []
+
+
+# --- recorded motion (motion = 1) ---------------------------------------------------------------------
+
+RECORDED_SCENE = """name = "recorded"
+stop_time = {stop_time}
+step_size = {step}
+[base_motion]
+type = "recorded"
+file = "motion.csv"
+[controller]
+type = "none"
+"""
+
+
+def write_recording(path: pathlib.Path, columns: dict, preamble: str = "") -> pathlib.Path:
+    """A CSV of the columns {name: values}, every number as Python writes it (repr: exact)."""
+    rows = zip(*columns.values())
+    path.write_text(preamble + ",".join(columns) + "\n" +
+                    "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rows))
+    return path
+
+
+def irregular_times(duration: float, samples: int, seed: int) -> np.ndarray:
+    """Sample times from 0 past `duration`, unevenly spaced (as a logger's time stamps are)."""
+    steps = np.random.default_rng(seed).uniform(0.5, 1.5, samples - 1)
+    return np.concatenate([[0.0], np.cumsum(steps) * (1.05 * duration / steps.sum())])
+
+
+def run_recorded_fmu(fmu, values: dict, step: float, steps: int, start_time: float = 0.0, stop_time=None,
+                     log=None) -> np.ndarray:
+    """The outputs at start_time + k step, k = 0 .. steps, with the recording parameters `values`."""
+    slave = fmu.instantiate(log=log)
+    try:
+        if stop_time is None:
+            slave.setupExperiment(startTime=start_time)
+        else:
+            slave.setupExperiment(startTime=start_time, stopTime=stop_time)
+        slave.setInteger([fmu.vr("motion")], [values["motion"]])
+        if "recording_file" in values:
+            slave.setString([fmu.vr("recording_file")], [values["recording_file"]])
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        vrs = [fmu.vr(name) for name in INPUTS]
+        rows = [slave.getReal(vrs)]
+        for k in range(steps):
+            slave.doStep(currentCommunicationPoint=start_time + k * step, communicationStepSize=step)
+            rows.append(slave.getReal(vrs))
+        slave.terminate()
+    finally:
+        slave.freeInstance()
+    return np.array(rows)
+
+
+def recorded_columns(kind: str, t: np.ndarray) -> dict:
+    """Recordings with derivatives missing (the spline's are used) and, for "degrees", angles in degrees."""
+    if kind == "radians":
+        return {"time": t, "delta": 0.03 * np.sin(0.9 * t), "gamma": 0.08 * np.sin(0.7 * t + 1.0),
+                "gamma_dot": 0.056 * np.cos(0.7 * t + 1.0), "x": 0.2 * np.cos(0.5 * t), "z": 0.9 * np.sin(0.6 * t)}
+    return {"time": t, "pitch_deg": 2.0 * np.sin(0.9 * t), "yaw_deg": 0.5 * np.cos(0.2 * t),
+            "roll_deg": 5.0 * np.sin(0.7 * t)}
+
+
+@pytest.mark.parametrize("kind", ["radians", "degrees"])
+def test_recorded_outputs_equal_the_scene_runners_base_inputs_bit_for_bit(ship_fmu, tmp_path, kind):
+    step, steps = 1e-3, 6000
+    columns = recorded_columns(kind, irregular_times(steps * step, 400, 5))
+    write_recording(tmp_path / "motion.csv", columns, preamble="# logged on the bridge\n")
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text(RECORDED_SCENE.format(stop_time=steps * step, step=step))
+    scene = load_scene(scene_path)
+    expected = scene.base_motion().sample(np.arange(steps + 1) * step)   # master.Plan's grid
+    outputs = run_recorded_fmu(ship_fmu, recording_parameters(scene), step, steps, stop_time=steps * step)
+    spline_derived = ["base.delta_dot", "base.delta_ddot", "base.gamma_ddot", "base.v_a[1]", "base.a_a[3]"] \
+        if kind == "radians" else ["base.delta_dot", "base.psi_ddot", "base.gamma_dot", "base.gamma_ddot"]
+    for name in spline_derived:
+        assert np.count_nonzero(expected[:, INPUTS.index(name)]) > 0.9 * (steps + 1), name
+    for column, name in enumerate(INPUTS):
+        differ = np.nonzero(bits(outputs[:, column]) != bits(expected[:, column]))[0]
+        assert len(differ) == 0, (f"{name}: {len(differ)} rows differ, first row {differ[0]}: "
+                                  f"{outputs[differ[0], column]!r} != {expected[differ[0], column]!r}")
+
+
+def kernel_spline(x: np.ndarray, y: np.ndarray):
+    """The C kernel's not-a-knot spline through (x, y), as a function of (t, derivative)."""
+    kernel = native.kernel()
+    x, y = np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float)
+    coefficients = np.empty(kernel.gimbal_cubic_spline_coefficient_count(len(x)))
+    assert kernel.gimbal_cubic_spline_fit(len(x), x.ctypes.data, y.ctypes.data, coefficients.ctypes.data) == 0
+    return lambda t, derivative: np.array([kernel.gimbal_cubic_spline_evaluate(len(x), x.ctypes.data,
+                                                                                coefficients.ctypes.data, float(ti),
+                                                                                derivative) for ti in t])
+
+
+@pytest.mark.parametrize("samples", [4, 5, 7, 60, 500])
+def test_the_kernels_spline_is_scipys_not_a_knot_spline(samples):
+    rng = np.random.default_rng(samples)
+    x = np.cumsum(rng.uniform(0.01, 1.0, samples))
+    y = rng.normal(size=samples) + np.sin(x)
+    t = np.concatenate([np.linspace(x[0] - 0.3, x[-1] + 0.3, 2001), x])   # inside, the knots, a little outside
+    ours, reference = kernel_spline(x, y), CubicSpline(x, y)   # scipy's default: not-a-knot at both ends
+    for derivative in range(3):
+        expected = reference(t, derivative)
+        error = np.max(np.abs(ours(t, derivative) - expected))
+        assert error <= 1e-12 * np.max(np.abs(expected)), (derivative, error)
+
+
+def test_recorded_motion_is_scipys_spline_of_the_columns(tmp_path):
+    t = irregular_times(5.0, 80, 9)
+    roll_deg, y = 4.0 * np.sin(0.8 * t), 0.3 * np.cos(1.1 * t)
+    gamma_ddot_given = -0.1 * np.sin(0.8 * t)
+    motion = Recorded(write_recording(tmp_path / "motion.csv", {"time": t, "roll_deg": roll_deg, "y": y,
+                                                                  "gamma_ddot": gamma_ddot_given}))
+    tt = np.linspace(0.0, 5.0, 777)
+    sampled = motion.sample(tt)
+    roll, position = CubicSpline(t, np.radians(roll_deg)), CubicSpline(t, y)
+    references = {"base.gamma": roll(tt), "base.gamma_dot": roll(tt, 1), "base.gamma_ddot": CubicSpline(t, gamma_ddot_given)(tt),
+                  "base.v_a[2]": position(tt, 1), "base.a_a[2]": position(tt, 2)}
+    for name, expected in references.items():
+        assert np.max(np.abs(sampled[:, INPUTS.index(name)] - expected)) <= 1e-12 * np.max(np.abs(expected)), name
+    untouched = [i for i, name in enumerate(INPUTS) if name not in references]
+    assert np.all(sampled[:, untouched] == 0.0)
+    np.testing.assert_allclose(motion.position(tt)[:, 1], position(tt) - position(tt[0]), rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("content", [
+    "time,gamma\n0,0\n0.005,0.001\n0.01,abc\n0.015,0.003\n",
+    "time,gamma\n0,0\n0.005,0.001\n0.01,\n0.015,0.003\n",
+    "time,gamma,heading\n0,0,1\n0.005,0.001,1\n0.01,0.002,1\n0.015,0.003,1\n",
+    "time,gamma_dot\n0,0\n0.005,0.001\n0.01,0.002\n0.015,0.003\n",
+    "time,gamma\n0,0\n0.005,0.001\n0.005,0.002\n0.015,0.003\n",
+    None,
+    "a directory",
+], ids=["non_numeric_cell", "empty_cell", "unknown_column", "rate_without_angle", "time_not_increasing", "missing",
+        "directory"])
+def test_a_bad_recording_is_refused_with_the_scene_runners_message(ship_fmu, tmp_path, content):
+    path = tmp_path / "motion.csv"
+    if content == "a directory":
+        path.mkdir()
+    elif content is not None:
+        path.write_text(content)
+    with pytest.raises(SceneError) as refused:
+        Recorded(path)
+    reason = str(refused.value).split(f"{path}: ", 1)[1]   # after the file's name: line, column, why
+    slave, log = instantiate_logged(ship_fmu)
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.setInteger([ship_fmu.vr("motion")], [1])
+        slave.setString([ship_fmu.vr("recording_file")], [str(path)])
+        slave.enterInitializationMode()
+        with pytest.raises(FMICallException):
+            slave.exitInitializationMode()
+        assert log[-1].text == f"fmi2ExitInitializationMode: recorded motion {path}: {reason}", (log[-1].text, reason)
+    finally:
+        slave.freeInstance()
+    if content is not None and "abc" in content:
+        assert reason == "line 4 (data row 3), column 'gamma' is not a number: 'abc'"
+
+
+def test_the_example_recording_in_the_resources_is_the_default(ship_fmu):
+    step, steps = 0.01, 500
+    outputs = run_recorded_fmu(ship_fmu, {"motion": 1}, step, steps, start_time=10.0)
+    resources = pathlib.Path(ship_fmu.unzipdir) / "resources"
+    assert ship_fmu.variable("recording_file").start == "ship_recording.csv"
+    expected = Recorded(resources / "ship_recording.csv").sample(np.arange(steps + 1) * step)
+    assert np.array_equal(bits(outputs), bits(expected))
+    assert np.ptp(outputs[:, INPUTS.index("base.gamma_ddot")]) > 0.01   # the roll recording's spline
+
+
+def test_a_recording_that_does_not_cover_the_run_is_refused(ship_fmu, tmp_path):
+    t = np.linspace(0.0, 1.0, 11)
+    path = write_recording(tmp_path / "motion.csv", {"time": t, "gamma": 0.01 * t})
+    log = []
+    with pytest.raises(FMICallException):
+        run_recorded_fmu(ship_fmu, {"motion": 1, "recording_file": str(path)}, 0.1, 10, stop_time=2.0, log=log)
+    assert f"recorded motion {path} covers [0, 1] s, not [0, 2] s" in log[-1].text
+    log.clear()
+    with pytest.raises(FMICallException):   # no stopTime: the step past the end is refused
+        run_recorded_fmu(ship_fmu, {"motion": 1, "recording_file": str(path)}, 0.1, 11, log=log)
+    assert "passes the recording's end at 1 s" in log[-1].text, log[-1].text
+    late = write_recording(tmp_path / "late.csv", {"time": t + 0.5, "gamma": 0.01 * t})
+    log.clear()
+    with pytest.raises(FMICallException):
+        run_recorded_fmu(ship_fmu, {"motion": 1, "recording_file": str(late)}, 0.1, 5, log=log)
+    assert f"recorded motion {late} covers [0.5, 1.5] s, not t = 0, where the outputs start" in log[-1].text
+
+
+def test_the_reader_has_pythons_doubles_and_line_endings(tmp_path):
+    # At a knot other than the last the spline's value is its sample exactly (d = 0 leaves it), so
+    # there are the reader's doubles: float()'s, for decimal notation however long or small.
+    numbers = ["1e-3", ".5", "7.", "+1.5", "-2.5e+2", "123456789012345678901234567890", "0.1000000000000000055511151231257827",
+               "2.2250738585072011e-308", "4.9e-324", "1e-400", "3.141592653589793238462643383279"]
+    times = [str(k) for k in range(len(numbers))]
+    text = "\ufeff\"time\" , gamma\r\n" + "".join(f"{t}, {n}  # sample\r\n" for t, n in zip(times, numbers)) + \
+        f"{len(numbers)},0\r\n"   # the last knot, whose value the last cubic computes
+    (tmp_path / "motion.csv").write_bytes(text.encode("utf-8"))
+    sampled = Recorded(tmp_path / "motion.csv").sample(np.array([float(t) for t in times]))
+    assert np.array_equal(bits(sampled[:, INPUTS.index("base.gamma")]), bits(np.array([float(n) for n in numbers])))
+    (tmp_path / "old_mac.csv").write_bytes(b"time,gamma\r0,0\r1,1\r2,4\r3,9")
+    assert Recorded(tmp_path / "old_mac.csv").sample(np.array([2.0]))[0, 2] == 4.0   # lines end at "\r" too
+    (tmp_path / "underscore.csv").write_text("time,gamma\n0,0\n1,1_0\n2,4\n3,9\n")
+    with pytest.raises(SceneError, match=r"line 3 \(data row 2\), column 'gamma' is not a number: '1_0'"):
+        Recorded(tmp_path / "underscore.csv")

@@ -5,7 +5,11 @@
  * The clock: row k of the grid at t = startTime + k h, h the first doStep's step size; the motion is
  * that of the scene runner's grid from t = 0 (the FMU does not depend on the absolute start time).
  * A doStep with another step size is refused: its outputs would no longer be the grid's rows
- * (canHandleVariableCommunicationStepSize="false"). */
+ * (canHandleVariableCommunicationStepSize="false").
+ *
+ * With motion = 1 the outputs are a recording's splines (recorded_motion.h) at the same grid times,
+ * read at the end of initialization from recording_file (recording_file.h finds it); a step past the
+ * recording's end is refused, as the scene runner refuses a recording that does not cover its run. */
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -15,6 +19,8 @@
 
 #include "fmi2Functions.h"
 #include "host_fp_environment.h"
+#include "recorded_motion.h"
+#include "recording_file.h"
 #include "ship_motion.h"
 #include "ship_motion_guid.h"
 #include "ship_motion_variables.h"
@@ -37,8 +43,11 @@ typedef struct {
     int category_enabled[LOG_CATEGORY_COUNT];
     State state;
     ShipMotionParameters parameters;
+    char* recording_file;             /* the String parameter's value, the instance's copy */
+    char* resources;                  /* the resources folder, NULL when fmuResourceLocation names none */
     ShipMotion motion;
-    int prepared;       /* motion holds the components of `parameters` */
+    GimbalRecordedMotion* recording; /* motion = 1: the file's splines, once prepared */
+    int prepared;       /* motion or recording holds what `parameters` say */
     double start_time;
     double step;        /* 0 until the first doStep */
     long row;           /* the grid row of the current communication point */
@@ -106,9 +115,52 @@ static const int kGetStates = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE
 static const int kSetStates = STATE_INSTANTIATED | STATE_INITIALIZATION;
 static const int kAnyState = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR;
 
-/* The components of the current parameters, and row 0 (the outputs before the first step). */
+/* The recording of recording_file, checked to cover the experiment from t = 0 (the grid's time; a
+ * stopTime, when given, to its end), and row 0. */
+static fmi2Status prepare_recording(Instance* instance, const char* function) {
+    char message[1024];
+    char* path = recording_path(instance->resources, instance->recording_file, message, sizeof message);
+    if (path == NULL) REFUSE(instance, "%s: %s", function, message);
+    size_t length = 0;
+    char* text = recording_read(path, &length, message, sizeof message);
+    if (text == NULL) {
+        free(path);
+        REFUSE(instance, "%s: %s", function, message);
+    }
+    const int status = gimbal_recorded_motion_read(text, length, &instance->recording, message, sizeof message);
+    free(text);
+    if (status != GIMBAL_RECORDED_MOTION_READ) {
+        log_message(instance, fmi2Error, "logStatusError", "%s: recorded motion %s: %s", function, path, message);
+        free(path);
+        return fmi2Error;
+    }
+    const double start = gimbal_recorded_motion_start(instance->recording);
+    const double end = gimbal_recorded_motion_end(instance->recording);
+    const double duration = instance->stop_time - instance->start_time;
+    if (start > 0.0 || (instance->stop_time_defined && end < duration)) {
+        if (instance->stop_time_defined)
+            log_message(instance, fmi2Error, "logStatusError", "%s: recorded motion %s covers [%g, %g] s, not [0, %g] s",
+                        function, path, start, end, duration);
+        else
+            log_message(instance, fmi2Error, "logStatusError",
+                        "%s: recorded motion %s covers [%g, %g] s, not t = 0, where the outputs start", function, path,
+                        start, end);
+        free(path);
+        gimbal_recorded_motion_free(instance->recording);
+        instance->recording = NULL;
+        return fmi2Error;
+    }
+    free(path);
+    instance->prepared = 1;
+    gimbal_recorded_motion_row(instance->recording, 0.0, instance->outputs);
+    return fmi2OK;
+}
+
+/* What the current parameters say (the sea state's components or the recording), and row 0 (the
+ * outputs before the first step). */
 static fmi2Status prepare(Instance* instance, const char* function) {
     if (instance->prepared) return fmi2OK;
+    if (instance->parameters.motion == SHIP_MOTION_RECORDED) return prepare_recording(instance, function);
     char message[512];
     if (ship_motion_check(&instance->parameters, message, sizeof message) != 0)
         REFUSE(instance, "%s: %s", function, message);
@@ -121,6 +173,8 @@ static fmi2Status prepare(Instance* instance, const char* function) {
 
 static void unprepare(Instance* instance) {
     ship_motion_release(&instance->motion);
+    gimbal_recorded_motion_free(instance->recording);
+    instance->recording = NULL;
     instance->prepared = 0;
 }
 
@@ -146,8 +200,19 @@ static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, s
     return fmi2OK;
 }
 
-static void reset_instance(Instance* instance) {
+static char* copy_text(const char* text) {
+    char* copy = malloc(strlen(text) + 1);
+    if (copy != NULL) strcpy(copy, text);
+    return copy;
+}
+
+/* 0, or -1 when out of memory (the recording file's value then stays as it was). */
+static int reset_instance(Instance* instance) {
     unprepare(instance);
+    char* file = copy_text(kShipStringVariables[SHIP_STRING_RECORDING_FILE].start);
+    if (file == NULL) return -1;
+    free(instance->recording_file);
+    instance->recording_file = file;
     ship_motion_start_parameters(&instance->parameters);
     instance->start_time = 0.0;
     instance->step = 0.0;
@@ -157,12 +222,12 @@ static void reset_instance(Instance* instance) {
     instance->last_step_status = fmi2OK;
     for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) instance->outputs[k] = 0.0;
     instance->state = STATE_INSTANTIATED;
+    return 0;
 }
 
 static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                                       fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
                                       fmi2Boolean visible, fmi2Boolean loggingOn) {
-    (void)fmuResourceLocation;
     (void)visible;
     if (functions == NULL || functions->logger == NULL) return NULL; /* nowhere to say why */
     Instance probe;
@@ -197,7 +262,15 @@ static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType,
     instance->environment = functions->componentEnvironment;
     instance->instance_name = name;
     for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
-    reset_instance(instance);
+    /* No resources folder is no error here: only a relative recording_file needs one. */
+    instance->resources = recording_resources_folder(fmuResourceLocation);
+    if (reset_instance(instance) != 0) {
+        free(instance->resources);
+        free(instance->instance_name);
+        free(instance);
+        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
+        return NULL;
+    }
     return instance;
 }
 
@@ -205,6 +278,8 @@ static void impl_FreeInstance(fmi2Component c) {
     Instance* instance = (Instance*)c;
     if (instance == NULL) return;
     unprepare(instance);
+    free(instance->recording_file);
+    free(instance->resources);
     free(instance->instance_name);
     free(instance);
 }
@@ -253,7 +328,7 @@ static fmi2Status impl_Terminate(fmi2Component c) {
 static fmi2Status impl_Reset(fmi2Component c) {
     Instance* instance = (Instance*)c;
     if (!allowed(instance, "fmi2Reset", kAnyState)) return fmi2Error;
-    reset_instance(instance);
+    if (reset_instance(instance) != 0) REFUSE(instance, "fmi2Reset: out of memory for recording_file's start value");
     return fmi2OK;
 }
 
@@ -348,7 +423,41 @@ static fmi2Status impl_SetInteger(fmi2Component c, const fmi2ValueReference vr[]
     return fmi2OK;
 }
 
-/* The FMU has no Boolean and no String variables. */
+static fmi2Status impl_GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2GetString", kGetStates) ||
+        !check_array_arguments(instance, "fmi2GetString", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) {
+        if (vr[i] >= SHIP_STRING_COUNT)
+            REFUSE(instance, "fmi2GetString: value reference %u is not a String variable", (unsigned)vr[i]);
+        value[i] = instance->recording_file; /* valid until it is set again or the instance is freed */
+    }
+    return fmi2OK;
+}
+
+static fmi2Status impl_SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+    Instance* instance = (Instance*)c;
+    if (!allowed(instance, "fmi2SetString", kSetStates) ||
+        !check_array_arguments(instance, "fmi2SetString", vr, nvr, value))
+        return fmi2Error;
+    for (size_t i = 0; i < nvr; ++i) { /* all checked before any is applied */
+        if (vr[i] >= SHIP_STRING_COUNT)
+            REFUSE(instance, "fmi2SetString: value reference %u is not a String variable", (unsigned)vr[i]);
+        if (value[i] == NULL)
+            REFUSE(instance, "fmi2SetString: the value of %s is a null pointer", kShipStringVariables[vr[i]].name);
+    }
+    for (size_t i = 0; i < nvr; ++i) {
+        char* copy = copy_text(value[i]);
+        if (copy == NULL) REFUSE(instance, "fmi2SetString: out of memory for %s", kShipStringVariables[vr[i]].name);
+        free(instance->recording_file);
+        instance->recording_file = copy;
+    }
+    if (nvr > 0) unprepare(instance);
+    return fmi2OK;
+}
+
+/* The FMU has no Boolean variables. */
 static fmi2Status no_variables(Instance* instance, const char* function, int states, const fmi2ValueReference vr[],
                                size_t nvr, const void* value, const char* type) {
     if (!allowed(instance, function, states) || !check_array_arguments(instance, function, vr, nvr, value))
@@ -385,6 +494,19 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
         end_time > instance->stop_time + 1e-12 * fmax(1.0, fabs(instance->stop_time)) + 1e-6 * step)
         REFUSE(instance, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end_time, instance->stop_time);
     if (instance->row >= LONG_MAX - 1) REFUSE(instance, "fmi2DoStep: the grid's %ld rows are used up", instance->row);
+    if (instance->recording != NULL) {
+        /* The grid's time, not the master's: the motion starts at t = 0 whatever startTime is. */
+        const double motion_time = (double)(instance->row + 1) * step;
+        const double end = gimbal_recorded_motion_end(instance->recording);
+        if (motion_time > end + 1e-12 * fmax(1.0, fabs(end)) + 1e-6 * step)
+            REFUSE(instance, "fmi2DoStep: step to t = %.17g s (the recording's time %.17g s) passes the recording's end at %.17g s",
+                   end_time, motion_time, end);
+        instance->step = step;
+        instance->row += 1;
+        gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
+        instance->last_step_status = fmi2OK;
+        return fmi2OK;
+    }
     if (instance->step == 0.0) {
         if (ship_motion_set_step(&instance->motion, step) != 0) {
             instance->state = STATE_ERROR;
@@ -497,7 +619,7 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2GetBoolean", kGetStates, vr, nvr, value, "Boolean"));
 }
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2GetString", kGetStates, vr, nvr, value, "String"));
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_GetString(c, vr, nvr, value));
 }
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetReal(c, vr, nvr, value));
@@ -509,7 +631,7 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2SetBoolean", kSetStates, vr, nvr, value, "Boolean"));
 }
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    IN_FMU_FP_ENVIRONMENT(fmi2Status, no_variables((Instance*)c, "fmi2SetString", kSetStates, vr, nvr, value, "String"));
+    IN_FMU_FP_ENVIRONMENT(fmi2Status, impl_SetString(c, vr, nvr, value));
 }
 
 static const char kNoState[] = "canGetAndSetFMUstate=\"false\"";

@@ -86,6 +86,15 @@ static int write_variables(FILE* out) {
         fprintf(out, "\">\n      <Integer start=\"%d\" min=\"%d\" max=\"%d\"/>\n    </ScalarVariable>\n", v->start, v->min,
                 v->max);
     }
+    for (int vr = 0; vr < SHIP_STRING_COUNT; ++vr) {
+        const ShipStringVariable* v = &kShipStringVariables[vr];
+        fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
+                     "initial=\"exact\"\n      description=\"", v->name, vr);
+        write_escaped(out, v->description);
+        fputs("\">\n      <String start=\"", out);
+        write_escaped(out, v->start);
+        fputs("\"/>\n    </ScalarVariable>\n", out);
+    }
     return 0;
 }
 

@@ -1,10 +1,12 @@
 # build/Gimbal2Axis-ShipMotion.fmu: modelDescription.xml from the variable table (the generator's
 # fragments in modelDescription.xml.in), binaries/linux64 and, with mingw-w64, binaries/win64
-# (fmu_src/win64.cmake builds it), the project's licence in documentation/licenses/.
+# (fmu_src/win64.cmake builds it), the project's licence in documentation/licenses/, the example
+# recording (recording_file's start value) in resources/.
 set(_ship_dir ${CMAKE_CURRENT_LIST_DIR})
 set(_ship_staging ${PROJECT_BINARY_DIR}/ship_motion_staging)
 set(_ship_fragments ${PROJECT_BINARY_DIR}/ship_motion_fragments)
 set(SHIP_MOTION_FMU ${PROJECT_BINARY_DIR}/Gimbal2Axis-ShipMotion.fmu)
+set(_ship_recording ${_ship_dir}/resources/ship_recording.csv)
 add_custom_command(
   OUTPUT ${_ship_staging}/modelDescription.xml
   COMMAND ${CMAKE_COMMAND} -E make_directory ${_ship_fragments} ${_ship_staging}
@@ -41,13 +43,16 @@ endif()
 add_custom_command(
   OUTPUT ${SHIP_MOTION_FMU}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${_ship_staging}/binaries/linux64 ${_ship_staging}/documentation/licenses
+          ${_ship_staging}/resources
+  COMMAND ${CMAKE_COMMAND} -E copy ${_ship_recording} ${_ship_staging}/resources/ship_recording.csv
   COMMAND ${CMAKE_COMMAND} -E copy $<TARGET_FILE:${SHIP_MODEL_IDENTIFIER}>
           ${_ship_staging}/binaries/linux64/${SHIP_MODEL_IDENTIFIER}.so
   COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/LICENSE ${_ship_staging}/documentation/licenses/Gimbal2Axis.txt
   ${_ship_win64_commands}
   COMMAND ${CMAKE_COMMAND} -E rm -f ${SHIP_MOTION_FMU}
-  COMMAND ${CMAKE_COMMAND} -E tar cf ${SHIP_MOTION_FMU} --format=zip modelDescription.xml binaries documentation
+  COMMAND ${CMAKE_COMMAND} -E tar cf ${SHIP_MOTION_FMU} --format=zip modelDescription.xml binaries documentation resources
   WORKING_DIRECTORY ${_ship_staging}
-  DEPENDS ${SHIP_MODEL_IDENTIFIER} ${_ship_staging}/modelDescription.xml ${PROJECT_SOURCE_DIR}/LICENSE ${_ship_win64_depends}
+  DEPENDS ${SHIP_MODEL_IDENTIFIER} ${_ship_staging}/modelDescription.xml ${PROJECT_SOURCE_DIR}/LICENSE ${_ship_recording}
+          ${_ship_win64_depends}
   COMMENT "Packaging Gimbal2Axis-ShipMotion.fmu")
 add_custom_target(ship_motion_fmu ALL DEPENDS ${SHIP_MOTION_FMU})

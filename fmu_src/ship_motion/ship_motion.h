@@ -17,6 +17,9 @@ enum { SHIP_PITCH, SHIP_YAW, SHIP_ROLL, SHIP_SURGE, SHIP_SWAY, SHIP_HEAVE, SHIP_
  * their rates and accelerations, v_a[1..3], a_a[1..3]. */
 enum { SHIP_MOTION_OUTPUTS = 15 };
 
+/* What the outputs are: the sea state of the parameters, or a recording (recorded_motion.h). */
+enum { SHIP_MOTION_SEA_STATE = 0, SHIP_MOTION_RECORDED = 1 };
+
 extern const char* const kShipDofNames[SHIP_MOTION_DOFS];
 
 typedef struct {
@@ -27,6 +30,7 @@ typedef struct {
     double velocity[3];                             /* constant velocity of point a in G, m/s */
     double band_lower, band_upper;                  /* the frequency band, in multiples of the peak frequency */
     int seed;
+    int motion;                                     /* SHIP_MOTION_SEA_STATE or SHIP_MOTION_RECORDED */
 } ShipMotionParameters;
 
 typedef struct {

@@ -53,6 +53,14 @@ const ShipIntegerVariable kShipIntegerVariables[SHIP_INTEGER_COUNT] = {
     {"sway.components", 120, 1, 10000, "sinusoids of the sway motion, one per equal bin of the band"},
     {"heave.components", 120, 1, 10000, "sinusoids of the heave motion, one per equal bin of the band"},
     {"seed", 7, 0, 2147483647, "seed of the frequencies' places in their bins and of the phases (numpy's default_rng([seed, index of the degree of freedom]))"},
+    {"motion", SHIP_MOTION_SEA_STATE, SHIP_MOTION_SEA_STATE, SHIP_MOTION_RECORDED,
+     "what the outputs are: 0 the sea state of the parameters, 1 the recording in recording_file (splined)"},
+};
+
+const ShipStringVariable kShipStringVariables[SHIP_STRING_COUNT] = {
+    {"recording_file", SHIP_EXAMPLE_RECORDING,
+     "the recorded motion (CSV: time and any of delta, psi, gamma or pitch_deg, yaw_deg, roll_deg, their _dot and "
+     "_ddot, x, y, z) when motion = 1: absolute, or relative to the FMU's resources folder"},
 };
 
 double* ship_real_parameter(ShipMotionParameters* parameters, unsigned value_reference) {
@@ -74,6 +82,7 @@ double* ship_real_parameter(ShipMotionParameters* parameters, unsigned value_ref
 int* ship_integer_parameter(ShipMotionParameters* parameters, unsigned value_reference) {
     if (value_reference < SHIP_INTEGER_SEED) return &parameters->components[value_reference];
     if (value_reference == SHIP_INTEGER_SEED) return &parameters->seed;
+    if (value_reference == SHIP_INTEGER_MOTION) return &parameters->motion;
     return NULL;
 }
 

@@ -37,11 +37,24 @@ enum {
     SHIP_REAL_COUNT
 };
 
-/* Integer value references: the components per degree of freedom, then the seed. */
-enum { SHIP_INTEGER_COMPONENTS = 0, SHIP_INTEGER_SEED = SHIP_MOTION_DOFS, SHIP_INTEGER_COUNT };
+typedef struct {
+    const char* name;
+    const char* start;
+    const char* description;
+} ShipStringVariable;
+
+/* Integer value references: the components per degree of freedom, the seed, the kind of motion. */
+enum { SHIP_INTEGER_COMPONENTS = 0, SHIP_INTEGER_SEED = SHIP_MOTION_DOFS, SHIP_INTEGER_MOTION, SHIP_INTEGER_COUNT };
+
+/* String value references: the recording's file (the FMU instance keeps its own copy of the value). */
+enum { SHIP_STRING_RECORDING_FILE = 0, SHIP_STRING_COUNT };
+
+/* The example recording in the FMU's resources folder (fmu_src/ship_motion/resources/). */
+#define SHIP_EXAMPLE_RECORDING "ship_recording.csv"
 
 extern const ShipRealVariable kShipRealVariables[SHIP_REAL_COUNT];
 extern const ShipIntegerVariable kShipIntegerVariables[SHIP_INTEGER_COUNT];
+extern const ShipStringVariable kShipStringVariables[SHIP_STRING_COUNT];
 
 /* The parameters at their start values. */
 void ship_motion_start_parameters(ShipMotionParameters* parameters);

@@ -1,7 +1,8 @@
 """The C kernel (gimbal2axis/native/*.c, built by `pip install -e .` as the extension
 gimbal2axis.native._native), loaded once through ctypes: the built-in controllers (scene/controllers.py)
 and their set points toward a target (scene/setpoints.py), the sensors (scene/sensors.py), the sums of
-sinusoids of the base motions and the sea state's components (scene/base_motion.py) and the compiled
+sinusoids of the base motions, the sea state's components and the recorded motion's splines
+(scene/base_motion.py) and the compiled
 communication loop (master/compiled_loop.py). The structs they share with Python are built here from
 the kernel's own layout table (`struct`), never copied. `why_not()` says why the kernel is missing."""
 from __future__ import annotations
@@ -59,6 +60,15 @@ def _declare(loaded) -> None:
         "gimbal_random_uniform": ([pointer, long, long, double, double, pointer], None),
         "gimbal_sea_state_components": ([pointer, long, double, double, double, long, double, double] + [pointer] * 3,
                                         integer),
+        "gimbal_cubic_spline_coefficient_count": ([long], long),
+        "gimbal_cubic_spline_fit": ([long, pointer, pointer, pointer], integer),
+        "gimbal_cubic_spline_evaluate": ([long, pointer, pointer, double, integer], double),
+        "gimbal_recorded_motion_read": ([text, ctypes.c_size_t, ctypes.POINTER(pointer), text, ctypes.c_size_t], integer),
+        "gimbal_recorded_motion_free": ([pointer], None),
+        "gimbal_recorded_motion_start": ([pointer], double),
+        "gimbal_recorded_motion_end": ([pointer], double),
+        "gimbal_recorded_motion_sample": ([pointer, long, pointer, pointer], None),
+        "gimbal_recorded_motion_position": ([pointer, long, pointer, pointer], None),
         "gimbal_layout_field_count": ([], long),
         "gimbal_layout_field": ([long] + [ctypes.POINTER(text)] * 2 + [ctypes.POINTER(long), ctypes.POINTER(text),
                                                                         ctypes.POINTER(long)], integer),

@@ -9,8 +9,10 @@ y_0, pitch delta about x), so surge = y_G, sway = x_G, heave = z_G (for a zero m
 """
 from __future__ import annotations
 
+import ctypes
 import math
 import pathlib
+import weakref
 
 import numpy as np
 
@@ -174,122 +176,66 @@ def sea_state_components(significant_amplitude: float, peak_period: float, gamma
     return amplitude, omega, phase
 
 
-def read_csv_columns(path: pathlib.Path) -> tuple[list[str], list[np.ndarray]]:
-    """The columns of a recorded motion: a header row of names, then rows of numbers, all separated
-    by commas ('#' starts a comment). Anything else is refused with the file, line and column."""
-    where = f"base_motion: recorded motion {path}"
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise SceneError(f"{where}: cannot read it: {exc.strerror}") from None
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"{where}: not a text file (byte {exc.start} is not UTF-8)") from None
-    lines = [(number, line.split("#", 1)[0].strip()) for number, line in enumerate(text.splitlines(), start=1)]
-    lines = [(number, line) for number, line in lines if line]
-    if not lines:
-        raise SceneError(f"{where}: the file is empty (expected a header such as 'time,gamma' and rows of numbers)")
-    header_line, header = lines[0]
-    if ";" in header and "," not in header:
-        raise SceneError(f"{where}: line {header_line} is separated by semicolons ({header!r}); the file must be "
-                         "comma-separated with '.' as the decimal point (save it as CSV with ',' separators)")
-    names = [name.strip().strip('"').strip() for name in header.split(",")]
-    for index, name in enumerate(names, start=1):
-        if not name:
-            raise SceneError(f"{where}: line {header_line} (the header): column {index} has no name")
-        if names.index(name) != index - 1:
-            raise SceneError(f"{where}: line {header_line} (the header): column '{name}' appears twice")
-    if "time" not in names:
-        raise SceneError(f"{where}: no 'time' column in the header (line {header_line}: {', '.join(names)})")
-    rows = []
-    for row, (number, line) in enumerate(lines[1:], start=1):
-        cells = line.split(",")
-        if len(cells) != len(names):
-            hint = " (semicolons: the file must be comma-separated)" if ";" in line else ""
-            raise SceneError(f"{where}: line {number} (data row {row}) has {len(cells)} cells, the header "
-                             f"{len(names)}{hint}")
-        values = []
-        for name, cell in zip(names, cells):
-            cell = cell.strip()
-            try:
-                value = float(cell)
-            except ValueError:
-                what = "is empty" if not cell else f"is not a number: {cell!r}"
-                raise SceneError(f"{where}: line {number} (data row {row}), column '{name}' {what}") from None
-            if not math.isfinite(value):
-                raise SceneError(f"{where}: line {number} (data row {row}), column '{name}' is {cell!r}, "
-                                 "not a finite number")
-            values.append(value)
-        rows.append(values)
-    if len(rows) < 4:
-        raise SceneError(f"{where}: {len(rows)} data rows; a cubic spline needs at least 4")
-    table = np.array(rows)
-    t = table[:, names.index("time")]
-    bad = np.nonzero(np.diff(t) <= 0)[0]
-    if len(bad):
-        i = int(bad[0]) + 1
-        raise SceneError(f"{where}: 'time' must increase strictly, but line {lines[i + 1][0]} has {t[i]:g} after "
-                         f"{t[i - 1]:g}")
-    return names, [table[:, j] for j in range(len(names))]
-
-
 class Recorded(BaseMotion):
     """A recorded motion: a comma-separated file with a header row of names (`#` starts a comment).
     Column `time` [s] and any of: delta, psi, gamma [rad] (or pitch_deg, yaw_deg, roll_deg), their
     `_dot` and `_ddot` [rad/s, rad/s2], x, y, z [m] of point a in G. Missing derivatives come from a
-    C2 cubic spline through the samples, so attitude, rates and accelerations stay consistent;
-    absent quantities are 0."""
+    C2 cubic spline through the samples (not-a-knot ends, as scipy's CubicSpline), so attitude, rates
+    and accelerations stay consistent; absent quantities are 0. The C kernel reads, checks and splines
+    the file (native/recorded_motion.c: anything else is refused with the file, line and column), the
+    one the ship-motion FMU reads a recording with, so both give the same bits."""
     kind = "recorded"
 
     def __init__(self, path: pathlib.Path):
-        from scipy.interpolate import CubicSpline
+        self.path = path
+        try:
+            self._text = path.read_bytes()
+        except OSError as exc:
+            raise SceneError(f"base_motion: recorded motion {path}: cannot read it: {exc.strerror}") from None
+        self._open()
 
-        names, columns = read_csv_columns(path)
-        data = dict(zip(names, columns))
-        t = data["time"]
-        self.t_end = float(t[-1])
-        self.t_start = float(t[0])
-        allowed = {"time"}
-        self.splines = {}
-        for i, (rad, deg) in enumerate([("delta", "pitch_deg"), ("psi", "yaw_deg"), ("gamma", "roll_deg")]):
-            allowed |= {rad, deg, rad + "_dot", rad + "_ddot"}
-            if rad in names and deg in names:
-                raise SceneError(f"base_motion: {path}: columns '{rad}' and '{deg}' are the same angle; give one")
-            for derivative in (rad + "_dot", rad + "_ddot"):
-                if derivative in names and rad not in names and deg not in names:
-                    raise SceneError(f"base_motion: {path}: column '{derivative}' without the angle '{rad}' "
-                                     f"(or '{deg}') would be ignored; add the angle")
-            if rad in names or deg in names:
-                q = data[rad] if rad in names else np.radians(data[deg])
-                spline = CubicSpline(t, q)
-                self.splines[i] = spline
-                self.splines[3 + i] = CubicSpline(t, data[rad + "_dot"]) if rad + "_dot" in names else spline.derivative(1)
-                self.splines[6 + i] = (CubicSpline(t, data[rad + "_ddot"]) if rad + "_ddot" in names
-                                       else spline.derivative(2))
-        self.position_splines = {}
-        for i, name in enumerate("xyz"):
-            allowed.add(name)
-            if name in names:
-                spline = CubicSpline(t, data[name])
-                self.position_splines[i] = spline
-                self.splines[9 + i] = spline.derivative(1)
-                self.splines[12 + i] = spline.derivative(2)
-        unknown = set(names) - allowed
-        if unknown:
-            raise SceneError(f"base_motion: {path}: unknown columns {sorted(unknown)} (allowed: {sorted(allowed)})")
+    def _open(self) -> None:
+        kernel = native.kernel()
+        handle = ctypes.c_void_p()
+        message = ctypes.create_string_buffer(1024)
+        status = kernel.gimbal_recorded_motion_read(self._text, len(self._text), ctypes.byref(handle), message,
+                                                    len(message))
+        reason = message.value.decode("utf-8", "replace")
+        if status == _RECORDING_BAD_TABLE:
+            raise SceneError(f"base_motion: recorded motion {self.path}: {reason}")
+        if status == _RECORDING_BAD_COLUMNS:
+            raise SceneError(f"base_motion: {self.path}: {reason}")
+        if status != 0:
+            raise MemoryError(f"base_motion: recorded motion {self.path}: {reason}")
+        self._handle = handle.value
+        weakref.finalize(self, kernel.gimbal_recorded_motion_free, self._handle)
+        self.t_start = kernel.gimbal_recorded_motion_start(self._handle)
+        self.t_end = kernel.gimbal_recorded_motion_end(self._handle)
+
+    # A scene (and its motion) goes to sweep workers by pickle: the file's bytes go, the kernel's
+    # splines are made again from them.
+    def __getstate__(self):
+        return {"path": self.path, "_text": self._text}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._open()
 
     def sample(self, t):
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        out = np.zeros((len(t), 15))
-        for column, spline in self.splines.items():
-            out[:, column] = spline(t)
+        t = np.ascontiguousarray(np.atleast_1d(np.asarray(t, dtype=float)))
+        out = np.empty((len(t), 15))
+        native.kernel().gimbal_recorded_motion_sample(self._handle, len(t), t.ctypes.data, out.ctypes.data)
         return out
 
     def position(self, t):
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        pos = np.zeros((len(t), 3))
-        for i, spline in self.position_splines.items():
-            pos[:, i] = spline(t) - spline(t[0])
-        return pos
+        t = np.ascontiguousarray(np.atleast_1d(np.asarray(t, dtype=float)))
+        pos = np.empty((len(t), 3))
+        native.kernel().gimbal_recorded_motion_position(self._handle, len(t), t.ctypes.data, pos.ctypes.data)
+        return pos - pos[:1]
+
+
+# What native.gimbal_recorded_motion_read says of a file (recorded_motion.h): its text or its columns refused.
+_RECORDING_BAD_TABLE, _RECORDING_BAD_COLUMNS = 1, 2
 
 
 def _sine_terms(axis: str, spec, angle: bool):

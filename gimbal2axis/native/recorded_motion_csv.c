@@ -1,0 +1,279 @@
+#include "recorded_motion_csv.h"
+
+#include <ctype.h>
+#include <locale.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { MINIMUM_ROWS = 4 };
+
+typedef struct {
+    const char* start;
+    size_t length;
+    long number; /* 1-based line number in the file */
+} Line;
+
+static int refuse(char* message, size_t size, const char* format, ...) {
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, size, format, args);
+    va_end(args);
+    return 1;
+}
+
+static int is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
+
+static void strip(const char** start, size_t* length, int quotes_too) {
+    while (*length > 0 && (is_blank(**start) || (quotes_too && **start == '"'))) ++*start, --*length;
+    while (*length > 0 && (is_blank((*start)[*length - 1]) || (quotes_too && (*start)[*length - 1] == '"'))) --*length;
+}
+
+/* The offset of the first byte that is not part of well-formed UTF-8 (as Python's decoder judges:
+ * no overlong forms, no surrogates, nothing above U+10FFFF), or -1. */
+static long first_non_utf8(const unsigned char* text, size_t length) {
+    size_t i = 0;
+    while (i < length) {
+        const unsigned char c = text[i];
+        size_t extra;
+        unsigned char low = 0x80, high = 0xBF; /* the range of the second byte */
+        if (c < 0x80) {
+            ++i;
+            continue;
+        } else if (c >= 0xC2 && c <= 0xDF) {
+            extra = 1;
+        } else if (c >= 0xE0 && c <= 0xEF) {
+            extra = 2;
+            if (c == 0xE0) low = 0xA0;
+            if (c == 0xED) high = 0x9F;
+        } else if (c >= 0xF0 && c <= 0xF4) {
+            extra = 3;
+            if (c == 0xF0) low = 0x90;
+            if (c == 0xF4) high = 0x8F;
+        } else {
+            return (long)i;
+        }
+        for (size_t k = 1; k <= extra; ++k) {
+            if (i + k >= length) return (long)i;
+            const unsigned char next = text[i + k];
+            if (k == 1 ? (next < low || next > high) : (next < 0x80 || next > 0xBF)) return (long)i;
+        }
+        i += extra + 1;
+    }
+    return -1;
+}
+
+/* The non-empty lines, comments cut off and stripped. -1 when out of memory, else their count. */
+static long split_lines(const char* text, size_t length, Line** lines) {
+    size_t capacity = 1;
+    for (size_t i = 0; i < length; ++i) capacity += text[i] == '\n' || text[i] == '\r';
+    *lines = malloc(sizeof(Line) * capacity);
+    if (*lines == NULL) return -1;
+    long count = 0, number = 0;
+    size_t i = 0;
+    while (i < length) {
+        const size_t begin = i;
+        while (i < length && text[i] != '\n' && text[i] != '\r') ++i;
+        ++number;
+        const char* start = text + begin;
+        size_t line_length = i - begin;
+        const char* comment = memchr(start, '#', line_length);
+        if (comment != NULL) line_length = (size_t)(comment - start);
+        strip(&start, &line_length, 0);
+        if (line_length > 0) (*lines)[count++] = (Line){start, line_length, number};
+        if (i < length) i += text[i] == '\r' && i + 1 < length && text[i + 1] == '\n' ? 2 : 1;
+    }
+    return count;
+}
+
+static size_t count_cells(const char* start, size_t length) {
+    size_t cells = 1;
+    for (size_t i = 0; i < length; ++i) cells += start[i] == ',';
+    return cells;
+}
+
+/* The next cell of a line from *position (comma-separated), stripped. */
+static void next_cell(const char* line, size_t length, size_t* position, const char** cell, size_t* cell_length) {
+    const size_t begin = *position;
+    while (*position < length && line[*position] != ',') ++*position;
+    *cell = line + begin;
+    *cell_length = *position - begin;
+    ++*position; /* past the comma */
+}
+
+static int is_word(const char* cell, size_t length, const char* word) {
+    if (length > 0 && (cell[0] == '+' || cell[0] == '-')) ++cell, --length;
+    if (length != strlen(word)) return 0;
+    for (size_t i = 0; i < length; ++i)
+        if (tolower((unsigned char)cell[i]) != word[i]) return 0;
+    return 1;
+}
+
+/* Does the cell follow the number grammar? */
+static int is_decimal(const char* cell, size_t length) {
+    size_t i = 0, digits = 0;
+    if (i < length && (cell[i] == '+' || cell[i] == '-')) ++i;
+    while (i < length && isdigit((unsigned char)cell[i])) ++i, ++digits;
+    if (i < length && cell[i] == '.') {
+        ++i;
+        while (i < length && isdigit((unsigned char)cell[i])) ++i, ++digits;
+    }
+    if (digits == 0) return 0;
+    if (i < length && (cell[i] == 'e' || cell[i] == 'E')) {
+        ++i;
+        if (i < length && (cell[i] == '+' || cell[i] == '-')) ++i;
+        size_t exponent_digits = 0;
+        while (i < length && isdigit((unsigned char)cell[i])) ++i, ++exponent_digits;
+        if (exponent_digits == 0) return 0;
+    }
+    return i == length;
+}
+
+/* The cell's number: 0; 1 when it is not one; -1 when out of memory. Not finite (inf, nan, overflow)
+ * is a number here; the caller names it. */
+static int parse_number(const char* cell, size_t length, double* value) {
+    if (is_word(cell, length, "inf") || is_word(cell, length, "infinity")) {
+        *value = cell[0] == '-' ? -HUGE_VAL : HUGE_VAL;
+        return 0;
+    }
+    if (is_word(cell, length, "nan")) {
+        *value = NAN;
+        return 0;
+    }
+    if (!is_decimal(cell, length)) return 1;
+    char* copy = malloc(length + 1);
+    if (copy == NULL) return -1;
+    memcpy(copy, cell, length);
+    copy[length] = '\0';
+    /* strtod reads the locale's decimal point: a host may have set one other than '.'. */
+    const char point = localeconv()->decimal_point[0];
+    if (point != '\0' && point != '.') {
+        char* dot = strchr(copy, '.');
+        if (dot != NULL) *dot = point;
+    }
+    char* end = NULL;
+    *value = strtod(copy, &end);
+    const int whole = end == copy + length;
+    free(copy);
+    return whole ? 0 : 1;
+}
+
+void gimbal_csv_table_free(GimbalCsvTable* table) {
+    if (table->names != NULL)
+        for (int k = 0; k < table->columns; ++k) free(table->names[k]);
+    free(table->names);
+    free(table->values);
+    memset(table, 0, sizeof *table);
+}
+
+int gimbal_csv_table_column(const GimbalCsvTable* table, const char* name) {
+    for (int k = 0; k < table->columns; ++k)
+        if (strcmp(table->names[k], name) == 0) return k;
+    return -1;
+}
+
+static int read_header(const Line* header, GimbalCsvTable* table, char* message, size_t size) {
+    if (memchr(header->start, ';', header->length) != NULL && memchr(header->start, ',', header->length) == NULL)
+        return refuse(message, size,
+                      "line %ld is separated by semicolons ('%.*s'); the file must be comma-separated with '.' as the "
+                      "decimal point (save it as CSV with ',' separators)",
+                      header->number, (int)header->length, header->start);
+    const size_t columns = count_cells(header->start, header->length);
+    if (columns > 100000) return refuse(message, size, "line %ld (the header) has %zu columns", header->number, columns);
+    table->names = calloc(columns, sizeof(char*));
+    if (table->names == NULL) return -1;
+    table->columns = (int)columns;
+    size_t position = 0;
+    for (size_t k = 0; k < columns; ++k) {
+        const char* name;
+        size_t length;
+        next_cell(header->start, header->length, &position, &name, &length);
+        strip(&name, &length, 1);
+        if (length == 0)
+            return refuse(message, size, "line %ld (the header): column %zu has no name", header->number, k + 1);
+        table->names[k] = malloc(length + 1);
+        if (table->names[k] == NULL) return -1;
+        memcpy(table->names[k], name, length);
+        table->names[k][length] = '\0';
+        for (size_t j = 0; j < k; ++j)
+            if (strcmp(table->names[j], table->names[k]) == 0)
+                return refuse(message, size, "line %ld (the header): column '%s' appears twice", header->number,
+                              table->names[k]);
+    }
+    table->time_column = gimbal_csv_table_column(table, "time");
+    if (table->time_column < 0) {
+        int written = snprintf(message, size, "no 'time' column in the header (line %ld: ", header->number);
+        for (int k = 0; k < table->columns && written >= 0 && (size_t)written < size; ++k)
+            written += snprintf(message + written, size - (size_t)written, "%s%s", k > 0 ? ", " : "", table->names[k]);
+        if (written >= 0 && (size_t)written < size) snprintf(message + written, size - (size_t)written, ")");
+        return 1;
+    }
+    return 0;
+}
+
+static int read_row(const Line* line, long row, GimbalCsvTable* table, char* message, size_t size) {
+    const size_t cells = count_cells(line->start, line->length);
+    if (cells != (size_t)table->columns)
+        return refuse(message, size, "line %ld (data row %ld) has %zu cells, the header %d%s", line->number, row, cells,
+                      table->columns,
+                      memchr(line->start, ';', line->length) != NULL ? " (semicolons: the file must be comma-separated)" : "");
+    double* values = table->values + (size_t)(row - 1) * (size_t)table->columns;
+    size_t position = 0;
+    for (int k = 0; k < table->columns; ++k) {
+        const char* cell;
+        size_t length;
+        next_cell(line->start, line->length, &position, &cell, &length);
+        strip(&cell, &length, 0);
+        const int parsed = parse_number(cell, length, &values[k]);
+        if (parsed < 0) return -1;
+        if (parsed > 0 && length == 0)
+            return refuse(message, size, "line %ld (data row %ld), column '%s' is empty", line->number, row, table->names[k]);
+        if (parsed > 0)
+            return refuse(message, size, "line %ld (data row %ld), column '%s' is not a number: '%.*s'", line->number, row,
+                          table->names[k], (int)length, cell);
+        if (!isfinite(values[k]))
+            return refuse(message, size, "line %ld (data row %ld), column '%s' is '%.*s', not a finite number",
+                          line->number, row, table->names[k], (int)length, cell);
+    }
+    return 0;
+}
+
+static int read_table(const Line* lines, long count, GimbalCsvTable* table,
+                      char* message, size_t size) {
+    if (count == 0)
+        return refuse(message, size, "the file is empty (expected a header such as 'time,gamma' and rows of numbers)");
+    int status = read_header(&lines[0], table, message, size);
+    if (status != 0) return status;
+    table->values = malloc(sizeof(double) * (size_t)table->columns * (size_t)(count > 1 ? count - 1 : 1));
+    if (table->values == NULL) return -1;
+    for (long row = 1; row < count; ++row)
+        if ((status = read_row(&lines[row], row, table, message, size)) != 0) return status;
+    table->rows = count - 1;
+    if (table->rows < MINIMUM_ROWS)
+        return refuse(message, size, "%ld data rows; a cubic spline needs at least %d", table->rows, MINIMUM_ROWS);
+    const int c = table->time_column;
+    for (long row = 1; row < table->rows; ++row) {
+        const double before = table->values[(size_t)(row - 1) * (size_t)table->columns + (size_t)c];
+        const double now = table->values[(size_t)row * (size_t)table->columns + (size_t)c];
+        if (!(now > before))
+            return refuse(message, size, "'time' must increase strictly, but line %ld has %g after %g", lines[row + 1].number,
+                          now, before);
+    }
+    return 0;
+}
+
+int gimbal_csv_table_read(const char* text, size_t length, GimbalCsvTable* table, char* message, size_t size) {
+    memset(table, 0, sizeof *table);
+    const long invalid = first_non_utf8((const unsigned char*)text, length);
+    if (invalid >= 0) return refuse(message, size, "not a text file (byte %ld is not UTF-8)", invalid);
+    if (length >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) text += 3, length -= 3;
+    Line* lines = NULL;
+    const long count = split_lines(text, length, &lines);
+    if (count < 0) return -1;
+    const int status = read_table(lines, count, table, message, size);
+    free(lines);
+    if (status != 0) gimbal_csv_table_free(table);
+    return status;
+}
