@@ -35,7 +35,7 @@ bool SwitchingElementSet::any_changed(const Modes& before, const Modes& after) c
 }
 
 void SwitchingElementSet::decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
-                                 const int* crossings, const std::function<void()>& refresh) const {
+                                 const int* crossings, FunctionRef<void()> refresh) const {
     double state_before[kMaxStateSize];
     std::copy(state, state + state_size_, state_before);
     for (const BacklashElement& element : backlash_) element.decide(context, previous, modes, state, crossings);

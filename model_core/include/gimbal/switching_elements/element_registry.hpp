@@ -4,10 +4,10 @@
 // knows no element by name.
 #pragma once
 
-#include <functional>
 #include <string>
 #include <vector>
 
+#include "gimbal/function_ref.hpp"
 #include "gimbal/switching_elements/current_limiter.hpp"
 #include "gimbal/switching_elements/dry_friction.hpp"
 #include "gimbal/switching_elements/gear_backlash.hpp"
@@ -40,7 +40,7 @@ public:
     // (whose torques depend on everything before). `refresh` re-evaluates context.dynamics at
     // (time, state) under the modes chosen so far, where a later decision depends on them.
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
-                const int* crossings, const std::function<void()>& refresh) const;
+                const int* crossings, FunctionRef<void()> refresh) const;
 
     // Whether any element's guards move with time alone (SwitchingElement::time_dependent).
     bool time_dependent(const StepInputs& inputs, const Modes& modes) const;
