@@ -701,12 +701,7 @@ static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolea
 
 /* ---------------------------------------------------------------- the exported functions */
 
-#define HOLD(type, call)                 \
-    HostFpEnvironment host_environment; \
-    enter_fmu_fp(&host_environment);    \
-    const type result = call;           \
-    leave_fmu_fp(&host_environment);    \
-    return result
+#define HOLD IN_FMU_FP_ENVIRONMENT /* host_fp_environment.h */
 #define I ((Instance3*)instance)
 
 const char* fmi3GetVersion(void) { return fmi3Version; }

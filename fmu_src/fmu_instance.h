@@ -79,12 +79,4 @@ fmi2Status model_exchange_directional_derivative(Instance* instance, const fmi2V
                                                  size_t unknown_count, const fmi2ValueReference knowns[],
                                                  size_t known_count, const fmi2Real seed[], fmi2Real result[]);
 
-/* Runs an implementation in the FMU's floating-point environment and gives the host its own back. */
-#define IN_FMU_FP_ENVIRONMENT(type, call)   \
-    HostFpEnvironment host_environment;     \
-    enter_fmu_fp(&host_environment);        \
-    const type result = call;               \
-    leave_fmu_fp(&host_environment);        \
-    return result
-
 #endif

@@ -53,4 +53,14 @@ static inline void leave_fmu_fp(const HostFpEnvironment* host) {
 #endif
 }
 
+/* The body of an exported function: `call` (of type `type`) runs in the FMU's environment, and the
+ * host gets its own back before the result is returned. Every FMU of the project (the gimbal's
+ * FMI 2.0 and 3.0 wrappers, the ship-motion and controller FMUs) wraps its entry points in it. */
+#define IN_FMU_FP_ENVIRONMENT(type, call)   \
+    HostFpEnvironment host_environment;     \
+    enter_fmu_fp(&host_environment);        \
+    const type result = call;               \
+    leave_fmu_fp(&host_environment);        \
+    return result
+
 #endif
