@@ -5,150 +5,60 @@
  * default floating-point environment whatever the host's (host_fp_environment.h), so that the
  * voltages are the bits the scene runner's compiled loop computes. */
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
+#include <stddef.h>
 
 #include "controller_guid.h"
 #include "controller_model.h"
+#include "cosim_instance.h"
 #include "fmi2Functions.h"
 #include "host_fp_environment.h"
-
-typedef enum {
-    STATE_INSTANTIATED = 1 << 0,
-    STATE_INITIALIZATION = 1 << 1,
-    STATE_STEP_COMPLETE = 1 << 2,
-    STATE_TERMINATED = 1 << 3,
-} InstanceState;
 
 enum { kAnyState = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED,
        kGetStates = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED,
        kSetStates = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE };
 
-/* <LogCategories> of the model description, in its order. */
-enum { LOG_STATUS_ERROR, LOG_ALL, LOG_CATEGORY_COUNT };
-static const char* const kLogCategories[LOG_CATEGORY_COUNT] = {"logStatusError", "logAll"};
-
 typedef struct {
-    fmi2CallbackLogger logger;
-    fmi2ComponentEnvironment environment;
-    char* name;
-    int category_enabled[LOG_CATEGORY_COUNT];
-    InstanceState state;
+    CosimInstance common; /* first: cosim_instantiate allocates the Instance around it */
     double time, stop_time;
     int stop_time_defined;
     ControllerModel model;
 } Instance;
-
-static void log_error(const Instance* instance, const char* format, ...) {
-    char text[1024], escaped[2048];
-    va_list args;
-    va_start(args, format);
-    vsnprintf(text, sizeof text, format, args);
-    va_end(args);
-    size_t j = 0; /* the logger takes its message as a format: every '%' doubled */
-    for (size_t i = 0; text[i] != '\0' && j + 2 < sizeof escaped; ++i) {
-        if (text[i] == '%') escaped[j++] = '%';
-        escaped[j++] = text[i];
-    }
-    escaped[j] = '\0';
-    instance->logger(instance->environment, instance->name, fmi2Error, kLogCategories[LOG_STATUS_ERROR], escaped);
-}
-
-static const char* state_name(InstanceState state) {
-    switch (state) {
-        case STATE_INSTANTIATED: return "instantiated";
-        case STATE_INITIALIZATION: return "initialization mode";
-        case STATE_STEP_COMPLETE: return "step complete";
-        default: return "terminated";
-    }
-}
+_Static_assert(offsetof(Instance, common) == 0, "the CosimInstance must be the Instance's first member");
 
 /* The instance when `function` may be called in its state; NULL (logged when it can be) otherwise. */
 static Instance* usable(fmi2Component c, const char* function, int states) {
     Instance* instance = (Instance*)c;
-    if (instance == NULL) return NULL;
-    if (instance->state & states) return instance;
-    log_error(instance, "%s is not allowed in state '%s'", function, state_name(instance->state));
-    return NULL;
+    return instance != NULL && cosim_allowed(&instance->common, function, states) ? instance : NULL;
 }
 
 static int arrays_given(const Instance* instance, const char* function, size_t nvr, const void* vr, const void* value) {
-    if (nvr == 0) return 1;
-    if (vr != NULL && value != NULL) return 1;
-    log_error(instance, "%s: argument %s is a null pointer", function, vr == NULL ? "vr" : "value");
-    return 0;
+    return nvr == 0 || (cosim_not_null(&instance->common, function, vr, "vr") &&
+                        cosim_not_null(&instance->common, function, value, "value"));
 }
 
 static fmi2Status refused(fmi2Component c, const char* function, const char* why) {
     Instance* instance = (Instance*)c;
-    if (instance != NULL) log_error(instance, "%s: %s", function, why);
-    return fmi2Error;
+    return cosim_refuse(instance != NULL ? &instance->common : NULL, "%s: %s", function, why);
 }
 
 /* ---------------------------------------------------------------- lifetime */
 
 static fmi2Component impl_Instantiate(fmi2String name, fmi2Type type, fmi2String guid, const fmi2CallbackFunctions* functions,
                                       fmi2Boolean logging_on) {
-    if (functions == NULL || functions->logger == NULL) return NULL; /* nowhere to say why */
-    Instance probe = {.logger = functions->logger, .environment = functions->componentEnvironment,
-                      .name = (char*)(name != NULL ? name : "?")};
-    if (name == NULL || name[0] == '\0') {
-        log_error(&probe, "fmi2Instantiate: instanceName must be a non-empty string");
-        return NULL;
-    }
-    if (type != fmi2CoSimulation) {
-        log_error(&probe, "fmi2Instantiate: fmuType = %d: this FMU is Co-Simulation only (fmi2CoSimulation = 1)", (int)type);
-        return NULL;
-    }
-    if (guid == NULL || strcmp(guid, CONTROLLER_GUID) != 0) {
-        log_error(&probe, "fmi2Instantiate: GUID '%s' does not match this FMU's '%s'", guid != NULL ? guid : "(null)",
-                  CONTROLLER_GUID);
-        return NULL;
-    }
-    Instance* instance = (Instance*)calloc(1, sizeof(Instance));
-    char* copy = (char*)malloc(strlen(name) + 1);
-    if (instance == NULL || copy == NULL) {
-        free(instance);
-        free(copy);
-        log_error(&probe, "fmi2Instantiate: out of memory");
-        return NULL;
-    }
-    strcpy(copy, name);
-    instance->logger = functions->logger, instance->environment = functions->componentEnvironment;
-    instance->name = copy;
-    for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = logging_on ? 1 : 0;
-    instance->state = STATE_INSTANTIATED;
-    controller_model_reset(&instance->model);
+    Instance* instance =
+        (Instance*)cosim_instantiate(sizeof(Instance), name, type, guid, CONTROLLER_GUID, functions, logging_on);
+    if (instance != NULL) controller_model_reset(&instance->model);
     return instance;
 }
 
 static void impl_FreeInstance(fmi2Component c) {
     Instance* instance = (Instance*)c;
-    if (instance == NULL) return;
-    free(instance->name);
-    free(instance);
+    if (instance != NULL) cosim_free(&instance->common);
 }
 
 static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t count, const fmi2String categories[]) {
-    Instance* instance = usable(c, "fmi2SetDebugLogging", kAnyState);
-    if (instance == NULL) return fmi2Error;
-    if (count > 0 && categories == NULL) return refused(c, "fmi2SetDebugLogging", "argument categories is a null pointer");
-    int chosen[LOG_CATEGORY_COUNT] = {0};
-    for (size_t i = 0; i < count; ++i) {
-        int found = -1;
-        for (int k = 0; k < LOG_CATEGORY_COUNT && categories[i] != NULL; ++k)
-            if (strcmp(categories[i], kLogCategories[k]) == 0) found = k;
-        if (found < 0) {
-            log_error(instance, "fmi2SetDebugLogging: unknown log category '%s'", categories[i] ? categories[i] : "(null)");
-            return fmi2Error;
-        }
-        chosen[found] = 1;
-    }
-    for (int k = 0; k < LOG_CATEGORY_COUNT; ++k)
-        if (count == 0 || chosen[k]) instance->category_enabled[k] = on ? 1 : 0;
-    return fmi2OK;
+    Instance* instance = (Instance*)c;
+    return instance != NULL ? cosim_set_debug_logging(&instance->common, on, count, categories) : fmi2Error;
 }
 
 /* ---------------------------------------------------------------- initialization and termination */
@@ -159,7 +69,7 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean tolerance_de
     Instance* instance = usable(c, "fmi2SetupExperiment", STATE_INSTANTIATED);
     if (instance == NULL) return fmi2Error;
     if (!isfinite(start) || (stop_defined && (!isfinite(stop) || stop < start))) {
-        log_error(instance, "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
+        cosim_log_error(&instance->common, "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
                   start, stop);
         return fmi2Error;
     }
@@ -170,7 +80,7 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean tolerance_de
 static fmi2Status impl_EnterInitializationMode(fmi2Component c) {
     Instance* instance = usable(c, "fmi2EnterInitializationMode", STATE_INSTANTIATED);
     if (instance == NULL) return fmi2Error;
-    instance->state = STATE_INITIALIZATION;
+    instance->common.state = STATE_INITIALIZATION;
     return fmi2OK;
 }
 
@@ -180,18 +90,18 @@ static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
     char why[512];
     if (!controller_model_check(&instance->model, why, sizeof why)) {
         /* still in initialization mode: the master may correct the parameter and retry */
-        log_error(instance, "fmi2ExitInitializationMode: %s", why);
+        cosim_log_error(&instance->common, "fmi2ExitInitializationMode: %s", why);
         return fmi2Error;
     }
     controller_model_start(&instance->model);
-    instance->state = STATE_STEP_COMPLETE;
+    instance->common.state = STATE_STEP_COMPLETE;
     return fmi2OK;
 }
 
 static fmi2Status impl_Terminate(fmi2Component c) {
     Instance* instance = usable(c, "fmi2Terminate", STATE_STEP_COMPLETE);
     if (instance == NULL) return fmi2Error;
-    instance->state = STATE_TERMINATED;
+    instance->common.state = STATE_TERMINATED;
     return fmi2OK;
 }
 
@@ -200,7 +110,7 @@ static fmi2Status impl_Reset(fmi2Component c) {
     if (instance == NULL) return fmi2Error;
     controller_model_reset(&instance->model);
     instance->time = 0.0, instance->stop_time_defined = 0;
-    instance->state = STATE_INSTANTIATED;
+    instance->common.state = STATE_INSTANTIATED;
     return fmi2OK;
 }
 
@@ -208,7 +118,7 @@ static fmi2Status impl_Reset(fmi2Component c) {
 
 /* Which variables may be set now: inputs always; parameters before initialization ends. */
 static int settable(const Instance* instance, int parameter) {
-    return !parameter || (instance->state & (STATE_INSTANTIATED | STATE_INITIALIZATION));
+    return !parameter || (instance->common.state & (STATE_INSTANTIATED | STATE_INITIALIZATION));
 }
 
 static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
@@ -216,16 +126,16 @@ static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], s
     if (instance == NULL || !arrays_given(instance, "fmi2SetReal", nvr, vr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) { /* all checked before any is applied */
         if (vr[i] >= REAL_COUNT) {
-            log_error(instance, "fmi2SetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
+            cosim_log_error(&instance->common, "fmi2SetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
             return fmi2Error;
         }
         const ControllerReal* v = &kControllerReals[vr[i]];
         if (v->causality == OUTPUT || !settable(instance, v->causality == PARAMETER)) {
-            log_error(instance, "fmi2SetReal: %s cannot be set in state '%s'", v->name, state_name(instance->state));
+            cosim_log_error(&instance->common, "fmi2SetReal: %s cannot be set in state '%s'", v->name, cosim_state_name(instance->common.state));
             return fmi2Error;
         }
         if (!isfinite(value[i])) {
-            log_error(instance, "fmi2SetReal: %s = %g is not finite", v->name, value[i]);
+            cosim_log_error(&instance->common, "fmi2SetReal: %s = %g is not finite", v->name, value[i]);
             return fmi2Error;
         }
     }
@@ -238,7 +148,7 @@ static fmi2Status impl_GetReal(fmi2Component c, const fmi2ValueReference vr[], s
     if (instance == NULL || !arrays_given(instance, "fmi2GetReal", nvr, vr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         if (vr[i] >= REAL_COUNT) {
-            log_error(instance, "fmi2GetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
+            cosim_log_error(&instance->common, "fmi2GetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
             return fmi2Error;
         }
         value[i] = instance->model.real[vr[i]];
@@ -259,7 +169,7 @@ static const char* int_name(int boolean, fmi2ValueReference vr) {
 static int int_reference_known(const Instance* instance, const char* function, fmi2ValueReference vr, int count,
                                int boolean) {
     if (vr < (unsigned)count) return 1;
-    log_error(instance, "%s: value reference %u is not a%s variable", function, (unsigned)vr,
+    cosim_log_error(&instance->common, "%s: value reference %u is not a%s variable", function, (unsigned)vr,
               boolean ? " Boolean" : "n Integer");
     return 0;
 }
@@ -273,8 +183,8 @@ static fmi2Status set_ints(fmi2Component c, const char* function, const fmi2Valu
     for (size_t i = 0; i < nvr; ++i) {
         if (!int_reference_known(instance, function, vr[i], count, boolean)) return fmi2Error;
         if (!settable(instance, 1)) {
-            log_error(instance, "%s: %s cannot be set in state '%s'", function, int_name(boolean, vr[i]),
-                      state_name(instance->state));
+            cosim_log_error(&instance->common, "%s: %s cannot be set in state '%s'", function, int_name(boolean, vr[i]),
+                      cosim_state_name(instance->common.state));
             return fmi2Error;
         }
     }
@@ -302,20 +212,20 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boole
     Instance* instance = usable(c, "fmi2DoStep", STATE_STEP_COMPLETE);
     if (instance == NULL) return fmi2Error;
     if (!(h > 0.0) || !isfinite(h)) {
-        log_error(instance, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", h);
+        cosim_log_error(&instance->common, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", h);
         return fmi2Error;
     }
     /* Masters keep time as k*h or as a running sum; those differ in the last bits, not by a step. */
     const double tolerance = 1e-12 * fmax(1.0, fabs(instance->time)) + 1e-6 * h;
     if (!(fabs(t - instance->time) <= tolerance)) {
-        log_error(instance, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", t,
+        cosim_log_error(&instance->common, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", t,
                   instance->time);
         return fmi2Error;
     }
     const double end = instance->time + h;
     if (instance->stop_time_defined &&
         end > instance->stop_time + 1e-12 * fmax(1.0, fabs(instance->stop_time)) + 1e-6 * h) {
-        log_error(instance, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end, instance->stop_time);
+        cosim_log_error(&instance->common, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end, instance->stop_time);
         return fmi2Error;
     }
     controller_model_step(&instance->model, h);
@@ -351,13 +261,6 @@ static fmi2Status impl_GetBooleanStatus(fmi2Component c, fmi2StatusKind kind, fm
 }
 
 /* ---------------------------------------------------------------- the exported functions */
-
-#define IN_FMU_FP_ENVIRONMENT(type, call)   \
-    HostFpEnvironment host_environment;     \
-    enter_fmu_fp(&host_environment);        \
-    const type result = call;               \
-    leave_fmu_fp(&host_environment);        \
-    return result
 
 const char* fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char* fmi2GetVersion(void) { return fmi2Version; }

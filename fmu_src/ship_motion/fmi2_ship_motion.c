@@ -12,11 +12,11 @@
  * recording's end is refused, as the scene runner refuses a recording that does not cover its run. */
 #include <limits.h>
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "cosim_instance.h"
 #include "fmi2Functions.h"
 #include "host_fp_environment.h"
 #include "recorded_motion.h"
@@ -25,23 +25,8 @@
 #include "ship_motion_guid.h"
 #include "ship_motion_variables.h"
 
-typedef enum {
-    STATE_INSTANTIATED = 1 << 0,
-    STATE_INITIALIZATION = 1 << 1,
-    STATE_STEP_COMPLETE = 1 << 2,
-    STATE_TERMINATED = 1 << 3,
-    STATE_ERROR = 1 << 4
-} State;
-
-enum { LOG_STATUS_ERROR, LOG_ALL, LOG_CATEGORY_COUNT };
-static const char* const kLogCategories[LOG_CATEGORY_COUNT] = {"logStatusError", "logAll"};
-
 typedef struct {
-    fmi2CallbackLogger logger;
-    fmi2ComponentEnvironment environment;
-    char* instance_name;
-    int category_enabled[LOG_CATEGORY_COUNT];
-    State state;
+    CosimInstance common; /* first: cosim_instantiate allocates the Instance around it */
     ShipMotionParameters parameters;
     char* recording_file;             /* the String parameter's value, the instance's copy */
     char* resources;                  /* the resources folder, NULL when fmuResourceLocation names none */
@@ -56,59 +41,17 @@ typedef struct {
     double stop_time;
     fmi2Status last_step_status;
 } Instance;
+_Static_assert(offsetof(Instance, common) == 0, "the CosimInstance must be the Instance's first member");
 
-static const char* state_name(State state) {
-    switch (state) {
-        case STATE_INSTANTIATED: return "instantiated";
-        case STATE_INITIALIZATION: return "initialization mode";
-        case STATE_STEP_COMPLETE: return "step complete";
-        case STATE_TERMINATED: return "terminated";
-        default: return "error";
-    }
-}
+#define REFUSE(instance, ...) return cosim_refuse(&(instance)->common, __VA_ARGS__)
 
-/* Errors are always reported; other messages when the host enabled their category or logAll. */
-static void log_message(const Instance* instance, fmi2Status status, const char* category, const char* format, ...) {
-    if (instance == NULL || instance->logger == NULL) return;
-    int enabled = status == fmi2Error || instance->category_enabled[LOG_ALL];
-    for (int k = 0; k < LOG_CATEGORY_COUNT; ++k)
-        if (strcmp(category, kLogCategories[k]) == 0 && instance->category_enabled[k]) enabled = 1;
-    if (!enabled) return;
-    char text[1024];
-    va_list args;
-    va_start(args, format);
-    vsnprintf(text, sizeof text, format, args);
-    va_end(args);
-    /* The logger treats its message as a format string: escape every '%'. */
-    char escaped[2 * sizeof text];
-    size_t j = 0;
-    for (size_t i = 0; text[i] != '\0' && j + 2 < sizeof escaped; ++i) {
-        if (text[i] == '%') escaped[j++] = '%';
-        escaped[j++] = text[i];
-    }
-    escaped[j] = '\0';
-    instance->logger(instance->environment, instance->instance_name, status, category, escaped);
-}
-
-#define REFUSE(instance, ...)                                                 \
-    do {                                                                      \
-        log_message((instance), fmi2Error, "logStatusError", __VA_ARGS__);    \
-        return fmi2Error;                                                     \
-    } while (0)
-
-/* NULL-safe: is `function` allowed in the instance's state (a bit set of State)? */
+/* NULL-safe: is `function` allowed in the instance's state (a mask of InstanceState)? */
 static int allowed(Instance* instance, const char* function, int states) {
-    if (instance == NULL) return 0;
-    if (instance->state & states) return 1;
-    log_message(instance, fmi2Error, "logStatusError", "%s is not allowed in state '%s'", function,
-                state_name(instance->state));
-    return 0;
+    return instance != NULL && cosim_allowed(&instance->common, function, states);
 }
 
 static int not_null(Instance* instance, const char* function, const void* pointer, const char* argument) {
-    if (pointer != NULL) return 1;
-    log_message(instance, fmi2Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
-    return 0;
+    return cosim_not_null(&instance->common, function, pointer, argument);
 }
 
 static const int kGetStates = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR;
@@ -130,7 +73,7 @@ static fmi2Status prepare_recording(Instance* instance, const char* function) {
     const int status = gimbal_recorded_motion_read(text, length, &instance->recording, message, sizeof message);
     free(text);
     if (status != GIMBAL_RECORDED_MOTION_READ) {
-        log_message(instance, fmi2Error, "logStatusError", "%s: recorded motion %s: %s", function, path, message);
+        cosim_log_error(&instance->common, "%s: recorded motion %s: %s", function, path, message);
         free(path);
         return fmi2Error;
     }
@@ -139,10 +82,10 @@ static fmi2Status prepare_recording(Instance* instance, const char* function) {
     const double duration = instance->stop_time - instance->start_time;
     if (start > 0.0 || (instance->stop_time_defined && end < duration)) {
         if (instance->stop_time_defined)
-            log_message(instance, fmi2Error, "logStatusError", "%s: recorded motion %s covers [%g, %g] s, not [0, %g] s",
+            cosim_log_error(&instance->common, "%s: recorded motion %s covers [%g, %g] s, not [0, %g] s",
                         function, path, start, end, duration);
         else
-            log_message(instance, fmi2Error, "logStatusError",
+            cosim_log_error(&instance->common,
                         "%s: recorded motion %s covers [%g, %g] s, not t = 0, where the outputs start", function, path,
                         start, end);
         free(path);
@@ -183,21 +126,7 @@ static void unprepare(Instance* instance) {
 static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                        const fmi2String categories[]) {
     Instance* instance = (Instance*)c;
-    if (!allowed(instance, "fmi2SetDebugLogging", kAnyState)) return fmi2Error;
-    if (nCategories == 0) {
-        for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
-        return fmi2OK;
-    }
-    if (!not_null(instance, "fmi2SetDebugLogging", categories, "categories")) return fmi2Error;
-    for (size_t i = 0; i < nCategories; ++i) {
-        int index = -1;
-        for (int k = 0; k < LOG_CATEGORY_COUNT; ++k)
-            if (categories[i] != NULL && strcmp(categories[i], kLogCategories[k]) == 0) index = k;
-        if (index < 0)
-            REFUSE(instance, "fmi2SetDebugLogging: unknown log category '%s'", categories[i] != NULL ? categories[i] : "(null)");
-        instance->category_enabled[index] = loggingOn ? 1 : 0;
-    }
-    return fmi2OK;
+    return instance != NULL ? cosim_set_debug_logging(&instance->common, loggingOn, nCategories, categories) : fmi2Error;
 }
 
 static char* copy_text(const char* text) {
@@ -221,7 +150,7 @@ static int reset_instance(Instance* instance) {
     instance->stop_time = 0.0;
     instance->last_step_status = fmi2OK;
     for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) instance->outputs[k] = 0.0;
-    instance->state = STATE_INSTANTIATED;
+    instance->common.state = STATE_INSTANTIATED;
     return 0;
 }
 
@@ -229,46 +158,15 @@ static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType,
                                       fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
                                       fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)visible;
-    if (functions == NULL || functions->logger == NULL) return NULL; /* nowhere to say why */
-    Instance probe;
-    memset(&probe, 0, sizeof probe);
-    probe.logger = functions->logger;
-    probe.environment = functions->componentEnvironment;
-    probe.instance_name = (char*)(instanceName != NULL ? instanceName : "?");
-    if (instanceName == NULL || instanceName[0] == '\0') {
-        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: instanceName must be a non-empty string");
-        return NULL;
-    }
-    if (fmuType != fmi2CoSimulation) {
-        log_message(&probe, fmi2Error, "logStatusError",
-                    "fmi2Instantiate: fmuType = %d: this FMU is Co-Simulation (1) only", (int)fmuType);
-        return NULL;
-    }
-    if (fmuGUID == NULL || strcmp(fmuGUID, SHIP_MOTION_GUID) != 0) {
-        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: GUID '%s' does not match this FMU's '%s'",
-                    fmuGUID != NULL ? fmuGUID : "(null)", SHIP_MOTION_GUID);
-        return NULL;
-    }
-    Instance* instance = (Instance*)calloc(1, sizeof(Instance));
-    char* name = (char*)malloc(strlen(instanceName) + 1);
-    if (instance == NULL || name == NULL) {
-        free(instance);
-        free(name);
-        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
-        return NULL;
-    }
-    strcpy(name, instanceName);
-    instance->logger = functions->logger;
-    instance->environment = functions->componentEnvironment;
-    instance->instance_name = name;
-    for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = loggingOn ? 1 : 0;
+    Instance* instance = (Instance*)cosim_instantiate(sizeof(Instance), instanceName, fmuType, fmuGUID, SHIP_MOTION_GUID,
+                                                      functions, loggingOn);
+    if (instance == NULL) return NULL;
     /* No resources folder is no error here: only a relative recording_file needs one. */
     instance->resources = recording_resources_folder(fmuResourceLocation);
     if (reset_instance(instance) != 0) {
+        cosim_log_error(&instance->common, "fmi2Instantiate: out of memory");
         free(instance->resources);
-        free(instance->instance_name);
-        free(instance);
-        log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
+        cosim_free(&instance->common);
         return NULL;
     }
     return instance;
@@ -280,8 +178,7 @@ static void impl_FreeInstance(fmi2Component c) {
     unprepare(instance);
     free(instance->recording_file);
     free(instance->resources);
-    free(instance->instance_name);
-    free(instance);
+    cosim_free(&instance->common);
 }
 
 /* ---------------------------------------------------------------- initialization and termination */
@@ -304,7 +201,7 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean toleranceDef
 static fmi2Status impl_EnterInitializationMode(fmi2Component c) {
     Instance* instance = (Instance*)c;
     if (!allowed(instance, "fmi2EnterInitializationMode", STATE_INSTANTIATED)) return fmi2Error;
-    instance->state = STATE_INITIALIZATION;
+    instance->common.state = STATE_INITIALIZATION;
     return fmi2OK;
 }
 
@@ -314,14 +211,14 @@ static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
     /* Refused parameters leave the instance in initialization mode: the master may correct them. */
     if (prepare(instance, "fmi2ExitInitializationMode") != fmi2OK) return fmi2Error;
     instance->row = 0;
-    instance->state = STATE_STEP_COMPLETE;
+    instance->common.state = STATE_STEP_COMPLETE;
     return fmi2OK;
 }
 
 static fmi2Status impl_Terminate(fmi2Component c) {
     Instance* instance = (Instance*)c;
     if (!allowed(instance, "fmi2Terminate", STATE_STEP_COMPLETE | STATE_ERROR)) return fmi2Error;
-    instance->state = STATE_TERMINATED;
+    instance->common.state = STATE_TERMINATED;
     return fmi2OK;
 }
 
@@ -373,21 +270,21 @@ static fmi2Status impl_GetInteger(fmi2Component c, const fmi2ValueReference vr[]
 /* A value the variable's bounds (and those the XML cannot say: > min, finite) refuse, named; 0 if fine. */
 static int real_refused(Instance* instance, const char* function, fmi2ValueReference vr, double value) {
     if (vr >= SHIP_REAL_COUNT) {
-        log_message(instance, fmi2Error, "logStatusError", "%s: value reference %u is not a Real variable", function,
+        cosim_log_error(&instance->common, "%s: value reference %u is not a Real variable", function,
                     (unsigned)vr);
         return 1;
     }
     const ShipRealVariable* variable = &kShipRealVariables[vr];
     if (variable->causality == SHIP_OUTPUT) {
-        log_message(instance, fmi2Error, "logStatusError", "%s: %s is an output and cannot be set", function, variable->name);
+        cosim_log_error(&instance->common, "%s: %s is an output and cannot be set", function, variable->name);
         return 1;
     }
     if (!isfinite(value)) {
-        log_message(instance, fmi2Error, "logStatusError", "%s: %s = %g must be finite", function, variable->name, value);
+        cosim_log_error(&instance->common, "%s: %s = %g must be finite", function, variable->name, value);
         return 1;
     }
     if (variable->min_exclusive ? !(value > variable->min) : !(value >= variable->min)) {
-        log_message(instance, fmi2Error, "logStatusError", "%s: %s = %.17g must be %s %g", function, variable->name,
+        cosim_log_error(&instance->common, "%s: %s = %.17g must be %s %g", function, variable->name,
                     value, variable->min_exclusive ? ">" : ">=", variable->min);
         return 1;
     }
@@ -509,7 +406,7 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
     }
     if (instance->step == 0.0) {
         if (ship_motion_set_step(&instance->motion, step) != 0) {
-            instance->state = STATE_ERROR;
+            instance->common.state = STATE_ERROR;
             instance->last_step_status = fmi2Error;
             REFUSE(instance, "fmi2DoStep: out of memory for the rotation tables of step %g", step);
         }
@@ -569,13 +466,6 @@ static fmi2Status unsupported(fmi2Component c, const char* function, const char*
 }
 
 /* ---------------------------------------------------------------- the exported functions */
-
-#define IN_FMU_FP_ENVIRONMENT(type, call) \
-    HostFpEnvironment host_environment;   \
-    enter_fmu_fp(&host_environment);      \
-    const type result = call;             \
-    leave_fmu_fp(&host_environment);      \
-    return result
 
 const char* fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char* fmi2GetVersion(void) { return fmi2Version; }
