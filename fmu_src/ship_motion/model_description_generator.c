@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "model_description_writer.h"
 #include "ship_motion_variables.h"
 
 typedef struct {
@@ -35,19 +36,6 @@ static const Unit* find_unit(const char* name) {
     return NULL;
 }
 
-/* The description as an XML attribute value. */
-static void write_escaped(FILE* out, const char* text) {
-    for (; *text != '\0'; ++text) {
-        switch (*text) {
-            case '&': fputs("&amp;", out); break;
-            case '<': fputs("&lt;", out); break;
-            case '>': fputs("&gt;", out); break;
-            case '"': fputs("&quot;", out); break;
-            default: fputc(*text, out);
-        }
-    }
-}
-
 static int write_units(FILE* out) {
     for (int k = 0; k < UNIT_COUNT; ++k) {
         fprintf(out, "    <Unit name=\"%s\">", kUnits[k].name);
@@ -71,7 +59,7 @@ static int write_variables(FILE* out) {
         fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"%s\" variability=\"%s\" initial=\"%s\"\n"
                      "      description=\"",
                 v->name, vr, output ? "output" : "parameter", output ? "continuous" : "fixed", output ? "calculated" : "exact");
-        write_escaped(out, v->description);
+        write_xml_escaped(out, v->description);
         fprintf(out, "\">\n      <Real unit=\"%s\"", v->unit);
         if (v->display_unit[0] != '\0') fprintf(out, " displayUnit=\"%s\"", v->display_unit);
         if (!output) fprintf(out, " start=\"%.17g\"", v->start);
@@ -82,7 +70,7 @@ static int write_variables(FILE* out) {
         const ShipIntegerVariable* v = &kShipIntegerVariables[vr];
         fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
                      "initial=\"exact\"\n      description=\"", v->name, vr);
-        write_escaped(out, v->description);
+        write_xml_escaped(out, v->description);
         fprintf(out, "\">\n      <Integer start=\"%d\" min=\"%d\" max=\"%d\"/>\n    </ScalarVariable>\n", v->start, v->min,
                 v->max);
     }
@@ -90,45 +78,33 @@ static int write_variables(FILE* out) {
         const ShipStringVariable* v = &kShipStringVariables[vr];
         fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
                      "initial=\"exact\"\n      description=\"", v->name, vr);
-        write_escaped(out, v->description);
+        write_xml_escaped(out, v->description);
         fputs("\">\n      <String start=\"", out);
-        write_escaped(out, v->start);
+        write_xml_escaped(out, v->start);
         fputs("\"/>\n    </ScalarVariable>\n", out);
     }
     return 0;
 }
 
+static int is_output(int value_reference) { return kShipRealVariables[value_reference].causality == SHIP_OUTPUT; }
+
 /* The outputs are the first variables (index = value reference + 1). They depend on no input (there
  * are none); at initialization on the parameters (no dependencies attribute: on all of them). */
 static int write_structure(FILE* out) {
     fputs("    <Outputs>\n", out);
-    for (int vr = 0; vr < SHIP_REAL_OUTPUTS; ++vr) fprintf(out, "      <Unknown index=\"%d\" dependencies=\"\"/>\n", vr + 1);
+    write_output_unknowns(out, SHIP_REAL_COUNT, is_output);
     fputs("    </Outputs>\n    <InitialUnknowns>\n", out);
     for (int vr = 0; vr < SHIP_REAL_OUTPUTS; ++vr) fprintf(out, "      <Unknown index=\"%d\"/>\n", vr + 1);
     fputs("    </InitialUnknowns>\n", out);
     return 0;
 }
 
-static int write_file(const char* path, int (*write)(FILE*)) {
-    FILE* out = fopen(path, "w");
-    if (out == NULL) {
-        fprintf(stderr, "cannot write %s\n", path);
-        return 1;
-    }
-    const int failed = write(out);
-    return (fclose(out) != 0) | failed;
-}
-
 int main(int argc, char** argv) {
-    if (argc != 4) {
-        fprintf(stderr, "usage: %s <units.xml> <variables.xml> <structure.xml>\n", argv[0]);
-        return 2;
-    }
-    for (int vr = 0; vr < SHIP_REAL_OUTPUTS; ++vr)
-        if (kShipRealVariables[vr].causality != SHIP_OUTPUT) {
-            fprintf(stderr, "%s: the first %d Real variables must be the outputs\n", kShipRealVariables[vr].name,
-                    SHIP_REAL_OUTPUTS);
+    for (int vr = 0; vr < SHIP_REAL_COUNT; ++vr)
+        if (is_output(vr) != (vr < SHIP_REAL_OUTPUTS)) {
+            fprintf(stderr, "%s: the first %d Real variables must be the outputs, and only they\n",
+                    kShipRealVariables[vr].name, SHIP_REAL_OUTPUTS);
             return 1;
         }
-    return write_file(argv[1], write_units) || write_file(argv[2], write_variables) || write_file(argv[3], write_structure);
+    return write_model_description_fragments(argc, argv, write_units, write_variables, write_structure);
 }
