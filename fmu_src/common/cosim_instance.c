@@ -39,6 +39,12 @@ fmi2Status cosim_refuse(const CosimInstance* instance, const char* format, ...) 
     return fmi2Error;
 }
 
+char* cosim_copy_text(const char* text) {
+    char* copy = (char*)malloc(strlen(text) + 1);
+    if (copy != NULL) strcpy(copy, text);
+    return copy;
+}
+
 void* cosim_instantiate(size_t instance_size, fmi2String instance_name, fmi2Type type, fmi2String guid,
                         const char* fmu_guid, const fmi2CallbackFunctions* functions, fmi2Boolean logging_on) {
     if (functions == NULL || functions->logger == NULL) return NULL; /* nowhere to say why */
@@ -63,17 +69,14 @@ void* cosim_instantiate(size_t instance_size, fmi2String instance_name, fmi2Type
         return NULL;
     }
     CosimInstance* instance = (CosimInstance*)calloc(1, instance_size);
-    char* name = (char*)malloc(strlen(instance_name) + 1);
-    if (instance == NULL || name == NULL) {
+    if (instance != NULL) instance->instance_name = cosim_copy_text(instance_name);
+    if (instance == NULL || instance->instance_name == NULL) {
         free(instance);
-        free(name);
         cosim_log_error(&probe, "fmi2Instantiate: out of memory");
         return NULL;
     }
-    strcpy(name, instance_name);
     instance->logger = functions->logger;
     instance->environment = functions->componentEnvironment;
-    instance->instance_name = name;
     for (int k = 0; k < LOG_CATEGORY_COUNT; ++k) instance->category_enabled[k] = logging_on ? 1 : 0;
     instance->state = STATE_INSTANTIATED;
     return instance;

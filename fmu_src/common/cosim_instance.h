@@ -47,6 +47,9 @@ typedef struct {
 void* cosim_instantiate(size_t instance_size, fmi2String instance_name, fmi2Type type, fmi2String guid,
                         const char* fmu_guid, const fmi2CallbackFunctions* functions, fmi2Boolean logging_on);
 
+/* A copy of `text` the caller frees; NULL when memory is short. */
+char* cosim_copy_text(const char* text);
+
 /* Frees what cosim_instantiate allocated (the model's own allocations are the FMU's to free first). */
 void cosim_free(CosimInstance* instance);
 

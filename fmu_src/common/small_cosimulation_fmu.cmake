@@ -63,25 +63,23 @@ function(package_small_cosimulation_fmu name)
   target_include_directories(${ARG_GENERATOR} PRIVATE ${_common})
   target_compile_options(${ARG_GENERATOR} PRIVATE -Wall -Wextra)
   target_link_libraries(${ARG_GENERATOR} PRIVATE ${ARG_GENERATOR_LIBRARIES})
+  # The template filled twice: with what is known now (the project's name, version, author,
+  # copyright and licence, the identifier, the GUID), then at build time with the generator's
+  # fragments and the date; their placeholders pass through the first filling as they are.
+  foreach(_build_time_value IN ITEMS UNIT_DEFINITIONS MODEL_VARIABLES MODEL_STRUCTURE GENERATION_DATE)
+    set(${_build_time_value} "@${_build_time_value}@")
+  endforeach()
+  set(MODEL_IDENTIFIER ${ARG_MODEL_IDENTIFIER})
+  set(FMU_GUID ${ARG_GUID})
+  configure_file(${ARG_TEMPLATE} ${_fragments}/modelDescription.xml.in @ONLY)
   add_custom_command(
     OUTPUT ${_staging}/modelDescription.xml
     COMMAND ${CMAKE_COMMAND} -E make_directory ${_fragments} ${_staging}
     COMMAND ${ARG_GENERATOR} ${_fragments}/units.xml ${_fragments}/variables.xml ${_fragments}/structure.xml
-    COMMAND ${CMAKE_COMMAND}
-      -DTEMPLATE=${ARG_TEMPLATE}
-      -DOUTPUT=${_staging}/modelDescription.xml
-      -DFRAGMENTS=${_fragments}
-      -DMODEL_IDENTIFIER=${ARG_MODEL_IDENTIFIER}
-      -DFMU_GUID=${ARG_GUID}
-      -DPROJECT_NAME=${PROJECT_NAME}
-      -DPROJECT_VERSION=${PROJECT_VERSION}
-      "-DGIMBAL_AUTHOR=${GIMBAL_AUTHOR}"
-      "-DGIMBAL_COPYRIGHT=${GIMBAL_COPYRIGHT}"
-      "-DGIMBAL_LICENSE=${GIMBAL_LICENSE}"
-      -DSOURCE_DIR=${PROJECT_SOURCE_DIR}
-      -DGIT_EXECUTABLE=${GIT_EXECUTABLE}
-      -P ${_common}/configure_model_description.cmake
-    DEPENDS ${ARG_GENERATOR} ${ARG_TEMPLATE} ${_common}/configure_model_description.cmake
+    COMMAND ${CMAKE_COMMAND} -DTEMPLATE=${_fragments}/modelDescription.xml.in -DOUTPUT=${_staging}/modelDescription.xml
+            -DFRAGMENTS=${_fragments} -DSOURCE_DIR=${PROJECT_SOURCE_DIR} -DGIT_EXECUTABLE=${GIT_EXECUTABLE}
+            -P ${_common}/configure_model_description.cmake
+    DEPENDS ${ARG_GENERATOR} ${_fragments}/modelDescription.xml.in ${_common}/configure_model_description.cmake
             ${_common}/generation_date.cmake ${GIMBAL_HEAD_LOG}
     COMMENT "Configuring the modelDescription.xml of ${ARG_FMU}"
     VERBATIM)

@@ -14,7 +14,6 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "cosim_instance.h"
 #include "fmi2Functions.h"
@@ -129,16 +128,10 @@ static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, s
     return instance != NULL ? cosim_set_debug_logging(&instance->common, loggingOn, nCategories, categories) : fmi2Error;
 }
 
-static char* copy_text(const char* text) {
-    char* copy = malloc(strlen(text) + 1);
-    if (copy != NULL) strcpy(copy, text);
-    return copy;
-}
-
 /* 0, or -1 when out of memory (the recording file's value then stays as it was). */
 static int reset_instance(Instance* instance) {
     unprepare(instance);
-    char* file = copy_text(kShipStringVariables[SHIP_STRING_RECORDING_FILE].start);
+    char* file = cosim_copy_text(kShipStringVariables[SHIP_STRING_RECORDING_FILE].start);
     if (file == NULL) return -1;
     free(instance->recording_file);
     instance->recording_file = file;
@@ -345,7 +338,7 @@ static fmi2Status impl_SetString(fmi2Component c, const fmi2ValueReference vr[],
             REFUSE(instance, "fmi2SetString: the value of %s is a null pointer", kShipStringVariables[vr[i]].name);
     }
     for (size_t i = 0; i < nvr; ++i) {
-        char* copy = copy_text(value[i]);
+        char* copy = cosim_copy_text(value[i]);
         if (copy == NULL) REFUSE(instance, "fmi2SetString: out of memory for %s", kShipStringVariables[vr[i]].name);
         free(instance->recording_file);
         instance->recording_file = copy;
