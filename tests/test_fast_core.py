@@ -116,20 +116,42 @@ def test_quasi_static_limiter_holds_the_current_and_matches_the_inductive_limit(
     assert errors[1] < 1e-3, errors
 
 
-def test_a_run_that_turns_stiff_and_back_switches_methods_and_stays_accurate(gimbal_fmu):
-    """Little shaft damping makes the free-play state stiff (eigenvalue -k_s/c_s) whenever the gear is
-    in its gap; meshed, the model is not stiff. The default switches to RODAS4 and back, and agrees
-    with CVODE BDF at a tight tolerance."""
-    start = {"gear2.c_s": 0.5, "gear2.eta": 2e-3, "base.fixed": True, "dry_friction": False}
+def gap_slews(t, y):
+    return {"u_R2": 4.0 * np.sin(2 * np.pi * 2 * t) - 0.5 * y["beta_dot"]}
 
-    def slews(t, y):
-        return {"u_R2": 4.0 * np.sin(2 * np.pi * 2 * t) - 0.5 * y["beta_dot"]}
 
-    outputs = ["beta", "beta_dot", "theta_b2", "gear2.contact", "solver.method_switches",
+GAP_OUTPUTS = ["beta", "beta_dot", "theta_b2", "gear2.contact", "solver.method_switches",
                "solver.jacobian_evaluations", "events.backlash2"]
-    fast = simulate(gimbal_fmu, 1.0, 1e-3, start, slews, outputs)
+
+
+@pytest.mark.parametrize("damping", [0.5, 1e-6])
+def test_the_free_play_relaxation_is_taken_exactly_and_does_not_make_the_model_stiff(gimbal_fmu, damping):
+    """Little shaft damping makes the free-play state relax fast in the gap (eigenvalue -k_s/c_s: -4e4
+    and -2e10 1/s here), but there it acts on nothing and its solution is known
+    (theta_d - theta_b decays as exp(-k_s t / c_s), docs/physics.md 4.2): the explicit method takes it
+    exactly and stays explicit, and agrees with CVODE BDF at a tight tolerance."""
+    start = {"gear2.c_s": damping, "gear2.eta": 2e-3, "base.fixed": True, "dry_friction": False}
+    fast = simulate(gimbal_fmu, 1.0, 1e-3, start, gap_slews, GAP_OUTPUTS)
     reference = simulate(gimbal_fmu, 1.0, 1e-3, {**start, "solver.method": 0, "solver.rtol": 1e-11,
-                                                  "solver.atol": 1e-13}, slews, outputs)
+                                                  "solver.atol": 1e-13}, gap_slews, GAP_OUTPUTS)
+    assert reference["events.backlash2"][-1] >= 40  # the gear leaves its stops and comes back
+    assert np.array_equal(fast["events.backlash2"], reference["events.backlash2"])
+    assert fast["solver.method_switches"][-1] == 0
+    assert np.max(np.abs(fast["beta"] - reference["beta"])) < 1e-6
+    assert np.max(np.abs(fast["theta_b2"] - reference["theta_b2"])) < 1e-6
+    # Dormand-Prince alone does the same: the exact relaxation is its own, not the switch's.
+    alone = simulate(gimbal_fmu, 1.0, 1e-3, {**start, "solver.method": 5}, gap_slews, GAP_OUTPUTS)
+    assert np.max(np.abs(alone["theta_b2"] - reference["theta_b2"])) < 1e-6
+
+
+def test_a_run_that_turns_stiff_and_back_switches_methods_and_stays_accurate(gimbal_fmu):
+    """A stiff, well-damped shaft (k_s = 1e8 N.m/rad, c_s = 1e3 N.m.s/rad): meshed, the contact mode's
+    eigenvalues reach 1e4-1e5 1/s and the model is stiff; in the gap it is not (the free play relaxes
+    exactly). The default switches to RODAS4 and back, and agrees with CVODE BDF at a tight tolerance."""
+    start = {"gear2.k_s": 1e8, "gear2.c_s": 1e3, "gear2.eta": 2e-3, "base.fixed": True, "dry_friction": False}
+    fast = simulate(gimbal_fmu, 1.0, 1e-3, start, gap_slews, GAP_OUTPUTS)
+    reference = simulate(gimbal_fmu, 1.0, 1e-3, {**start, "solver.method": 0, "solver.rtol": 1e-11,
+                                                  "solver.atol": 1e-13}, gap_slews, GAP_OUTPUTS)
     assert reference["events.backlash2"][-1] >= 4  # the gear leaves its stops and comes back
     assert fast["solver.method_switches"][-1] >= 2, fast["solver.method_switches"][-1]
     assert fast["solver.jacobian_evaluations"][-1] > 0

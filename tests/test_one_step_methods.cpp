@@ -64,6 +64,37 @@ public:
     int update_modes(double, double*, const int*) override { return 0; }
 };
 
+// The forced oscillator plus a state b that relaxes onto s = x / 2 - v at the rate 1e8 and acts on
+// nothing: b' = s' + rate (s - b), b = s - (s - b)(0) exp(-rate t). Offered as a relaxing state, the
+// explicit method takes b exactly: its order stays 5 with steps 5e6 times beyond its stability bound
+// for b alone.
+class OscillatorWithFollower final : public HybridSystem {
+public:
+    static constexpr double kRate = 1e8;
+    int state_size() const override { return 3; }
+    int event_count() const override { return 0; }
+    static double x(double t) { return ForcedOscillator::exact(t); }
+    static double v(double t) { return -4.0 / 3.0 * std::sin(t) + 2.0 / 3.0 * std::sin(2.0 * t); }
+    static double source(double t) { return x(t) / 2.0 - v(t); }
+    // b(0) = 0.3 with s(0) = 1/2.
+    static double follower(double t) { return source(t) - (0.5 - 0.3) * std::exp(-kRate * t); }
+    bool derivative(double t, const double* y, double* dy) override {
+        dy[0] = y[1];
+        dy[1] = -y[0] + std::cos(2.0 * t);
+        const double source_rate = dy[0] / 2.0 - dy[1];
+        dy[2] = source_rate + kRate * (y[0] / 2.0 - y[1] - y[2]);
+        return true;
+    }
+    int relaxing_states(RelaxingState* out) const override {
+        if (!offered) return 0;
+        out[0] = RelaxingState{2, kRate, 0, 2.0, 1};
+        return 1;
+    }
+    void event_functions(double, const double*, double*) override {}
+    int update_modes(double, double*, const int*) override { return 0; }
+    bool offered = true;
+};
+
 IntegratorSettings fixed_steps(IntegrationMethod method) {
     IntegratorSettings settings;
     settings.method = method;
@@ -190,8 +221,83 @@ void check_iteration_matrix() {
     }
 }
 
+// Dormand-Prince with the relaxing state taken exactly: order 5 at the end and 4 in the continuous
+// extension for every state, the follower included, with h rate = 5e6.
+void check_relaxing_state_is_exact() {
+    double previous_end = 0.0, previous_dense = 0.0;
+    for (int steps : {20, 40}) {
+        OscillatorWithFollower system;
+        OneStepIntegrator integrator(system, fixed_steps(IntegrationMethod::dormand_prince), quiet, quiet);
+        const double h = 1.0 / steps;
+        IntegratorMemory memory;
+        memory.step_size = h;
+        double y[3] = {1.0, 0.0, 0.3};
+        CHECK(integrator.resume(0.0, y, memory));
+        double dense = 0.0, follower_dense = 0.0;
+        for (int k = 1; k <= steps; ++k) {
+            const double end = k == steps ? 1.0 : k * h;
+            CHECK(integrator.advance(end, y));
+            double middle[3];
+            const double t_middle = end - 0.5 * h;
+            integrator.dense_output(t_middle, middle);
+            dense = std::max(dense, std::fabs(middle[0] - OscillatorWithFollower::x(t_middle)));
+            follower_dense = std::max(follower_dense, std::fabs(middle[2] - OscillatorWithFollower::follower(t_middle)));
+        }
+        const double end_error = std::max(std::fabs(y[0] - OscillatorWithFollower::x(1.0)),
+                                          std::fabs(y[2] - OscillatorWithFollower::follower(1.0)));
+        std::printf("Dormand-Prince, relaxing follower (rate 1e8), %d steps: end error %.3g (follower %.3g), dense %.3g "
+                    "(follower %.3g)\n", steps, end_error, std::fabs(y[2] - OscillatorWithFollower::follower(1.0)), dense,
+                    follower_dense);
+        CHECK(std::isfinite(end_error) && end_error < 1e-6);
+        // The follower is exact but for its source's error, which has the method's orders.
+        CHECK(follower_dense < 4.0 * dense + 1e-15);
+        if (previous_end > 0.0) {
+            CHECK(std::fabs(std::log2(previous_end / end_error) - 5.0) < 0.3);
+            CHECK(std::log2(previous_dense / std::max(dense, follower_dense)) > 3.7);
+        }
+        previous_end = end_error, previous_dense = std::max(dense, follower_dense);
+    }
+    {
+        // The automatic method at a tolerance: no switch to RODAS4 (the follower's rate is no stiffness
+        // for a method that takes it exactly), steps set by the oscillator alone.
+        OscillatorWithFollower system;
+        IntegratorSettings settings;
+        settings.method = IntegrationMethod::automatic;
+        settings.relative_tolerance = 1e-8;
+        settings.absolute_tolerance = 1e-10;
+        OneStepIntegrator integrator(system, settings, quiet, quiet);
+        double y[3] = {1.0, 0.0, 0.3};
+        CHECK(integrator.restart(0.0, y));
+        for (int k = 1; k <= 100; ++k) CHECK(integrator.advance(0.01 * k, y));
+        const IntegratorStatistics stats = integrator.statistics();
+        std::printf("automatic, relaxing follower: %ld steps, %ld method switches, error %.3g\n", stats.steps,
+                    stats.method_switches, std::fabs(y[2] - OscillatorWithFollower::follower(1.0)));
+        CHECK(stats.method_switches == 0);
+        CHECK(!integrator.stiff());
+        CHECK(stats.steps < 200);
+        CHECK(std::fabs(y[2] - OscillatorWithFollower::follower(1.0)) < 1e-7);
+        CHECK(std::fabs(y[0] - OscillatorWithFollower::x(1.0)) < 1e-7);
+    }
+    {
+        // Not offered, the same problem is stiff: the automatic method must switch to RODAS4.
+        OscillatorWithFollower system;
+        system.offered = false;
+        IntegratorSettings settings;
+        settings.method = IntegrationMethod::automatic;
+        settings.relative_tolerance = 1e-8;
+        settings.absolute_tolerance = 1e-10;
+        OneStepIntegrator integrator(system, settings, quiet, quiet);
+        double y[3] = {1.0, 0.0, 0.3};
+        CHECK(integrator.restart(0.0, y));
+        for (int k = 1; k <= 100; ++k) CHECK(integrator.advance(0.01 * k, y));
+        CHECK(integrator.stiff());
+        CHECK(std::fabs(y[2] - OscillatorWithFollower::follower(1.0)) < 1e-6);
+    }
+}
+
 int main() {
     check_small_lu();
+    check_relaxing_state_is_exact();
     check_iteration_matrix();
     check_order("Dormand-Prince 5(4)", IntegrationMethod::dormand_prince, 5.0, 4.0);
     check_order("RODAS4", IntegrationMethod::rosenbrock, 4.0, 3.0);

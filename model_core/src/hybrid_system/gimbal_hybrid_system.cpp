@@ -84,6 +84,22 @@ bool GimbalHybridSystem::jacobian(double time, const double* state, double* colu
     return true;
 }
 
+int GimbalHybridSystem::relaxing_states(RelaxingState* out) const {
+    const StateLayout& layout = params_.layout;
+    if (layout.energy_slot >= 0) return 0;
+    int count = 0;
+    for (int axis = 0; axis < 2; ++axis) {
+        const GearParameters& gear = params_.gear[axis];
+        const int backlash = layout.backlash_slot[axis];
+        const int rotor = layout.angle_slot[rotor_index(axis)], load = layout.angle_slot[load_index(axis)];
+        if (backlash < 0 || rotor < 0 || load < 0 || modes_.gear_contact[axis] != 0) continue;
+        if (params_.fidelity.gear[axis] != GearModel::backlash || !(gear.half_backlash > 0.0) || !(gear.damping > 0.0))
+            continue;
+        out[count++] = RelaxingState{backlash, gear.stiffness / gear.damping, rotor, gear.ratio, load};
+    }
+    return count;
+}
+
 void GimbalHybridSystem::event_functions(double time, const double* state, double* values) {
     const SwitchingContext context{params_, inputs_, dynamics_at(time, state), time};
     elements_.guards(context, modes_, values);

@@ -206,8 +206,11 @@ double OneStepIntegrator::error_norm(const Vector& error, const Vector& y_old, c
 double OneStepIntegrator::initial_step(double end_time) {
     double limit = end_time - t_;
     if (settings_.max_step > 0.0) limit = std::min(limit, settings_.max_step);
+    // The relaxing states' rates say nothing of the step (Dormand-Prince takes them exactly).
+    relaxing_count_ = memory_.stiff ? 0 : system_.relaxing_states(relaxing_);
     double norm_y = 0.0, norm_f = 0.0;
     for (int k = 0; k < size_; ++k) {
+        if (relaxing_count_ > 0 && relaxing(k)) continue;
         const double scale = settings_.absolute_tolerance + settings_.relative_tolerance * std::fabs(y_[k]);
         norm_y += (y_[k] / scale) * (y_[k] / scale);
         norm_f += (f_[k] / scale) * (f_[k] / scale);
@@ -219,6 +222,7 @@ double OneStepIntegrator::initial_step(double end_time) {
     if (!rhs(t_ + h, stage_state_, stage_[1])) return std::min(1e-6, limit);
     double second = 0.0;
     for (int k = 0; k < size_; ++k) {
+        if (relaxing_count_ > 0 && relaxing(k)) continue;
         const double scale = settings_.absolute_tolerance + settings_.relative_tolerance * std::fabs(y_[k]);
         const double d = (stage_[1][k] - f_[k]) / scale;
         second += d * d;
@@ -234,8 +238,13 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
     const int n = size_;
     Vector* k = stage_;
     k[0] = f_;
+    // A relaxing state is not integrated: each stage and the step's end take its exact value, so neither
+    // its rate (up to 1e10 1/s) nor its error limits the step.
+    relaxing_count_ = system_.relaxing_states(relaxing_);
+    for (int r = 0; r < relaxing_count_; ++r) relaxing_distance_[r] = relaxing_[r].source(y_.data()) - y_[relaxing_[r].index];
     auto stage = [&](int index, double c, auto&& combine) {
         for (int i = 0; i < n; ++i) stage_state_[i] = y_[i] + h * combine(i);
+        place_relaxing_states(c - t_, stage_state_.data());
         return rhs(c, stage_state_, k[index]);
     };
     bool ok = stage(1, t_ + c2 * h, [&](int i) { return a21 * k[0][i]; }) &&
@@ -250,6 +259,7 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
     if (ok) {
         for (int i = 0; i < n; ++i)
             y_new_[i] = y_[i] + h * (b1 * k[0][i] + b3 * k[2][i] + b4 * k[3][i] + b5 * k[4][i] + b6 * k[5][i]);
+        place_relaxing_states(t_new - t_, y_new_.data());
         ok = rhs(t_new, y_new_, f_new_);
     }
     if (!ok) {  // a non-finite right-hand side: try a much smaller step
@@ -260,11 +270,14 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
     }
     for (int i = 0; i < n; ++i)
         error_[i] = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] + e6 * k[5][i] + e7 * f_new_[i]);
+    for (int r = 0; r < relaxing_count_; ++r) error_[relaxing_[r].index] = 0.0;  // exact
     const double err = error_norm(error_, y_, y_new_);
     // Hairer's stiffness test: h |lambda| estimated from the last two stages, both at t_new. Taken on
     // rejected steps too: a step rejected for instability is the clearest sign of stiffness.
+    // The relaxing states' own rate is no limit on this method's stability: left out.
     double numerator = 0.0, denominator = 0.0;
     for (int i = 0; i < n; ++i) {
+        if (relaxing_count_ > 0 && relaxing(i)) continue;
         numerator += (f_new_[i] - k[5][i]) * (f_new_[i] - k[5][i]);
         denominator += (y_new_[i] - stage_state_[i]) * (y_new_[i] - stage_state_[i]);
     }
@@ -294,6 +307,11 @@ OneStepIntegrator::StepResult OneStepIntegrator::dormand_prince_step(double h, d
         dense_[2][i] = slope_start;
         dense_[3][i] = difference - h * f_new_[i] - slope_start;
         dense_[4][i] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] + d6 * k[5][i] + d7 * f_new_[i]);
+    }
+    dense_relaxing_count_ = relaxing_count_;
+    for (int r = 0; r < relaxing_count_; ++r) {
+        dense_relaxing_[r] = relaxing_[r];
+        dense_relaxing_distance_[r] = relaxing_distance_[r];
     }
     proposal_ = next;
     return StepResult::accepted;
@@ -400,6 +418,12 @@ void OneStepIntegrator::dense_output(double time, double* state) const {
             state[i] = dense_[0][i] + s * (dense_[1][i] + r * (dense_[2][i] + s * (dense_[3][i] + r * dense_[4][i])));
         }
     }
+    if (dense_rosenbrock_) return;
+    for (int k = 0; k < dense_relaxing_count_; ++k) {
+        const RelaxingState& relaxing = dense_relaxing_[k];
+        state[relaxing.index] =
+            relaxing.source(state) - dense_relaxing_distance_[k] * std::exp(-relaxing.rate * (time - dense_t0_));
+    }
 }
 
 // Magnitude of the Jacobian's dominant eigenvalue by power iteration: (|J^m v| / |v|)^(1/m). A
@@ -413,6 +437,12 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
     const int n = size_;
     double v[kMaxStates], w[kMaxStates];
     for (int i = 0; i < n; ++i) v[i] = power_iteration_start_[i];
+    // The relaxing states act on no other state (their column is zero but for the diagonal), so J is
+    // block-triangular: without their rows and columns it has the eigenvalues the explicit method must
+    // be stable for, as it takes them exactly.
+    RelaxingState relaxing[HybridSystem::kMaxRelaxingStates];
+    const int relaxing_count = settings_.method == IntegrationMethod::automatic ? system_.relaxing_states(relaxing) : 0;
+    for (int r = 0; r < relaxing_count; ++r) v[relaxing[r].index] = 0.0;
     double growth = 1.0;  // |J^m v| / |v|: at most (1e38)^8 before it counts as infinite
     for (int iteration = 0; iteration < kIterations; ++iteration) {
         double norm = 0.0;
@@ -421,6 +451,7 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
             const double* column = jacobian_.data() + j * n;  // n x n, column-major
             for (int i = 0; i < n; ++i) w[i] += column[i] * v[j];
         }
+        for (int r = 0; r < relaxing_count; ++r) w[relaxing[r].index] = 0.0;
         for (int i = 0; i < n; ++i) norm += w[i] * w[i];
         norm = std::sqrt(norm);
         if (!std::isfinite(norm)) return std::numeric_limits<double>::infinity();
@@ -429,6 +460,9 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
             double bound = 0.0;
             for (int i = 0; i < n; ++i) {
                 double row = 0.0;
+                bool left_out = false;
+                for (int r = 0; r < relaxing_count; ++r) left_out = left_out || relaxing[r].index == i;
+                if (left_out) continue;
                 for (int j = 0; j < n; ++j) row += std::fabs(jacobian_.data()[i + j * n]);
                 bound = std::max(bound, row);
             }

@@ -8,6 +8,7 @@
 // integration goes on from there with the same step size. An input jump costs one right-hand side.
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -126,6 +127,27 @@ private:
     bool dense_rosenbrock_ = false;
     double dense_t0_ = 0.0, dense_h_ = 0.0;
     Vector dense_[5];
+    // The relaxing states (HybridSystem::relaxing_states) that Dormand-Prince takes exactly: those of the
+    // step being attempted, and their distance from their source at its start, s - state[index]; the
+    // dense output's copy belongs to the last accepted step.
+    RelaxingState relaxing_[HybridSystem::kMaxRelaxingStates];
+    double relaxing_distance_[HybridSystem::kMaxRelaxingStates] = {};
+    int relaxing_count_ = 0;
+    RelaxingState dense_relaxing_[HybridSystem::kMaxRelaxingStates];
+    double dense_relaxing_distance_[HybridSystem::kMaxRelaxingStates] = {};
+    int dense_relaxing_count_ = 0;
+    // Sets the relaxing states of `state` to their exact values a time `elapsed` after the step start.
+    void place_relaxing_states(double elapsed, double* state) const {
+        for (int r = 0; r < relaxing_count_; ++r) {
+            const RelaxingState& relaxing = relaxing_[r];
+            state[relaxing.index] = relaxing.source(state) - relaxing_distance_[r] * std::exp(-relaxing.rate * elapsed);
+        }
+    }
+    bool relaxing(int index) const {
+        for (int r = 0; r < relaxing_count_; ++r)
+            if (relaxing_[r].index == index) return true;
+        return false;
+    }
     // Rosenbrock: Jacobian, df/dt and the factorized iteration matrix.
     Matrix jacobian_;
     IterationMatrix<kMaxStates> iteration_matrix_;

@@ -21,6 +21,10 @@ public:
     int kinematic_pairs(int* position, int* velocity) const override;
     bool has_jacobian() const override { return true; }
     bool jacobian(double time, const double* state, double* column_major) override;
+    // The backlash states of the gears in their gap (docs/physics.md section 4.2): there
+    // d(theta_d - theta_b)/dt = -(k_s / c_s)(theta_d - theta_b) and T_E = 0 exactly. Not offered with
+    // energy accounting, whose damper dissipation would then need the relaxation resolved.
+    int relaxing_states(RelaxingState* out) const override;
     void event_functions(double time, const double* state, double* values) override;
     int update_modes(double time, double* state, const int* directions) override;
 

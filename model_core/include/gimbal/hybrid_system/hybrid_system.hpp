@@ -7,6 +7,21 @@
 
 namespace gimbal {
 
+// A state that, under the current modes, relaxes exponentially onto a combination of two others and
+// acts on no other state: with s = state[numerator] / divisor - state[subtrahend],
+// d(s - state[index])/dt = -rate (s - state[index]) exactly, whatever the rest of the system does. An
+// integrator may take it exactly, state[index](t) = s(t) - (s - state[index])(t0) exp(-rate (t - t0)),
+// instead of resolving the relaxation with its steps (a gear's shaft end in the free play,
+// docs/physics.md section 4.2, whose rate k_s / c_s reaches 1e10 1/s).
+struct RelaxingState {
+    int index;
+    double rate;
+    int numerator;
+    double divisor;
+    int subtrahend;
+    double source(const double* state) const { return state[numerator] / divisor - state[subtrahend]; }
+};
+
 class HybridSystem {
 public:
     virtual ~HybridSystem() = default;
@@ -26,6 +41,12 @@ public:
     // position[k]' = state[velocity[k]]. An implicit method may eliminate them first. Returns the count.
     virtual int kinematic_pairs(int* position, int* velocity) const {
         (void)position, (void)velocity;
+        return 0;
+    }
+    // The relaxing states under the current modes (at most kMaxRelaxingStates), written to `out`.
+    static constexpr int kMaxRelaxingStates = 4;
+    virtual int relaxing_states(RelaxingState* out) const {
+        (void)out;
         return 0;
     }
     virtual void event_functions(double time, const double* state, double* values) = 0;
