@@ -83,6 +83,8 @@ private:
     StepResult dormand_prince_step(double h, double t_new);
     StepResult rosenbrock_step(double h, double t_new);
     bool jacobian_at(double time, const Vector& y);
+    // Whether a guard changes sign between (t_, y_) and (t_new_, y_new_) where handle_events would look.
+    bool crosses_a_guard();
     // Stops early once the estimate exceeds `enough`.
     double spectral_radius_estimate(double enough = std::numeric_limits<double>::infinity()) const;
     // Automatic method: RODAS4's predicted work per unit time over the explicit method's.
@@ -93,7 +95,6 @@ private:
     void remember_accuracy_step(double h);
     void vote_on_stiffness_explicit(double h, bool accepted);
     void vote_on_stiffness_rosenbrock(double taken);
-    void check_stiffness_after_switch();
     bool time_derivative_at_current_point();
     // Looks for sign changes between g_ (at t_) and g_new_ (at t_new_); if any, locates the first root on
     // the dense output, switches modes there and restarts. False on failure.
@@ -153,6 +154,9 @@ private:
     IterationMatrix<kMaxStates> iteration_matrix_;
     Vector time_derivative_, perturbed_;
     double stiffness_estimate_ = 0.0;  // h |lambda| of the last explicit step
+    // RODAS4's unfiltered error norm of an accepted step (0 when the filtered one rejected it, or the
+    // step was explicit): above 1, the step passed over a boundary layer it did not resolve.
+    double unresolved_layer_ = 0.0;
     double power_iteration_start_[kMaxStates] = {};  // spectral_radius_estimate's start vector, unit length
     // The switch rule's |lambda_max|, reused for kLambdaReuseSteps Rosenbrock steps within a mode and a
     // communication step (-1: none).
