@@ -15,9 +15,11 @@ namespace gimbal {
 constexpr int kRealTimeEventIterations = 10;        // Illinois iterations per located mode change
 constexpr int kRealTimeModeChangesPerSubstep = 8;   // located mode changes per substep, on average
 constexpr double kRealTimeContactResolution = 1.0;  // largest omega h of a gear's contact oscillation
+constexpr double kRealTimeArmatureResolution = 0.1; // smallest (L/R) / h of an inductive motor
 
 // True when every compliant gear's contact oscillation is resolved by substeps of step_size /
-// params.substeps (omega h <= kRealTimeContactResolution); otherwise false, with the refusal in `why`.
+// params.substeps (omega h <= kRealTimeContactResolution) and every inductive motor's armature time
+// constant is at least kRealTimeArmatureResolution substeps; otherwise false, with the refusal in `why`.
 bool real_time_resolution_ok(const ModelParameters& params, const Dynamics& dynamics, double step_size,
                              std::string& why);
 
