@@ -153,6 +153,11 @@ int main() {
     CHECK(names(m, "motor1.i_L"));
     m = refusal(vr_gear2_eta, -1e-4);
     CHECK(names(m, "gear2.eta"));
+    // A damping whose relaxation rate k_s / c_s overflows (a subnormal c_s) is refused; 0, the dead zone,
+    // and 1e-300 (rate 3e304) are not.
+    m = refusal(vr_gear1_c_s, 1e-320);
+    CHECK(names(m, "gear1.c_s") && names(m, "k_s / c_s overflows") && names(m, "dead zone"));
+    CHECK(refusal(vr_gear1_c_s, 0.0).empty() && refusal(vr_gear1_c_s, 1e-300).empty());
     m = refusal(vr_i_R2, 3.5);  // default i_L of motor 2 is 3 A
     CHECK(names(m, "i_R2") && names(m, "current limit"));
     m = refusal(vr_theta_b1, 3e-4);  // default eta of gear 1 is 2e-4 rad

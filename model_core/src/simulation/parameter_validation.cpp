@@ -236,6 +236,12 @@ bool read_drive_train(Checker& check, ModelParameters& params) {
                                           values[m.i_L], values[m.U_L]};
         const GearVariables& g = gears[j];
         if (!check.require(g.N, values[g.N] != 0.0, "a gear ratio must not be 0")) return false;
+        // The free play relaxes at k_s / c_s (docs/physics.md 4.2); a damping so small that the rate
+        // overflows is no damping: 0 is the pure dead zone.
+        if (!check.require(g.c_s, values[g.c_s] == 0.0 || std::isfinite(values[g.k_s] / values[g.c_s]),
+                           "k_s / c_s overflows: set c_s = 0 for the pure dead zone, or a c_s that is no "
+                           "smaller than k_s * 1e-300"))
+            return false;
         params.gear[j] = GearParameters{values[g.N], values[g.k_s], values[g.c_s], values[g.eta]};
     }
     return true;
