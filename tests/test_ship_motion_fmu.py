@@ -43,23 +43,28 @@ def parameters_of(base_motion: dict) -> dict:
     return ship_motion_fmu_parameters(load_scene(SHIP_SCENE).with_changes(base_motion_spec=base_motion))
 
 
+def initialize_and_record(fmu, slave, step: float, steps: int, start_time: float) -> np.ndarray:
+    """Initializes a set-up instance and records INPUTS at start_time + k step, k = 0 .. steps."""
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    vrs = [fmu.vr(name) for name in INPUTS]
+    rows = [slave.getReal(vrs)]
+    for k in range(steps):
+        slave.doStep(currentCommunicationPoint=start_time + k * step, communicationStepSize=step)
+        rows.append(slave.getReal(vrs))
+    slave.terminate()
+    return np.array(rows)
+
+
 def run_fmu(fmu, parameters: dict, step: float, steps: int, start_time: float = 0.0) -> np.ndarray:
     """The outputs at the communication points start_time + k step, k = 0 .. steps, in INPUTS order."""
     slave = fmu.instantiate()
     try:
         slave.setupExperiment(startTime=start_time)
         fmu.set_values(slave, parameters)
-        slave.enterInitializationMode()
-        slave.exitInitializationMode()
-        vrs = [fmu.vr(name) for name in INPUTS]
-        rows = [slave.getReal(vrs)]
-        for k in range(steps):
-            slave.doStep(currentCommunicationPoint=start_time + k * step, communicationStepSize=step)
-            rows.append(slave.getReal(vrs))
-        slave.terminate()
+        return initialize_and_record(fmu, slave, step, steps, start_time)
     finally:
         slave.freeInstance()
-    return np.array(rows)
 
 
 def scene_base_inputs(step: float, steps: int) -> np.ndarray:
@@ -263,17 +268,9 @@ def run_recorded_fmu(fmu, values: dict, step: float, steps: int, start_time: flo
         slave.setInteger([fmu.vr("motion")], [values["motion"]])
         if "recording_file" in values:
             slave.setString([fmu.vr("recording_file")], [values["recording_file"]])
-        slave.enterInitializationMode()
-        slave.exitInitializationMode()
-        vrs = [fmu.vr(name) for name in INPUTS]
-        rows = [slave.getReal(vrs)]
-        for k in range(steps):
-            slave.doStep(currentCommunicationPoint=start_time + k * step, communicationStepSize=step)
-            rows.append(slave.getReal(vrs))
-        slave.terminate()
+        return initialize_and_record(fmu, slave, step, steps, start_time)
     finally:
         slave.freeInstance()
-    return np.array(rows)
 
 
 def recorded_columns(kind: str, t: np.ndarray) -> dict:

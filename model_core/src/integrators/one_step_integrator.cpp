@@ -444,7 +444,7 @@ double OneStepIntegrator::spectral_radius_estimate(double enough) const {
     // block-triangular: without their rows and columns it has the eigenvalues the explicit method must
     // be stable for, as it takes them exactly.
     RelaxingState relaxing[HybridSystem::kMaxRelaxingStates];
-    const int relaxing_count = settings_.method == IntegrationMethod::automatic ? system_.relaxing_states(relaxing) : 0;
+    const int relaxing_count = system_.relaxing_states(relaxing);
     for (int r = 0; r < relaxing_count; ++r) v[relaxing[r].index] = 0.0;
     double growth = 1.0;  // |J^m v| / |v|: at most (1e38)^8 before it counts as infinite
     for (int iteration = 0; iteration < kIterations; ++iteration) {

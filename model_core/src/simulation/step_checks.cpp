@@ -19,13 +19,15 @@ namespace gimbal {
 // on, the method keeps its order. The quasi-static motor is the limit L -> 0 of such a motor.
 static bool armatures_resolved(const ModelParameters& params, double step_size, std::string& why) {
     const double substep = step_size / params.substeps;
+    double unresolved[2] = {0.0, 0.0};  // the time constant of each armature the substeps do not resolve
     double needed = 0.0;
     for (int axis = 0; axis < 2; ++axis) {
         const MotorParameters& motor = params.motor[axis];
-        if (params.fidelity.motor[axis] != MotorModel::inductive) continue;
         const double time_constant = motor.inductance / motor.resistance;
-        if (time_constant < kRealTimeArmatureResolution * substep)
-            needed = std::max(needed, std::ceil(kRealTimeArmatureResolution * step_size / time_constant));
+        if (params.fidelity.motor[axis] != MotorModel::inductive || !(time_constant < kRealTimeArmatureResolution * substep))
+            continue;
+        unresolved[axis] = time_constant;
+        needed = std::max(needed, std::ceil(kRealTimeArmatureResolution * step_size / time_constant));
     }
     if (needed == 0.0) return true;  // every doStep: nothing formatted
     std::ostringstream s;
@@ -33,12 +35,9 @@ static bool armatures_resolved(const ModelParameters& params, double step_size, 
     s << "the real-time method cannot resolve ";
     const char* separator = "";
     for (int axis = 0; axis < 2; ++axis) {
-        const MotorParameters& motor = params.motor[axis];
-        const double time_constant = motor.inductance / motor.resistance;
-        if (params.fidelity.motor[axis] != MotorModel::inductive || !(time_constant < kRealTimeArmatureResolution * substep))
-            continue;
-        s << separator << "motor" << axis + 1 << "'s armature transient (L/R = " << time_constant
-          << " s at L = " << motor.inductance << " H)";
+        if (unresolved[axis] == 0.0) continue;
+        s << separator << "motor" << axis + 1 << "'s armature transient (L/R = " << unresolved[axis]
+          << " s at L = " << params.motor[axis].inductance << " H)";
         separator = "; ";
     }
     s << " with substeps of " << substep << " s (L/R at least " << kRealTimeArmatureResolution
