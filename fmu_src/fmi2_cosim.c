@@ -12,6 +12,7 @@
 
 #include "fmu_instance.h"
 #include "gimbal_guid.h"
+#include "common/communication_point.h"
 
 static const struct {
     const char* name;
@@ -728,25 +729,22 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
                     communicationStepSize);
         return fmi2Error;
     }
-    /* Masters keep time as k*h or as a running sum: the two drift apart in the last bits over long
-     * runs. A mismatch below a millionth of the step is that; the FMU keeps its own sum, so that every
-     * master gets the same results. */
-    const double tolerance = 1e-12 * fmax(1.0, fabs(instance->time)) + 1e-6 * communicationStepSize;
-    if (!(fabs(currentCommunicationPoint - instance->time) <= tolerance)) {
+    /* The master's point becomes the FMU's time (common/communication_point.h). */
+    if (!communication_point_matches(instance->time, currentCommunicationPoint, communicationStepSize)) {
         log_message(instance, fmi2Error, "logStatusError",
                     "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
                     currentCommunicationPoint, instance->time);
         return fmi2Error;
     }
-    const double end_time = instance->time + communicationStepSize;
+    const double end_time = currentCommunicationPoint + communicationStepSize;
     if (instance->stop_time_defined &&
-        end_time > instance->stop_time + 1e-12 * fmax(1.0, fabs(instance->stop_time)) + 1e-6 * communicationStepSize) {
+        communication_step_passes_stop_time(end_time, instance->stop_time, communicationStepSize)) {
         log_message(instance, fmi2Error, "logStatusError", "fmi2DoStep: step to t = %.17g passes the stopTime %.17g",
                     end_time, instance->stop_time);
         return fmi2Error;
     }
     const fmi2Status status =
-        from_core(gimbal_core_do_step(instance->core, instance->time, communicationStepSize));
+        from_core(gimbal_core_do_step(instance->core, currentCommunicationPoint, communicationStepSize));
     instance->last_step_status = status;
     if (status > fmi2Warning) {
         instance->state = status == fmi2Discard ? STATE_STEP_FAILED : STATE_ERROR;

@@ -22,6 +22,7 @@
 #include "gimbal_guid.h"
 #include "gimbal/gimbal_c_api.h"
 #include "host_fp_environment.h"
+#include "common/communication_point.h"
 
 enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_EVENT_INDICATORS = 3000, FMI3_TIME = 3001 };
 _Static_assert(sizeof(fmi3ValueReference) == sizeof(unsigned), "value references are passed to the core as unsigned");
@@ -670,29 +671,29 @@ static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolea
         say(i, fmi3Error, "logStatusError", "%s: communicationStepSize = %g must be finite and > 0", f, h);
         return fmi3Error;
     }
-    const double tolerance = 1e-12 * fmax(1.0, fabs(i->time)) + 1e-6 * h;
-    if (!(fabs(t - i->time) <= tolerance)) {
+    /* The master's point becomes the FMU's time (common/communication_point.h). */
+    if (!communication_point_matches(i->time, t, h)) {
         say(i, fmi3Error, "logStatusError", "%s: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", f, t,
             i->time);
         return fmi3Error;
     }
-    const double end = i->time + h;
-    if (i->stop_time_defined && end > i->stop_time + 1e-12 * fmax(1.0, fabs(i->stop_time)) + 1e-6 * h) {
+    const double end = t + h;
+    if (i->stop_time_defined && communication_step_passes_stop_time(end, i->stop_time, h)) {
         say(i, fmi3Error, "logStatusError", "%s: step to t = %.17g passes the stopTime %.17g", f, end, i->stop_time);
         return fmi3Error;
     }
     /* With early return allowed, the step ends right after the first mode change inside it: the
      * importer sees the event where it happens (and handles it in Event Mode if it uses that). */
-    double reached = end;
+    double elapsed = h; /* how far the step went: all of it, or to the first mode change */
     const fmi3Status status = from_core(i->early_return_allowed
-                                            ? gimbal_core_do_step_until_mode_change(i->core, i->time, h, &reached)
-                                            : gimbal_core_do_step(i->core, i->time, h));
+                                            ? gimbal_core_do_step_until_mode_change(i->core, t, h, &elapsed)
+                                            : gimbal_core_do_step(i->core, t, h));
     if (status > fmi3Warning) {
         i->state = status == fmi3Discard ? S_STEP_DISCARDED : S_ERROR;
         return status;
     }
-    const int ended_early = i->early_return_allowed && reached < end;
-    i->time = ended_early ? reached : end;
+    const int ended_early = i->early_return_allowed && elapsed < h;
+    i->time = ended_early ? t + elapsed : end;
     *last = i->time;
     *early = ended_early ? fmi3True : fmi3False;
     *event = ended_early && i->event_mode_used ? fmi3True : fmi3False;

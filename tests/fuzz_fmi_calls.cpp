@@ -947,7 +947,7 @@ void do_step(Sequence& s, Instance* inst, bool valid) {
     } else {
         switch (r.integer(0, 11)) {
             case 0: case 1: case 2: case 3: case 4: point = t; break;
-            case 5: point = t + 1e-13 * std::max(1.0, std::fabs(t)); break;  // within the FMU's tolerance
+            case 5: point = t + 1e-13 * std::max(1.0, std::fabs(t)); break;  // near the tolerance of communication_point.h
             case 6: point = t + 1e-3; break;
             case 7: point = t - 0.5; break;
             case 8: point = r.pick(std::vector<double>{kNaN, kInf, -kInf}); break;
@@ -983,7 +983,7 @@ void do_step(Sequence& s, Instance* inst, bool valid) {
         call(inst, d, [&] { return api.doStep(inst != nullptr ? inst->component : nullptr, point, h, no_prior); });
     if (inst == nullptr) return;
     if (status <= fmi2Warning) {
-        inst->time = inst->time + h;  // the FMU advances its own time, not the point passed
+        inst->time = point + h;  // the master's point becomes the FMU's time (communication_point.h)
         inst->phase = Phase::step_complete;
         ++stats.successful_steps;
         verify_after_step(*inst);

@@ -8,6 +8,7 @@
 #include <stddef.h>
 
 #include "controller_guid.h"
+#include "communication_point.h"
 #include "controller_model.h"
 #include "cosim_instance.h"
 #include "fmi2Functions.h"
@@ -215,16 +216,14 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boole
         cosim_log_error(&instance->common, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", h);
         return fmi2Error;
     }
-    /* Masters keep time as k*h or as a running sum; those differ in the last bits, not by a step. */
-    const double tolerance = 1e-12 * fmax(1.0, fabs(instance->time)) + 1e-6 * h;
-    if (!(fabs(t - instance->time) <= tolerance)) {
+    /* The master's point becomes the FMU's time (communication_point.h). */
+    if (!communication_point_matches(instance->time, t, h)) {
         cosim_log_error(&instance->common, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", t,
                   instance->time);
         return fmi2Error;
     }
-    const double end = instance->time + h;
-    if (instance->stop_time_defined &&
-        end > instance->stop_time + 1e-12 * fmax(1.0, fabs(instance->stop_time)) + 1e-6 * h) {
+    const double end = t + h;
+    if (instance->stop_time_defined && communication_step_passes_stop_time(end, instance->stop_time, h)) {
         cosim_log_error(&instance->common, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end, instance->stop_time);
         return fmi2Error;
     }

@@ -2,10 +2,12 @@
  * argument and value, logging, over ship_motion.h. Every exported fmi2* function holds the host's
  * floating-point environment around its implementation (host_fp_environment.h), as the gimbal's do.
  *
- * The clock: row k of the grid at t = startTime + k h, h the first doStep's step size; the motion is
- * that of the scene runner's grid from t = 0 (the FMU does not depend on the absolute start time).
- * A doStep with another step size is refused: its outputs would no longer be the grid's rows
- * (canHandleVariableCommunicationStepSize="false").
+ * The clock: the outputs after k steps are row k of the grid at t = k h from the motion's start, h
+ * the first doStep's step size; the motion is that of the scene runner's grid from t = 0 (the FMU
+ * does not depend on the absolute start time, nor on how the master keeps its clock: its time is the
+ * master's last point plus the step, communication_point.h). A doStep with another step size is
+ * refused: its outputs would no longer be the grid's rows (canHandleVariableCommunicationStepSize=
+ * "false"); one far below the grid's step is the master's clock rounding and moves no row.
  *
  * With motion = 1 the outputs are a recording's splines (recorded_motion.h) at the same grid times,
  * read at the end of initialization from recording_file (recording_file.h finds it); a step past the
@@ -15,6 +17,7 @@
 #include <stddef.h>
 #include <stdlib.h>
 
+#include "communication_point.h"
 #include "cosim_instance.h"
 #include "fmi2Functions.h"
 #include "host_fp_environment.h"
@@ -33,6 +36,7 @@ typedef struct {
     GimbalRecordedMotion* recording; /* motion = 1: the file's splines, once prepared */
     int prepared;       /* motion or recording holds what `parameters` say */
     double start_time;
+    double time;        /* the master's last communication point plus its step (communication_point.h) */
     double step;        /* 0 until the first doStep */
     long row;           /* the grid row of the current communication point */
     double outputs[SHIP_MOTION_OUTPUTS];
@@ -41,6 +45,9 @@ typedef struct {
     fmi2Status last_step_status;
 } Instance;
 _Static_assert(offsetof(Instance, common) == 0, "the CosimInstance must be the Instance's first member");
+
+/* Below this fraction of the grid's step, a step is the master's clock rounding (see impl_DoStep). */
+static const double kClockRoundingOfStep = 1e-6;
 
 #define REFUSE(instance, ...) return cosim_refuse(&(instance)->common, __VA_ARGS__)
 
@@ -137,6 +144,7 @@ static int reset_instance(Instance* instance) {
     instance->recording_file = file;
     ship_motion_start_parameters(&instance->parameters);
     instance->start_time = 0.0;
+    instance->time = 0.0;
     instance->step = 0.0;
     instance->row = 0;
     instance->stop_time_defined = 0;
@@ -186,6 +194,7 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean toleranceDef
         REFUSE(instance, "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
                startTime, stopTime);
     instance->start_time = startTime;
+    instance->time = startTime;
     instance->stop_time_defined = stopTimeDefined ? 1 : 0;
     instance->stop_time = stopTime;
     return fmi2OK;
@@ -204,6 +213,7 @@ static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
     /* Refused parameters leave the instance in initialization mode: the master may correct them. */
     if (prepare(instance, "fmi2ExitInitializationMode") != fmi2OK) return fmi2Error;
     instance->row = 0;
+    instance->time = instance->start_time;
     instance->common.state = STATE_STEP_COMPLETE;
     return fmi2OK;
 }
@@ -365,6 +375,23 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
     if (!allowed(instance, "fmi2DoStep", STATE_STEP_COMPLETE)) return fmi2Error;
     if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
         REFUSE(instance, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", communicationStepSize);
+    /* The master's point becomes the FMU's time (communication_point.h); the outputs stay the rows of
+     * the grid, counted, whatever clock the master keeps. */
+    if (!communication_point_matches(instance->time, currentCommunicationPoint, communicationStepSize))
+        REFUSE(instance, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
+               currentCommunicationPoint, instance->time);
+    const double end_time = currentCommunicationPoint + communicationStepSize;
+    if (instance->stop_time_defined &&
+        communication_step_passes_stop_time(end_time, instance->stop_time, communicationStepSize))
+        REFUSE(instance, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end_time, instance->stop_time);
+    /* A master whose clock rounds differently from its step (an SSP engine that ends on its stop time
+     * with a last step of 5e-11 s) takes a step far below the grid's: the clock's rounding, not a
+     * step. The rows stay where they are; only the time follows the master. */
+    if (instance->step != 0.0 && communicationStepSize < kClockRoundingOfStep * instance->step) {
+        instance->time = end_time;
+        instance->last_step_status = fmi2OK;
+        return fmi2OK;
+    }
     /* A master that keeps time in integer nanoseconds (libcosim) passes steps a few units in the last
      * place off h: the same grid step. More than that is another step, which the grid cannot give. */
     if (instance->step != 0.0 && !(fabs(communicationStepSize - instance->step) <= 1e-9 * instance->step))
@@ -373,16 +400,6 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
                "of one grid (canHandleVariableCommunicationStepSize=\"false\")",
                communicationStepSize, instance->step);
     const double step = instance->step != 0.0 ? instance->step : communicationStepSize;
-    const double time = instance->start_time + (double)instance->row * step;
-    /* Masters keep time as k*h or as a running sum: a mismatch below a millionth of the step is that. */
-    const double tolerance = 1e-12 * fmax(1.0, fabs(time)) + 1e-6 * step;
-    if (!(fabs(currentCommunicationPoint - time) <= tolerance))
-        REFUSE(instance, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
-               currentCommunicationPoint, time);
-    const double end_time = instance->start_time + (double)(instance->row + 1) * step;
-    if (instance->stop_time_defined &&
-        end_time > instance->stop_time + 1e-12 * fmax(1.0, fabs(instance->stop_time)) + 1e-6 * step)
-        REFUSE(instance, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end_time, instance->stop_time);
     if (instance->row >= LONG_MAX - 1) REFUSE(instance, "fmi2DoStep: the grid's %ld rows are used up", instance->row);
     if (instance->recording != NULL) {
         /* The grid's time, not the master's: the motion starts at t = 0 whatever startTime is. */
@@ -393,6 +410,7 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
                    end_time, motion_time, end);
         instance->step = step;
         instance->row += 1;
+        instance->time = end_time;
         gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
         instance->last_step_status = fmi2OK;
         return fmi2OK;
@@ -406,6 +424,7 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
         instance->step = step;
     }
     instance->row += 1;
+    instance->time = end_time;
     ship_motion_row(&instance->motion, instance->row, instance->outputs);
     instance->last_step_status = fmi2OK;
     return fmi2OK;
@@ -427,7 +446,7 @@ static fmi2Status impl_GetRealStatus(fmi2Component c, const fmi2StatusKind s, fm
         !not_null(instance, "fmi2GetRealStatus", value, "value"))
         return fmi2Error;
     if (s != fmi2LastSuccessfulTime) REFUSE(instance, "fmi2GetRealStatus: status kind %d is not a Real status", (int)s);
-    *value = instance->start_time + (double)instance->row * instance->step;
+    *value = instance->time;
     return fmi2OK;
 }
 

@@ -67,9 +67,10 @@ GimbalStatus gimbal_core_initialize(GimbalCore* core, double start_time);
  * state is rolled back to current_time and GIMBAL_DISCARD or GIMBAL_ERROR is returned. */
 GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double step_size);
 /* The same, but ending right after the first mode change when one comes before the end (a master
- * that allows an early return); *reached is the time the step ended at. */
+ * that allows an early return); *elapsed is how far the step went (step_size when it did not end
+ * early), on the model's own clock: current_time + *elapsed is the host's time where it ended. */
 GimbalStatus gimbal_core_do_step_until_mode_change(GimbalCore* core, double current_time, double step_size,
-                                                   double* reached);
+                                                   double* elapsed);
 double gimbal_core_time(const GimbalCore* core);
 
 /* Snapshots for fmi2GetFMUstate / fmi2SetFMUstate and their serialization: plain bytes of a fixed size. */

@@ -88,7 +88,7 @@ size_t gimbal_first_unsettable(GimbalType type, const unsigned* vr, size_t count
         const bool settable = v.causality == gimbal::Causality::input ||
                               (initialized ? v.causality == gimbal::Causality::parameter &&
                                                  v.variability == gimbal::Variability::tunable
-                                           : v.initial == gimbal::Initial::exact);
+                                           : v.initial == gimbal::Initial::exact || v.initial == gimbal::Initial::approx);
         if (!settable) return k;
     }
     return count;
@@ -171,11 +171,16 @@ GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double s
 }
 
 GimbalStatus gimbal_core_do_step_until_mode_change(GimbalCore* core, double current_time, double step_size,
-                                                   double* reached) {
+                                                   double* elapsed) {
     return guarded(core, [&] {
+        const double clock_at_start = core->instance.model_clock();
         double end = current_time;
         const GimbalStatus status = core->instance.do_step_until_mode_change(current_time, step_size, end);
-        if (reached != nullptr) *reached = end;
+        if (elapsed != nullptr) {
+            const double clock_at_end = core->instance.model_clock();
+            // The clock moved by step_size itself when the step was not cut short.
+            *elapsed = clock_at_end == clock_at_start + step_size ? step_size : clock_at_end - clock_at_start;
+        }
         return status;
     });
 }

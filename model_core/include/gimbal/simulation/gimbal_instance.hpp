@@ -67,6 +67,7 @@ public:
     // (simulation/step_checks.hpp).
     static constexpr long kStepWorkBudget = gimbal::kStepWorkBudget;
     double time() const { return time_; }
+    double model_clock() const { return clock_; }  // the time since initialization
     bool initialized() const { return system_ != nullptr && integrator_ != nullptr; }
     // The continuous model linearized at the current time and state, with the inputs as last set.
     GimbalStatus linearize(LinearModel& model);
