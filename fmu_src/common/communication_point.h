@@ -12,8 +12,8 @@
  * the run's length or start time. A master in integer nanoseconds may pass the step it was asked
  * for (0.1/3) while its clock moves by the rounded step (33333333 ns): a millionth of the step
  * covers that. A repeated or a skipped step is off by a whole step and is refused, as long as the
- * step is more than twice this tolerance (at t = 1.7e9 s, steps above about 2e-6 s); a step below
- * that is below what the master's double clock can resolve, and cannot be told from rounding.
+ * step is larger than this tolerance (at t = 1.7e9 s, steps above about 1e-6 s); a step below that
+ * is below what the master's double clock can resolve, and cannot be told from rounding.
  *
  * The model's own time is the FMU's business: the gimbal's core integrates from t = 0 of its own
  * clock with the step sizes the master passes, so the results are the same, bit for bit, for every
