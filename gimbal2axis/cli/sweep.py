@@ -7,6 +7,7 @@ Dask scheduler. Each worker extracts the FMU once and reuses its instance (fmi2R
 Writes <out>/<sweep>__<scene>.parquet and .csv (one row per case: parameters, seeds, metrics,
 status, and the error and FMU log of a failed case) and .png (a summary plot). A rerun skips the
 cases already in the table, so an interrupted sweep (Ctrl-C, SIGTERM) continues where it stopped.
+Several sweeps may write one table at the same time: each merges its rows in under a lock.
 """
 import signal
 import sys
@@ -31,7 +32,9 @@ exit status:
   1  some cases failed: their rows in the table have status = failed, the error in
      the column 'message' and the FMU's log in 'fmu_log'
   2  nothing ran: the scene, the sweep file or the options were refused
-     (a misspelt parameter name, a scheduler that does not answer, ...)
+     (a misspelt parameter name, a scheduler that does not answer, an --out
+     that cannot be written, a table of the same name from a sweep over other
+     parameters, ...)
   130, 143  interrupted by Ctrl-C or SIGTERM: the cases finished so far are kept
 
 example:
@@ -62,6 +65,8 @@ def add_arguments(parser) -> None:
                                                               "process")
     parser.add_argument("--threads", action="store_true",
                         help="local cluster of threads in this process instead of worker processes")
+    parser.add_argument("--save-every", type=float, default=20.0, metavar="SECONDS",
+                        help="while cases finish, merge them into the table at least this often (default 20)")
     parser.add_argument("--redo", choices=["failed", "all"], default=None,
                         help="run the failed cases (or all cases) again, although the table has them")
 
@@ -69,10 +74,13 @@ def add_arguments(parser) -> None:
 def execute(args) -> int:
     if args.workers < 1:
         args.command_parser.error("--workers must be >= 1")
+    if not args.save_every >= 0:   # also refuses nan
+        args.command_parser.error("--save-every must be >= 0 seconds")
     signal.signal(signal.SIGTERM, _terminated)
     try:
         options = SweepOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
-                               serial=args.serial, redo=args.redo, progress=not args.quiet)
+                               serial=args.serial, redo=args.redo, progress=not args.quiet,
+                               checkpoint_s=args.save_every)
         outcome = run_sweep(args.scene, args.sweep, fmu_path(args.fmu), args.out, options)
     except (SceneError, SweepError) as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)

@@ -1,8 +1,10 @@
 """An FMU extracted once per worker and reused: a Dask worker (or, without Dask, the calling thread)
 keeps the FMU it was sent, one instance of it (reset with fmi2Reset between runs) and a pool of
 instances for lockstep batches. The cache is an attribute of the Dask worker (`get_worker()`), else
-thread-local, and is keyed by the FMU's SHA-256: a rebuilt FMU is loaded afresh. Used by the sweeps
-(gimbal2axis.sweep.worker) and the frequency responses on Dask (gimbal2axis.analysis.frequency_response).
+thread-local, and is keyed by the FMU's SHA-256: a rebuilt FMU is loaded afresh. The FMU arrives as
+bytes (scattered to the workers with each sweep), so a worker on another machine needs no copy of its
+own; the bytes are checked against the SHA-256 they were sent with before the first use. Used by the
+sweeps (gimbal2axis.sweep.worker) and the frequency responses on Dask (gimbal2axis.analysis.frequency_response).
 """
 from __future__ import annotations
 
@@ -92,10 +94,14 @@ def _workdir() -> pathlib.Path:
 
 
 def loaded_fmu(fmu_bytes: bytes, digest: str) -> _Loaded:
-    """The worker's FMU with this digest: written to the worker's directory and extracted once."""
+    """The worker's FMU with this digest: written to the worker's directory and extracted once (bytes
+    that do not have this SHA-256 are refused: ValueError)."""
     cache = _cache()
     entry = cache.get(digest)
     if entry is None:
+        received = fmu_digest(fmu_bytes)
+        if received != digest:
+            raise ValueError(f"the FMU received (SHA-256 {received[:12]}) is not the one sent ({digest[:12]})")
         for old in list(cache.values()):   # an older build: free it
             old.close()
         cache.clear()

@@ -1,6 +1,7 @@
-"""A sweep end to end, in phases: plan (expand the cases, skip those already in the table), run
-the others on Dask or serially while recording each result (the table written as they come), finish
-(the merged table, Parquet + CSV, and the summary plot)."""
+"""A sweep end to end, in phases: plan (expand the cases, check the output folder and claim the
+table, skip the cases already in it), run the others on Dask or serially while recording each result
+(the table saved as they come), finish (the merged table, Parquet + CSV, and the summary plot). The
+table is shared safely with other sweeps writing it at the same time (store.py)."""
 from __future__ import annotations
 
 import logging
@@ -8,10 +9,8 @@ import math
 import pathlib
 import signal
 import sys
-import tempfile
 import threading
 import time
-import zipfile
 from dataclasses import dataclass
 
 from ..errors import SceneError
@@ -19,7 +18,7 @@ from ..fmu import FMU
 from ..fmu.worker_cache import fmu_digest
 from ..scene.scene import check_against_fmu, load_scene
 
-from . import table
+from . import store, table
 from .names import check_cases_accepted, resolve_names
 from .progress import Progress
 from .spec import SweepError, apply_case, case_key, load_sweep, scene_hash
@@ -64,6 +63,9 @@ def prepare(scene_path, sweep_path, fmu: FMU):
     """(scene, sweep, cases): every case keyed and applied to the scene; a case whose values the
     scene or the FMU refuse before running carries its error (it is reported as failed)."""
     scene = load_scene(scene_path)
+    # The files a scene names (a user controller's module, a recorded motion) are looked for beside
+    # it, on the workers: from an absolute folder, as the workers' current directory is not ours.
+    scene = scene.with_changes(path=scene.path.resolve())
     check_against_fmu(scene, fmu)
     sweep = load_sweep(sweep_path)
     resolved, candidates = resolve_names(sweep, scene, fmu)
@@ -94,24 +96,11 @@ def _base_row(case: Case, scene, sweep, scene_digest: str, fmu_sha: str) -> dict
     return row
 
 
-def _zip_package() -> pathlib.Path:
-    """The gimbal2axis package's Python files in a zip, for client.upload_file to workers of an existing
-    scheduler (its compiled kernels stay behind: there the Python versions run, with the same results)."""
-    import importlib.resources
-
-    root_name = __package__.partition(".")[0]
-    root = pathlib.Path(str(importlib.resources.files(root_name)))   # wherever this process imported it from
-    path = pathlib.Path(tempfile.mkdtemp(prefix="gimbal_sweep_upload_")) / "gimbal2axis_package.zip"
-    with zipfile.ZipFile(path, "w") as z:
-        for file in sorted(root.rglob("*.py")):
-            z.write(file, f"{root_name}/{file.relative_to(root).as_posix()}")
-    return path
-
-
 def make_client(scheduler: str | None = None, workers: int = 2, processes: bool = True):
-    """(client, cluster): a Client of the scheduler at `scheduler`, else of a new LocalCluster with
-    `workers` workers of one thread each (processes by default; they ignore Ctrl-C, see
-    worker_interrupts.py)."""
+    """(client, cluster): a Client of the scheduler at `scheduler`, its workers sent this gimbal2axis
+    package and checked (worker_package.py; SweepError in one line if one cannot run it), else of a
+    new LocalCluster with `workers` workers of one thread each (processes by default; they ignore
+    Ctrl-C, see worker_interrupts.py)."""
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -123,11 +112,11 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
             raise SweepError(f"no Dask scheduler answered at {scheduler} within {SCHEDULER_TIMEOUT_S:g} s; start one "
                              f"(dask scheduler; dask worker ADDRESS --nthreads 1), or leave out --scheduler for a "
                              f"local cluster") from None
-        try:   # workers elsewhere may not have this checkout on their path
-            client.upload_file(str(_zip_package()))
-        except Exception as exc:  # pragma: no cover - depends on the remote cluster
-            print(f"sweep: warning: could not upload the gimbal2axis package to the workers ({exc}); they must "
-                  "have it installed (pip install the repository there)", file=sys.stderr)
+        try:
+            send_package(client, scheduler)
+        except BaseException:
+            client.close()
+            raise
         return client, None
     # The local workers are processes of this Python: they import the installed gimbal2axis.
     cluster = None
@@ -141,6 +130,70 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
         if cluster is not None:
             cluster.close()
         raise
+
+
+def send_package(client, scheduler: str) -> None:
+    """Sends this gimbal2axis package, compiled kernel included, to the workers of the scheduler
+    (worker_package.ShippedPackage, also for workers that join later) and checks that each of them
+    imports it and loads its kernel; SweepError in one line, before any case runs, if there is no
+    worker or one cannot."""
+    from . import worker_package
+
+    worker_package.register_by_value()   # the workers cannot import it before it ran
+    try:
+        client.wait_for_workers(1, timeout=SCHEDULER_TIMEOUT_S)
+    except TimeoutError:
+        raise SweepError(f"no Dask worker is connected to the scheduler at {scheduler} (waited "
+                         f"{SCHEDULER_TIMEOUT_S:g} s); start some: dask worker {scheduler} --nthreads 1") from None
+    archive, digest = worker_package.package_archive()
+    try:
+        client.register_plugin(worker_package.ShippedPackage(archive, digest), name=worker_package.PLUGIN_NAME)
+    except Exception as exc:
+        raise SweepError(f"could not send the gimbal2axis package to the workers of {scheduler}: "
+                         f"{_first_line(exc)}") from None
+    reports = client.run(worker_package.check_worker, digest, worker_package.python_and_platform(),
+                         on_error="return")
+    refusal = worker_refusal(reports, scheduler)
+    if refusal:
+        raise SweepError(refusal)
+    difference = version_difference(reports, worker_package.dependency_versions())
+    if difference:
+        print(f"sweep: warning: {difference}", file=sys.stderr)
+
+
+def version_difference(reports: dict, here: dict) -> str | None:
+    """A worker whose numpy, scipy or fmpy differs from this process's (its results may differ from a
+    local run's in the last digits), in one line; None if all have the same versions."""
+    for address, report in sorted(reports.items()):
+        theirs = report.get("versions", {})
+        differing = [f"{name} {theirs.get(name)} (here {version})" for name, version in here.items()
+                     if theirs.get(name) != version]
+        if differing:
+            return (f"worker {address} has {', '.join(differing)}: its results may differ from this machine's in the "
+                    f"last digits (requirements-run.txt pins the versions)")
+    return None
+
+
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).strip().splitlines() or [""])[0] or type(exc).__name__
+
+
+def worker_refusal(reports: dict, scheduler: str) -> str | None:
+    """The one-line refusal of a sweep whose workers' reports (worker_package.check_worker, or the
+    exception it raised, by worker address) are not all ok; None if they are."""
+    bad = {}
+    for address, report in sorted(reports.items()):
+        if isinstance(report, BaseException):
+            bad[address] = f"the check failed ({type(report).__name__}: {_first_line(report)})"
+        elif not report.get("ok"):
+            bad[address] = report.get("reason", "?")
+    if not bad:
+        return None
+    address, reason = next(iter(bad.items()))
+    others = f" (and {len(bad) - 1} more of the {len(reports)} workers)" if len(bad) > 1 else ""
+    return (f"worker {address} of {scheduler}{others} cannot run the cases: {reason}; the workers need this "
+            f"Python version and platform with the package's dependencies (pip install -r requirements-run.txt, "
+            f"docs/sweeps.md)")
 
 
 class _StopRequests:
@@ -192,7 +245,8 @@ class SweepOptions:
     workers: int = 2               # workers of that local cluster, one thread each
     processes: bool = True         # its workers are processes (False: threads of this process)
     serial: bool = False           # no Dask: the cases one after the other in this process (one reused instance)
-    client: object = None          # a Dask client to use (left open); None: one is made and closed after
+    client: object = None          # a Dask client to use (left open); None: one is made and closed after. A
+                                   # client of a scheduler whose workers lack gimbal2axis: send_package first
     redo: str | None = None        # None, 'failed' (rerun the failed cases) or 'all'
     progress: bool = True          # what runs where, and how far it got, on stderr
     checkpoint_s: float = 20.0     # while cases finish, the table is written at least this often
@@ -211,23 +265,33 @@ class Plan:
     fmu_bytes: bytes
     fmu_sha: str
     scene_digest: str
-    parquet: pathlib.Path
-    csv: pathlib.Path
-    png: pathlib.Path
+    files: store.TableFiles
+
+    @property
+    def parquet(self) -> pathlib.Path:
+        return self.files.parquet
+
+    @property
+    def csv(self) -> pathlib.Path:
+        return self.files.csv
+
+    @property
+    def png(self) -> pathlib.Path:
+        return self.files.png
 
 
 def plan_sweep(scene_path, sweep_path, fmu_path, out_dir, redo: str | None = None) -> Plan:
-    """Expands and checks the cases (SceneError, SweepError before anything runs) and reads the
-    table of earlier runs to leave out the cases done already."""
+    """Expands and checks the cases, checks the output folder and claims the table (SceneError,
+    SweepError before anything runs), and reads the table of earlier runs to leave out the cases
+    done already."""
     with FMU(fmu_path) as fmu:
         scene, sweep, cases = prepare(scene_path, sweep_path, fmu)
     fmu_bytes = pathlib.Path(fmu_path).read_bytes()
-    out, stem = pathlib.Path(out_dir), f"{sweep.name}__{scene.name}"
-    parquet = out / f"{stem}.parquet"
-    existing = table.read_rows(parquet)
+    files = store.TableFiles.of(out_dir, f"{sweep.name}__{scene.name}")
+    existing = store.claim(files, sweep.parameters)
     todo, skipped = cases_to_run(cases, existing, redo)
     return Plan(scene, sweep, cases, todo, skipped, existing, fmu_bytes, fmu_digest(fmu_bytes), scene_hash(scene),
-                parquet, out / f"{stem}.csv", out / f"{stem}.png")
+                files)
 
 
 def cases_to_run(cases: list, existing: list, redo: str | None) -> tuple[list, int]:
@@ -263,9 +327,10 @@ def announce(plan: Plan, options: SweepOptions) -> None:
 
 class Recorder:
     """The rows of the cases finished in this run, one per result as it comes, with the progress
-    display; the table (the earlier rows and these) is written every `checkpoint_s` seconds, at
-    the end, and when the sweep is interrupted: leaving the `with` block by Ctrl-C or SIGTERM saves
-    the rows and says so (the exception is marked `reported` for gimbal2axis sweep)."""
+    display; they are merged into the table (as it is on disk then: other sweeps may write it too)
+    every `checkpoint_s` seconds, at the end, and when the sweep is interrupted: leaving the `with`
+    block by Ctrl-C or SIGTERM saves the rows and says so (the exception is marked `reported` for
+    gimbal2axis sweep)."""
 
     def __init__(self, plan: Plan, checkpoint_s: float = 20.0, progress: bool = True):
         self.plan, self.checkpoint_s = plan, checkpoint_s
@@ -284,10 +349,8 @@ class Recorder:
             self.last_save = time.perf_counter()
 
     def save(self) -> list[dict]:
-        """Writes the table (Parquet and CSV); returns its rows."""
-        rows = table.merge(self.plan.existing, self.rows)
-        table.write(rows, self.plan.sweep.parameters, self.plan.parquet, self.plan.csv)
-        return rows
+        """Merges this run's rows into the table (Parquet and CSV); returns the table's rows."""
+        return store.save(self.plan.files, self.rows, self.plan.sweep.parameters)
 
     def __enter__(self):
         return self
@@ -392,13 +455,18 @@ class DaskRun:
     def _submit(self, plan: Plan, cases: list, fmu_future) -> dict:
         """Submits the tasks; returns the cases of each task by its key. Several cases per task: a
         short case costs the scheduler about as much as it costs to run, so tasks carry a few (at
-        least 8 tasks per worker remain, to balance the load)."""
+        least 8 tasks per worker remain, to balance the load). A task's call goes as bytes that only
+        the worker unpickles (worker_package.call_pickled): a scheduler elsewhere need not have
+        gimbal2axis to take it."""
+        from . import worker_package
+
         cases_of = {}
         per_task = cases_per_task(len(cases), _worker_count(self.client))
         for first in range(0, len(cases), per_task):
             chunk = cases[first:first + per_task]
-            future = self.client.submit(run_cases, [(c.scene, c.case_id) for c in chunk], fmu_future, plan.fmu_sha,
-                                        plan.sweep.metrics_from_s,
+            call = worker_package.pickled_call(run_cases, [(c.scene, c.case_id) for c in chunk], digest=plan.fmu_sha,
+                                               from_s=plan.sweep.metrics_from_s)
+            future = self.client.submit(worker_package.call_pickled, call, fmu_bytes=fmu_future,
                                         key=f"gimbal-cases-{plan.fmu_sha[:8]}-{chunk[0].case_id}-{len(chunk)}",
                                         pure=False, retries=1)
             self.futures.append(future)
@@ -486,9 +554,9 @@ def finish(plan: Plan, rows: list, plot: bool, wall0: float) -> Outcome:
     failed_before = sum(r.get("status") != "ok" and r["case_id"] not in ran_now for r in mine)
     if plot:
         sweep = plan.sweep
-        table.plot_summary(mine, sweep.parameters, plan.png, f"sweep {sweep.name} on {plan.scene.name}: {len(mine)} "
-                                                             f"cases, {len(mine) - failed} ok, {failed} failed",
-                           grid=list(sweep.grid))
+        title = f"sweep {sweep.name} on {plan.scene.name}: {len(mine)} cases, {len(mine) - failed} ok, {failed} failed"
+        store.publish(plan.png, lambda path: table.plot_summary(mine, sweep.parameters, path, title,
+                                                                grid=list(sweep.grid)))
     return Outcome(plan.parquet, plan.csv, plan.png, rows, len(plan.todo), plan.skipped, failed,
                    time.perf_counter() - wall0, failed_before)
 

@@ -1,5 +1,6 @@
 """The results table: one row per case (tidy), Parquet (the truth) plus CSV (for convenience);
-merging new rows into an existing table (rows are keyed by case_id), and the summary plot."""
+merging new rows into an existing table (rows are keyed by case_id), and the summary plot. Reading
+and writing the files, safely for several sweeps at once: store.py."""
 from __future__ import annotations
 
 import math
@@ -19,6 +20,15 @@ def band_metrics(rows: list[dict]) -> list[str]:
 
 def is_band_metric(name: str) -> bool:
     return name.startswith("los_band_") and name.endswith("_rms_mrad")
+
+
+# Columns a worker's result adds besides those of LAST (a case of a lockstep batch).
+RESULT_EXTRAS = ["batch_size"]
+
+
+def is_result_or_key(name: str) -> bool:
+    """A column that is not a swept parameter: the case's key and metadata, a metric, a status."""
+    return name in FIRST or name in LAST or name in RESULT_EXTRAS or is_band_metric(name)
 
 
 def column_order(rows: list[dict], parameters: list[str]) -> list[str]:
@@ -59,11 +69,21 @@ def to_arrow(rows: list[dict], parameters: list[str]):
 
 
 def read_rows(path: pathlib.Path) -> list[dict]:
-    if not path.is_file():
+    """The rows of a table ([] if there is none yet), whole even while a sweep replaces the file."""
+    try:
+        with open(path, "rb") as file:
+            return read_parquet(file).to_pylist()
+    except FileNotFoundError:
         return []
+
+
+def read_parquet(file):
+    """A Parquet table from one open file. Not pq.read_table(path): that opens the path several times
+    (pyarrow's dataset reader: the footer from one open, the pages from another), so a file replaced
+    in between, as a sweep saving its table does, reads as corrupt; an open file stays one version."""
     import pyarrow.parquet as pq
 
-    return pq.read_table(path).to_pylist()
+    return pq.ParquetFile(file).read()
 
 
 def merge(existing: list[dict], new: list[dict]) -> list[dict]:
@@ -72,21 +92,6 @@ def merge(existing: list[dict], new: list[dict]) -> list[dict]:
     by_id.update({row["case_id"]: row for row in new})
     return sorted(by_id.values(), key=lambda r: (r.get("case") if r.get("case") is not None else math.inf,
                                                  r["case_id"]))
-
-
-def write(rows: list[dict], parameters: list[str], parquet_path: pathlib.Path, csv_path: pathlib.Path) -> None:
-    """Writes both files atomically (a temporary file renamed), so an interrupted sweep keeps a valid table."""
-    import pyarrow.csv as pcsv
-    import pyarrow.parquet as pq
-
-    table = to_arrow(rows, parameters)
-    parquet_path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = parquet_path.with_suffix(".parquet.tmp")
-    pq.write_table(table, tmp)
-    tmp.replace(parquet_path)
-    tmp = csv_path.with_suffix(".csv.tmp")
-    pcsv.write_csv(table, tmp)
-    tmp.replace(csv_path)
 
 
 LABELS = {"los_rms_mrad": "LOS RMS [mrad]", "los_peak_mrad": "LOS peak [mrad]", "i_peak_A": "peak |i| [A]",
@@ -144,11 +149,12 @@ def _log_scale(values, ratio: float = 50.0) -> bool:
 
 def plot_summary(rows: list[dict], parameters: list[str], path: pathlib.Path, title: str = "",
                  grid: list[str] | None = None) -> None:
-    """Writes the summary plot of a sweep (summary_figure) to `path`."""
+    """Writes the summary plot of a sweep (summary_figure) to `path`, as PNG whatever its suffix (a
+    temporary file of store.publish)."""
     import matplotlib.pyplot as plt
 
     fig = summary_figure(rows, parameters, title, grid)
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, format="png")
     plt.close(fig)
 
 
