@@ -26,9 +26,16 @@ tree (gimbal2axis.locations says more). Default files of the commands (a scene, 
 are paths relative to the current directory, as in the repository's root: `gimbal2axis run` runs
 scenes/free_swing.toml there and writes results/.
 """
+from importlib.metadata import PackageNotFoundError, version as _distribution_version
+
 from .errors import SceneError
 from .fmu import FMU
 from .master import run, run_scene_file
 from .scene import Scene, check_against_fmu, load_scene
 
-__all__ = ["SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run", "run_scene_file"]
+try:
+    __version__ = _distribution_version("gimbal2axis")   # setup.py's, which is CMakeLists.txt's project(VERSION)
+except PackageNotFoundError:   # imported from a source tree that was never installed: no metadata says
+    __version__ = "0+unknown"
+
+__all__ = ["__version__", "SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run", "run_scene_file"]

@@ -25,7 +25,8 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
     GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
     "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider \
-    --deselect tests/test_reference_solution.py --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py
+    --deselect tests/test_reference_solution.py --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
+    --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py
   unset ASAN_OPTIONS UBSAN_OPTIONS
   echo "[test] sanitizer pass clean; now the release build"
 fi

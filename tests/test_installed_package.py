@@ -94,6 +94,19 @@ def test_the_command_and_every_subcommand_have_help(installed):
     assert done.returncode == 0 and all(name in done.stdout for name in SUBCOMMANDS), done.stderr
 
 
+def test_the_version_is_the_projects(installed):
+    """`gimbal2axis --version` and gimbal2axis.__version__ both give CMakeLists.txt's project VERSION,
+    from the installed package's metadata."""
+    import re
+
+    declared = re.search(r"project\(\s*Gimbal2Axis\s+VERSION\s+([0-9.]+)",
+                         (REPO / "CMakeLists.txt").read_text()).group(1)
+    done = run(installed, "--version")
+    assert done.returncode == 0 and done.stdout == f"gimbal2axis {declared}\n", (done.stdout, done.stderr)
+    done = run(installed, "-c", "import gimbal2axis; print(gimbal2axis.__version__)", executable=installed["python"])
+    assert done.returncode == 0 and done.stdout.strip() == declared, (done.stdout, done.stderr)
+
+
 @pytest.mark.parametrize("name", SUBCOMMANDS)
 def test_a_bad_argument_is_one_line_and_status_2(installed, name):
     done = run(installed, name, *BAD_ARGUMENTS[name])

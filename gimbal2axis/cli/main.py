@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .. import __version__
 from . import bench, freqresp, linearize, report, run, sweep, system
 
 PROG = "gimbal2axis"
@@ -27,6 +28,8 @@ def _wide_help(prog: str) -> argparse.HelpFormatter:
 
 def build_parser() -> OneLineErrorParser:
     parser = OneLineErrorParser(prog=PROG, description=__doc__, formatter_class=_wide_help)
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}",
+                        help="print the package's version (the FMU's: CMakeLists.txt's project VERSION) and exit")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, module in SUBCOMMANDS.items():
         command = commands.add_parser(name, help=module.SUMMARY, description=module.__doc__,
