@@ -114,3 +114,18 @@ def test_a_scene_the_system_cannot_be_made_of_is_refused(scene, build_dir):
         ship_system(scene.with_changes(controller_spec={**scene.controller_spec, "delay_steps": 2}), build_dir)
     with pytest.raises(SceneError, match="makes a sea state"):
         ship_system(load_scene(REPO / "scenes" / "pointing_step.toml"), build_dir)
+
+
+def test_names_with_xml_characters_make_valid_structures(scene, build_dir, tmp_path):
+    """A scene file named `R&D <"x">` (the system's name is the file's stem): both structures parse,
+    and the name comes back as written, nothing injected."""
+    awkward = 'R&D <"x"> \'y\''
+    named = ship_system(scene.with_changes(name=awkward), build_dir, stop_time=STOP)
+    ssd = ET.fromstring(zipfile.ZipFile(write_ssp(named, tmp_path / "awkward.ssp")).read("SystemStructure.ssd"))
+    assert ssd.get("name") == awkward
+    assert [element.get("name") for element in ssd.iter() if element.tag.endswith("}System")] == [awkward]
+    parameters = ET.fromstring(zipfile.ZipFile(tmp_path / "awkward.ssp").read("resources/parameters.ssv"))
+    assert parameters.get("name") == awkward
+    osp = ET.parse(write_osp(named, tmp_path / "osp")).getroot()
+    assert {element.get("name") for element in osp.iter() if element.tag.endswith("}Simulator")} == \
+        {component.name for component in named.components}

@@ -75,7 +75,7 @@ def write_osp(system: System, out: pathlib.Path) -> pathlib.Path:
             shutil.copyfile(component.osp_description, out / component.osp_description.name)
         values = "".join(f"\n                <InitialValue variable={quoteattr(name)}>{_value(value)}</InitialValue>"
                          for name, value in initial_values(component).items())
-        simulators.append(f'        <Simulator name="{component.name}" source="{component.fmu.name}" '
+        simulators.append(f'        <Simulator name={quoteattr(component.name)} source={quoteattr(component.fmu.name)} '
                           f'stepSize="{system.step!r}">\n            <InitialValues>{values}\n'
                           f'            </InitialValues>\n        </Simulator>')
     connections = []
@@ -89,15 +89,15 @@ def write_osp(system: System, out: pathlib.Path) -> pathlib.Path:
                              f"{sorted(missing)[:3]}")
         grouped |= pairs
         connections.append(f'        <VariableGroupConnection>\n'
-                           f'            <VariableGroup simulator="{source}" name="{source_group}"/>\n'
-                           f'            <VariableGroup simulator="{target}" name="{target_group}"/>\n'
+                           f'            <VariableGroup simulator={quoteattr(source)} name={quoteattr(source_group)}/>\n'
+                           f'            <VariableGroup simulator={quoteattr(target)} name={quoteattr(target_group)}/>\n'
                            f'        </VariableGroupConnection>')
     for c in system.connections:
         if (c.source, c.output, c.target, c.input) in grouped:
             continue
         connections.append(f'        <VariableConnection>\n'
-                           f'            <Variable simulator="{c.source}" name={quoteattr(c.output)}/>\n'
-                           f'            <Variable simulator="{c.target}" name={quoteattr(c.input)}/>\n'
+                           f'            <Variable simulator={quoteattr(c.source)} name={quoteattr(c.output)}/>\n'
+                           f'            <Variable simulator={quoteattr(c.target)} name={quoteattr(c.input)}/>\n'
                            f'        </VariableConnection>')
     path = out / "OspSystemStructure.xml"
     path.write_text(f'<?xml version="1.0" encoding="utf-8"?>\n<OspSystemStructure xmlns="{NAMESPACE}" version="0.1">\n'

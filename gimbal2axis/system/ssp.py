@@ -42,7 +42,7 @@ def _parameter(name: str, value) -> str:
 def parameter_set(system: System) -> str:
     rows = [_parameter(f"{c.name}.{name}", value) for c in system.components for name, value in c.start_values.items()]
     return (f'<?xml version="1.0" encoding="UTF-8"?>\n<ssv:ParameterSet xmlns:ssv="{SSV}" version="1.0" '
-            f'name="{system.name}">\n  <ssv:Parameters>\n' + "\n".join(rows) + "\n  </ssv:Parameters>\n</ssv:ParameterSet>\n")
+            f'name={quoteattr(system.name)}>\n  <ssv:Parameters>\n' + "\n".join(rows) + "\n  </ssv:Parameters>\n</ssv:ParameterSet>\n")
 
 
 def write_ssp(system: System, path: pathlib.Path) -> pathlib.Path:
@@ -50,13 +50,13 @@ def write_ssp(system: System, path: pathlib.Path) -> pathlib.Path:
     for component in system.components:
         used = {c.output for c in system.connections if c.source == component.name} | \
                {c.input for c in system.connections if c.target == component.name}
-        elements.append(f'      <ssd:Component name="{component.name}" type="application/x-fmu-sharedlibrary" '
-                        f'source="resources/{component.fmu.name}">\n        <ssd:Connectors>\n'
+        elements.append(f'      <ssd:Component name={quoteattr(component.name)} type="application/x-fmu-sharedlibrary" '
+                        f'source={quoteattr("resources/" + component.fmu.name)}>\n        <ssd:Connectors>\n'
                         f'{_connectors(component.fmu, used)}\n        </ssd:Connectors>\n      </ssd:Component>')
-    connections = [f'      <ssd:Connection startElement="{c.source}" startConnector={quoteattr(c.output)} '
-                   f'endElement="{c.target}" endConnector={quoteattr(c.input)}/>' for c in system.connections]
+    connections = [f'      <ssd:Connection startElement={quoteattr(c.source)} startConnector={quoteattr(c.output)} '
+                   f'endElement={quoteattr(c.target)} endConnector={quoteattr(c.input)}/>' for c in system.connections]
     ssd = (f'<?xml version="1.0" encoding="UTF-8"?>\n<ssd:SystemStructureDescription xmlns:ssd="{SSD}" '
-           f'xmlns:ssc="{SSC}" version="1.0" name="{system.name}">\n  <ssd:System name="{system.name}">\n'
+           f'xmlns:ssc="{SSC}" version="1.0" name={quoteattr(system.name)}>\n  <ssd:System name={quoteattr(system.name)}>\n'
            f'    <ssd:ParameterBindings>\n      <ssd:ParameterBinding source="resources/parameters.ssv"/>\n'
            f'    </ssd:ParameterBindings>\n    <ssd:Elements>\n' + "\n".join(elements) +
            '\n    </ssd:Elements>\n    <ssd:Connections>\n' + "\n".join(connections) +
