@@ -261,3 +261,16 @@ def test_no_trend_line_over_a_seed_and_tick_labels_stay_apart():
     assert not touching
     width, height = fig.bbox.width, fig.bbox.height
     assert all(box.x0 >= 0 and box.x1 <= width and box.y0 >= 0 and box.y1 <= height for _, box in texts)
+
+
+def test_a_serial_sweep_leaves_no_temporary_folder(fmu_path, tmp_path):
+    """The FMU a serial sweep extracts for itself goes away with the process (it left a 2.2 MB
+    gimbal_sweep_* folder in /tmp at every run)."""
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    sweep = write(tmp_path, LIMITED, "limited")
+    done = subprocess.run(SWEEP + [str(SCENE), str(sweep), "--fmu", str(fmu_path), "--out", str(tmp_path / "out"),
+                                   "--serial", "--quiet"], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "TMPDIR": str(scratch)})
+    assert done.returncode == 0, done.stderr
+    assert list(scratch.iterdir()) == []

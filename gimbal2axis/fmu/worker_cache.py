@@ -11,6 +11,7 @@ from __future__ import annotations
 import atexit
 import hashlib
 import pathlib
+import shutil
 import sys
 import tempfile
 import threading
@@ -25,6 +26,7 @@ class _Loaded:
         from .fmu import FMU
 
         self.fmu = FMU(fmu_path, workdir=workdir)
+        self.workdir = workdir   # the FMU's bytes and its extraction: removed with the entry
         self.log: list = []
         self.slave = None
         self.pool: list = []   # (instance, its log) for lockstep batches
@@ -63,6 +65,7 @@ class _Loaded:
         self.discard_instance()
         self.discard_pool()
         self.fmu.close()
+        shutil.rmtree(self.workdir, ignore_errors=True)
 
 
 def dask_worker():
