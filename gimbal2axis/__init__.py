@@ -12,7 +12,7 @@ Layout, and the one direction imports go (tests/test_package_layout.py refuses a
      -> master               the co-simulation loop (Python, compiled, lockstep), results, plots
      -> scene                scene files, base motion, references, controllers, sensors, geometry
      -> fmu                  the FMU wrapper, an FMU kept per worker
-     -> errors, progress, native, locations    leaves: error types, progress bars, the C kernels
+     -> errors, version, progress, native, locations    leaves: error types, the version, progress bars, the C kernels
                                                (native/*.c, the extension gimbal2axis.native._native),
                                                where the build is
 
@@ -26,16 +26,10 @@ tree (gimbal2axis.locations says more). Default files of the commands (a scene, 
 are paths relative to the current directory, as in the repository's root: `gimbal2axis run` runs
 scenes/free_swing.toml there and writes results/.
 """
-from importlib.metadata import PackageNotFoundError, version as _distribution_version
-
 from .errors import SceneError
 from .fmu import FMU
 from .master import run, run_scene_file
 from .scene import Scene, check_against_fmu, load_scene
-
-try:
-    __version__ = _distribution_version("gimbal2axis")   # setup.py's, which is CMakeLists.txt's project(VERSION)
-except PackageNotFoundError:   # imported from a source tree that was never installed: no metadata says
-    __version__ = "0+unknown"
+from .version import __version__
 
 __all__ = ["__version__", "SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run", "run_scene_file"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .. import __version__
+from ..version import __version__
 from . import bench, freqresp, linearize, report, run, sweep, system
 
 PROG = "gimbal2axis"
