@@ -316,7 +316,10 @@ static int settable(Instance* instance, const GimbalVariableInfo* info) {
     switch (instance->state) {
         case STATE_INSTANTIATED:
         case STATE_INITIALIZATION:
-            return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT;
+            /* The rotors (initial="approx") stay settable in Initialization Mode as when they were
+               "exact": scripts that set them there keep working. */
+            return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT ||
+                   info->initial == GIMBAL_INITIAL_APPROX;
         case STATE_STEP_COMPLETE:
         case STATE_EVENT_MODE:
         case STATE_CONTINUOUS_TIME:

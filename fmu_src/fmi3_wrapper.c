@@ -278,7 +278,9 @@ static int core_variable(fmi3ValueReference vr, Kind* kind, unsigned* core_vr, G
 
 static int settable(const Instance3* i, const GimbalVariableInfo* info) {
     if (i->state & (S_INSTANTIATED | S_INITIALIZATION))
-        return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT;
+        /* The rotors (initial="approx") stay settable in Initialization Mode as when they were "exact". */
+        return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT ||
+               info->initial == GIMBAL_INITIAL_APPROX;
     return info->causality == GIMBAL_INPUT || (info->causality == GIMBAL_PARAMETER && info->variability == GIMBAL_TUNABLE);
 }
 

@@ -80,6 +80,7 @@ def test_backlash_traversal_time_matches_the_free_flight_of_the_load(gimbal_fmu)
         "motor2.k_torque": 0.0, "motor2.k_emf": 0.0,
         "gear2.eta": eta, "gear2.k_s": stiffness, "gear2.c_s": damping,
         "beta_dot": -speed,  # dtheta_d = beta_m_dot / N - beta_dot = +speed
+        "gear2.start": 2,    # as_given: beta_m_dot stays 0, the rotor at rest (not in mesh)
     }
     expected = eta / speed
     r = simulate(gimbal_fmu, 0.006, 1e-3, dict(TIGHT, **free_load), None,

@@ -220,7 +220,8 @@ def test_shaft_damping_1e6_with_explicit_rk_is_discarded_not_garbage(gimbal_fmu)
 FREE_LOAD = {"g": 0.0, "body2.I_xy": 0.0, "body2.I_xz": 0.0, "body2.I_yz": 0.0, "body2.d_bd[1]": 0.0,
              "body2.d_bd[2]": 0.0, "body2.d_bd[3]": 0.0, "body2.c_visc": 0.0, "rotor2.c_visc": 0.0,
              "rotor2.T_max": 0.0, "rotor2.T_din": 0.0, "motor2.k_torque": 0.0, "motor2.k_emf": 0.0,
-             "solver.rtol": 1e-10, "solver.atol": 1e-12}
+             "solver.rtol": 1e-10, "solver.atol": 1e-12,
+             "gear2.start": 2}  # as_given: rotor 2 stays at rest while its load coasts (not in mesh)
 
 
 def test_large_backlash_load_flies_freely_through_the_gap(gimbal_fmu):
@@ -679,6 +680,7 @@ def test_degenerate_parameters_conserve_energy(gimbal_fmu):
     for rtol in (1e-10, 1e-11):
         start = dict(DEGENERATE, **{"alpha_dot": 1.0, "beta_dot": 0.7, "alpha_m_dot": 1.3, "beta_m_dot": 0.2,
                                     "beta": 0.4, "gear1.k_s": 100.0, "gear2.k_s": 100.0, "solver.rtol": rtol,
+                                    "gear2.start": 2,  # as_given: beta_m stays 0, gear 2 wound up
                                     "solver.atol": rtol * 1e-2})
         r = timed(gimbal_fmu, 0.3, 1e-2, start, None, LOOP_OUT + ["energy.kinetic", "energy.spring"])
         energy = r["energy.kinetic"] + r["energy.spring"]

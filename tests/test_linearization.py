@@ -42,6 +42,7 @@ STUCK_POINT = {
     "solver.rtol": 1e-11, "solver.atol": 1e-13, "base.fixed": True,
     "body2.d_bd[2]": 0.0, "body2.d_bd[3]": 0.0,
     "u_R1": 0.02, "u_R2": -0.02, "i_R1": 0.01, "i_R2": -0.01, "alpha_dot": 0.01, "beta_dot": -0.02,
+    "gear1.start": 2, "gear2.start": 2,  # as_given: the rotors at rest (stuck), not in mesh with the loads
 }
 
 

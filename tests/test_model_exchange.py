@@ -177,7 +177,9 @@ def test_backlash_chatter_of_a_stiff_undamped_gear_ends_every_event_iteration(gi
     2,000 events in 20 ms, each iteration settled by one call; a chattering hold (50 events within 1 ns
     each; none occurs here) would be said in the log as often as events.zeno_guard counts."""
     log = []
-    start = {"base.fixed": True, "gear2.k_s": 1e8, "gear2.c_s": 1e-6, "beta": 0.3, "dry_friction": False}
+    # gear2.start = as_given (2): beta_m stays at 0, the gear twisted by 0.3 rad on purpose.
+    start = {"base.fixed": True, "gear2.k_s": 1e8, "gear2.c_s": 1e-6, "beta": 0.3, "dry_friction": False,
+             "gear2.start": 2}
     me = simulate_model_exchange(gimbal_fmu, 0.02, start, square_wave(12.0, 0.005),
                                  input_events=np.arange(1, 4) * 0.005, outputs=["beta", "events.zeno_guard",
                                                                                 "events.total"],

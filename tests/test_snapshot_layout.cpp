@@ -1,4 +1,4 @@
-// The FMU state's bytes (snapshot format 8: format 7's layout over the present variable tables) field by
+// The FMU state's bytes (snapshot format 9: format 7's layout over the present variable tables) field by
 // field: the table of gimbal/simulation/snapshot.hpp must lay every field where format 7 put it. Format 7 was a C++ struct copied as bytes; that struct is kept
 // here as the reference (Format7), and every row's offset and size is compared with its member's.
 // Then: content survives encode/decode bit for bit, and single faults are refused naming the field.
@@ -95,7 +95,7 @@ const Place kFormat7[] = {
 };
 
 void test_layout_is_format_7() {
-    CHECK(kSnapshotFormat == 8);
+    CHECK(kSnapshotFormat == 9);
     CHECK(snapshot_bytes() == sizeof(Format7));
     CHECK(GimbalInstance::snapshot_size() == sizeof(Format7));
     const std::size_t rows = sizeof kFormat7 / sizeof kFormat7[0];
@@ -192,7 +192,7 @@ void test_single_faults_name_the_field() {
         CHECK(reason.compare(0, fault.reason.size(), fault.reason) == 0);
     }
     CHECK(check_snapshot_content(good, false, false) ==
-          "it was not saved by this version of Gimbal2Axis (snapshot format 8)");
+          "it was not saved by this version of Gimbal2Axis (snapshot format 9)");
     // An uninitialized instance's snapshot has no run: its modes are not looked at.
     GimbalInstance fresh([](GimbalStatus, const char*, const std::string&) {}, [](const char*) { return false; });
     fresh.save(bytes.data());

@@ -192,6 +192,8 @@ const std::map<std::string, IntegerField>& integer_parameter_fields() {
         {"solver.substeps", [](const ModelParameters& m) { return static_cast<long>(m.substeps); }},
         {"motor1.cogging_periods", [](const ModelParameters& m) { return static_cast<long>(m.disturbances.cogging[0].periods); }},
         {"motor2.cogging_periods", [](const ModelParameters& m) { return static_cast<long>(m.disturbances.cogging[1].periods); }},
+        {"gear1.start", [](const ModelParameters& m) { return static_cast<long>(m.gear_start[0]); }},
+        {"gear2.start", [](const ModelParameters& m) { return static_cast<long>(m.gear_start[1]); }},
     };
     return fields;
 }
@@ -247,15 +249,15 @@ void check_real_parameters(const std::vector<RealParameter>& reals) {
 }
 
 void check_integer_parameters() {
-    // Models fit in {0, 1, 2} (gears) and {0, 1} (motors): no single setting tells all four apart, but
+    // Models and start rules fit in {0, 1, 2} (gears) and {0, 1} (motors): no single setting tells them all apart, but
     // every pair differs in one of these two.
     const std::map<std::string, int> settings[2] = {
         {{"gear1.model", 2}, {"gear2.model", 1}, {"motor1.model", 0}, {"motor2.model", 1}, {"solver.method", 6},
          {"solver.max_steps", 12345}, {"solver.substeps", 3}, {"motor1.cogging_periods", 24},
-         {"motor2.cogging_periods", 18}},
+         {"motor2.cogging_periods", 18}, {"gear1.start", 0}, {"gear2.start", 2}},
         {{"gear1.model", 0}, {"gear2.model", 2}, {"motor1.model", 1}, {"motor2.model", 0}, {"solver.method", 2},
          {"solver.max_steps", 777}, {"solver.substeps", 250}, {"motor1.cogging_periods", 7},
-         {"motor2.cogging_periods", 11}},
+         {"motor2.cogging_periods", 11}, {"gear1.start", 2}, {"gear2.start", 1}},
     };
     for (const auto& setting : settings) {
         Values values;

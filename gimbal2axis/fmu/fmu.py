@@ -21,9 +21,11 @@ FIDELITY = ["gear1.model", "gear2.model", "motor1.model", "motor2.model", "dry_f
 
 
 def state_names(model_description) -> list[str]:
-    """The model's states, in the model description's order: the outputs with initial="exact", whose
-    start values set the initial state (the core holds that rule: kStartState in variable_groups.hpp)."""
-    return [v.name for v in model_description.modelVariables if v.causality == "output" and v.initial == "exact"]
+    """The model's states, in the model description's order: the outputs with a start value that sets
+    the initial state, initial="exact", or "approx" for the rotors, which gear<j>.start may put in mesh
+    with their loads instead (the core holds that rule: kStartState in variable_groups.hpp)."""
+    return [v.name for v in model_description.modelVariables
+            if v.causality == "output" and v.initial in ("exact", "approx")]
 
 _CASTS = {"Real": float, "Integer": int, "Boolean": bool}   # the types set and read by name
 
@@ -57,7 +59,7 @@ class FMU:
     files on exit (or call close()).
 
     variables      {name: fmpy ModelVariable} of the model description (`model_description`)
-    states         the names of the states (outputs with initial="exact"), in the description's order
+    states         the names of the states (outputs with initial="exact" or "approx"), in the description's order
     vr(name)       the value reference; variable(name) the ModelVariable; has(name), start(name)
     check(...)     validates scene values (names, causalities, types) before a run
     set_values(slave, {name: value})   Real, Integer (and Enumeration) and Boolean, each with the setter of its type

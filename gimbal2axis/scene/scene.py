@@ -44,7 +44,7 @@ from . import analysis, geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
 from ..errors import SceneError, SceneWarning, check_keys, number, positive, read_toml
-from ..fmu import FIDELITY, FMU
+from ..fmu import FIDELITY, FMU, enumeration_items
 from .sensors import Sensors
 from .setpoints import target_direction
 
@@ -367,6 +367,7 @@ def start_values(scene: Scene, fmu: FMU, base_row0: np.ndarray, base_row_eps: np
             a1, b1 = geometry.gimbal_angles_for(scene.target, *base_row_eps[:3], alpha_near=a0)
             initial.setdefault("alpha_dot", (a1 - a0) / eps)
             initial.setdefault("beta_dot", (b1 - b0) / eps)
+    runner_starts_rotors = {}
     for axis, (load, rotor) in enumerate([("alpha", "alpha_m"), ("beta", "beta_m")], start=1):
         gear_model = parameter_value(scene, fmu, f"gear{axis}.model")
         if gear_model == 0:   # rigid gear: the FMU has no rotor state of its own
@@ -376,7 +377,27 @@ def start_values(scene: Scene, fmu: FMU, base_row0: np.ndarray, base_row_eps: np
             initial[rotor] = ratio * initial[load]
         if load + "_dot" in initial and rotor + "_dot" not in initial:
             initial[rotor + "_dot"] = ratio * initial[load + "_dot"]
+        # The runner has decided where the rotor starts (as the scene gives it, else N times its load).
+        # The FMU's default rule (gear<j>.start = in_mesh_unless_given) keeps that too, except for a
+        # rotor value of 0 whose value in mesh is not 0: then the runner asks for as_given, unless the
+        # scene chooses the rule itself. Only then: libcosim cannot set an Enumeration (gimbal2axis system).
+        rule = f"gear{axis}.start"
+        if fmu.has(rule) and rule not in scene.parameters:
+            def start(name):
+                return float(initial[name]) if name in initial else float(fmu.start(name))
+            backlash = start(f"theta_b{axis}") if gear_model == 2 else 0.0
+            moved_angle = start(rotor) == 0.0 and ratio * (start(load) + backlash) != 0.0
+            moved_rate = start(rotor + "_dot") == 0.0 and ratio * start(load + "_dot") != 0.0
+            if moved_angle or moved_rate:
+                runner_starts_rotors[rule] = gear_start_item(fmu, rule, "as_given")
     values = dict(scene.fidelity)
     values.update(scene.parameters)
+    values.update(runner_starts_rotors)
     values.update(initial)
     return values
+
+
+def gear_start_item(fmu: FMU, name: str, item: str) -> int:
+    """The value of the item named `item` of the Enumeration parameter `name` (gear<j>.start)."""
+    values = {label: value for value, label in enumeration_items(fmu.variable(name)).items()}
+    return values[item]

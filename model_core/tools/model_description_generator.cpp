@@ -250,6 +250,7 @@ int write_fmi3(char** paths) {
             variables << "    <" << element << " name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
                       << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
             if (v.initial == Initial::exact) variables << " initial=\"exact\"";
+            if (v.initial == Initial::approx) variables << " initial=\"approx\"";
             if (v.initial == Initial::calculated) variables << " initial=\"calculated\"";
             variables << "\n      description=\"" << xml_escape(v.description) << "\"";
             if (enumeration) variables << " declaredType=\"" << v.declared_type << "\"";
@@ -272,7 +273,9 @@ int write_fmi3(char** paths) {
                     for (unsigned i : output_dependencies(static_cast<RealVariable>(index))) dependencies.push_back(i - 1);
                 outputs << "    <Output valueReference=\"" << vr << "\" dependencies=\"" << vr_list(dependencies) << "\"/>\n";
             }
-            if ((v.causality == Causality::output || v.causality == Causality::local) && v.initial == Initial::calculated)
+            // Computed in Initialization Mode: the calculated outputs, and the approx ones (the rotors).
+            if ((v.causality == Causality::output || v.causality == Causality::local) &&
+                (v.initial == Initial::calculated || v.initial == Initial::approx))
                 initial_unknowns << "    <InitialUnknown valueReference=\"" << vr << "\"/>\n";
         }
     }
@@ -356,6 +359,7 @@ int main(int argc, char** argv) {
                       << "    <ScalarVariable name=\"" << v.name << "\" valueReference=\"" << vr << "\" causality=\""
                       << to_string(v.causality) << "\" variability=\"" << to_string(v.variability) << "\"";
             if (v.initial == gimbal::Initial::exact) variables << " initial=\"exact\"";
+            if (v.initial == gimbal::Initial::approx) variables << " initial=\"approx\"";
             if (v.initial == gimbal::Initial::calculated) variables << " initial=\"calculated\"";
             variables << "\n      description=\"" << xml_escape(v.description) << "\">\n      <"
                       << (enumeration ? "Enumeration" : table.element);
@@ -382,8 +386,9 @@ int main(int argc, char** argv) {
                 // Event counters, modes and the last event's time change at events only.
                 outputs << "      <Unknown index=\"" << index << "\" dependencies=\"\"/>\n";
             }
+            // Computed in Initialization Mode: the calculated outputs, and the approx ones (the rotors).
             if ((v.causality == gimbal::Causality::output || v.causality == gimbal::Causality::local) &&
-                v.initial == gimbal::Initial::calculated)
+                (v.initial == gimbal::Initial::calculated || v.initial == gimbal::Initial::approx))
                 initial_unknowns << "      <Unknown index=\"" << index << "\"/>\n";
         }
     }

@@ -18,7 +18,13 @@ typedef struct GimbalCore GimbalCore;
 typedef enum { GIMBAL_OK = 0, GIMBAL_WARNING = 1, GIMBAL_DISCARD = 2, GIMBAL_ERROR = 3 } GimbalStatus;
 typedef enum { GIMBAL_PARAMETER = 0, GIMBAL_INPUT = 1, GIMBAL_OUTPUT = 2, GIMBAL_LOCAL = 3 } GimbalCausality;
 typedef enum { GIMBAL_FIXED = 0, GIMBAL_TUNABLE = 1, GIMBAL_CONTINUOUS = 2 } GimbalVariability;
-typedef enum { GIMBAL_INITIAL_NONE = 0, GIMBAL_INITIAL_EXACT = 1, GIMBAL_INITIAL_CALCULATED = 2 } GimbalInitial;
+/* APPROX: the rotor angles and rates, settable like EXACT, which gear<j>.start may put in mesh instead. */
+typedef enum {
+    GIMBAL_INITIAL_NONE = 0,
+    GIMBAL_INITIAL_EXACT = 1,
+    GIMBAL_INITIAL_CALCULATED = 2,
+    GIMBAL_INITIAL_APPROX = 3
+} GimbalInitial;
 
 /* category is one of the logCategories of modelDescription.xml. */
 typedef void (*GimbalLogFunction)(void* context, GimbalStatus status, const char* category, const char* message);

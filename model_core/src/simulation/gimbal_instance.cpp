@@ -112,6 +112,15 @@ GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
         const GimbalStatus status = preview_outputs(kRealVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
+    if (!system_ && kRealVariables[vr].initial == Initial::approx) {
+        // Before initialization a rotor reads where it will start (in mesh, or as given); its start
+        // value stays what the host set.
+        const GimbalStatus status = preview_outputs(kRealVariables[vr].name);
+        if (status != GIMBAL_OK) return status;
+        for (int k = 0; k < 4; ++k)
+            if (kRotorStart[k] == vr) value = preview_rotor_start_[k];
+        return GIMBAL_OK;
+    }
     if (system_ && continuous_time_ && outputs_stale_) {
         const GimbalStatus status = publish_continuous_time_outputs();
         if (status != GIMBAL_OK) return status;
@@ -166,6 +175,27 @@ StepInputs GimbalInstance::read_step_inputs(double step_start) const {
     return gimbal::read_step_inputs(params_, reals_, voltage_rate_, step_start);
 }
 
+// gear<j>.start (docs/physics.md section 3.3). By default a rotor angle or rate left at its start value 0
+// follows its load: an FMI host that sets only alpha and beta gets relaxed gears, whether or not it
+// also sets the rotors' untouched start values (importers differ in that, the values decide alike).
+GearStart GimbalInstance::gear_start(int axis) const { return params_.gear_start[axis]; }
+
+bool GimbalInstance::rotor_start_given(int axis, double value) const {
+    const GearStart rule = gear_start(axis);
+    return rule == GearStart::as_given || (rule == GearStart::in_mesh_unless_given && value != 0.0);
+}
+
+// In mesh, the shaft is neither twisted (theta_d = theta_b, the backlash state as given: centred by
+// default) nor twisting (theta_d' = 0): T_E = 0 (section 4.2). A gear without backlash has theta_b = 0.
+void GimbalInstance::rotor_in_mesh(int axis, double& angle, double& rate) const {
+    const RealVariable backlash = axis == 0 ? vr_theta_b1 : vr_theta_b2;
+    const double theta_b = params_.fidelity.gear[axis] == GearModel::backlash ? reals_[backlash] : 0.0;
+    const int load = load_index(axis);
+    const double ratio = params_.gear[axis].ratio;
+    angle = ratio * (reals_[kBodyAngle[load]] + theta_b);
+    rate = ratio * reals_[kBodyRate[load]];
+}
+
 void GimbalInstance::load_start_state() {
     const StateLayout& layout = params_.layout;
     std::fill(state_, state_ + kMaxStateSize, 0.0);
@@ -178,14 +208,89 @@ void GimbalInstance::load_start_state() {
     for (int axis = 0; axis < 2; ++axis) {
         if (layout.current_slot[axis] >= 0) state_[layout.current_slot[axis]] = reals_[currents[axis]];
         if (layout.backlash_slot[axis] >= 0) state_[layout.backlash_slot[axis]] = reals_[backlash[axis]];
+        const int rotor = rotor_index(axis);
+        if (!layout.independent(rotor)) continue;  // a rigid gear: the rotor is N times its load anyway
+        double mesh_angle = 0.0, mesh_rate = 0.0;
+        rotor_in_mesh(axis, mesh_angle, mesh_rate);
+        if (!rotor_start_given(axis, reals_[kBodyAngle[rotor]])) state_[layout.angle_slot[rotor]] = mesh_angle;
+        if (!rotor_start_given(axis, reals_[kBodyRate[rotor]])) state_[layout.rate_slot[rotor]] = mesh_rate;
+    }
+}
+
+// Said once, at initialization (not at the previews before it): a start value of a rotor that is not
+// used, and a gear that starts twisted because its rotor's start values were given so.
+void GimbalInstance::report_gear_starts() const {
+    const StateLayout& layout = params_.layout;
+    for (int axis = 0; axis < 2; ++axis) {
         const int rotor = rotor_index(axis), load = load_index(axis);
-        const double ratio = params_.gear[axis].ratio;
-        if (!layout.independent(rotor) && (reals_[kBodyAngle[rotor]] != ratio * reals_[kBodyAngle[load]] ||
-                                           reals_[kBodyRate[rotor]] != ratio * reals_[kBodyRate[load]])) {
-            logger_(GIMBAL_WARNING, "logStatusWarning",
-                    std::string("rigid gear ") + std::to_string(axis + 1) + ": the start values of " +
-                        kRealVariables[kBodyAngle[rotor]].name + " and its rate are replaced by N times the load's");
+        const std::string gear = "gear" + std::to_string(axis + 1);
+        const char* angle_name = kRealVariables[kBodyAngle[rotor]].name;
+        const char* rate_name = kRealVariables[kBodyRate[rotor]].name;
+        const double given_angle = reals_[kBodyAngle[rotor]], given_rate = reals_[kBodyRate[rotor]];
+        std::ostringstream s;
+        s.precision(6);
+        if (!layout.independent(rotor)) {
+            const double ratio = params_.gear[axis].ratio;
+            const double angle = ratio * reals_[kBodyAngle[load]], rate = ratio * reals_[kBodyRate[load]];
+            if ((rotor_start_given(axis, given_angle) && given_angle != angle) ||
+                (rotor_start_given(axis, given_rate) && given_rate != rate)) {
+                s << "rigid gear " << axis + 1 << ": the start values " << angle_name << " = " << given_angle << ", "
+                  << rate_name << " = " << given_rate << " are not used: a rigid gear's rotor is " << gear
+                  << ".N times its load, " << angle << " rad, " << rate << " rad/s";
+                logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
+            }
+            continue;
         }
+        double mesh_angle = 0.0, mesh_rate = 0.0;
+        rotor_in_mesh(axis, mesh_angle, mesh_rate);
+        if (gear_start(axis) == GearStart::in_mesh) {
+            const bool angle_dropped = given_angle != 0.0 && given_angle != mesh_angle;
+            const bool rate_dropped = given_rate != 0.0 && given_rate != mesh_rate;
+            if (angle_dropped || rate_dropped) {
+                s << gear << ".start = in_mesh: the start value";
+                if (angle_dropped) s << " " << angle_name << " = " << given_angle << " rad";
+                if (angle_dropped && rate_dropped) s << " and";
+                if (rate_dropped) s << " " << rate_name << " = " << given_rate << " rad/s";
+                s << " not used; the rotor starts in mesh at " << mesh_angle << " rad, " << mesh_rate
+                  << " rad/s (set " << gear << ".start = as_given to start from the given values)";
+                logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
+            }
+            continue;
+        }
+        // The twist the shaft carries from the start: the deflection beyond the backlash play (the
+        // shaft's end reaches the stop within c_s/k_s), and the rate of deflection.
+        const double ratio = params_.gear[axis].ratio;
+        const double rotor_angle = state_[layout.angle_slot[rotor]], rotor_rate = state_[layout.rate_slot[rotor]];
+        const double load_angle = reals_[kBodyAngle[load]];
+        const double deflection = rotor_angle / ratio - load_angle;
+        const double deflection_rate = rotor_rate / ratio - reals_[kBodyRate[load]];
+        const double play = params_.fidelity.gear[axis] == GearModel::backlash ? params_.gear[axis].half_backlash : 0.0;
+        const double twist = deflection - std::clamp(deflection, -play, play);
+        // Rounding of N (q_l + theta_b) / N - q_l is not a twist.
+        const double resolution = 1e-12 * (1.0 + std::fabs(load_angle) + std::fabs(rotor_angle / ratio));
+        const bool twisted = std::fabs(twist) > resolution;
+        const bool twisting = std::fabs(deflection_rate) > 1e-12 * (1.0 + std::fabs(rotor_rate / ratio));
+        if (!twisted && !twisting) continue;
+        s << gear << " starts twisted: " << angle_name << " = " << rotor_angle << " rad";
+        if (twisting) s << ", " << rate_name << " = " << rotor_rate << " rad/s";
+        s << " against " << kRealVariables[kBodyAngle[load]].name << " = " << load_angle << " rad";
+        if (twisting) s << ", " << kRealVariables[kBodyRate[load]].name << " = " << reals_[kBodyRate[load]] << " rad/s";
+        if (twisted) {
+            s << ": the shaft is twisted by " << twist << " rad";
+            if (play > 0.0) s << " beyond the backlash (" << gear << ".eta = " << play << " rad)";
+            s << ", a torque of " << params_.gear[axis].stiffness * twist << " N.m (" << gear << ".k_s times the twist)";
+        }
+        if (twisting) {
+            s << (twisted ? "; " : ": ") << "the shaft twists at " << deflection_rate << " rad/s, a damping torque of "
+              << params_.gear[axis].damping * deflection_rate << " N.m (" << gear << ".c_s times the rate)";
+            if (!twisted && play > 0.0) s << " once the backlash closes";
+        }
+        if (gear_start(axis) == GearStart::as_given)
+            s << "; " << gear << ".start = as_given keeps the rotor's start values";
+        else
+            s << "; the rotor's start values were given (left at 0, they follow the load: " << mesh_angle << " rad, "
+              << mesh_rate << " rad/s)";
+        logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
     }
 }
 
@@ -286,7 +391,15 @@ GimbalStatus GimbalInstance::preview_outputs(const char* name) {
     system->update_modes(0.0, state_, nullptr);
     system_ = std::move(system);
     integrator_ = std::move(integrator);
+    // Publishing writes the rotors' start into their variables: keep the host's start values there
+    // (gear<j>.start reads them again), and the start the preview computed aside.
+    double rotor_start_values[4];
+    for (int k = 0; k < 4; ++k) rotor_start_values[k] = reals_[kRotorStart[k]];
     publish_outputs();
+    for (int k = 0; k < 4; ++k) {
+        preview_rotor_start_[k] = reals_[kRotorStart[k]];
+        reals_[kRotorStart[k]] = rotor_start_values[k];
+    }
     // The continuous-time interface may ask for the states and indicators during initialization.
     full_state_vector(params_, system_->dynamics_at(0.0, state_), state_, preview_states_);
     system_->event_indicators(0.0, state_, preview_indicators_);
@@ -343,6 +456,7 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
     inputs_stale_ = decided_here_ = false;
     chattering_ = ChatteringMemory{};
     zeno_holds_ = 0;
+    report_gear_starts();  // reads the rotors' start values: before publishing replaces them
     publish_outputs();
     outputs_stale_ = false;
     return check_initial_outputs();

@@ -103,6 +103,12 @@ static_assert(GearModel_rigid == static_cast<int>(GearModel::rigid) &&
 static_assert(MotorModel_quasi_static == static_cast<int>(MotorModel::quasi_static) &&
                   MotorModel_inductive == static_cast<int>(MotorModel::inductive) && items_are("MotorModel", 0, 1),
               "MotorModel items: quasi_static, inductive, and the validation accepts 0..1");
+static_assert(GearStart_in_mesh_unless_given == static_cast<int>(GearStart::in_mesh_unless_given) &&
+                  GearStart_in_mesh == static_cast<int>(GearStart::in_mesh) &&
+                  GearStart_as_given == static_cast<int>(GearStart::as_given) &&
+                  items_are("GearStart", 0, 2),
+              "GearStart items: in_mesh_unless_given, in_mesh, as_given (GimbalInstance::load_start_state), and "
+              "the validation accepts 0..2");
 static_assert(IntegrationMethod_cvode_bdf == static_cast<int>(IntegrationMethod::bdf_analytic_jacobian) &&
                   IntegrationMethod_cvode_bdf_dq == static_cast<int>(IntegrationMethod::bdf_difference_jacobian) &&
                   IntegrationMethod_cvode_adams == static_cast<int>(IntegrationMethod::adams) &&
@@ -117,7 +123,9 @@ static_assert(variable_table::joins(variable_table::kInteger[vi_gear1_model].dec
                   variable_table::joins(variable_table::kInteger[vi_gear2_model].declared_type, "GearModel", "") &&
                   variable_table::joins(variable_table::kInteger[vi_motor1_model].declared_type, "MotorModel", "") &&
                   variable_table::joins(variable_table::kInteger[vi_motor2_model].declared_type, "MotorModel", "") &&
-                  variable_table::joins(variable_table::kInteger[vi_solver_method].declared_type, "IntegrationMethod", ""),
+                  variable_table::joins(variable_table::kInteger[vi_solver_method].declared_type, "IntegrationMethod", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_gear1_start].declared_type, "GearStart", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_gear2_start].declared_type, "GearStart", ""),
               "the structural selectors are declared with the Enumeration types they are validated against");
 
 // An Enumeration-typed parameter takes exactly its type's items; the refusal lists them (the start
@@ -307,6 +315,9 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     if (!read_drive_train(check, params) || !read_solver(integers, params, error)) return false;
     read_disturbances(values, integers, params.disturbances);
     read_fidelity(integers, flags, params);
+    // Checked against its Enumeration items with the other single-variable rules.
+    params.gear_start[0] = static_cast<GearStart>(integers[vi_gear1_start]);
+    params.gear_start[1] = static_cast<GearStart>(integers[vi_gear2_start]);
     params.finalize();
     params.relative_tolerance = values[vr_solver_rtol];
     params.absolute_tolerance = values[vr_solver_atol];

@@ -85,7 +85,7 @@ extern "C" int gimbal_probe_linearize(const GimbalProbeSetting* settings, size_t
         if (setting.type < GIMBAL_REAL || setting.type > GIMBAL_BOOLEAN ||
             !gimbal_variable_info(static_cast<GimbalType>(setting.type), setting.vr, &info))
             return fail(message, message_size, "setting " + std::to_string(k) + " names no variable");
-        if (info.causality == GIMBAL_OUTPUT && info.initial != GIMBAL_INITIAL_EXACT)
+        if (info.causality == GIMBAL_OUTPUT && info.initial != GIMBAL_INITIAL_EXACT && info.initial != GIMBAL_INITIAL_APPROX)
             return fail(message, message_size,
                         std::string(info.name) + " is a computed output: it has no start value to set");
         if (setting.type != GIMBAL_REAL &&

@@ -28,6 +28,9 @@ enum EnergyFlow : int { kElectricalIn = 0, kResistive, kViscous, kShaftDamping, 
 
 // "Model only what a scene needs" (docs/physics.md section 6): each reduction removes states.
 enum class GearModel : int { rigid = 0, compliant = 1, backlash = 2 };
+// Where a compliant gear's rotor starts (gear<j>.start, docs/physics.md section 3.3): in mesh with its
+// load unless a start value other than 0 was given, always in mesh, or at its start values as given.
+enum class GearStart : int { in_mesh_unless_given = 0, in_mesh = 1, as_given = 2 };
 enum class MotorModel : int { quasi_static = 0, inductive = 1 };
 
 struct Fidelity {
@@ -65,6 +68,8 @@ struct ModelParameters {
     DryFrictionParameters dry_friction[4];      // per body, as given
     DisturbanceParameters disturbances;         // cable restraints and cogging; `active` set by finalize()
     Fidelity fidelity;
+    // Where the compliant gears' rotors start (gear<j>.start): used only by the start state.
+    GearStart gear_start[2] = {GearStart::in_mesh_unless_given, GearStart::in_mesh_unless_given};
     bool energy_accounting = false;
     double relative_tolerance = 1e-6;
     double absolute_tolerance = 1e-8;

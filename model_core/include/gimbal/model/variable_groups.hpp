@@ -282,9 +282,17 @@ static_assert(variable_table::components_of_one_vector(kPayloadAngularVelocity) 
               "kPayloadAngularVelocity is los.omega[1..3] in component order");
 static_assert(variable_table::holds_exactly(kStartState, variable_table::kReal,
                                             [](const VariableInfo& v) {
-                                                return v.causality == Causality::output && v.initial == Initial::exact;
+                                                return v.causality == Causality::output &&
+                                                       (v.initial == Initial::exact || v.initial == Initial::approx);
                                             }),
-              "kStartState is every output whose start value is used (initial = exact): the start state");
+              "kStartState is every output whose start value is used (initial = exact, or approx: the rotors, "
+              "which may start in mesh instead): the start state");
+// The rotor angles and rates: the start values a compliant gear's start rule (gear<j>.start) may replace
+// by the values in mesh with the loads, hence initial = approx.
+inline constexpr RealVariable kRotorStart[4] = {vr_alpha_m, vr_alpha_m_dot, vr_beta_m, vr_beta_m_dot};
+static_assert(variable_table::holds_exactly(kRotorStart, variable_table::kReal,
+                                            [](const VariableInfo& v) { return v.initial == Initial::approx; }),
+              "kRotorStart is every variable with initial = approx: the rotor angles and rates");
 static_assert([] {
     for (int k = 0; k < kContinuousStateCount; ++k) {
         const char* state = variable_table::name(kContinuousStates[k]);

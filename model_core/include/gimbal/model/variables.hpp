@@ -9,7 +9,10 @@ namespace gimbal {
 
 enum class Causality { parameter, input, output, local };
 enum class Variability { fixed, tunable, discrete, continuous };
-enum class Initial { none, exact, calculated };
+// approx: the start value is where the FMU begins, not necessarily where it ends: the rotor angles and
+// rates, which a compliant gear's start rule (gear<j>.start) may put in mesh with their loads. In the
+// order of the C interface's GimbalInitial (gimbal_c_api.h), which gimbal_variable_info casts to.
+enum class Initial { none, exact, calculated, approx };
 
 // Bounds of the .def tables' min and max columns. FMI's min and max are inclusive, so a strict bound
 // is written as the nearest double inside it: "> 0" as the least positive normal double (not the

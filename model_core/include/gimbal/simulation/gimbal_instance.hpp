@@ -113,6 +113,10 @@ private:
     StepInputs read_step_inputs(double step_start) const;
     bool build_parameters(ModelParameters& params, std::string& error) const;
     void load_start_state();
+    GearStart gear_start(int axis) const;
+    bool rotor_start_given(int axis, double value) const;
+    void rotor_in_mesh(int axis, double& angle, double& rate) const;
+    void report_gear_starts() const;
     GimbalStatus check_fixed_base() const;
     std::unique_ptr<HybridIntegrator> make_integrator(GimbalHybridSystem& system, const ModelParameters& params);
     void create_integrator();
@@ -210,6 +214,7 @@ private:
     ChatteringMemory chattering_;      // model times
     GuardSettling guard_settling_;
     double preview_states_[kContinuousStateCount] = {};      // at the start values, before initialization
+    double preview_rotor_start_[4] = {};                      // where the rotors start (kRotorStart order)
     double preview_indicators_[GimbalHybridSystem::kIndicatorCount] = {};
     int integrated_count_ = 0;
     int integrated_state_[kContinuousStateCount] = {};  // index among the 17 states

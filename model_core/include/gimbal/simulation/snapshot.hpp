@@ -57,7 +57,8 @@ struct SnapshotContent {
 constexpr std::uint32_t kSnapshotMagic = 0x47324158;
 // Format 8: format 7's fields with the longer variable tables of the disturbance elements (cables,
 // cogging): the variable arrays grew, so a format-7 state is refused by its number, not misread.
-constexpr std::uint32_t kSnapshotFormat = 8;
+// Format 9: format 8's fields with the Integer table grown by gear1.start and gear2.start.
+constexpr std::uint32_t kSnapshotFormat = 9;
 
 std::size_t snapshot_bytes();
 // The bytes of a content (every gap zero).
