@@ -248,6 +248,8 @@ def test_open_loop_command_adds_the_linear_models_curve(fmu_path, build_dir, tmp
     rows = list(csv.DictReader(open(tmp_path / "frequency_response_open_loop_2.csv")))
     # (2 variants + the linear model) x 2 frequencies x (beta_dot, los.omega[1])
     assert len(rows) == 12
+    # the summary counts frequencies as frequencies, rows as rows
+    assert out.stdout.splitlines()[-1].startswith("2 frequencies x 2 simulated curves (12 CSV rows"), out.stdout
     assert {r["curve"] for r in rows} == {"full model", "no backlash, no dry friction", "linear model"}
     linear = {(r["output"], r["frequency_hz"]): float(r["gain"]) for r in rows if r["curve"] == "linear model"}
     simulated = {(r["output"], r["frequency_hz"]): float(r["gain"]) for r in rows
@@ -280,6 +282,8 @@ def test_several_amplitudes_give_a_curve_each(fmu_path, tmp_path):
     (["isolation", "--axis", "sideways"], "roll, pitch or yaw"),
     (["open-loop", "--fmin", "0"], "need 0 < fmin <= fmax"),
     (["isolation", "--amplitude", "0"], "need a positive amplitude"),
+    (["open-loop", "--fmax", "474"], "resolves, 250 Hz: a dwell needs at least 4 steps per period"),
+    (["open-loop", "--set", "body2.d_bd[4]=0"], "--set: 'body2.d_bd[4]' is not a variable"),
 ])
 def test_command_refusals_name_the_culprit_without_a_traceback(fmu_path, tmp_path, args, message):
     import subprocess
@@ -288,5 +292,6 @@ def test_command_refusals_name_the_culprit_without_a_traceback(fmu_path, tmp_pat
     out = subprocess.run([sys.executable, "-m", "gimbal2axis", "freqresp", *args, "--serial",
                           "--fmu", str(fmu_path), "--out", str(tmp_path)], capture_output=True, text=True, timeout=300,
                          cwd=REPO)
-    assert out.returncode == 1
+    assert out.returncode == 2
     assert message in out.stderr and "Traceback" not in out.stderr, out.stderr
+    assert out.stderr.startswith("gimbal2axis freqresp: error: ") and len(out.stderr.splitlines()) == 1, out.stderr

@@ -54,10 +54,14 @@ def test_refusals_name_the_culprit_without_a_traceback(build_dir, fmu_path, tmp_
           str(fmu_path)], "--at-time 0.0005: not a whole number"),
         (["--scene", str(REPO / "scenes" / "ship_stabilization.toml"), "--at-time", "-1"], "need a positive time"),
         (["--set", "gear1.model=1.5"], "is not a whole number"),
+        (["--set", "motor1.RR=3"], "--set: 'motor1.RR' is not a variable of the gimbal model (did you mean 'motor1.R'"),
+        (["--scene", str(REPO / "scenes" / "ship_stabilization.toml"), "--at-time", "0.01", "--fmu", str(fmu_path),
+          "--set", "u_R11=3"], "(did you mean 'u_R1'"),
     ]
     for args, message in cases:
         out = linearize(build_dir, *args)
-        assert out.returncode == 1, args
+        assert out.returncode == 2, args
         assert message in out.stderr and "Traceback" not in out.stderr, (args, out.stderr)
-        assert "linearize: linearize:" not in out.stderr and out.stderr.startswith("gimbal2axis linearize: ")
+        assert "linearize: linearize:" not in out.stderr and out.stderr.startswith("gimbal2axis linearize: error: ")
+        assert len(out.stderr.splitlines()) == 1, out.stderr
     assert not (tmp_path / "m.txt").exists()

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import SceneError
 from ..locations import probe_library_path
+from .names import did_you_mean
 
 REAL, INTEGER, BOOLEAN = 0, 1, 2
 INPUT_CAUSALITY = 1
@@ -107,7 +108,8 @@ class Probe:
         settings = (_Setting * max(len(values), 1))()
         for k, (name, value) in enumerate(values.items()):
             if name not in self.variables:
-                raise SceneError(f"linearize: '{name}' is not a variable of the gimbal model")
+                raise SceneError(f"linearize: '{name}' is not a variable of the gimbal model"
+                                 f"{did_you_mean(name, self.variables)}")
             type_, vr, causality = self.variables[name]
             if snapshot is not None and causality != INPUT_CAUSALITY:
                 raise SceneError(f"linearize: '{name}' is not an input: at a running instance's operating point "
@@ -150,6 +152,23 @@ class Probe:
                            outputs=[self.real_names[model.output_vr[k]] for k in range(output_count)],
                            modes=modes, time=float(model.time),
                            point={name: float(value) for name, value in values.items()})
+
+
+# is_identically_zero: round-off of the core's differences is ~1e-16 of the largest gain; a physical
+# path, however weak, is far above 1e-10 of it. Checked from 0.01 Hz to 1 kHz (the Bode plot's default band).
+ZERO_GAIN_RATIO = 1e-10
+ZERO_CHECK_HZ = np.logspace(-2, 3, 11)
+
+
+def _axes_of(signal: str) -> set[int]:
+    """The gimbal axes (1 azimuth, 2 elevation) a signal belongs to: a motor voltage, a body's angle or
+    rate, a current, a backlash position or shaft torque its own axis; the carrier's inputs and the line
+    of sight's rates both."""
+    if signal.startswith("alpha") or signal in ("u_R1", "i_R1", "theta_b1", "T_E1"):
+        return {1}
+    if signal.startswith("beta") or signal in ("u_R2", "i_R2", "theta_b2", "T_E2"):
+        return {2}
+    return {1, 2}
 
 
 def control_name(name: str) -> str:
@@ -217,6 +236,62 @@ class LinearModel:
             out.append(samples / hold)
         return np.array(out)
 
+    def is_identically_zero(self, input: str, output: str) -> bool:
+        """Whether G from `input` to `output` is zero at every frequency, to round-off: below ZERO_GAIN_RATIO
+        times the largest gain from the same input to any output, at every frequency of ZERO_CHECK_HZ. A
+        held mode makes a path exactly 0 in A or B (a stuck body's rows), or leaves round-off (1e-17 through
+        the mass matrix's differences for a gear in its gap); a physical path, however weak (the azimuth
+        moving the elevation through the payload's products of inertia), is many decades above that."""
+        i, o = self.inputs.index(input), self.outputs.index(output)
+        n = len(self.states)
+        largest = np.abs(self.D[:, i])   # over the frequencies, per output
+        for f in ZERO_CHECK_HZ:
+            x = np.linalg.solve(2j * math.pi * f * np.eye(n) - self.A, self.B[:, i]) if n else np.zeros(0)
+            largest = np.maximum(largest, np.abs(self.C @ x + self.D[:, i]))
+        return bool(largest[o] <= ZERO_GAIN_RATIO * largest.max())
+
+    def held_modes_on(self, input: str, output: str) -> list[tuple[str, object, str]]:
+        """(mode, its value, the setting that frees it) for each mode in force at this point that holds a
+        link between `input` and `output`: on the axis (motor, rotor, gear, load) of the input and of the
+        output (both axes for the carrier's inputs and the line-of-sight rates)."""
+        held = []
+        for axis in sorted(_axes_of(input) | _axes_of(output)):
+            load_rate, rotor_rate = ("alpha_dot", "alpha_m_dot") if axis == 1 else ("beta_dot", "beta_m_dot")
+            if self.modes.get(f"motor{axis}.voltage_clamped", 0) != 0:
+                held.append((f"motor{axis}.voltage_clamped", self.modes[f"motor{axis}.voltage_clamped"],
+                             f"a voltage inside the clamp, --set u_R{axis}=V with |V| < motor{axis}.U_L"))
+            if self.modes.get(f"motor{axis}.limited", 0) != 0:
+                held.append((f"motor{axis}.limited", self.modes[f"motor{axis}.limited"],
+                             f"a current below the limit, a smaller --set u_R{axis}=V or a larger --set motor{axis}.i_L=A"))
+            for body, rate in ((f"rotor{axis}", rotor_rate), (f"body{axis}", load_rate)):
+                if self.modes.get(f"{body}.friction") == "stuck":
+                    how = (f"--set dry_friction=false, or a start rate that makes it slip, e.g. --set {rate}=0.1"
+                           if rate in self.states else "--set dry_friction=false")
+                    held.append((f"{body}.friction", "stuck", how))
+            # contact 0 means "in the gap" only where there is a gap: the backlash position is then a state
+            if self.modes.get(f"gear{axis}.contact", 0) == 0 and f"theta_b{axis}" in self.states:
+                held.append((f"gear{axis}.contact", 0, f"a gear without backlash, --set gear{axis}.model=1 "
+                                                       f"(compliant) or gear{axis}.model=0 (rigid)"))
+        return held
+
+    def zero_path_warning(self, input: str, output: str) -> str | None:
+        """One line saying that G from `input` to `output` is identically zero and which held modes (with
+        the settings that free them) make it so; None where it is not zero."""
+        if not self.is_identically_zero(input, output):
+            return None
+        i = self.inputs.index(input)
+        if input.startswith("base.") and not (self.B[:, i].any() or self.D[:, i].any()):
+            why = ("base.fixed = true: the carrier's inputs are not used" if self.point.get("base.fixed")
+                   else "a uniform translation of the carrier does not act on the gimbal" if input.startswith("base.v_a")
+                   else "this carrier input acts on nothing at this operating point")
+            return f"{input} -> {output} is identically zero in this linear model: {why}"
+        held = self.held_modes_on(input, output)
+        if not held:
+            return (f"{input} -> {output} is identically zero in this linear model, and no held mode explains "
+                    f"it: the input does not act on that output at this operating point")
+        reasons = "; ".join(f"{mode} = {value} (freed by {how})" for mode, value, how in held)
+        return f"{input} -> {output} is identically zero in this linear model: held by {reasons}"
+
     def to_statespace(self, inputs: list[str] | None = None, outputs: list[str] | None = None):
         """A python-control StateSpace (package `control`), with the states, inputs and outputs named as the
         FMU names them but with '.' written '_' (python-control reserves '.' for subsystems):
@@ -282,6 +357,11 @@ def _probe(build_dir=None) -> Probe:
     if key not in _PROBES:
         _PROBES[key] = Probe(build_dir)
     return _PROBES[key]
+
+
+def variable_names(build_dir: str | os.PathLike | None = None) -> list[str]:
+    """The names of the gimbal model's variables that linearize() takes (the probe library's, the FMU's)."""
+    return list(_probe(build_dir).variables)
 
 
 def linearize(values: dict | None = None, build_dir: str | os.PathLike | None = None) -> LinearModel:

@@ -21,6 +21,12 @@ phase and gain margins.
 
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
+Each frequency is snapped so that --measure-periods periods are a whole number of the scene's steps h;
+a frequency left with fewer than 4 steps per period (above 1/(4 h): 250 Hz at 1 ms) is refused before
+anything runs: closer to the Nyquist frequency 1/(2 h) the samples alias and the measurement leaves the
+linear prediction (docs/frequency_response.md).
+
+Exit status: 0 written, 2 refused (an argument, a --set name, the scene, the output directory).
 
   gimbal2axis freqresp isolation --axis roll --fmin 0.1 --fmax 100 --points 13
   gimbal2axis freqresp open-loop --axis 1 --amplitude 1 --serial
@@ -39,39 +45,70 @@ from ..errors import SceneError
 from ..locations import fmu_path
 from ..scene import load_scene
 from .defaults import scene_file
+from .failures import run_reporting_failures
 
 SUMMARY = "frequency responses by sine dwell: open loop, isolation, loop gain, with the linear prediction"
 PROG = "gimbal2axis freqresp"
 DEFAULT_SCENE = pathlib.Path("scenes", "ship_stabilization.toml")   # relative to the current directory
 
 
-def with_overrides(scene, assignments: list[str]):
+def with_overrides(scene, assignments: list[str], fmu_file):
     """The scene with NAME=VALUE assignments: a name of [fidelity] (gear1.model, dry_friction, ...) goes
-    there, any other name to [parameters]."""
+    there, any other name to [parameters]. A name the FMU does not have, or that is no parameter, is
+    refused here, as the command-line option it is (with the close matches), not later as the scene's."""
+    from fmpy import read_model_description
+
+    from ..analysis.names import did_you_mean
     from ..fmu import FIDELITY
 
+    variables = {v.name: v for v in read_model_description(str(fmu_file)).modelVariables}
+    parameters_of_fmu = [name for name, v in variables.items() if v.causality in SETTABLE_CAUSALITIES]
     fidelity, parameters = dict(scene.fidelity), dict(scene.parameters)
     for item in assignments:
         name, sep, text = item.partition("=")
+        name = name.strip()
         if not sep:
             raise SceneError(f"--set {item!r}: expected NAME=VALUE")
+        if name not in variables:
+            raise SceneError(f"--set: '{name}' is not a variable of {fmu_file}{did_you_mean(name, variables)}")
+        if variables[name].causality not in SETTABLE_CAUSALITIES:
+            raise SceneError(f"--set: '{name}' is {variables[name].causality!r}, not a parameter or fidelity "
+                             f"switch (freqresp drives the inputs itself){did_you_mean(name, parameters_of_fmu)}")
         low = text.strip().lower()
-        value = True if low == "true" else False if low == "false" else float(text)
-        if isinstance(value, float) and value.is_integer() and name.strip() in FIDELITY:
+        try:
+            value = True if low == "true" else False if low == "false" else float(text)
+        except ValueError:
+            raise SceneError(f"--set {item!r}: {text!r} is not a number, true or false") from None
+        if isinstance(value, float) and value.is_integer() and name in FIDELITY:
             value = int(value)
-        (fidelity if name.strip() in FIDELITY else parameters)[name.strip()] = value
+        (fidelity if name in FIDELITY else parameters)[name] = value
     return scene.with_changes(fidelity=fidelity, parameters=parameters)
 
 
+SETTABLE_CAUSALITIES = ("parameter", "structuralParameter")   # what a scene's [parameters] and [fidelity] take
+
+
 def check_arguments(args) -> None:
-    """What argparse cannot say: ranges."""
-    if not (args.fmin > 0 and args.fmax >= args.fmin):
+    """What argparse cannot say: ranges (the frequencies against the scene's step: check_frequencies)."""
+    if not (args.fmin > 0 and args.fmax >= args.fmin and math.isfinite(args.fmax)):
         raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
     if args.points < 1:
         raise SceneError(f"--points {args.points}: need at least 1")
+    if args.measure_periods < 1:
+        raise SceneError(f"--measure-periods {args.measure_periods}: need at least 1")
+    if not (args.settle_periods >= 0 and args.settle_s >= 0 and math.isfinite(args.settle_periods + args.settle_s)):
+        raise SceneError(f"--settle-periods {args.settle_periods:g} --settle-s {args.settle_s:g}: need finite "
+                         f"values >= 0")
     for amplitude in args.amplitude or []:
         if not (amplitude > 0 and math.isfinite(amplitude)):
             raise SceneError(f"--amplitude {amplitude:g}: need a positive amplitude")
+
+
+def check_frequencies(frequencies, scene, dwell) -> None:
+    """Refuses, before anything runs, a frequency the scene's step cannot resolve, named as the option
+    that asked for it: the highest of the log-spaced frequencies is --fmax, and it has the fewest steps
+    per period (the snapped step count falls with the frequency), so it is the one to check."""
+    fr.check_resolvable([max(frequencies)], scene.step_size, dwell, what="--fmax")
 
 
 def unit_of(mode: str) -> str:
@@ -186,71 +223,79 @@ def add_arguments(parser) -> None:
 
 
 def execute(args) -> int:
-    try:
-        check_arguments(args)
-        fmu = fmu_path(args.fmu)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
-            scene = load_scene(scene_file(args.scene, DEFAULT_SCENE, "--scene SCENE.toml"))
-        scene = with_overrides(scene, args.set)
-        frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
-        dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
-        amplitudes = args.amplitude or [0.2 if args.mode == "loop-gain" else 1.0]
-        if args.mode == "open-loop":
-            axis = args.axis or "1"
-            excitations = [fr.Excitation("voltage", axis, a, args.offset) for a in amplitudes]
-            scene = scene.with_changes(base_motion_spec={"type": "fixed"},
-                                       fidelity={**scene.fidelity, "base.fixed": True},
-                                       controller_spec={"type": "none"})
-            outputs = excitations[0].default_outputs()
-        elif args.mode == "loop-gain":
-            axis = args.axis or "1"
-            if axis not in fr.MOTOR_AXES:
-                raise SceneError(f"loop-gain --axis must be 1 or 2, got {axis!r}")
-            excitations = [fr.Excitation("injection", axis, a) for a in amplitudes]
-            outputs = None
-        else:
-            axis = args.axis or "roll"
-            excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
-            outputs = None
-        excitation = excitations[0]
-        sea = None
-        if args.sea_estimate:
-            if excitation.kind != "base":
-                raise SceneError("--sea-estimate goes with freqresp isolation (a carrier rate as the input)")
-            sea = fr.read_sea_estimate(args.sea_estimate, args.fmin, args.fmax, dwell_scale(scene, axis))
-        variants = []
-        if not args.linear_only:
-            variants.append(("full model", None))
-        if not args.full_only:
-            variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
-        lines, predict_rows = None, None
-        if not args.no_linear:
-            try:
-                lines, predict_rows, summary = linear_prediction(scene, fmu, excitation, outputs, args.fmin,
-                                                                 args.fmax)
-                if summary:
-                    print(summary)
-            except SceneError as exc:   # e.g. not a PID scene, or a loop that does not settle: measure anyway
-                print(f"{PROG}: no linear prediction: {exc}", file=sys.stderr)
-        client = cluster = None
-        if not args.serial:
-            from ..sweep import make_client
-            client, cluster = make_client(args.scheduler, workers=args.workers)
-        rows = []
-        wall = time.perf_counter()
+    return run_reporting_failures(PROG, lambda: measure_and_write(args))
+
+
+def measure_and_write(args) -> int:
+    check_arguments(args)
+    fmu = fmu_path(args.fmu)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
+        scene = load_scene(scene_file(args.scene, DEFAULT_SCENE, "--scene SCENE.toml"))
+    scene = with_overrides(scene, args.set, fmu)
+    frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
+    dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
+    check_frequencies(frequencies, scene, dwell)
+    amplitudes = args.amplitude or [0.2 if args.mode == "loop-gain" else 1.0]
+    if args.mode == "open-loop":
+        axis = args.axis or "1"
+        if axis not in fr.MOTOR_AXES:
+            raise SceneError(f"--axis {axis!r}: open-loop drives motor 1 or 2")
+        excitations = [fr.Excitation("voltage", axis, a, args.offset) for a in amplitudes]
+        scene = scene.with_changes(base_motion_spec={"type": "fixed"},
+                                   fidelity={**scene.fidelity, "base.fixed": True},
+                                   controller_spec={"type": "none"})
+        outputs = excitations[0].default_outputs()
+    elif args.mode == "loop-gain":
+        axis = args.axis or "1"
+        if axis not in fr.MOTOR_AXES:
+            raise SceneError(f"--axis {axis!r}: loop-gain injects at motor 1 or 2")
+        excitations = [fr.Excitation("injection", axis, a) for a in amplitudes]
+        outputs = None
+    else:
+        axis = args.axis or "roll"
+        if axis not in fr.BASE_AXES:
+            raise SceneError(f"--axis {axis!r}: isolation moves the carrier in roll, pitch or yaw")
+        excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
+        outputs = None
+    excitation = excitations[0]
+    sea = None
+    if args.sea_estimate:
+        if excitation.kind != "base":
+            raise SceneError("--sea-estimate goes with freqresp isolation (a carrier rate as the input)")
         try:
-            for each, amplitude in zip(excitations, amplitudes):
-                for label, fidelity in variants:
-                    curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode)}"
-                    rows += fr.sweep(scene, fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
-        finally:
-            if client is not None:
-                from ..sweep import close_client
-                close_client(client, cluster)
-    except (SceneError, ValueError) as exc:   # ValueError: an Excitation refusing its axis
-        print(f"{PROG}: {exc}", file=sys.stderr)
-        return 1
+            sea = fr.read_sea_estimate(args.sea_estimate, args.fmin, args.fmax, dwell_scale(scene, axis))
+        except ValueError as exc:   # a file that is not an isolation CSV: refused like a bad argument
+            raise SceneError(str(exc)) from None
+    variants = []
+    if not args.linear_only:
+        variants.append(("full model", None))
+    if not args.full_only:
+        variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
+    lines, predict_rows = None, None
+    if not args.no_linear:
+        try:
+            lines, predict_rows, summary = linear_prediction(scene, fmu, excitation, outputs, args.fmin,
+                                                             args.fmax)
+            if summary:
+                print(summary)
+        except SceneError as exc:   # e.g. not a PID scene, or a loop that does not settle: measure anyway
+            print(f"{PROG}: warning: no linear prediction: {exc}", file=sys.stderr)
+    client = cluster = None
+    if not args.serial:
+        from ..sweep import make_client
+        client, cluster = make_client(args.scheduler, workers=args.workers)
+    rows = []
+    wall = time.perf_counter()
+    try:
+        for each, amplitude in zip(excitations, amplitudes):
+            for label, fidelity in variants:
+                curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode)}"
+                rows += fr.sweep(scene, fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
+    finally:
+        if client is not None:
+            from ..sweep import close_client
+            close_client(client, cluster)
     if predict_rows is not None:
         rows += predict_rows(rows)
     out = pathlib.Path(args.out)
@@ -274,5 +319,9 @@ def execute(args) -> int:
     if excitation.kind == "injection":
         for line in measured_margins(rows):
             print(line)
-    print(f"{len(rows)} points in {time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
+    simulated = len({r["frequency_hz"] for r in rows if r["curve"] != fr.LINEAR_CURVE})
+    runs = len(excitations) * len(variants)
+    print(f"{simulated} frequencies x {runs} simulated curve{'s' if runs != 1 else ''} ({len(rows)} CSV rows: "
+          f"one per frequency, curve and output, the linear prediction's included) in "
+          f"{time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
     return 0

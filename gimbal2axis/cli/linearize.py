@@ -9,10 +9,17 @@ voltages applied from T on and the carrier's motion at T (--set may change these
 
 Writes <out> (.npz or .mat: A, B, C, D, the names of states, inputs and outputs, the modes and the
 point) and prints the states, the modes and the poles. With --bode INPUT:OUTPUT (repeatable) it also
-writes <out stem>_bode.png and .csv of those transfer functions.
+writes <out stem>_bode.png and .csv of those transfer functions, and warns (one line each on stderr)
+where one of them is identically zero because of a mode the model holds in at the point (a body stuck
+by dry friction, a gear in its backlash gap, a limited current, a clamped voltage), naming the setting
+that frees it: the linear model holds within those modes (docs/linearization.md).
 
-  gimbal2axis linearize --set gear1.model=0 --set motor1.model=0 --out results/azimuth.npz \\
-      --bode u_R1:alpha_dot
+Exit status: 0 written (warnings or not), 2 refused (an argument, a name, the scene, the output).
+
+  # the rigid azimuth axis with a quasi-static motor, without dry friction, on a fixed base: from
+  # u_R1 to alpha_dot a first-order lag, 0.206 rad/s per V, its pole at -26.2 1/s (4.18 Hz)
+  gimbal2axis linearize --set gear1.model=0 --set motor1.model=0 --set dry_friction=false \\
+      --set base.fixed=true --out results/azimuth.npz --bode u_R1:alpha_dot
   gimbal2axis linearize --scene scenes/ship_stabilization.toml --at-time 5 --out results/ship_5s.mat
 """
 from __future__ import annotations
@@ -26,11 +33,14 @@ import warnings
 import numpy as np
 
 from ..analysis import linearization
+from ..analysis.names import did_you_mean
 from ..errors import SceneError
 from ..locations import fmu_path
 from ..scene import load_scene
+from .failures import run_reporting_failures
 
 SUMMARY = "linearize the model at an operating point: A, B, C, D, poles, Bode plots"
+PROG = "gimbal2axis linearize"
 
 
 def parse_assignments(assignments: list[str]) -> dict:
@@ -160,37 +170,55 @@ def add_arguments(parser) -> None:
     parser.add_argument("--fmax", type=float, default=1000.0, help="Bode plot to (Hz)")
 
 
+def check_names(overrides: dict, known) -> None:
+    """Refuses a --set name the gimbal model does not have, naming the option and the close matches."""
+    for name in overrides:
+        if name not in known:
+            raise SceneError(f"--set: '{name}' is not a variable of the gimbal model"
+                             f"{did_you_mean(name, known)}")
+
+
 def execute(args) -> int:
+    return run_reporting_failures(PROG, lambda: linearize_and_write(args))
+
+
+def linearize_and_write(args) -> int:
+    overrides = parse_assignments(args.set)
+    if args.at_time is not None and args.scene is None:
+        raise SceneError("--at-time needs --scene: the run that reaches the operating point")
+    if args.at_time is not None and not (args.at_time > 0 and math.isfinite(args.at_time)):
+        raise SceneError(f"--at-time {args.at_time:g}: need a positive time (s)")
+    if args.bode and not (0 < args.fmin <= args.fmax and math.isfinite(args.fmax)):
+        raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
+    bode_pairs = [parse_pair(pair) for pair in args.bode]
+    out = pathlib.Path(args.out)
+    if out.suffix not in (".npz", ".mat"):
+        raise SceneError(f"--out {out}: write .npz or .mat")
     try:
-        overrides = parse_assignments(args.set)
-        if args.at_time is not None and args.scene is None:
-            raise SceneError("--at-time needs --scene: the run that reaches the operating point")
-        if args.at_time is not None and not (args.at_time > 0 and math.isfinite(args.at_time)):
-            raise SceneError(f"--at-time {args.at_time:g}: need a positive time (s)")
-        if args.bode and not (0 < args.fmin <= args.fmax):
-            raise SceneError(f"--fmin {args.fmin:g} --fmax {args.fmax:g}: need 0 < fmin <= fmax (Hz)")
-        bode_pairs = [parse_pair(pair) for pair in args.bode]
+        check_names(overrides, linearization.variable_names(args.build_dir))
         if args.scene is not None:
             model = scene_point(args.scene, fmu_path(args.fmu), args.at_time, overrides, args.build_dir)
         else:
             model = linearization.linearize(overrides, args.build_dir)
-        for source, target in bode_pairs:
-            if source not in model.inputs or target not in model.outputs:
-                raise SceneError(f"--bode '{source}:{target}': expected INPUT:OUTPUT with an input of {model.inputs} "
-                                 f"and an output of {model.outputs}")
-        out = pathlib.Path(args.out)
-        if out.suffix not in (".npz", ".mat"):
-            raise SceneError(f"--out {out}: write .npz or .mat")
-        out.parent.mkdir(parents=True, exist_ok=True)
-        model.save(out)
-        written = [out]
-        if bode_pairs:
-            written += write_bode(model, bode_pairs, out.with_suffix(""), args.fmin, args.fmax)
-    except SceneError as exc:
-        text = str(exc)   # the linearization's own messages start with "linearize: "
-        print(f"gimbal2axis {text}" if text.startswith("linearize: ") else f"gimbal2axis linearize: {text}",
-              file=sys.stderr)
-        return 1
+    except SceneError as exc:   # the linearization's own messages start with "linearize: ": the PROG says it
+        text = str(exc)
+        raise SceneError(text.removeprefix("linearize: ")) from None
+    for source, target in bode_pairs:
+        if source not in model.inputs:
+            raise SceneError(f"--bode '{source}:{target}': '{source}' is not an input of the model"
+                             f"{did_you_mean(source, model.inputs) or ' (' + ', '.join(model.inputs) + ')'}")
+        if target not in model.outputs:
+            raise SceneError(f"--bode '{source}:{target}': '{target}' is not an output of the model"
+                             f"{did_you_mean(target, model.outputs) or ' (' + ', '.join(model.outputs) + ')'}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    model.save(out)
+    written = [out]
+    if bode_pairs:
+        written += write_bode(model, bode_pairs, out.with_suffix(""), args.fmin, args.fmax)
     print(model.summary())
     print("wrote " + ", ".join(str(p) for p in written))
+    for source, target in bode_pairs:   # after the summary: the last lines a user reads
+        warning = model.zero_path_warning(source, target)
+        if warning:
+            print(f"{PROG}: warning: {warning}", file=sys.stderr)
     return 0
