@@ -74,7 +74,8 @@ class Progress:
     def update(self, t: float) -> None:
         self.bar.update(t - self.bar.n)
 
-    def close(self) -> None:
-        if self.bar.n < self.bar.total:
+    def close(self, complete: bool = True) -> None:
+        """Ends the bar; `complete` False (a run that stopped early) leaves it where the run got to."""
+        if complete and self.bar.n < self.bar.total:
             self.bar.update(self.bar.total - self.bar.n)
         self.bar.close()

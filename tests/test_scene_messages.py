@@ -123,8 +123,7 @@ def test_a_stop_time_that_is_not_positive_is_refused_and_keeps_the_results(tmp_p
     assert not (out / "scene.png").exists()
 
 
-@pytest.mark.parametrize("value, fragment", [("0.02", "after the scene's stop_time"),
-                                             ("0.0015", "not a whole number of steps")])
+@pytest.mark.parametrize("value, fragment", [("0.0015", "not a whole number of steps")])
 def test_a_stop_time_the_scene_cannot_take_is_refused(tmp_path, fmu_path, value, fragment):
     done = run_cli(scene_file(tmp_path, QUIET), "--fmu", fmu_path, "--out", tmp_path / "out", "--stop-time", value,
                    cwd=tmp_path)
@@ -251,7 +250,7 @@ def test_results_are_named_after_the_scene_file_not_its_name(tmp_path, fmu_path)
     out = tmp_path / "out"
     done = run_cli(copy, "--fmu", fmu_path, "--out", out, "--stop-time", "0.01", "--quiet", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
-    assert sorted(p.name for p in out.iterdir()) == ["my_copy.csv", "my_copy.png"]
+    assert sorted(p.name for p in out.iterdir()) == ["my_copy.csv", "my_copy.parquet", "my_copy.png", "my_copy_run.json"]
     assert f"wrote {out / 'my_copy.csv'}" in done.stdout
 
 

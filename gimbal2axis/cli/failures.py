@@ -1,17 +1,35 @@
 """How a command ends when its work fails: one line on stderr naming the command, and an exit
-status (2 refused or failed, 130 interrupted), never a traceback for what the user can fix."""
+status, never a traceback for what the user can fix.
+
+Exit statuses (the same for every command; `gimbal2axis run` uses all of them):
+  0    done
+  1    --check: the scene's requirements are not met
+  2    refused: an argument, the scene, the output directory, a run that cannot fit
+  3    the run failed part-way (the FMU refused a step, the controller raised); what it recorded up
+       to the last good step is written, marked partial
+  130  interrupted (SIGINT, Ctrl-C: 128 + 2); a run keeps what it recorded, marked partial
+  143  terminated (SIGTERM: 128 + 15); likewise
+"""
 from __future__ import annotations
 
+import signal
 import sys
+from contextlib import contextmanager
 
 from ..errors import SceneError
 
-EXIT_ERROR, EXIT_INTERRUPTED = 2, 130
+EXIT_ERROR, EXIT_FAILED_PARTIAL, EXIT_INTERRUPTED, EXIT_TERMINATED = 2, 3, 130, 143
+# master.Stop.kind -> the exit status of a run that ended that way
+EXIT_FOR_STOP = {"failed": EXIT_FAILED_PARTIAL, "interrupted": EXIT_INTERRUPTED, "terminated": EXIT_TERMINATED}
+
+
+class Terminated(Exception):
+    """SIGTERM outside a run that could end at its next step (or a second one during it)."""
 
 
 def run_reporting_failures(prog: str, work) -> int:
     """work()'s exit status, or the status of its refusal (SceneError), of a file it could not write
-    (OSError) or of Ctrl-C, each said in one line."""
+    (OSError) or of Ctrl-C or SIGTERM, each said in one line."""
     try:
         return work()
     except SceneError as exc:
@@ -24,3 +42,28 @@ def run_reporting_failures(prog: str, work) -> int:
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated:
+        print(f"{prog}: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
+
+
+SIGNAL_STOPS = {signal.SIGINT: ("interrupted", "interrupted by SIGINT (Ctrl-C)"),
+                signal.SIGTERM: ("terminated", "terminated by SIGTERM")}
+
+
+@contextmanager
+def signals_end_the_run(stop):
+    """While inside: SIGINT and SIGTERM ask `stop` (a master.StopRequest) to end the run at its next
+    step, so that what it recorded is written; a second signal ends at once (KeyboardInterrupt or
+    Terminated: nothing written). The handlers before are restored on leaving."""
+    def handle(signum, frame):
+        if stop.kind is not None:
+            raise KeyboardInterrupt if signum == signal.SIGINT else Terminated()
+        stop.request(*SIGNAL_STOPS[signum])
+
+    previous = {signum: signal.signal(signum, handle) for signum in SIGNAL_STOPS}
+    try:
+        yield stop
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)

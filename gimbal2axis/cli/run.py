@@ -1,10 +1,11 @@
 """Run a scene file (scenes/*.toml) on the Gimbal2Axis FMU.
 
 An fmpy master steps the FMU with the scene's controller in the loop (the voltage computed from the
-sensors at one communication point is applied over the step after the next) and writes
-<out>/<scene>.csv (every recorded signal, SI units) and <out>/<scene>.png (plots), where <scene> is
-the scene file's name without .toml; then it prints a summary line (line-of-sight error, wall time,
-real-time factor, events, requirements).
+sensors at one communication point is applied over the step after the next) and writes, as the run
+goes, <out>/<scene>.parquet (every recorded signal at every step, SI units) and <out>/<scene>.csv
+(the same at the scene's output interval), then <out>/<scene>.png (plots) and <out>/<scene>_run.json
+(complete or partial), where <scene> is the scene file's name without .toml; then it prints a summary
+line (line-of-sight error, wall time, real-time factor, events, requirements).
 """
 import math
 import os
@@ -16,9 +17,11 @@ import warnings
 from ..errors import SceneError, SceneWarning
 from ..locations import fmu_path
 from ..master import run_scene_file
+from ..master.master import STOP_KINDS, StopRequest
 from ..scene import load_scene
 from .defaults import scene_file
-from .failures import EXIT_ERROR, run_reporting_failures
+from .failures import (EXIT_ERROR, EXIT_FAILED_PARTIAL, EXIT_FOR_STOP, EXIT_INTERRUPTED, EXIT_TERMINATED,
+                       run_reporting_failures, signals_end_the_run)
 
 SUMMARY = "run a scene file: CSV, plots and a summary line"
 PROG = "gimbal2axis run"
@@ -34,11 +37,9 @@ def show_warning(message, category, filename, lineno, file=None, line=None):
 
 
 def check_stop_time(stop_time: float, scene) -> None:
+    """A --stop-time shortens or lengthens the run, by whole steps."""
     if not math.isfinite(stop_time) or stop_time <= 0:
         raise SceneError(f"--stop-time must be a positive number of seconds, got {stop_time:g}")
-    if stop_time > scene.stop_time * (1 + 1e-12):
-        raise SceneError(f"--stop-time {stop_time:g} is after the scene's stop_time ({scene.stop_time:g} s); "
-                         "it can only shorten a run (change stop_time in the scene file to run longer)")
     steps = stop_time / scene.step_size
     if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
         raise SceneError(f"--stop-time {stop_time:g} is not a whole number of steps of the scene's step_size "
@@ -58,7 +59,7 @@ def check_output_directory(out: pathlib.Path, stem: str) -> None:
             pass
     except OSError as exc:
         raise SceneError(f"--out {out}: cannot write there: {exc.strerror or exc}") from None
-    for suffix in (".csv", ".png"):
+    for suffix in (".csv", ".parquet", ".png", "_run.json"):
         target = out / f"{stem}{suffix}"
         if target.is_dir() or (target.exists() and not os.access(target, os.W_OK)):
             raise SceneError(f"cannot write {target}: {'it is a directory' if target.is_dir() else 'not writable'}")
@@ -67,7 +68,10 @@ def check_output_directory(out: pathlib.Path, stem: str) -> None:
 def add_arguments(parser) -> None:
     parser.epilog = ("Warnings (a scene that runs, but probably not as meant) and errors go to stderr, one line\n"
                      f"each. Exit status: 0 done, 1 --check found unmet requirements, {EXIT_ERROR} the scene or an\n"
-                     "option was refused or the run failed.")
+                     f"option was refused (a run too long for the disk included), {EXIT_FAILED_PARTIAL} the run failed "
+                     f"part-way,\n{EXIT_INTERRUPTED} interrupted (SIGINT, Ctrl-C), {EXIT_TERMINATED} terminated "
+                     "(SIGTERM). A run that stops early writes\nwhat it computed up to its last good step, marked "
+                     "partial in <scene>_run.json and the summary.")
     parser.add_argument("scene", nargs="?", default=None,
                         help=f"the scene file (default: {DEFAULT_SCENE} in the current directory, the "
                              "repository's free swing when run from its root)")
@@ -79,7 +83,8 @@ def add_arguments(parser) -> None:
                              "directory); files of the same scene are overwritten")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--stop-time", type=float, default=None, metavar="T",
-                        help="end the run at T seconds, before the scene's stop_time (a whole number of steps)")
+                        help="end the run at T seconds instead of the scene's stop_time, before or after it (a whole "
+                             "number of steps)")
     parser.add_argument("--check", action="store_true",
                         help="exit with status 1 when the scene's [requirements] are not met")
 
@@ -95,9 +100,29 @@ def _run(args) -> int:
     if args.stop_time is not None:
         check_stop_time(args.stop_time, scene)
     fmu = fmu_path(args.fmu)
-    check_output_directory(pathlib.Path(args.out), scene.name)
-    result, csv_path, png_path = run_scene_file(scene_path, fmu, args.out, progress=not args.quiet,
-                                                stop_time=args.stop_time)
+    out = pathlib.Path(args.out)
+    check_output_directory(out, scene.name)
+    stop = StopRequest()
+    try:
+        with signals_end_the_run(stop):
+            result, csv_path, png_path = run_scene_file(scene_path, fmu, out, progress=not args.quiet,
+                                                        stop_time=args.stop_time, keep_partial=True, stop=stop,
+                                                        stream=True)
+    except SceneError as exc:
+        if stop.kind is None:
+            raise
+        # stopped before the first communication point (nothing recorded, nothing written)
+        print(f"{PROG}: {STOP_KINDS[stop.kind]} before the run started: {exc}", file=sys.stderr)
+        return EXIT_FOR_STOP[stop.kind]
     print(result.summary())
-    print(f"wrote {csv_path} and {png_path}")
+    print(f"wrote {csv_path}, {csv_path.with_suffix('.parquet')} and {png_path}")
+    if result.stopped is not None:
+        stopped = result.stopped
+        kept = (f"the results for [0, {stopped.time:g}] s are in {csv_path} and .parquet, marked partial in "
+                f"{csv_path.with_name(scene.name + '_run.json')}")
+        if stopped.kind == "failed":   # the reason says where and why
+            print(f"{PROG}: error: {stopped.reason}; {kept}", file=sys.stderr)
+        else:
+            print(f"{PROG}: {stop.reason} at t = {stopped.time:g} s; {kept}", file=sys.stderr)
+        return EXIT_FOR_STOP[stopped.kind]
     return 1 if args.check and result.requirement_failures() else 0

@@ -1,9 +1,11 @@
 """The co-simulation master: a scene run on one FMU instance with its sensors, controller and the
 voltages' delay (master.py, with the compiled loop of compiled_loop.py for the built-in controllers),
 many user-controller scenes stepped together (lockstep.py), a run's signals and metrics (results.py),
-its plots (plotting.py), and a scene file run to its CSV and PNG (scene_files.py)."""
-from .master import Plan, real_outputs, run
+its plots (plotting.py), a run streamed to disk chunk by chunk in bounded memory (streaming.py), and
+a scene file run to its CSV, Parquet and PNG (scene_files.py)."""
+from .master import Plan, Stop, StopRequest, real_outputs, run
 from .results import RunResult
 from .scene_files import run_scene_file
+from .streaming import run_streamed
 
-__all__ = ["Plan", "RunResult", "real_outputs", "run", "run_scene_file"]
+__all__ = ["Plan", "RunResult", "Stop", "StopRequest", "real_outputs", "run", "run_scene_file", "run_streamed"]

@@ -28,12 +28,15 @@ def supports(controller) -> bool:
 class CompiledLoop:
     """One run's loop state; `run(first, last)` steps k = first .. last like master.step_loop."""
 
-    def __init__(self, slave, calls, plan):
+    def __init__(self, slave, calls, plan, chunked: bool = False):
+        """`chunked`: the plan's tables hold a chunk of the run at a time (streaming.py: point_at_chunk
+        before each); else they hold the whole run and the commands' tables are made here."""
         self.library = native.kernel()
         self.plan = plan   # keeps every array the struct points into alive
         self.vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
-        self.u_cmd = np.zeros((plan.n + 1, 2))
-        self.refs = np.full((plan.n + 1, 2), np.nan)
+        rows = 0 if chunked else plan.n + 1
+        self.u_cmd = np.zeros((rows, 2))
+        self.refs = np.full((rows, 2), np.nan)
         m = self.loop = native.struct("GimbalMasterLoop")()
         m.component = slave.component
         for name in ("get_real", "get_integer", "set_real", "do_step"):
@@ -49,6 +52,24 @@ class CompiledLoop:
         m.sensors = plan.sensors.state
         # A copy: the run leaves the controller object's own state as it was (as before the run).
         m.controller = plan.controller.state
+
+    def point_at_chunk(self, first: int, plan) -> None:
+        """For a run streamed in chunks (streaming.py): the kernel indexes every table by the run's
+        step k, so each table of the chunk whose row 0 is step `first` is given as the address its
+        row 0 of the run would have (sensors.SensorStream's _shifted); the commands' table starts
+        `delay` rows earlier, with the commands of the chunk before (the delayed voltage reads them).
+        The sensors' and controller's running states stay the loop's own."""
+        from ..scene.sensors import _shifted
+
+        m = self.loop
+        m.rec_real, m.rec_mode, m.inputs = (_shifted(a, first) for a in (plan.rec_real, plan.rec_mode, plan.inputs))
+        m.u_cmd = _shifted(plan.u_cmd, first - plan.delay)
+        m.refs = _shifted(plan.refs, first)
+        source = plan.sensors.state
+        m.sensors.gyro_noise, m.sensors.carrier_rate = source.gyro_noise, source.carrier_rate
+        m.sensors.gyro.error = source.gyro.error
+        m.controller.set_points.values = plan.controller.state.set_points.values
+        m.controller.set_points.rates = plan.controller.state.set_points.rates
 
     def run(self, first: int, last: int) -> None:
         failed = self.library.gimbal_master_loop(ctypes.addressof(self.loop), first, last)

@@ -13,6 +13,7 @@ With a fixed base the base inputs are never set (they stay 0).
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,6 +28,34 @@ from ..scene.scene import Scene, check_against_fmu, parameter_value, start_value
 class FMUCallFailed(Exception):
     def __init__(self, function: str):
         super().__init__(f"{function} returned fmi2Discard or fmi2Error")
+        self.function = function
+
+
+# How a run ended before its stop time (Stop.kind), in the words of the summary line.
+STOP_KINDS = {"failed": "failed", "interrupted": "interrupted (SIGINT)", "terminated": "terminated (SIGTERM)"}
+
+
+@dataclass(frozen=True)
+class Stop:
+    """Why and where a run ended before its stop time; its record ends at `time` (the last
+    communication point whose outputs, sensors and controller output were all recorded)."""
+    kind: str       # a key of STOP_KINDS
+    time: float     # s
+    reason: str     # one line
+
+
+class StopRequest:
+    """Asks a running loop to end, keeping what it recorded: `request(kind, reason)` (from a signal
+    handler, say) is seen at the next step of the Python loop or at the next chunk boundary of the
+    compiled loop (CHUNK_STEPS steps, a few tens of milliseconds)."""
+
+    def __init__(self):
+        self.kind, self.reason = None, None
+
+    def request(self, kind: str, reason: str) -> None:
+        if kind not in STOP_KINDS:
+            raise ValueError(f"unknown stop kind {kind!r}")
+        self.kind, self.reason = kind, reason
 
 
 class RawCalls:
@@ -67,8 +96,9 @@ class Plan:
         self.scene, self.h = scene, scene.step_size
         self.t_end = scene.stop_time if stop_time is None else stop_time
         self.n = int(round(self.t_end / self.h))
-        self.times = np.arange(self.n + 1) * self.h
         self.motion = scene.base_motion()
+        check_memory(scene, fmu, self)
+        self.times = np.arange(self.n + 1) * self.h
         self.base = self.motion.sample(self.times)
         u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
         self.controller = controller or scene.controller(u_limit)
@@ -79,19 +109,7 @@ class Plan:
         self.measured_attitude = self.sensors.prepare(self.base, self.h)
         self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
 
-        self.real_names = real_outputs(fmu)
-        self.mode_names = [name for name in MODE_OUTPUTS
-                           if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
-        for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]", "alpha_dot", "beta_dot"):
-            if needed not in self.real_names:
-                raise SceneError(f"{fmu.path} has no output '{needed}', which the sensors need")
-        self.real_vrs = [fmu.vr(name) for name in self.real_names]
-        self.mode_vrs = [fmu.vr(name) for name in self.mode_names]
-        self.i_alpha, self.i_beta = self.real_names.index("alpha"), self.real_names.index("beta")
-        self.i_gyro = [self.real_names.index(f"los.omega[{j}]") for j in (1, 2, 3)]
-        self.i_joint_rates = [self.real_names.index(name) for name in ("alpha_dot", "beta_dot")]
-        self.input_vrs = [fmu.vr("u_R1"), fmu.vr("u_R2")] + ([] if self.motion.fixed else
-                                                              [fmu.vr(b) for b in BASE_INPUTS])
+        choose_records(self, fmu)
 
         self.rec_real = np.zeros((self.n + 1, len(self.real_names)))
         self.rec_mode = np.zeros((self.n + 1, len(self.mode_names)), dtype=np.int32)
@@ -100,6 +118,49 @@ class Plan:
             self.inputs[:, 2:] = self.base
         self.u_cmd, self.refs = [], []  # lists: appending costs less than writing a numpy row
         self.k = 0                      # the step reached (for the message of a failure)
+        self.rows = 0                   # communication points recorded whole (rows 0 .. rows - 1)
+
+
+def memory_needed(fmu: FMU, points: int) -> int:
+    """Bytes a run held in memory takes at least for `points` communication points: per point the records (the
+    outputs, the modes), the inputs and base motion, the times, the measured attitude, the set points,
+    the commands, and the RunResult's columns (recorded and derived) made from them."""
+    real = len(real_outputs(fmu))
+    modes = sum(1 for name in MODE_OUTPUTS if fmu.has(name))
+    plan = real + modes / 2 + (2 + len(BASE_INPUTS)) + len(BASE_INPUTS) + 1 + 3 + 4 + 4
+    result = 1 + real + modes + 6 + len(BASE_INPUTS) + 1 + 10
+    return int(points * (plan + result) * 8)
+
+
+def check_memory(scene: Scene, fmu: FMU, plan) -> None:
+    """Refuses (SceneError, one line) a run whose record cannot be held in the memory available, before
+    anything is allocated (numpy would fail part-way with a traceback); `gimbal2axis run` streams the
+    record to disk instead (streaming.py)."""
+    from .streaming import available_memory, size_text
+
+    needed, available = memory_needed(fmu, plan.n + 1), available_memory()
+    if available is not None and needed > available:
+        raise SceneError(f"{scene.name}: a run of {plan.n + 1:,} points ({plan.t_end:g} s at {plan.h:g} s) held in "
+                         f"memory needs {size_text(needed)}, {size_text(available)} is available; shorten it, or "
+                         f"run it with `gimbal2axis run`, which writes it to disk as it goes")
+
+
+def choose_records(plan, fmu: FMU) -> None:
+    """What a run records and sets, on `plan` (a Plan or a streaming.StreamPlan): the outputs' names
+    and value references, the columns the sensors read, the inputs' value references."""
+    plan.real_names = real_outputs(fmu)
+    plan.mode_names = [name for name in MODE_OUTPUTS
+                       if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
+    for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]", "alpha_dot", "beta_dot"):
+        if needed not in plan.real_names:
+            raise SceneError(f"{fmu.path} has no output '{needed}', which the sensors need")
+    plan.real_vrs = [fmu.vr(name) for name in plan.real_names]
+    plan.mode_vrs = [fmu.vr(name) for name in plan.mode_names]
+    plan.i_alpha, plan.i_beta = plan.real_names.index("alpha"), plan.real_names.index("beta")
+    plan.i_gyro = [plan.real_names.index(f"los.omega[{j}]") for j in (1, 2, 3)]
+    plan.i_joint_rates = [plan.real_names.index(name) for name in ("alpha_dot", "beta_dot")]
+    plan.input_vrs = [fmu.vr("u_R1"), fmu.vr("u_R2")] + ([] if plan.motion.fixed else
+                                                         [fmu.vr(b) for b in BASE_INPUTS])
 
 
 def initialize(slave, scene: Scene, fmu: FMU, plan: Plan) -> None:
@@ -112,9 +173,11 @@ def initialize(slave, scene: Scene, fmu: FMU, plan: Plan) -> None:
     slave.exitInitializationMode()
 
 
-def step_loop(slave, plan: Plan, bar: Progress) -> None:
+def step_loop(slave, plan: Plan, bar: Progress, stop: StopRequest | None = None) -> None:
     """The communication steps: outputs at t_k, sensors, controller, the delayed voltage, one step.
-    Locals only inside the loop: it is the master's whole per-step cost."""
+    Locals only inside the loop: it is the master's whole per-step cost. Ends early, before reading
+    the outputs at t_k, when `stop` is requested. plan.rows: the points recorded whole (one per
+    controller output), also when a call or the controller raises."""
     calls = RawCalls(slave)
     vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
     (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
@@ -132,39 +195,61 @@ def step_loop(slave, plan: Plan, bar: Progress) -> None:
     i_alpha, i_beta, i_gyro, (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, plan.i_joint_rates
     u_cmd, refs = plan.u_cmd, plan.refs
     zero = (0.0, 0.0)
-    for k in range(n + 1):
-        plan.k = k
-        t = k * h
-        if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
-            raise FMUCallFailed("fmi2GetReal")
-        if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
-            raise FMUCallFailed("fmi2GetInteger")
-        y = rec_real[k].tolist()
-        alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro], y[i_alpha_dot], y[i_beta_dot])
-        u = controller(t, h, alpha, beta, gyro, attitude_rows[k], rate_rows[k], step=k)
-        u_cmd.append(u)
-        refs.append(controller.reference)
-        applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
-        if k == n:
-            break
-        inputs[k, 0], inputs[k, 1] = applied
-        if set_real(component, input_refs, input_count, input_row + k * input_stride) > 1:
-            raise FMUCallFailed("fmi2SetReal")
-        if do_step(component, t, h, 1) > 1:
-            raise FMUCallFailed("fmi2DoStep")
-        if k % 256 == 0:
-            bar.update((k + 1) * h)
+    stop = stop or StopRequest()   # nobody can ask: one attribute read per step all the same
+    try:
+        for k in range(n + 1):
+            if stop.kind is not None:
+                break
+            plan.k = k
+            t = k * h
+            if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
+                raise FMUCallFailed("fmi2GetReal")
+            if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
+                raise FMUCallFailed("fmi2GetInteger")
+            y = rec_real[k].tolist()
+            alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro], y[i_alpha_dot],
+                                        y[i_beta_dot])
+            u = controller(t, h, alpha, beta, gyro, attitude_rows[k], rate_rows[k], step=k)
+            u_cmd.append(u)
+            refs.append(controller.reference)
+            applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
+            if k == n:
+                break
+            inputs[k, 0], inputs[k, 1] = applied
+            if set_real(component, input_refs, input_count, input_row + k * input_stride) > 1:
+                raise FMUCallFailed("fmi2SetReal")
+            if do_step(component, t, h, 1) > 1:
+                raise FMUCallFailed("fmi2DoStep")
+            if k % 256 == 0:
+                bar.update((k + 1) * h)
+    finally:
+        plan.rows = len(u_cmd)
 
 
-def compiled_step_loop(slave, plan: Plan, bar: Progress) -> None:
-    """step_loop for the built-in controllers, compiled (compiled_loop.py): the same results."""
+# Steps of the compiled loop between progress updates and looks at a StopRequest: about 40 ms of
+# the ship scene, so Ctrl-C or SIGTERM is answered at once to a person.
+CHUNK_STEPS = 4096
+
+
+def compiled_step_loop(slave, plan: Plan, bar: Progress, stop: StopRequest | None = None) -> None:
+    """step_loop for the built-in controllers, compiled (compiled_loop.py): the same results. Ends
+    at a chunk boundary when `stop` is requested (the FMU has then made the step after the last
+    recorded point, whose outputs are not recorded)."""
     loop = compiled_loop.CompiledLoop(slave, RawCalls(slave), plan)
-    chunk = 4096   # steps between progress updates (and chances to take Ctrl-C)
-    for first in range(0, plan.n + 1, chunk):
-        last = min(first + chunk - 1, plan.n)
-        loop.run(first, last)
-        bar.update(min(last + 1, plan.n) * plan.h)
-    plan.u_cmd, plan.refs = loop.u_cmd, loop.refs
+    try:
+        for first in range(0, plan.n + 1, CHUNK_STEPS):
+            if stop is not None and stop.kind is not None:
+                break
+            last = min(first + CHUNK_STEPS - 1, plan.n)
+            loop.run(first, last)
+            plan.rows = last + 1
+            bar.update(min(last + 1, plan.n) * plan.h)
+    except FMUCallFailed as failure:
+        # the outputs at the failed step were recorded unless reading them is what failed
+        plan.rows = plan.k + (failure.function in ("fmi2SetReal", "fmi2DoStep"))
+        raise
+    finally:
+        plan.u_cmd, plan.refs = loop.u_cmd, loop.refs
 
 
 def choose_loop(controller, compiled: bool | None) -> str:
@@ -184,37 +269,52 @@ def choose_loop(controller, compiled: bool | None) -> str:
 
 def failure_message(scene: Scene, plan: Plan, exc: Exception, log: list | None) -> str:
     """The message of a run stopped by `exc` at step plan.k, with the FMU's last log messages."""
+    if isinstance(exc, SceneError):   # the controller's own words (a user controller's nonsense)
+        return str(exc)
+    if not isinstance(exc, FMUCallFailed) and not type(exc).__module__.startswith("fmpy"):
+        # a user controller (or its sensors) raised: say what, not "the FMU failed"
+        return f"{scene.name}: the controller raised at t = {plan.k * plan.h:.6g} s: {type(exc).__name__}: {exc}"
     details = "; ".join(map(str, (log or [])[-5:])) or "no log message"
     return f"{scene.name}: the FMU failed at t = {plan.k * plan.h:.6g} s ({exc}): {details}"
 
 
-def recorded_signals(plan: Plan) -> dict:
+def recorded_signals(plan: Plan, rows: int | None = None) -> dict:
     """'time' and one array per signal; row k: outputs at t_k, the voltage applied over
-    [t_k, t_k+1], the controller's output at t_k, the base inputs at t_k."""
-    u_cmd = np.array(plan.u_cmd, dtype=float).reshape(-1, 2)
-    refs = np.array(plan.refs, dtype=float).reshape(-1, 2)
+    [t_k, t_k+1], the controller's output at t_k, the base inputs at t_k. `rows`: only the first
+    rows (a run that ended early), default all."""
+    rows = plan.n + 1 if rows is None else rows
+    u_cmd = np.array(plan.u_cmd, dtype=float).reshape(-1, 2)[:rows]
+    refs = np.array(plan.refs, dtype=float).reshape(-1, 2)[:rows]
     # Applied over [t_k, t_k+1]: the command of `delay` steps before (0 V until the first is due).
     u_applied = np.zeros_like(u_cmd)
     u_applied[plan.delay:] = u_cmd[:len(u_cmd) - plan.delay]
-    signals = {"time": plan.times}
-    signals.update({name: plan.rec_real[:, j] for j, name in enumerate(plan.real_names)})
-    signals.update({name: plan.rec_mode[:, j].astype(float) for j, name in enumerate(plan.mode_names)})
+    times = plan.times[:rows]
+    signals = {"time": times}
+    signals.update({name: plan.rec_real[:rows, j] for j, name in enumerate(plan.real_names)})
+    signals.update({name: plan.rec_mode[:rows, j].astype(float) for j, name in enumerate(plan.mode_names)})
     signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0],
                     "u_R2_cmd": u_cmd[:, 1], "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
-    signals.update({name: plan.base[:, j] for j, name in enumerate(BASE_INPUTS)})
-    signals["heave"] = plan.motion.position(plan.times)[:, 2]
+    signals.update({name: plan.base[:rows, j] for j, name in enumerate(BASE_INPUTS)})
+    signals["heave"] = plan.motion.position(times)[:, 2]
     return signals
 
 
 def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None = None,
-        controller=None, slave=None, log: list | None = None, compiled: bool | None = None) -> RunResult:
+        controller=None, slave=None, log: list | None = None, compiled: bool | None = None,
+        keep_partial: bool = False, stop: StopRequest | None = None) -> RunResult:
     """Runs `scene` (to `stop_time` if given) and returns the recorded signals (recorded_signals),
     with line-of-sight signals added.
 
     `slave` (with the `log` list its logger appends to, from `fmu.instantiate(name, log)`): reuse this
     instance instead of instantiating a fresh one; it is reset first (fmi2Reset: back to the start
     values, state 'instantiated'), the log is cleared, and the instance is left alive for the next run.
-    `compiled`: which loop (choose_loop); the result's `loop` says which ran."""
+    `compiled`: which loop (choose_loop); the result's `loop` says which ran.
+
+    A run that fails in its loop (the FMU refuses a call, the controller raises) raises SceneError
+    with the message of where and why, unless `keep_partial`: then it returns what it recorded up to
+    the last whole communication point, with `result.stopped` (a Stop) saying where and why. `stop`:
+    a StopRequest that ends the run early the same way (a signal handler's). A run that recorded no
+    point at all raises SceneError either way. `result.stopped` is None for a whole run."""
     plan = Plan(scene, fmu, stop_time, controller)
     loop = choose_loop(plan.controller, compiled)
     owned = slave is None
@@ -227,21 +327,38 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
         slave.reset()
     bar = Progress(plan.t_end, enabled=progress)
     wall0, cpu0 = time.perf_counter(), time.process_time()
+    stopped = None
     try:
-        initialize(slave, scene, fmu, plan)
-        plan.controller.start(plan.h, scene.name)
-        (compiled_step_loop if loop == "compiled" else step_loop)(slave, plan, bar)
-        bar.close()
-        slave.terminate()
-    except SceneError:
-        raise
-    except Exception as exc:   # a refused FMI call, or fmpy raising on fmi2Error / fmi2Discard
-        raise SceneError(failure_message(scene, plan, exc, log)) from None
+        try:
+            initialize(slave, scene, fmu, plan)
+            plan.controller.start(plan.h, scene.name)
+        except SceneError:
+            raise
+        except Exception as exc:   # refused at initialization: the scene, not the run
+            raise SceneError(failure_message(scene, plan, exc, log)) from None
+        try:
+            (compiled_step_loop if loop == "compiled" else step_loop)(slave, plan, bar, stop)
+        except Exception as exc:   # a refused FMI call, fmpy raising on fmi2Error / fmi2Discard, the controller
+            message = failure_message(scene, plan, exc, log)
+            if not keep_partial or plan.rows == 0:
+                raise SceneError(message) from None
+            stopped = Stop("failed", (plan.rows - 1) * plan.h, message)
+        if stopped is None and plan.rows < plan.n + 1:
+            if plan.rows == 0:
+                raise SceneError(f"{scene.name}: {stop.reason} before the first communication point: nothing "
+                                 "recorded")
+            stopped = Stop(stop.kind, (plan.rows - 1) * plan.h, f"{scene.name}: {stop.reason}")
+        bar.close(complete=stopped is None)
+        if stopped is None:
+            slave.terminate()
     finally:
         if owned:
             slave.freeInstance()
     wall, loop_cpu = time.perf_counter() - wall0, time.process_time() - cpu0
-    result = RunResult(scene, recorded_signals(plan), wall, plan.t_end)
+    end = plan.t_end if stopped is None else stopped.time
+    result = RunResult(scene, recorded_signals(plan, plan.rows), wall, end)
     result.loop_cpu_time = loop_cpu  # set-up, initialization and the loop; not the base motion's evaluation
     result.loop = loop
+    result.stopped = stopped
+    result.requested_stop_time = plan.t_end
     return result

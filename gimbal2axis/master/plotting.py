@@ -72,15 +72,16 @@ def draw_los_error(ax, result, t: np.ndarray, values: np.ndarray) -> None:
     The RMS line spans the window it is taken over."""
     ax.plot(t, values, "-", lw=0.9, label=LABELS["los_error"])
     m = result.los_metrics()
-    in_window = t >= m["from_s"] - 1e-12
-    start = t[in_window][0] if in_window.any() else t[0]   # los_metrics takes the whole run then
+    # the window's first and last sample (los_metrics takes the whole run when the window is empty),
+    # from the result: a decimated `t` has no sample at the window's start
+    start, end = result.window_bounds()
     rms = m["rms"] * 1e3
-    ax.hlines(rms, start, t[-1], color="C1", lw=1.2, ls=":",
-              label=f"RMS over [{start:g}, {t[-1]:g}] s: {rms:.3g} mrad")
+    ax.hlines(rms, start, end, color="C1", lw=1.2, ls=":",
+              label=f"RMS over [{start:g}, {end:g}] s: {rms:.3g} mrad")
     references = [rms]
     bound = result.scene.requirements.get("los_rms_max_mrad")
     if bound:
-        ax.hlines(bound, start, t[-1], color="C3", lw=0.8, ls="--", label=f"required RMS <= {bound:g} mrad")
+        ax.hlines(bound, start, end, color="C3", lw=0.8, ls="--", label=f"required RMS <= {bound:g} mrad")
         references.append(bound)
     finite = values[np.isfinite(values)]
     resolved = np.concatenate([finite[finite > ROUND_OFF_MRAD], [r for r in references if r > ROUND_OFF_MRAD]])
@@ -127,10 +128,14 @@ def figure(result, limits: dict | None = None):
         # outside the axes: a legend box inside would cover samples
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0, fontsize="x-small")
     axes[-1, 0].set_xlabel("time [s]")
-    axes[-1, 0].set_xlim(t[0], t[-1])
+    if t[-1] > t[0]:   # a record of one point keeps matplotlib's margins around it
+        axes[-1, 0].set_xlim(t[0], t[-1])
     title = f"{scene.title}: {scene.description}" if scene.description else scene.title
     if scene.title != scene.name:
         title = f"{title} ({scene.path.name})"
+    stopped = getattr(result, "stopped", None)
+    if stopped is not None:
+        title = f"PARTIAL: {stopped.kind} at t = {stopped.time:g} s of {result.requested_stop_time:g} s. {title}"
     fig.suptitle("\n".join(textwrap.wrap(title, 130)), fontsize="medium")
     fig.tight_layout()
     return fig
@@ -177,7 +182,7 @@ def spectrum_figure(result):
         axes[1].loglog(f[f > 0], cumulative[f > 0], lw=1.1, color=f"C{index}",
                        label=f"{LOS_AXIS_LABELS[name]}: total {cumulative[-1]:.3g} mrad RMS")
     spectrum = next(iter(found.values()))
-    t = result.signals["time"][result.metrics_window()]
+    t = result.window_bounds()
     axes[0].set_title(f"Welch: {spectrum.resolution:g} Hz resolution, Hann window, 50 % overlap, "
                       f"{spectrum.segments} segment(s) over [{t[0]:g}, {t[-1]:g}] s", fontsize="small")
     axes[0].set_ylabel("LOS error PSD\n[mrad^2/Hz]", fontsize="small")

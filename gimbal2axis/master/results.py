@@ -21,8 +21,14 @@ ISOLATION_AXES = {1: "elevation", 3: "cross_elevation"}
 
 
 class RunResult:
+    """`stop_time`: the end of the record (the last communication point recorded). `stopped`: None
+    for a whole run, else a master.Stop (kind, time, reason) of a run that ended early, whose record
+    covers [0, stopped.time] (master.run(keep_partial=True)); `requested_stop_time` is where it was
+    to end."""
+
     def __init__(self, scene, signals: dict, wall_time: float, stop_time: float):
         self.scene, self.signals, self.wall_time, self.stop_time = scene, signals, wall_time, stop_time
+        self.stopped, self.requested_stop_time = None, stop_time
         s = signals
         attitude = (s["base.delta"], s["base.psi"], s["base.gamma"])
         s["alpha_error"] = s["alpha_ref"] - s["alpha"]
@@ -52,6 +58,21 @@ class RunResult:
         s = self.signals
         return any(np.any(s[f"base.{n}_dot"] != 0) for n in ("delta", "psi", "gamma")) if "base.delta_dot" in s \
             else False
+
+    def final(self, name: str) -> float | None:
+        """The last recorded value of a signal (None when not recorded)."""
+        return float(self.signals[name][-1]) if name in self.signals else None
+
+    def window_bounds(self) -> tuple[float, float]:
+        """The first and last time of the metrics window (metrics_window)."""
+        t = self.signals["time"][self.metrics_window()]
+        return float(t[0]), float(t[-1])
+
+    def carrier_spectrum(self, i: int) -> np.ndarray:
+        """The PSD [(rad/s)^2/Hz] of the carrier's rate about payload axis i over the metrics window, at
+        the isolation estimate's resolution."""
+        return spectra.psd(self.derived[f"base.omega2[{i}]"][self.metrics_window()], 1.0 / self.scene.step_size,
+                           self.scene.analysis.isolation_resolution_hz).psd
 
     def signal(self, name: str) -> np.ndarray:
         """A recorded or a derived signal by name."""
@@ -123,7 +144,7 @@ class RunResult:
         for name, spectrum in found.items():
             columns += [spectrum.psd, spectrum.cumulative_rms()]
             names += [f"psd_{name[len('los_error_'):]}_rad2_per_hz", f"cumulative_rms_{name[len('los_error_'):]}_rad"]
-        t = self.signals["time"][self.metrics_window()]
+        t = self.window_bounds()
         means = ", ".join(f"{AXIS_ERRORS[n]} {sp.mean:.6g} rad" for n, sp in found.items())
         comment = (f"# Welch PSD of the line-of-sight error (line of sight minus target) over [{t[0]:g}, {t[-1]:g}] s: "
                    f"Hann window, {spectra.OVERLAP:.0%} overlap, {first.resolution:g} Hz resolution, "
@@ -142,14 +163,13 @@ class RunResult:
         columns, names = [first.frequency], ["frequency_hz"]
         for i, estimate in found.items():
             axis = ISOLATION_AXES[i]
-            carrier = spectra.psd(self.derived[f"base.omega2[{i}]"][self.metrics_window()], 1.0 / self.scene.step_size,
-                                  self.scene.analysis.isolation_resolution_hz).psd   # where the sea has energy
+            carrier = self.carrier_spectrum(i)   # where the sea has energy
             with np.errstate(divide="ignore"):
                 gain_db = 20 * np.log10(np.abs(estimate.response))
             columns += [carrier, np.abs(estimate.response), gain_db, np.degrees(np.angle(estimate.response)),
                         estimate.coherence]
             names += [f"{axis}_carrier_psd", f"{axis}_gain", f"{axis}_gain_db", f"{axis}_phase_deg", f"{axis}_coherence"]
-        t = self.signals["time"][self.metrics_window()]
+        t = self.window_bounds()
         comment = (f"# H1 estimate of los.omega[i] against the carrier's inertial rate about the same payload axis "
                    f"(i = 1 elevation, 3 cross-elevation) over [{t[0]:g}, {t[-1]:g}] s: {spectra.WINDOW} window, "
                    f"{spectra.OVERLAP:.0%} overlap, {first.resolution:g} Hz resolution, {first.segments} segment(s); "
@@ -191,13 +211,19 @@ class RunResult:
         rtf = self.stop_time / self.wall_time if self.wall_time > 0 else math.inf
         parts = [f"{self.scene.name}: {self.stop_time:g} s simulated in {self.wall_time:.2f} s wall "
                  f"({rtf:.1f}x real time)"]
+        if self.stopped is not None:
+            from .master import STOP_KINDS
+            parts[0] = (f"{self.scene.name}: PARTIAL, {STOP_KINDS[self.stopped.kind]} at t = {self.stopped.time:g} s "
+                        f"of {self.requested_stop_time:g} s; {self.stop_time:g} s simulated in {self.wall_time:.2f} s "
+                        f"wall ({rtf:.1f}x real time)")
         if self.has_target:
             m = self.los_metrics()
             window = f" from {m['from_s']:g} s" if m["from_s"] > 0 else ""
             parts.append(f"LOS error final {m['final'] * 1e3:.4g} mrad, RMS{window} {m['rms'] * 1e3:.4g} mrad "
                          f"(max {m['max'] * 1e3:.4g} mrad)")
         else:
-            parts.append(f"final alpha {math.degrees(s['alpha'][-1]):.4f} deg, beta {math.degrees(s['beta'][-1]):.4f} deg")
+            parts.append(f"final alpha {math.degrees(self.final('alpha')):.4f} deg, "
+                         f"beta {math.degrees(self.final('beta')):.4f} deg")
         bands = self.scene.analysis.bands
         if self.has_target and bands:
             spectrum = next(iter(self.los_spectra().values()), None)
@@ -207,8 +233,8 @@ class RunResult:
             window = f" from {m['from_s']:g} s" if m["from_s"] > 0 else ""
             parts.append(f"LOS RMS by band{window} ({resolution}): " + ", ".join(
                 f"{name} [{lo:g}, {hi:g}) Hz {rms[name] * 1e3:.4g} mrad" for name, (lo, hi) in bands.items()))
-        if "events.total" in s:
-            parts.append(f"{int(s['events.total'][-1])} events")
+        if self.final("events.total") is not None:
+            parts.append(f"{int(self.final('events.total'))} events")
         if self.scene.requirements and self.has_target:
             failures = self.requirement_failures()
             if self.window_start() >= self.stop_time:

@@ -125,3 +125,70 @@ def transfer_estimate(x, y, sample_rate: float, resolution_hz: float) -> Transfe
         coherence = np.where((s_xx > 0) & (s_yy > 0), np.abs(s_xy) ** 2 / (s_xx * s_yy), np.nan)
     return TransferEstimate(frequency, response, np.clip(coherence, 0.0, 1.0), sample_rate / segment,
                             segment_count(x.size, segment))
+
+
+class WelchAccumulator:
+    """psd and transfer_estimate of signals too long to hold, fed a chunk at a time (a run streamed
+    to disk, master/streaming.py): the same segments, window, overlap, scaling and mean removal as
+    scipy's welch and csd do over the whole signal, so the same estimate up to the order of the
+    sums (the segments' periodograms are summed in order instead of averaged by numpy's pairwise
+    mean: the last bits may differ).
+
+    `means`: {signal: its mean over the samples that will be fed} (found by a first pass);
+    `samples`: how many will be fed; `pairs`: the (x, y) whose cross spectrum is wanted."""
+
+    def __init__(self, sample_rate: float, resolution_hz: float, samples: int, means: dict, pairs=()):
+        from scipy import signal
+
+        if samples < 2:
+            raise ValueError(f"need at least 2 samples, got {samples}")
+        self.sample_rate, self.samples, self.means = sample_rate, samples, dict(means)
+        self.segment = min(segment_length(sample_rate, resolution_hz), samples)
+        self.step = self.segment - int(self.segment * OVERLAP)
+        self.window = signal.get_window(WINDOW, self.segment)
+        self.scale = 1.0 / (sample_rate * np.sum(self.window * self.window))
+        self.pairs = list(pairs)
+        self.pending = {name: np.empty(0) for name in self.means}
+        self.power = {name: 0.0 for name in self.means}
+        self.cross = {pair: 0.0 for pair in self.pairs}
+        self.segments = 0
+
+    def feed(self, chunk: dict) -> None:
+        """The next samples of every signal (equal lengths)."""
+        for name in self.pending:
+            self.pending[name] = np.concatenate([self.pending[name], np.asarray(chunk[name], dtype=float)])
+        while len(next(iter(self.pending.values()))) >= self.segment:
+            spectra = {name: np.fft.rfft(self.window * (x[:self.segment] - self.means[name]))
+                       for name, x in self.pending.items()}
+            for name, values in spectra.items():
+                self.power[name] = self.power[name] + (np.conjugate(values) * values).real
+            for x, y in self.pairs:
+                self.cross[(x, y)] = self.cross[(x, y)] + np.conjugate(spectra[x]) * spectra[y]
+            self.segments += 1
+            self.pending = {name: x[self.step:] for name, x in self.pending.items()}
+
+    def _one_sided(self, summed):
+        density = summed * (self.scale / self.segments)
+        if self.segment % 2 == 0:
+            density[1:-1] *= 2
+        else:
+            density[1:] *= 2
+        return density
+
+    @property
+    def frequency(self) -> np.ndarray:
+        return np.fft.rfftfreq(self.segment, 1.0 / self.sample_rate)
+
+    def spectrum(self, name: str) -> Spectrum:
+        return Spectrum(self.frequency, self._one_sided(np.array(self.power[name], dtype=float)),
+                        self.sample_rate / self.segment, self.segments, float(self.means[name]))
+
+    def transfer(self, x: str, y: str) -> TransferEstimate:
+        s_xx = self._one_sided(np.array(self.power[x], dtype=float))
+        s_yy = self._one_sided(np.array(self.power[y], dtype=float))
+        s_xy = self._one_sided(np.array(self.cross[(x, y)], dtype=complex))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            response = np.where(s_xx > 0, s_xy / s_xx, np.nan)
+            coherence = np.where((s_xx > 0) & (s_yy > 0), np.abs(s_xy) ** 2 / (s_xx * s_yy), np.nan)
+        return TransferEstimate(self.frequency, response, np.clip(coherence, 0.0, 1.0), self.sample_rate / self.segment,
+                                self.segments)

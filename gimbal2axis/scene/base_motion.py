@@ -45,6 +45,16 @@ class BaseMotion:
         """(len(t), 3) position of point a in G relative to its start (for plots); zeros if unknown."""
         return np.zeros((len(t), 3))
 
+    # Rows first .. first + count - 1 of the run's grid t_k = k h (k = 0 .. n): the same bits as
+    # sample(np.arange(n + 1) * h)[first:first + count], for a run made chunk by chunk
+    # (master/streaming.py).
+    def sample_rows(self, first: int, count: int, h: float) -> np.ndarray:
+        return self.sample(np.arange(first, first + count) * h)
+
+    def position_rows(self, first: int, count: int, h: float) -> np.ndarray:
+        """position's rows of the grid, relative to t = 0 as position(whole grid) is."""
+        return self.position(np.arange(first, first + count) * h)
+
 
 class FixedBase(BaseMotion):
     fixed = True
@@ -122,6 +132,59 @@ class _SumOfSines(BaseMotion):
         pos = np.outer(t, self.velocity)
         for axis, terms in self.translation_terms.items():
             q, _, _ = self._eval(terms, t)
+            q0, _, _ = self._eval(terms, np.zeros(1))
+            pos[:, axis] += q - q0
+        return pos
+
+    @classmethod
+    def _eval_rows(cls, terms, first: int, count: int, h: float):
+        """_eval's values on the grid t_k = k h for rows first .. first + count - 1: the kernel's rows
+        of the same grid (blocks at the same multiples of rows), so the same bits as _eval of the
+        whole grid."""
+        kernel = native.kernel()
+        kernel.gimbal_sum_of_sines_rows.argtypes = [ctypes.c_long, ctypes.c_long, ctypes.c_double, ctypes.c_double,
+                                                    ctypes.c_long] + [ctypes.c_void_p] * 7
+        kernel.gimbal_sum_of_sines_rows.restype = None
+        kernel.gimbal_sum_of_sines_rotation.argtypes = [ctypes.c_double, ctypes.c_long, ctypes.c_void_p,
+                                                        ctypes.c_void_p]
+        kernel.gimbal_sum_of_sines_rotation.restype = None
+        kernel.gimbal_sum_of_sines_rotation_doubles.argtypes = [ctypes.c_long]
+        kernel.gimbal_sum_of_sines_rotation_doubles.restype = ctypes.c_long
+        amplitude, omega, phase = (np.ascontiguousarray(x, dtype=float) for x in terms)
+        components = len(omega)
+        weights = np.empty(3 * components)
+        kernel.gimbal_sum_of_sines_weights(components, amplitude.ctypes.data, omega.ctypes.data, weights.ctypes.data)
+        rotation = np.empty(kernel.gimbal_sum_of_sines_rotation_doubles(components))
+        kernel.gimbal_sum_of_sines_rotation(h, components, omega.ctypes.data, rotation.ctypes.data)
+        results = [np.empty(count) for _ in range(3)]   # element 0: row `first`
+        kernel.gimbal_sum_of_sines_rows(first, count, 0.0, h, components, omega.ctypes.data, phase.ctypes.data,
+                                        weights.ctypes.data, rotation.ctypes.data, *(r.ctypes.data for r in results))
+        return tuple(results)
+
+    def sample_rows(self, first, count, h):
+        if first == 0 and count < 2:   # _eval takes a single instant directly, not by the kernel's grid
+            return self.sample(np.arange(first, first + count) * h)
+        out = np.zeros((count, 15))
+        for axis in range(3):
+            out[:, axis] = self.offsets.get(axis, 0.0)
+        for axis, terms in self.angle_terms.items():
+            q, qd, qdd = self._eval_rows(terms, first, count, h)
+            out[:, axis] += q
+            out[:, 3 + axis] = qd
+            out[:, 6 + axis] = qdd
+        out[:, 9:12] = self.velocity
+        for axis, terms in self.translation_terms.items():
+            _, v, a = self._eval_rows(terms, first, count, h)
+            out[:, 9 + axis] += v
+            out[:, 12 + axis] = a
+        return out
+
+    def position_rows(self, first, count, h):
+        if first == 0 and count < 2:
+            return self.position(np.arange(first, first + count) * h)
+        pos = np.outer(np.arange(first, first + count) * h, self.velocity)
+        for axis, terms in self.translation_terms.items():
+            q, _, _ = self._eval_rows(terms, first, count, h)
             q0, _, _ = self._eval(terms, np.zeros(1))
             pos[:, axis] += q - q0
         return pos
@@ -232,6 +295,15 @@ class Recorded(BaseMotion):
         pos = np.empty((len(t), 3))
         native.kernel().gimbal_recorded_motion_position(self._handle, len(t), t.ctypes.data, pos.ctypes.data)
         return pos - pos[:1]
+
+    def position_rows(self, first, count, h):
+        start = np.zeros(1)
+        at_start = np.empty((1, 3))
+        native.kernel().gimbal_recorded_motion_position(self._handle, 1, start.ctypes.data, at_start.ctypes.data)
+        t = np.ascontiguousarray(np.arange(first, first + count) * h)
+        pos = np.empty((count, 3))
+        native.kernel().gimbal_recorded_motion_position(self._handle, count, t.ctypes.data, pos.ctypes.data)
+        return pos - at_start
 
 
 # What native.gimbal_recorded_motion_read says of a file (recorded_motion.h): its text or its columns refused.

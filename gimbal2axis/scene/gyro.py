@@ -142,6 +142,13 @@ class GyroModel:
     def configure(self, state, h: float, count: int, rng: np.random.Generator):
         """Fills the kernel's GimbalGyro `state` for a run of `count` samples of step h; returns the
         error table it points into (keep it alive for the run)."""
+        self.configure_deterministic(state, h)
+        errors = self.error_table(h, count, rng)
+        state.error = None if errors is None else errors.ctypes.data
+        return errors
+
+    def configure_deterministic(self, state, h: float) -> None:
+        """configure without the error table (state.error None): axes, filter, quantization, delay."""
         state.enabled = 1
         state.axes[:] = self.axes().ravel().tolist()
         state.filtered = int(self.bandwidth > 0)
@@ -149,7 +156,63 @@ class GyroModel:
             a, b, c, d, settled = self.filter(h)
             state.filter_a[:], state.filter_b[:] = a.ravel().tolist(), b.tolist()
             state.filter_c[:], state.filter_d, state.filter_settled[:] = c.tolist(), d, settled.tolist()
-        errors = self.error_table(h, count, rng)
-        state.error = None if errors is None else errors.ctypes.data
+        state.error = None
         state.quantum, state.delay = self.quantum, self.delay
-        return errors
+
+
+class GyroErrorStream:
+    """error_table made a chunk of rows at a time, for a run too long to hold it whole
+    (master/streaming.py): `rows(count)` gives the next `count` rows, the same bits as the rows of
+    error_table(h, total, rng). `generator(draw)` is a numpy Generator positioned where error_table's
+    draw number `draw` starts (draws: error_draws)."""
+
+    def __init__(self, gyro: GyroModel, h: float, generator):
+        self.gyro, self.h = gyro, h
+        self.flicker = []   # per process: [generator, b, a, zi]
+        draw = 0
+        if gyro.angle_random_walk > 0:
+            self.arw = (generator(draw), gyro.angle_random_walk * math.radians(1.0) / SQRT_HOUR / math.sqrt(h))
+            draw += 1
+        for correlation_time, deviation in gyro.flicker_processes(h):
+            phi = math.exp(-h / correlation_time)
+            start = generator(draw).normal(0.0, deviation, (1, 3))
+            self.flicker.append([generator(draw + 1), [math.sqrt(1.0 - phi * phi) * deviation], [1.0, -phi],
+                                 phi * start])
+            draw += 2
+        if gyro.rate_random_walk > 0:
+            self.rrw = (generator(draw), gyro.rate_random_walk * DEG_PER_HOUR / SQRT_HOUR * math.sqrt(h))
+            self.walk = None   # the last row of the cumulative sum so far
+        self.drawn = draw > 0 or bool(np.any(gyro.bias != 0))
+
+    def rows(self, count: int) -> np.ndarray | None:
+        if not self.drawn:
+            return None
+        table = np.zeros((count, 3))
+        if self.gyro.angle_random_walk > 0:
+            table += self.arw[0].normal(0.0, self.arw[1], (count, 3))
+        for process in self.flicker:
+            driving = process[0].normal(0.0, 1.0, (count, 3))
+            filtered, process[3] = signal.lfilter(process[1], process[2], driving, axis=0, zi=process[3])
+            table += filtered
+        if self.gyro.rate_random_walk > 0:
+            steps = self.rrw[0].normal(0.0, self.rrw[1], (count, 3))
+            # the sum carried on from the chunk before, in the same order of additions as one cumsum
+            walk = np.cumsum(steps, axis=0) if self.walk is None else \
+                np.cumsum(np.concatenate([self.walk, steps]), axis=0)[1:]
+            self.walk = walk[-1:].copy()
+            table += walk
+        if np.any(self.gyro.bias != 0):
+            table += self.gyro.bias * DEG_PER_HOUR
+        return table
+
+
+def error_draws(gyro: GyroModel, h: float, count: int) -> list[tuple[int, float]]:
+    """The normal draws error_table makes from its generator, in order: (rows of 3, standard deviation)."""
+    draws = []
+    if gyro.angle_random_walk > 0:
+        draws.append((count, gyro.angle_random_walk * math.radians(1.0) / SQRT_HOUR / math.sqrt(h)))
+    for _, deviation in gyro.flicker_processes(h):
+        draws += [(1, deviation), (count, 1.0)]
+    if gyro.rate_random_walk > 0:
+        draws.append((count, gyro.rate_random_walk * DEG_PER_HOUR / SQRT_HOUR * math.sqrt(h)))
+    return draws

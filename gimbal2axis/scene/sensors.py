@@ -30,7 +30,7 @@ import numpy as np
 from .. import native
 from . import geometry
 from ..errors import SceneError, check_keys, number
-from .gyro import GyroModel
+from .gyro import GyroErrorStream, GyroModel, error_draws
 
 KEYS = {"encoder_resolution_deg", "encoder_offset_deg", "gyro_noise_deg_s", "imu_attitude_noise_deg", "seed",
         "stabilization", "joint_rate", "gyro"}
@@ -121,6 +121,10 @@ class Sensors:
             gyro_state.enabled = 0      # no payload gyro
         return measured_attitude
 
+    def stream(self, count: int, h: float) -> "SensorStream":
+        """prepare, a chunk at a time: SensorStream.rows(first, base) for consecutive chunks."""
+        return SensorStream(self, count, h)
+
     def measure(self, step: int, alpha: float, beta: float, gyro: list, alpha_dot: float = 0.0,
                 beta_dot: float = 0.0):
         """(alpha, beta, [w1, w2, w3]) as measured at communication point `step` (after prepare) from
@@ -129,3 +133,101 @@ class Sensors:
         measured[0], measured[1], measured[2:5], measured[5], measured[6] = alpha, beta, gyro, alpha_dot, beta_dot
         native.kernel().gimbal_sensors_measure(ctypes.addressof(self.state), step, measured)
         return measured[0], measured[1], measured[2:5]
+
+
+# Rows of the generators' draws skipped at a time while positioning a stream (bounds the memory).
+SKIP_ROWS = 1 << 16
+
+
+def _shifted(array: np.ndarray, first: int) -> int:
+    """The address row 0 of the run would have if `array` (a chunk's rows, its row 0 the run's row
+    `first`) were part of a table of the whole run: the C kernel indexes its tables by the run's step
+    k, and this lets it read a chunk's rows at k = first .. first + len - 1 without copies."""
+    address = array.ctypes.data - first * array.strides[0]
+    if address <= 0:
+        raise MemoryError("a chunk's rows cannot be addressed by the run's step")
+    return address
+
+
+class SensorStream:
+    """What Sensors.prepare makes for a whole run (the noise tables, the IMU's attitude, the carrier
+    gyro's readings), made a chunk at a time for a run streamed to disk (master/streaming.py): the
+    same bits, in memory bounded by the chunk. Each random draw of prepare (in its fixed order) gets a
+    generator positioned at its start, found by drawing the draws before it and dropping them."""
+
+    def __init__(self, sensors: "Sensors", count: int, h: float):
+        self.sensors, self.h, self.count = sensors, h, count
+        draws = []   # (rows, standard deviation) of prepare's draws, in order
+        if sensors.gyro_noise > 0:
+            draws.append((count, sensors.gyro_noise))
+        if sensors.imu_noise > 0:
+            draws.append((count, sensors.imu_noise))
+        gyro_draws = error_draws(sensors.gyro, h, count) if sensors.gyro is not None else []
+        draws += gyro_draws
+        rng = np.random.default_rng(sensors.seed)
+        self.starts = []   # the bit generator's state at the start of each draw
+        for rows, deviation in draws:
+            self.starts.append(rng.bit_generator.state)
+            for first in range(0, rows, SKIP_ROWS):
+                rng.normal(0.0, deviation, (min(SKIP_ROWS, rows - first), 3))
+        index = 0
+        self.gyro_noise = self.imu = None
+        if sensors.gyro_noise > 0:
+            self.gyro_noise, index = self._generator(index), index + 1
+        if sensors.imu_noise > 0:
+            self.imu, index = self._generator(index), index + 1
+        state = sensors.state
+        state.h = h
+        self.errors = None
+        if sensors.gyro is not None:
+            if not h > 0:
+                raise SceneError("sensors: the gyro model needs the communication step")
+            sensors.gyro.configure_deterministic(state.gyro, h)   # the error table: per chunk
+            self.errors = GyroErrorStream(sensors.gyro, h, lambda draw: self._generator(index + draw))
+        self.indirect = sensors.scheme == "indirect"
+        if self.indirect:
+            # the carrier gyro: its own copy of the configured gyro (filter and delay states run on
+            # over the chunks); the payload gyro is off
+            self.carrier_gyro = type(state.gyro).from_buffer_copy(state.gyro) if sensors.gyro is not None else None
+            state.gyro.enabled = 0
+        self.previous_base = None   # the last base row of the chunk before (indirect: carrier_rate's h form)
+        self._kept = []
+
+    def _generator(self, index: int) -> np.random.Generator:
+        bits = np.random.PCG64()
+        bits.state = self.starts[index]
+        return np.random.Generator(bits)
+
+    def rows(self, first: int, base: np.ndarray) -> np.ndarray:
+        """Makes rows first .. first + len(base) - 1 (base: the base motion's rows there) and points the
+        sensors' kernel state at them; returns the attitude the IMU measures there."""
+        count, state = len(base), self.sensors.state
+        kept = []
+        if self.gyro_noise is not None:
+            noise = self.gyro_noise.normal(0.0, self.sensors.gyro_noise, (count, 3))
+            kept.append(noise)
+            state.gyro_noise = _shifted(noise, first)
+        measured_attitude = base[:, :3] + self.imu.normal(0.0, self.sensors.imu_noise, (count, 3)) \
+            if self.imu is not None else base[:, :3]
+        errors = self.errors.rows(count) if self.errors is not None else None
+        if errors is not None:
+            kept.append(errors)
+        if self.indirect:
+            if base.shape[1] < 9:
+                raise SceneError("sensors: indirect stabilization needs the base attitude, rates and accelerations")
+            with_previous = base if self.previous_base is None else np.concatenate([self.previous_base, base])
+            readings = np.ascontiguousarray(carrier_rate(with_previous, self.h)[len(with_previous) - count:])
+            if self.carrier_gyro is not None:
+                gyro = self.carrier_gyro
+                gyro.error = None if errors is None else _shifted(errors, first)
+                measure, row_bytes = native.kernel().gimbal_gyro_measure, readings.strides[0]
+                for k in range(count):
+                    address = readings.ctypes.data + k * row_bytes
+                    measure(ctypes.addressof(gyro), first + k, address, address)
+            kept.append(readings)
+            state.carrier_rate = _shifted(readings, first)
+        elif errors is not None:
+            state.gyro.error = _shifted(errors, first)
+        self.previous_base = base[-1:].copy()
+        self._kept = kept   # the kernel reads these until the next chunk
+        return measured_attitude

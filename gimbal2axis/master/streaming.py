@@ -1,0 +1,591 @@
+"""A scene run streamed to disk: what `gimbal2axis run` does, in memory bounded by a chunk of steps
+whatever the run's length.
+
+master.run holds the whole run (its inputs prepared up front, its record returned in memory), which
+the sweeps, the reports and the tests want for their short runs; an hour at 1 ms is 3.6 million rows
+of about 60 signals, 1.7 GB of record and more of inputs. Here the run is made CHUNK_ROWS
+communication points at a time, with the same loops and the same bits:
+
+- the base motion, the sensors' noise (each random draw of Sensors.prepare from a generator placed
+  at its start, scene/sensors.py SensorStream) and the controller's set points of a chunk only, all
+  elementwise or carried over from the chunk before, so equal to the rows of the whole run's;
+- the loop (the compiled one for built-in controllers, else the Python one) on the chunk's tables:
+  the C kernel indexes by the run's step, and reads a chunk's rows through shifted addresses;
+- each chunk's record (its derived line-of-sight signals included, RunResult's) appended to
+  <name>.parquet (one row group per chunk: a columnar file, so the plots and spectra read back only
+  the columns they need) and its rows at the output interval to <name>.csv;
+- the summary's metrics accumulated chunk by chunk; the spectra by Welch over the file read back a
+  chunk at a time (spectra.WelchAccumulator); the plots from the file decimated to the minimum and
+  maximum of each pixel column (plots never drop an extreme).
+
+A run that fails, or is asked to stop (a StopRequest: SIGINT, SIGTERM), ends its files at the last
+whole communication point and says so (StreamedResult.stopped; <name>_run.json; the Parquet file's
+metadata "gimbal2axis.status").
+"""
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+import shutil
+import time
+
+import numpy as np
+
+from ..errors import SceneError
+from ..fmu import FMU
+from ..progress import Progress
+from ..scene.base_motion import INPUTS as BASE_INPUTS
+from ..scene.scene import Scene, check_against_fmu, parameter_value
+from . import compiled_loop, spectra
+from .master import (FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records, failure_message,
+                     initialize)
+from .results import AXIS_ERRORS, CARRIER_RATES, ISOLATION_AXES, RunResult
+
+# Communication points per chunk: 2^14 rows of ~60 doubles are 7.9 MB of record, some 50 MB with
+# their copies (the columns, Arrow's table, the CSV's rows): the ship scene's hour stays under 300 MB
+# (docs/benchmarks.md). A row group per chunk: 220 for the hour, whose metadata the file carries.
+# The compiled loop returns to Python every CHUNK_STEPS (master.py) within a chunk to show progress
+# and see a stop.
+CHUNK_ROWS = 1 << 14
+# Pixel columns the plots' signals are decimated to (the figure is 1200 pixels wide at 100 dpi):
+# per column the minimum and the maximum, so no extreme is lost.
+PLOT_COLUMNS = 2000
+# The widest a %.12g number and its comma can be in the CSV: sign, 12 digits, point, e-308, comma.
+CSV_FIELD_BYTES = 20
+
+
+class StreamPlan:
+    """master.Plan for one chunk at a time: the same attributes (the loops and initialize read
+    them), with the tables of CHUNK_ROWS rows; `load_chunk(first, count)` makes the inputs of rows
+    first .. first + count - 1."""
+
+    def __init__(self, scene: Scene, fmu: FMU, stop_time: float | None, controller, chunk_rows: int):
+        check_against_fmu(scene, fmu)
+        self.scene, self.h = scene, scene.step_size
+        self.t_end = scene.stop_time if stop_time is None else stop_time
+        self.n = int(round(self.t_end / self.h))
+        self.motion = scene.base_motion()
+        u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+        self.controller = controller or scene.controller(u_limit)
+        self.sensors = scene.sensors()
+        self.delay = scene.delay_steps
+        choose_records(self, fmu)
+        self.chunk_rows = min(chunk_rows, self.n + 1)
+        rows = self.chunk_rows
+        self.rec_real = np.zeros((rows, len(self.real_names)))
+        self.rec_mode = np.zeros((rows, len(self.mode_names)), dtype=np.int32)
+        self.inputs = np.zeros((rows, len(self.input_vrs)))
+        # the commands: `delay` rows of the chunk before, then this chunk's (the delayed voltage reads back)
+        self.u_cmd = np.zeros((self.delay + rows, 2))
+        self.refs = np.full((rows, 2), np.nan)
+        self.sensor_stream = self.sensors.stream(self.n + 1, self.h)
+        self.k, self.rows = 0, 0   # the step reached; the points recorded whole (as Plan's)
+        self.first = 0
+
+    def load_chunk(self, first: int, count: int) -> None:
+        self.first, h = first, self.h
+        if first > 0 and self.delay:   # the last `delay` commands carry over
+            self.u_cmd[:self.delay] = self.u_cmd[self.chunk_rows:self.chunk_rows + self.delay]
+        self.refs[:] = np.nan
+        self.times = np.arange(first, first + count) * h
+        self.base = self.motion.sample_rows(first, count, h)
+        if not self.motion.fixed:
+            self.inputs[:count, 2:] = self.base
+        self.measured_attitude = self.sensor_stream.rows(first, self.base)
+        self.controller.prepare(self.times, h, self.measured_attitude, self.base[:, 3:6])
+        state = getattr(self.controller, "state", None)   # a user controller has no kernel state
+        points = state.set_points if state is not None else None
+        if points is not None and points.values:   # the set points' tables of this chunk, addressed by the run's step
+            points.values -= first * 2 * 8
+            points.rates -= first * 2 * 8
+
+    def chunk_signals(self, count: int) -> dict:
+        """master.recorded_signals of the chunk's first `count` rows."""
+        u_cmd = self.u_cmd[self.delay:self.delay + count]
+        u_applied = self.u_cmd[:count].copy()
+        early = np.arange(self.first, self.first + count) < self.delay
+        u_applied[early] = 0.0
+        times = self.times[:count]
+        signals = {"time": times}
+        signals.update({name: self.rec_real[:count, j].copy() for j, name in enumerate(self.real_names)})
+        signals.update({name: self.rec_mode[:count, j].astype(float) for j, name in enumerate(self.mode_names)})
+        signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0].copy(),
+                        "u_R2_cmd": u_cmd[:, 1].copy(), "alpha_ref": self.refs[:count, 0].copy(),
+                        "beta_ref": self.refs[:count, 1].copy()})
+        signals.update({name: self.base[:count, j] for j, name in enumerate(BASE_INPUTS)})
+        signals["heave"] = self.motion.position_rows(self.first, count, self.h)[:, 2]
+        return signals
+
+
+def python_chunk(slave, calls: RawCalls, plan: StreamPlan, first: int, last: int, stop: StopRequest, bar) -> None:
+    """master.step_loop over steps first .. last of the chunk's tables (row k - first); plan.rows
+    says how many points are recorded whole, also when a call or the controller raises."""
+    vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
+    (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
+        [a.ctypes.data for a in vr_arrays], [len(a) for a in vr_arrays]
+    rec_real, inputs = plan.rec_real, plan.inputs
+    real_row, real_stride = rec_real.ctypes.data, rec_real.strides[0]
+    mode_row, mode_stride = plan.rec_mode.ctypes.data, plan.rec_mode.strides[0]
+    input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
+    component = slave.component
+    get_real, get_integer, set_real, do_step = calls.get_real, calls.get_integer, calls.set_real, calls.do_step
+    measure, controller = plan.sensors.measure, plan.controller
+    h, n, delay = plan.h, plan.n, plan.delay
+    attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
+    i_alpha, i_beta, i_gyro, (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, plan.i_joint_rates
+    u_cmd, refs = plan.u_cmd, plan.refs
+    zero = (0.0, 0.0)
+    recorded = first
+    try:
+        for k in range(first, last + 1):
+            if stop.kind is not None:
+                break
+            plan.k, row = k, k - first
+            t = k * h
+            if get_real(component, real_refs, real_count, real_row + row * real_stride) > 1:
+                raise FMUCallFailed("fmi2GetReal")
+            if mode_count and get_integer(component, mode_refs, mode_count, mode_row + row * mode_stride) > 1:
+                raise FMUCallFailed("fmi2GetInteger")
+            y = rec_real[row].tolist()
+            alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro], y[i_alpha_dot],
+                                        y[i_beta_dot])
+            u = controller(t, h, alpha, beta, gyro, attitude_rows[row], rate_rows[row], step=k)
+            u_cmd[delay + row] = u
+            refs[row] = controller.reference
+            recorded = k + 1
+            applied = u if delay == 0 else (u_cmd[row] if k >= delay else zero)
+            if k == n:
+                break
+            inputs[row, 0], inputs[row, 1] = applied
+            if set_real(component, input_refs, input_count, input_row + row * input_stride) > 1:
+                raise FMUCallFailed("fmi2SetReal")
+            if do_step(component, t, h, 1) > 1:
+                raise FMUCallFailed("fmi2DoStep")
+            if k % 256 == 0:
+                bar.update((k + 1) * h)
+    finally:
+        plan.rows = recorded
+
+
+def compiled_chunk(loop: compiled_loop.CompiledLoop, plan: StreamPlan, first: int, last: int, stop: StopRequest,
+                   bar) -> None:
+    """master.compiled_step_loop over steps first .. last."""
+    from .master import CHUNK_STEPS
+
+    loop.point_at_chunk(first, plan)
+    try:
+        for start in range(first, last + 1, CHUNK_STEPS):
+            if stop.kind is not None:
+                break
+            end = min(start + CHUNK_STEPS - 1, last)
+            loop.run(start, end)
+            plan.rows = end + 1
+            bar.update(min(end + 1, plan.n) * plan.h)
+    except FMUCallFailed as failure:
+        plan.rows = plan.k + (failure.function in ("fmi2SetReal", "fmi2DoStep"))
+        raise
+
+
+class Metrics:
+    """What the summary line needs of the line-of-sight error and the last row, accumulated chunk by
+    chunk (results.RunResult.los_metrics over the whole record, with sums in chunk order), and the
+    means over the metrics window the spectra remove."""
+
+    def __init__(self, window_start: float, spectral: list[str]):
+        self.window_start = window_start
+        self.sum_squares = {"window": 0.0, "all": 0.0}
+        self.count = {"window": 0, "all": 0}
+        self.maximum = {"window": -math.inf, "all": -math.inf}
+        self.sums = {name: {"window": 0.0, "all": 0.0} for name in spectral}
+        self.base_moves = False
+        self.last = {}
+        self.first_in_window = None   # the window's first sample's time
+
+    def add(self, columns: dict) -> None:
+        t = columns["time"]
+        window = t >= self.window_start - 1e-12
+        if self.first_in_window is None and window.any():
+            self.first_in_window = float(t[window][0])
+        e = columns["los_error"]
+        for part, mask in (("window", window), ("all", slice(None))):
+            values = e[mask]
+            self.sum_squares[part] += float(np.sum(values ** 2))
+            self.count[part] += int(values.size)
+            if values.size:
+                self.maximum[part] = max(self.maximum[part], float(np.max(values)))
+            for name, sums in self.sums.items():
+                sums[part] += float(np.sum(columns[name][mask]))
+        if "base.delta_dot" in columns:
+            self.base_moves = self.base_moves or any(np.any(columns[f"base.{n}_dot"] != 0)
+                                                     for n in ("delta", "psi", "gamma"))
+        self.last = {name: float(values[-1]) for name, values in columns.items()}
+
+    def part(self) -> str:
+        """"window" when the window holds samples (RunResult: else the whole run)."""
+        return "window" if self.count["window"] else "all"
+
+    def mean(self, name: str) -> float:
+        part = self.part()
+        return self.sums[name][part] / self.count[part]
+
+
+class RecordFiles:
+    """<name>.parquet (every row, one row group per chunk) and <name>.csv (rows at the output
+    interval and the last row, as RunResult.write_csv), written as the chunks come."""
+
+    def __init__(self, out: pathlib.Path, name: str, every: int):
+        self.parquet_path, self.csv_path = out / f"{name}.parquet", out / f"{name}.csv"
+        self.every, self.writer, self.csv, self.names = every, None, None, None
+        self.last_row, self.last_written = None, None
+
+    def append(self, first: int, columns: dict) -> None:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        if self.writer is None:
+            self.names = list(columns)
+            table = pa.table({name: columns[name] for name in self.names})
+            # no dictionary encoding: it took 60 % of the write's time and finds nothing to share in
+            # measured signals; snappy still saves a fifth to a quarter of the size
+            self.writer = pq.ParquetWriter(self.parquet_path, table.schema, use_dictionary=False)
+            self.csv = open(self.csv_path, "w")
+            self.csv.write(",".join(self.names) + "\n")
+        else:
+            table = pa.table({name: columns[name] for name in self.names})
+        self.writer.write_table(table, row_group_size=len(table))
+        count = len(columns["time"])
+        rows = np.flatnonzero(np.arange(first, first + count) % self.every == 0)
+        # the CSV's rows and the chunk's last (the run's last row when it is the last chunk)
+        picked = rows if rows.size and rows[-1] == count - 1 else np.r_[rows, count - 1]
+        data = np.column_stack([np.asarray(columns[name], dtype=float)[picked] for name in self.names])
+        if rows.size:
+            np.savetxt(self.csv, data[:rows.size], delimiter=",", fmt="%.12g")
+            self.last_written = first + rows[-1]
+        self.last_row, self.last_step = data[-1:].copy(), first + count - 1
+
+    def close(self, status: dict) -> None:
+        """The CSV's last row (when the output interval skipped it) and the Parquet file's metadata."""
+        if self.writer is None:
+            return
+        if self.last_written != self.last_step:
+            np.savetxt(self.csv, self.last_row, delimiter=",", fmt="%.12g")
+        self.csv.close()
+        self.writer.add_key_value_metadata({"gimbal2axis.status": json.dumps(status)})
+        self.writer.close()
+
+
+class StreamedResult(RunResult):
+    """A RunResult whose record is on disk: `signals` holds the plots' signals decimated to the
+    minimum and maximum per pixel column (exact when the run has fewer points than that), the
+    summary's metrics and the spectra come from the chunks and the file (Metrics,
+    spectra.WelchAccumulator). `parquet_path`: the whole record."""
+
+    def __init__(self, scene, signals: dict, wall_time: float, stop_time: float, metrics: Metrics,
+                 spectra_found: dict, isolation: dict, carrier_psd: dict, window_times: tuple):
+        self.scene, self.signals, self.wall_time, self.stop_time = scene, signals, wall_time, stop_time
+        self.stopped, self.requested_stop_time = None, stop_time
+        self.derived = {}
+        self.metrics, self._spectra, self._isolation, self.carrier_psd = metrics, spectra_found, isolation, carrier_psd
+        self.window_times = window_times
+
+    @property
+    def base_moves(self) -> bool:
+        return self.metrics.base_moves
+
+    def final(self, name: str) -> float | None:
+        return self.metrics.last.get(name)
+
+    def los_metrics(self, from_s: float | None = None) -> dict:
+        m, part = self.metrics, self.metrics.part()
+        return {"final": m.last["los_error"], "rms": math.sqrt(m.sum_squares[part] / m.count[part]),
+                "max": m.maximum[part], "from_s": m.window_start,
+                "rms_all": math.sqrt(m.sum_squares["all"] / m.count["all"])}
+
+    def los_spectra(self, from_s: float | None = None) -> dict:
+        return self._spectra
+
+    def isolation_estimates(self) -> dict:
+        return self._isolation
+
+    def carrier_spectrum(self, i: int) -> np.ndarray:
+        return self.carrier_psd[i]
+
+    def window_bounds(self) -> tuple[float, float]:
+        return self.window_times
+
+
+def record_needs(plan: StreamPlan, columns: int) -> tuple[int, int]:
+    """(bytes on disk at most, bytes in memory) of a streamed run of `plan` with `columns` signals:
+    the Parquet file uncompressed (8 bytes a value: noise does not compress), the CSV at its widest,
+    and in memory the chunk's tables, its copies as columns, Parquet and CSV rows, and the same again
+    for the spectra's and plots' reading back."""
+    rows = plan.n + 1
+    csv_rows = rows // max(1, int(round(plan.scene.output_interval / plan.h))) + 2
+    disk = rows * columns * 8 + csv_rows * columns * CSV_FIELD_BYTES
+    memory = 4 * plan.chunk_rows * columns * 8
+    return disk, memory
+
+
+def available_memory() -> int | None:
+    """MemAvailable of /proc/meminfo in bytes; None where there is none."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
+def size_text(size: float) -> str:
+    for unit, factor in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if size >= factor:
+            return f"{size / factor:.3g} {unit}"
+    return f"{size / 1e3:.3g} kB"
+
+
+def column_count(plan: StreamPlan, scene: Scene) -> int:
+    """The record's signals: time, outputs, modes, commands and set points, base inputs and heave,
+    and the derived line-of-sight signals (RunResult)."""
+    derived = 5 + (len(AXIS_ERRORS) if scene.target_spec is not None else 0) + \
+        (len(CARRIER_RATES) if not plan.motion.fixed else 0)
+    return 1 + len(plan.real_names) + len(plan.mode_names) + 6 + len(BASE_INPUTS) + 1 + derived
+
+
+def check_fits(plan: StreamPlan, scene: Scene, out: pathlib.Path) -> None:
+    """Refuses, before the run, a record the disk under `out` (or the chunk the memory) cannot hold."""
+    disk, memory = record_needs(plan, column_count(plan, scene))
+    free = shutil.disk_usage(out).free
+    steps = f"{plan.n + 1:,} points ({plan.t_end:g} s at {plan.h:g} s)"
+    if disk > free:
+        raise SceneError(f"{scene.name}: the record of {steps} needs up to {size_text(disk)} on disk, {out} has "
+                         f"{size_text(free)} free; shorten the run (--stop-time) or lengthen step_size")
+    available = available_memory()
+    if available is not None and memory > available:
+        raise SceneError(f"{scene.name}: a chunk of {plan.chunk_rows:,} points needs {size_text(memory)} of memory, "
+                         f"{size_text(available)} is available")
+
+
+def _derived_columns(scene: Scene, signals: dict, base_moving: bool) -> dict:
+    """The chunk's record with RunResult's derived signals, in the CSV's column order."""
+    result = RunResult(scene, signals, 0.0, 0.0)
+    columns = {name: np.asarray(result.signal(name), dtype=float) for name in result.csv_columns()}
+    if base_moving and not result.derived.keys() & set(CARRIER_RATES):
+        # a chunk where the carrier stands still: RunResult leaves its rates out, the file keeps its columns
+        attitude = [signals[f"base.{n}"] for n in ("psi", "gamma")]
+        rates = [signals[f"base.{n}_dot"] for n in ("delta", "psi", "gamma")]
+        from ..scene import geometry
+        columns.update(zip(CARRIER_RATES, geometry.carrier_rate_in_payload(signals["alpha"], signals["beta"],
+                                                                           *attitude, *rates)))
+    return columns
+
+
+def plot_names(scene: Scene, names: list[str]) -> list[str]:
+    """The record's columns the plots may draw: every one of plotting.default_panels (which drops some
+    once it sees the data: no set points, no target) and of the scene's [plot]."""
+    from .plotting import default_panels
+
+    probe = RunResult.__new__(RunResult)   # default_panels asks only for names and the scene
+    probe.scene, probe.signals, probe.derived = scene, {name: np.zeros(1) for name in names}, {}
+    panels = default_panels(probe)
+    panels.update(scene.plot)
+    wanted = {"time", "los_error", "alpha_ref"} | {name for signals in panels.values() for name in signals}
+    return [name for name in names if name in wanted]
+
+
+class Decimator:
+    """The plots' signals as the chunks come, decimated to PLOT_COLUMNS pixel columns over [0, t_end]:
+    per column its minimum and maximum, drawn at its first and last sample's time, so no extreme is
+    lost; every sample when the run has at most two per column."""
+
+    def __init__(self, names: list[str], t_end: float, rows: int):
+        self.names, self.plotted = names, [name for name in names if name != "time"]
+        self.exact = rows <= 2 * PLOT_COLUMNS
+        self.kept = {name: [] for name in names}
+        self.edges = np.linspace(0.0, t_end, PLOT_COLUMNS + 1)
+        self.low = {name: np.full(PLOT_COLUMNS, np.nan) for name in self.plotted}
+        self.high = {name: np.full(PLOT_COLUMNS, np.nan) for name in self.plotted}
+        self.first_time, self.last_time = np.full(PLOT_COLUMNS, np.nan), np.full(PLOT_COLUMNS, np.nan)
+
+    def add(self, columns: dict) -> None:
+        if self.exact:
+            for name in self.names:
+                self.kept[name].append(np.asarray(columns[name], dtype=float).copy())
+            return
+        t = columns["time"]
+        pixel = np.clip(np.searchsorted(self.edges, t, side="right") - 1, 0, PLOT_COLUMNS - 1)
+        starts = np.flatnonzero(np.r_[True, pixel[1:] != pixel[:-1]])
+        where = pixel[starts]
+        self.first_time[where] = np.fmin(self.first_time[where], t[starts])
+        self.last_time[where] = np.fmax(self.last_time[where], t[np.r_[starts[1:] - 1, len(t) - 1]])
+        for name in self.plotted:
+            values = columns[name]
+            self.low[name][where] = np.fmin(self.low[name][where], np.fmin.reduceat(values, starts))
+            self.high[name][where] = np.fmax(self.high[name][where], np.fmax.reduceat(values, starts))
+
+    def signals(self) -> dict:
+        if self.exact:
+            return {name: np.concatenate(parts) if parts else np.empty(0) for name, parts in self.kept.items()}
+        used = np.flatnonzero(np.isfinite(self.first_time))   # a run that stopped early fills fewer columns
+        signals = {"time": np.column_stack([self.first_time[used], self.last_time[used]]).ravel()}
+        for name in self.plotted:
+            signals[name] = np.column_stack([self.low[name][used], self.high[name][used]]).ravel()
+        return signals
+
+
+def spectra_from_file(parquet_path: pathlib.Path, scene: Scene, metrics: Metrics, h: float, has_target: bool):
+    """The Welch accumulators of the line-of-sight error's spectra and of the isolation estimate over
+    the metrics window, fed from the file a row group (a chunk) at a time, its spectral columns only;
+    None where there is nothing to estimate."""
+    import pyarrow.parquet as pq
+
+    window_start = metrics.window_start if metrics.part() == "window" else -math.inf
+    samples = metrics.count[metrics.part()]
+    psd_names = list(AXIS_ERRORS) if has_target else []
+    isolation_names = ([CARRIER_RATES[i - 1] for i in ISOLATION_AXES] + [f"los.omega[{i}]" for i in ISOLATION_AXES]) \
+        if metrics.base_moves else []
+    if samples < 2 or not psd_names + isolation_names:
+        return None, None
+    fs = 1.0 / h
+    psd = spectra.WelchAccumulator(fs, scene.analysis.psd_resolution_hz, samples,
+                                   {name: metrics.mean(name) for name in psd_names}) if psd_names else None
+    pairs = [(CARRIER_RATES[i - 1], f"los.omega[{i}]") for i in ISOLATION_AXES]
+    isolation = spectra.WelchAccumulator(fs, scene.analysis.isolation_resolution_hz, samples,
+                                         {name: metrics.mean(name) for name in isolation_names}, pairs) \
+        if isolation_names else None
+    file = pq.ParquetFile(parquet_path)
+    wanted = ["time"] + psd_names + isolation_names
+    for group in range(file.num_row_groups):
+        batch = file.read_row_group(group, columns=wanted, use_threads=False)
+        columns = {name: batch.column(name).to_numpy() for name in wanted}
+        del batch
+        window = columns["time"] >= window_start - 1e-12
+        for accumulator in (psd, isolation):
+            if accumulator is not None:
+                accumulator.feed({name: columns[name][window] for name in accumulator.means})
+    return psd, isolation
+
+
+def release_freed_memory() -> None:
+    """Hands the memory freed by a phase (the chunks' tables, Arrow's buffers) back to the system
+    before the next: the allocators keep it otherwise, and the phases' peaks would add up."""
+    import ctypes
+    import ctypes.util
+
+    import pyarrow as pa
+
+    pa.default_memory_pool().release_unused()
+    name = ctypes.util.find_library("c")
+    if name:
+        libc = ctypes.CDLL(name)
+        if hasattr(libc, "malloc_trim"):   # glibc
+            libc.malloc_trim(0)
+
+
+def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = False, stop_time: float | None = None,
+                 controller=None, compiled: bool | None = None, stop: StopRequest | None = None,
+                 chunk_rows: int = CHUNK_ROWS) -> StreamedResult:
+    """Runs `scene` chunk by chunk, writing <out>/<name>.parquet and <name>.csv as it goes; returns a
+    StreamedResult (for the summary, plots and spectra). A failure in the loop or a `stop` request
+    ends the files at the last whole point and the result says so (stopped); a failure before the
+    first point (or at initialization) raises SceneError, as does a run the disk cannot hold."""
+    stop = stop or StopRequest()
+    plan = StreamPlan(scene, fmu, stop_time, controller, chunk_rows)
+    check_fits(plan, scene, out)
+    loop_kind = choose_loop(plan.controller, compiled)
+    files = RecordFiles(out, scene.name, max(1, int(round(scene.output_interval / plan.h))))
+    has_target = scene.target_spec is not None
+    spectral = (list(AXIS_ERRORS) if has_target else []) + \
+        ([] if plan.motion.fixed else [CARRIER_RATES[i - 1] for i in ISOLATION_AXES] +
+         [f"los.omega[{i}]" for i in ISOLATION_AXES])
+    metrics = Metrics(float(scene.requirements.get("from_s", 0.0)), spectral)
+    log: list = []
+    slave = fmu.instantiate(scene.name, log)
+    bar = Progress(plan.t_end, enabled=progress)
+    stopped, decimator = None, None
+    try:
+        plan.load_chunk(0, plan.chunk_rows)
+        wall0 = time.perf_counter()
+        try:
+            initialize(slave, scene, fmu, plan)
+            plan.controller.start(plan.h, scene.name)
+        except SceneError:
+            raise
+        except Exception as exc:
+            raise SceneError(failure_message(scene, plan, exc, log)) from None
+        # The summary's wall time: initialization and the loops, as master.run's (the chunks'
+        # preparation and writing are the streaming's own cost, in the command's wall time).
+        loop_wall = time.perf_counter() - wall0
+        calls = RawCalls(slave)
+        loop = compiled_loop.CompiledLoop(slave, calls, plan, chunked=True) if loop_kind == "compiled" else None
+        for first in range(0, plan.n + 1, plan.chunk_rows):
+            count = min(plan.chunk_rows, plan.n + 1 - first)
+            if first > 0:
+                plan.load_chunk(first, count)
+            failure = None
+            loop_start = time.perf_counter()
+            try:
+                if loop is not None:
+                    compiled_chunk(loop, plan, first, first + count - 1, stop, bar)
+                else:
+                    python_chunk(slave, calls, plan, first, first + count - 1, stop, bar)
+            except Exception as exc:
+                failure = exc
+            loop_wall += time.perf_counter() - loop_start
+            recorded = plan.rows - first
+            if recorded > 0:
+                columns = _derived_columns(scene, plan.chunk_signals(recorded), not plan.motion.fixed)
+                files.append(first, columns)
+                metrics.add(columns)
+                if decimator is None:
+                    decimator = Decimator(plot_names(scene, list(columns)), plan.t_end, plan.n + 1)
+                decimator.add(columns)
+                del columns
+            if failure is not None:
+                message = failure_message(scene, plan, failure, log)
+                if plan.rows == 0:
+                    raise SceneError(message)
+                stopped = Stop("failed", (plan.rows - 1) * plan.h, message)
+                break
+            if recorded < count:
+                if plan.rows == 0:
+                    raise SceneError(f"{scene.name}: {stop.reason} before the first communication point: nothing "
+                                     "recorded")
+                stopped = Stop(stop.kind, (plan.rows - 1) * plan.h, f"{scene.name}: {stop.reason}")
+                break
+        bar.close(complete=stopped is None)
+        if stopped is None:
+            slave.terminate()
+    except BaseException:
+        files.close({"status": "failed before the first point"})
+        for path in (files.parquet_path, files.csv_path):
+            path.unlink(missing_ok=True)
+        raise
+    finally:
+        slave.freeInstance()
+    wall = loop_wall
+    end = plan.t_end if stopped is None else stopped.time
+    status = {"status": "complete" if stopped is None else stopped.kind, "partial": stopped is not None,
+              "stop_time_s": plan.t_end, "recorded_until_s": end, "reason": None if stopped is None else stopped.reason}
+    files.close(status)
+    del plan, loop   # the chunk's tables
+    files.last_row = None
+    release_freed_memory()
+
+    # The spectra, from the file (the plots' signals were decimated as the chunks came).
+    psd, isolation = spectra_from_file(files.parquet_path, scene, metrics, scene.step_size, has_target)
+    release_freed_memory()
+    found = {name: psd.spectrum(name) for name in AXIS_ERRORS} if psd is not None and psd.segments else {}
+    estimates, carrier = {}, {}
+    if isolation is not None and isolation.segments:
+        for i in ISOLATION_AXES:
+            estimates[i] = isolation.transfer(CARRIER_RATES[i - 1], f"los.omega[{i}]")
+            carrier[i] = isolation.spectrum(CARRIER_RATES[i - 1]).psd
+    t_window = (metrics.first_in_window if metrics.part() == "window" else 0.0, end)
+    result = StreamedResult(scene, decimator.signals(), wall, end, metrics, found, estimates, carrier, t_window)
+    result.stopped, result.requested_stop_time = stopped, status["stop_time_s"]
+    result.loop, result.parquet_path, result.csv_path = loop_kind, files.parquet_path, files.csv_path
+    result.status = status
+    return result
