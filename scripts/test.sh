@@ -18,15 +18,17 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   ctest --test-dir "$asan_dir" --output-on-failure
-  # Left out here: the tests whose time goes to Python (the independent reference solution) or to
-  # Dask worker processes (sweeps); they run in the release pass below.
+  # Left out here: the tests whose time goes to Python (the independent reference solution, the run
+  # command's streaming, signals and long runs) or to Dask worker processes (sweeps); they run in the
+  # release pass below.
   # libstdc++ is preloaded too: ASan's exception interceptor must find it at start-up, and Python
   # only loads it later (with matplotlib's C++ extensions, which throw).
   LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
     GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
     "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider \
     --deselect tests/test_reference_solution.py --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
-    --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py
+    --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py \
+    --ignore tests/test_run_partial.py --ignore tests/test_long_run.py
   unset ASAN_OPTIONS UBSAN_OPTIONS
   echo "[test] sanitizer pass clean; now the release build"
 fi

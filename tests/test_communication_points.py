@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+import os
 
 import numpy as np
 import pytest
@@ -247,7 +248,9 @@ def run_clock(start, clock, t0: float, h: float, n: int, names) -> tuple[list, f
 
 
 @pytest.mark.parametrize("case", CASES)
-def test_every_clock_style_runs_past_the_old_refusal_with_the_same_results(starter, case):
+def test_every_clock_style_runs_past_the_old_refusal_with_the_same_results(which, starter, case):
+    if os.environ.get("GIMBAL_SANITIZED") == "1" and which.startswith("gimbal") and "0.1/3" in case:
+        pytest.skip("30 minutes of the gimbal per clock: the release pass runs it; the sanitizer pass runs the rest")
     start, names = starter
     t0, h, n = CASES[case]
     results = {}
