@@ -2,7 +2,7 @@
 # Installs what a fresh machine lacks (Debian packages, a Python virtual environment with the
 # project's package of pyproject.toml), then configures and builds. Safe to run again: it only does
 # what is missing.
-#   GIMBAL_SETUP_FOR=run   what running needs (scripts/run.sh): requirements-run.txt, the FMU only
+#   GIMBAL_SETUP_FOR=run   what running needs (scripts/run.sh): requirements-run.txt, the FMUs only
 #   GIMBAL_SETUP_FOR=test  (default) also the test tool chain and the other masters, and every target
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -48,7 +48,7 @@ fi
 if [ "$setup_for" = test ]; then
   requirements="$repo/requirements.txt"
   marker="$venv/.requirements-installed"
-  modules="fmpy, numpy, scipy, sympy, matplotlib, pytest, libcosimpy, ecospy, dask.distributed, pyarrow, tqdm, control, nbclient, ipykernel"
+  modules="fmpy, numpy, scipy, sympy, matplotlib, pytest, xdist, libcosimpy, ecospy, dask.distributed, pyarrow, tqdm, control, nbclient, ipykernel"
 else
   requirements="$repo/requirements-run.txt"
   marker="$venv/.requirements-run-installed"
@@ -85,7 +85,10 @@ cmake -S "$repo" -B "$build_dir" -G Ninja -DPython3_EXECUTABLE="$venv/bin/python
 if [ "$setup_for" = test ]; then
   cmake --build "$build_dir"
 else
-  # the FMU, and the analysis library `gimbal2axis linearize` loads; no tests, no fuzzer, no benchmarks
-  cmake --build "$build_dir" --target fmu gimbal_probe
+  # Every FMU the README names (the gimbal for FMI 2.0 and 3.0; the ship-motion and controller FMUs that
+  # `gimbal2axis system` puts beside it) and the analysis library `gimbal2axis linearize` loads; no
+  # tests, no fuzzer, no benchmarks.
+  cmake --build "$build_dir" --target fmu fmu3 ship_motion_fmu controller_fmu gimbal_probe
 fi
-echo "[setup] FMU ready: $build_dir/Gimbal2Axis.fmu (the gimbal2axis command of .venv finds it)"
+echo "[setup] FMUs ready in $build_dir: Gimbal2Axis.fmu (FMI 2.0, the one the gimbal2axis command of .venv runs)," \
+     "Gimbal2Axis-fmi3.fmu, Gimbal2Axis-ShipMotion.fmu, Gimbal2Axis-Controller.fmu"

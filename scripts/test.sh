@@ -2,9 +2,13 @@
 # Install what is missing, build, and run every test: C++ through CTest, Python through pytest,
 # then the same again on an AddressSanitizer + UndefinedBehaviorSanitizer build
 # (set GIMBAL_SKIP_SANITIZERS=1 to skip that second pass on a quick local run).
+# pytest runs the test files on GIMBAL_TEST_JOBS processes (default: one per core), a file's tests
+# together in one process (--dist loadfile: a file's module fixtures, its Dask cluster, are built once).
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${GIMBAL_BUILD_DIR:-$repo/build}"
+test_jobs="${GIMBAL_TEST_JOBS:-$(nproc)}"
+parallel=(-n "$test_jobs" --dist loadfile)
 bash "$repo/scripts/setup.sh"
 cd "$repo"
 
@@ -17,7 +21,7 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   # Python itself leaks by design: leak checking would only report the interpreter.
   export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-  ctest --test-dir "$asan_dir" --output-on-failure
+  ctest --test-dir "$asan_dir" --output-on-failure --parallel "$test_jobs"
   # Left out here: the tests whose time goes to Python (the independent reference solution, the run
   # command's streaming, signals and long runs) or to Dask worker processes (sweeps); they run in the
   # release pass below.
@@ -25,7 +29,7 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   # only loads it later (with matplotlib's C++ extensions, which throw).
   LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
     GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
-    "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider \
+    "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider "${parallel[@]}" \
     --deselect tests/test_reference_solution.py --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
     --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py \
     --ignore tests/test_run_partial.py --ignore tests/test_long_run.py
@@ -33,5 +37,5 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   echo "[test] sanitizer pass clean; now the release build"
 fi
 
-ctest --test-dir "$build_dir" --output-on-failure
-GIMBAL_BUILD_DIR="$build_dir" "$repo/.venv/bin/python" -m pytest tests "$@"
+ctest --test-dir "$build_dir" --output-on-failure --parallel "$test_jobs"
+GIMBAL_BUILD_DIR="$build_dir" "$repo/.venv/bin/python" -m pytest tests "${parallel[@]}" "$@"
