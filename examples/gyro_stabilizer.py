@@ -4,13 +4,15 @@ A scene names it in its [controller] table (see user_controller.toml next to thi
 
     [controller]
     type = "python"
-    module = "gyro_stabilizer.py"      # relative to the scene file, or an importable module name
+    file = "gyro_stabilizer.py"        # relative to the scene file (older scenes say module = ...)
     class = "GyroStabilizer"
     options = { kp = 400.0, ki = 8000.0, k_gyro = 8.0 }
 
-The runner builds the class once with the options as keyword arguments, calls reset(context) before
-every run and step(t, measurements) at every communication point; step returns the two motor
-voltages. Here: per axis, PI on the error between the set point that points the line of sight at
+The runner loads this file (it is code that runs with your rights), checks the class, builds it once
+with the options as keyword arguments, calls reset(context) before every run and step(t,
+measurements) at every communication point; step returns the two motor voltages, two finite numbers
+(clamped to the motors' limits by the runner too). The context's and the measurements' attributes,
+units and order, and the helpers imported below: docs/controller_api.md. Here: per axis, PI on the error between the set point that points the line of sight at
 the target (inverse kinematics for the measured carrier attitude) and the encoder angle, plus
 damping on the payload gyro, which rejects the carrier's motion directly.
 
@@ -33,7 +35,7 @@ class GyroStabilizer:
 
     def reset(self, context):
         """context: step_size [s], u_limit (U_L1, U_L2) [V], target (unit vector in G, or None),
-        delay_steps, scene_name."""
+        delay_steps, scene_name, cases (docs/controller_api.md)."""
         if context.target is None:
             raise ValueError("GyroStabilizer points at a target: the scene needs a [target] table")
         self.h, self.u_limit, self.target = context.step_size, context.u_limit, context.target
@@ -41,7 +43,8 @@ class GyroStabilizer:
         self.reference = (math.nan, math.nan)
 
     def step(self, t, m):
-        """m: alpha, beta [rad], gyro (w1, w2, w3) [rad/s], base_attitude, base_rates -> (u_R1, u_R2) [V]."""
+        """m: alpha, beta [rad], gyro (w1, w2, w3) [rad/s], base_attitude (delta, psi, gamma: pitch, yaw,
+        roll) [rad], base_rates [rad/s] -> (u_R1, u_R2) [V]."""
         references = gimbal_angles_for(self.target, *m.base_attitude, alpha_near=m.alpha)
         self.reference = references
         rates = gyro_axis_rates(m.gyro, m.beta)

@@ -1,5 +1,6 @@
 """gimbal2axis: scenes, a co-simulation master, analyses and sweeps for the Gimbal2Axis FMU, and the
-`gimbal2axis` command (subcommands run, sweep, linearize, freqresp, bench; `python -m gimbal2axis`).
+`gimbal2axis` command (subcommands run, sweep, linearize, freqresp, report, system, bench; `python -m
+gimbal2axis`).
 
     from gimbal2axis import FMU, load_scene, run
     with FMU("build/Gimbal2Axis.fmu") as fmu:
@@ -17,7 +18,8 @@ Layout, and the one direction imports go (tests/test_package_layout.py refuses a
                                                where the build is
 
 A module imports from its own subpackage and from the layers below it, never from above or from its
-sibling (sweep and analysis do not import each other); this file imports only the public API below.
+sibling (sweep and analysis do not import each other); this file imports only the public API below, and
+all but the leaves (errors, version) on first use, so that a subcommand imports only what it needs.
 
 Where the FMU and libgimbal_probe.so (the linearization's library) are: `--fmu` (linearize:
 `--build-dir`), else $GIMBAL2AXIS_FMU and $GIMBAL2AXIS_PROBE_LIBRARY, else gimbal2axis/build_locations.json,
@@ -27,9 +29,27 @@ are paths relative to the current directory, as in the repository's root: `gimba
 scenes/free_swing.toml there and writes results/.
 """
 from .errors import SceneError
-from .fmu import FMU
-from .master import run, run_scene_file
-from .scene import Scene, check_against_fmu, load_scene
 from .version import __version__
 
 __all__ = ["__version__", "SceneError", "FMU", "Scene", "load_scene", "check_against_fmu", "run", "run_scene_file"]
+
+
+def __getattr__(name: str):
+    """The public API's heavier names (numpy, fmpy and the C kernels behind them), imported on first
+    use: `gimbal2axis --help` and `--version` import this package too, and answer without them."""
+    if name == "FMU":
+        from .fmu import FMU as found
+    elif name in ("run", "run_scene_file"):
+        from . import master
+        found = getattr(master, name)
+    elif name in ("Scene", "check_against_fmu", "load_scene"):
+        from . import scene
+        found = getattr(scene, name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = found   # the next look-up is an ordinary one
+    return found
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -41,7 +41,8 @@ metrics_from_s = 0.02
 
 def scene_file(tmp_path, class_name="GyroStabilizerBatch", module=MODULE, name="batch"):
     """The example scene naming another class (of examples/gyro_stabilizer.py, by absolute path)."""
-    text = EXAMPLE.read_text().replace('module = "gyro_stabilizer.py"', f'module = "{module}"')
+    text = EXAMPLE.read_text().replace('file = "gyro_stabilizer.py"', f'file = "{module}"')
+    assert f'file = "{module}"' in text
     text = text.replace('class = "GyroStabilizer"', f'class = "{class_name}"')
     path = tmp_path / f"{name}.toml"
     path.write_text(text)
@@ -140,7 +141,8 @@ def test_a_failing_case_inside_a_batch_fails_alone_with_its_message(tmp_path, fm
     with pytest.raises(SceneError) as alone:
         run(cases[2], fmu)
     assert isinstance(second[0], SceneError) and str(second[0]) == str(alone.value)
-    assert "NanAfter.step(t = 0.05)" in str(second[0]) and "must be finite" in str(second[0])
+    assert "NanAfter (" in str(second[0]) and "step() at t = 0.05 s returned" in str(second[0])
+    assert "must be finite" in str(second[0])
     # the others ran to the end, equal to their runs alone
     for result, scene_alone in ((first[0], cases[0]), (second[1], cases[3])):
         assert result.loop == "lockstep"
@@ -156,6 +158,7 @@ def test_a_batch_class_returning_the_wrong_shape_is_refused_naming_it(tmp_path, 
     outcomes = run_lockstep([scene, scene], fmu)
     for outcome in outcomes:
         assert isinstance(outcome, SceneError)
-        assert "WrongShape.step(t = 0) returned (3,)" in str(outcome) and "shape (2, 2)" in str(outcome)
-    with pytest.raises(SceneError, match=r"WrongShape\.step\(t = 0\) returned \(3,\).*shape \(1, 2\)"):
+        assert "WrongShape (" in str(outcome) and "step() at t = 0 s returned shape (3,)" in str(outcome)
+        assert "shape (2, 2)" in str(outcome)
+    with pytest.raises(SceneError, match=r"WrongShape \(.*step\(\) at t = 0 s returned shape \(3,\).*shape \(1, 2\)"):
         run(scene, fmu)   # alone: arrays of one case

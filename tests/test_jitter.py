@@ -98,7 +98,7 @@ def test_a_scene_file_run_writes_its_spectrum_and_isolation(tmp_path, fmu_path):
     out = tmp_path / "out"
     assert (out / "scene_spectrum.png").stat().st_size > 0
     header = csv_path.read_text().splitlines()[0].split(",")
-    assert {"los_error_xel", "los_error_el", "base.omega2[1]", "base.omega2[3]"} <= set(header)
+    assert {"los_error_xel [rad]", "los_error_el [rad]", "base.omega2[1] [rad/s]", "base.omega2[3] [rad/s]"} <= set(header)
     psd = np.genfromtxt(out / "scene_psd.csv", delimiter=",", names=True, skip_header=1)
     assert psd["frequency_hz"][1] == pytest.approx(0.5) and psd["frequency_hz"][-1] == pytest.approx(500.0)
     # the cumulative RMS of both axes at the top is the error's spread (the mean is reported apart); 20 s
@@ -163,6 +163,8 @@ def test_the_sea_estimate_is_put_on_the_dwell_scale_by_the_pointing_geometry(tmp
     scaled = read_sea_estimate(path, 0.01, 100.0, scale)
     assert [c[0].split(":")[1].split("/")[0].strip() for c in plain] == ["los.omega[1]", "los.omega[3]"]
     assert np.allclose(scaled[0][2], plain[0][2] * 0.5) and plain[0][1].min() > 0
+    # 3 s at 0.05 Hz is one segment: no bin's gain is known (coherent = 0); they are drawn dotted
+    assert not plain[0][4].any() and "bins of low coherence dotted" in plain[0][0]
     with pytest.raises(ValueError, match="not an isolation CSV"):
         (tmp_path / "other.csv").write_text("# x\na,b\n1,2\n")
         read_sea_estimate(tmp_path / "other.csv", 0.1, 1.0)

@@ -1,9 +1,11 @@
 """The package's import direction (gimbal2axis/__init__.py draws it): cli -> sweep | analysis -> master ->
 scene -> fmu -> the leaf modules, read from the source with ast (every import, also those inside
-functions), and no module deriving paths from where its own file lies."""
+functions), and no module deriving paths from where its own file lies; what the package and its command
+line import at start (nothing heavy: --help answers at once), and what `gimbal2axis run` does without."""
 import ast
 import pathlib
 
+import numpy as np
 import pytest
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "gimbal2axis"
@@ -106,3 +108,58 @@ def test_no_module_derives_paths_from_its_own_file():
                  for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
                  if isinstance(node, ast.Name) and node.id == "__file__"]
     assert offenders == []
+
+
+# What `gimbal2axis --help`, `--version` and a refused argument must answer without: each takes 0.1 to
+# 0.8 s to import (benchmarks/cli_latency.py measures the command).
+HEAVY = ["numpy", "fmpy", "scipy", "matplotlib", "pyarrow", "dask", "distributed", "control", "tqdm"]
+
+
+def modules_imported_by(code: str, cwd: pathlib.Path | None = None) -> set:
+    """The HEAVY modules in sys.modules after running `code` in a fresh interpreter."""
+    import json
+    import subprocess
+    import sys
+
+    probe = f"{code}\nimport json, sys\nprint(json.dumps(sorted(m for m in {HEAVY!r} if m in sys.modules)))"
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300, cwd=cwd)
+    assert done.returncode == 0, done.stderr
+    return set(json.loads(done.stdout.splitlines()[-1]))
+
+
+@pytest.mark.parametrize("code", ["import gimbal2axis", "import gimbal2axis.cli.main",
+                                  "from gimbal2axis.cli.main import build_parser; build_parser()"])
+def test_the_package_and_the_command_line_import_nothing_heavy(code):
+    assert modules_imported_by(code) == set()
+
+
+def test_the_public_api_is_still_there_when_asked_for():
+    """gimbal2axis imports FMU, load_scene, run, ... on first use (its module __getattr__)."""
+    assert modules_imported_by("from gimbal2axis import FMU, Scene, load_scene, run, run_scene_file, "
+                               "check_against_fmu, SceneError, __version__") >= {"numpy"}
+    import gimbal2axis
+    for name in gimbal2axis.__all__:
+        assert getattr(gimbal2axis, name) is not None
+    with pytest.raises(AttributeError):
+        gimbal2axis.no_such_name
+
+
+def test_run_imports_neither_dask_nor_control_nor_scipy_signal(fmu_path, tmp_path):
+    """`gimbal2axis run` of the ship scene (a target, a moving base: spectra and isolation estimates)
+    without the modules only other subcommands need; scipy.signal alone took 0.5 s to import."""
+    code = (f"import sys\nfrom gimbal2axis.cli.main import main\n"
+            f"assert main(['run', 'scenes/ship_stabilization.toml', '--stop-time', '2', '--quiet', "
+            f"'--out', {str(tmp_path)!r}, '--fmu', {str(fmu_path)!r}]) == 0\n"
+            f"assert 'scipy.signal' not in sys.modules, 'scipy.signal imported'")
+    imported = modules_imported_by(code, cwd=PACKAGE.parent)
+    assert not imported & {"dask", "distributed", "control"}, imported
+    assert (tmp_path / "ship_stabilization_spectrum.png").is_file()   # the spectra were made, without scipy.signal
+
+
+@pytest.mark.parametrize("length", [2, 3, 4, 5, 64, 100, 1001, 2000, 4096, 10000, 65537])
+def test_the_welch_window_is_scipys_bit_for_bit(length):
+    """master/spectra.py's Hann window, made without importing scipy.signal, is the one welch uses."""
+    from scipy.signal import get_window
+
+    from gimbal2axis.master import spectra
+    assert np.array_equal(spectra.hann_window(length), get_window(spectra.WINDOW, length))

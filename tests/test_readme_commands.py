@@ -83,3 +83,19 @@ def test_each_readme_python_example_runs(index):
                           text=True, env=environment(), timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
     assert done.stdout.strip(), "the example prints nothing"
+
+
+def test_the_readme_frequency_response_is_one_where_the_linear_curve_is_measured():
+    """The README's freqresp example balances the payload: the linear fidelity's points are all a
+    frequency response and nothing is warned about (issue 34: it measured the payload falling over,
+    silently). The full model's are marked, as the README says: backlash and friction."""
+    command = next(c for c in shell_commands() if c.startswith(".venv/bin/gimbal2axis freqresp "))
+    done = subprocess.run(command.replace(" --serial", " --serial --out results/readme_freqresp_check"), shell=True,
+                          cwd=REPO, capture_output=True, text=True, env=environment(), timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "warning" not in done.stderr, done.stderr
+    points = re.search(r"full model (\d+) of (\d+).*no backlash, no dry friction (\d+) of (\d+)", done.stdout)
+    assert points, done.stdout
+    full_marked, full_total, linear_marked, linear_total = map(int, points.groups())
+    assert linear_marked == 0 and linear_total > 0
+    assert full_marked == full_total, "the README says the full model's points are all marked"

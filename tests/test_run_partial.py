@@ -19,6 +19,7 @@ import pytest
 
 from gimbal2axis import FMU, load_scene, run
 from gimbal2axis.cli.failures import EXIT_FAILED_PARTIAL, EXIT_INTERRUPTED, EXIT_TERMINATED
+from gimbal2axis.master.units import split_label
 
 RUN = [sys.executable, "-m", "gimbal2axis", "run"]
 
@@ -74,11 +75,11 @@ def finish(*args, cwd, timeout=600):
 
 
 def read_csv(path: pathlib.Path) -> dict:
-    """The CSV as a plain reader takes it: a header row, then numbers."""
+    """The CSV as a plain reader takes it: a header row (`name [unit]`), then numbers; by plain name."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))
     header, values = rows[0], np.array(rows[1:], dtype=float)
-    return {name: values[:, j] for j, name in enumerate(header)}
+    return {split_label(label)[0]: values[:, j] for j, label in enumerate(header)}
 
 
 def assert_partial(out: pathlib.Path, name: str, kind: str, step_size: float, stop_time: float) -> float:
@@ -133,7 +134,8 @@ def test_a_signalled_run_keeps_its_record_marked_partial(tmp_path, fmu_path, sig
     assert "t = " in message and "partial" in message and signal.Signals(signum).name in message
     end = assert_partial(out, "cheap", kind, 1e-3, 3600.0)
     assert end > 0
-    assert "PARTIAL" in stdout and f"{end:g} s" in stdout
+    assert stdout == ""   # --quiet: the line on stderr and <scene>_run.json say it
+    assert f"{end:g} s" in json.loads((out / "cheap_run.json").read_text())["summary"]
     assert (out / "cheap.png").stat().st_size > 0
 
 
@@ -222,7 +224,7 @@ def test_a_run_the_disk_cannot_hold_is_refused_before_it_starts(tmp_path, fmu_pa
 def test_stop_time_lengthens_a_run(tmp_path, fmu_path):
     scene = cheap_scene(tmp_path, stop_time=0.01)
     out = tmp_path / "out"
-    done = finish(scene, "--fmu", fmu_path, "--out", out, "--quiet", "--stop-time", "0.05", cwd=tmp_path)
+    done = finish(scene, "--fmu", fmu_path, "--out", out, "--stop-time", "0.05", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("cheap: 0.05 s simulated")
     table = read_csv(out / "cheap.csv")   # 12 significant digits

@@ -44,12 +44,12 @@ def test_scene_runs_and_writes_csv_and_png(path, fmu_path, tmp_path):
     stop = float(scene.test.get("stop_time", min(scene.stop_time, 0.3)))
     result, csv_path, png_path = run_scene_file(path, fmu_path, tmp_path, stop_time=stop)
     header = csv_path.read_text().splitlines()[0].split(",")
-    for column in ("time", "alpha", "beta", "i_R1", "i_R2", "theta_b1", "u_R1", "u_R1_cmd", "los.omega[1]",
-                   "base.gamma", "los_error"):
+    for column in ("time [s]", "alpha [rad]", "beta [rad]", "i_R1 [A]", "i_R2 [A]", "theta_b1 [rad]", "u_R1 [V]",
+                   "u_R1_cmd [V]", "los.omega[1] [rad/s]", "base.gamma [rad]", "los_error [rad]"):
         assert column in header
     data = np.loadtxt(csv_path, delimiter=",", skiprows=1, ndmin=2)
     assert data[-1, 0] == pytest.approx(stop)
-    assert np.all(np.isfinite(data[:, header.index("alpha")]))
+    assert np.all(np.isfinite(data[:, header.index("alpha [rad]")]))
     assert png_path.stat().st_size > 10_000 and png_path.read_bytes()[:4] == b"\x89PNG"
     # the line-of-sight bounds the scene states hold on the shortened run too (when it reaches their window)
     assert result.requirement_failures() == [], result.summary()

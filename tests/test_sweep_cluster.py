@@ -164,8 +164,8 @@ def test_a_sweep_on_workers_without_the_package_equals_the_local_clusters_bit_fo
     sweep = tmp_path / "small.toml"
     sweep.write_text(SMALL)
     remote = subprocess.run([*SWEEP, str(SCENE), str(sweep), "--fmu", str(fmu_path), "--out", str(tmp_path / "remote"),
-                             "--scheduler", cluster["address"], "--quiet"], capture_output=True, text=True,
-                            cwd=tmp_path, timeout=300)
+                             "--scheduler", cluster["address"]], capture_output=True, text=True,
+                            cwd=tmp_path, timeout=300)   # not --quiet: the summary line
     assert remote.returncode == 0, remote.stderr
     assert "8 cases (8 run, 0 already done): 8 ok, 0 failed" in remote.stdout, remote.stdout
     assert "warning" not in remote.stderr   # e.g. of workers with other versions of numpy, scipy, fmpy

@@ -84,7 +84,7 @@ def test_two_sweeps_into_one_table_at_once_keep_every_row_while_a_reader_polls_i
     reader = TableReader(out)
     reader.start()
     # Serial sweeps that save after every case: two writers of one table as often as they can be.
-    processes = [subprocess.Popen(command(fmu_path, sweep, out, "--serial", "--quiet", "--save-every", "0"),
+    processes = [subprocess.Popen(command(fmu_path, sweep, out, "--serial", "--save-every", "0"),   # the summary
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
                  for sweep in sweeps]
     try:
@@ -108,7 +108,7 @@ def test_two_sweeps_into_one_table_at_once_keep_every_row_while_a_reader_polls_i
     assert sorted(p.name for p in out.iterdir()) == sorted([f".{STEM}.lock", f"{STEM}.csv", f"{STEM}.parquet",
                                                             f"{STEM}.png"])
     # the same command again finds every case of its sweep done, the other sweep's rows kept
-    again = subprocess.run(command(fmu_path, sweeps[0], out, "--serial", "--quiet"), capture_output=True, text=True,
+    again = subprocess.run(command(fmu_path, sweeps[0], out, "--serial"), capture_output=True, text=True,
                            cwd=tmp_path, timeout=120)
     assert again.returncode == 0 and "16 cases (0 run, 16 already done)" in again.stdout, again.stderr
     assert len(read_rows(out / f"{STEM}.parquet")) == 26

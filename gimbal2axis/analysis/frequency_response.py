@@ -36,6 +36,12 @@ average over).
 A frequency that the snapping leaves with fewer than MIN_STEPS_PER_PERIOD steps per period is refused
 (check_resolvable, SceneError) before it runs: nearer the Nyquist frequency the samples alias.
 
+Each point carries the window's own measures of linearity (harmonic_amplitude, drift_amplitude:
+linearity_measures) and the window's mean gimbal angles; mark_rows writes into `marks` why a point is
+not a frequency response to LINEARITY_TOLERANCE (harmonics, drift, off the linear prediction, measured
+away from the prediction's operating point), marks_summary counts them in one line and plot_bode draws
+such points grey (docs/frequency_response.md, "Points that are not a frequency response").
+
 For a base excitation the combined line-of-sight output "los" is sqrt(|G_1|^2 + |G_3|^2) of the two
 gyro components that move the line of sight (los.omega[1], elevation; los.omega[3], cross-elevation):
 the isolation (stabilization) ratio, LOS inertial rate / carrier rate. It has no phase (NaN).
@@ -132,6 +138,11 @@ class InjectingController:
     @property
     def u_limit(self):
         return self.controller.u_limit
+
+    @property
+    def asked(self):
+        """The wrapped controller's voltages before its own clamp (the injection is added after it)."""
+        return self.controller.asked
 
     def prepare(self, times, h, attitude, rates) -> None:
         self.controller.prepare(times, h, attitude, rates)
@@ -275,7 +286,9 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
             limited |= np.asarray(sig[f"motor{j}.limited"])[window] != 0
     common = dict(frequency_hz=f, requested_hz=frequency, input=excitation.input_signal,
                   input_amplitude=abs(U), samples_per_period=1.0 / (f * h), settle_s=n_settle * h,
-                  measure_periods=dwell.measure_periods, current_limited_fraction=float(limited.mean()))
+                  measure_periods=dwell.measure_periods, current_limited_fraction=float(limited.mean()),
+                  alpha_mean_deg=math.degrees(float(np.mean(sig["alpha"][window]))),
+                  beta_mean_deg=math.degrees(float(np.mean(sig["beta"][window]))))
     rows = _injection_rows(common, sig, window, t, f, excitation.axis, U) if excitation.kind == "injection" else []
     gains = {}
     for name in outputs or excitation.default_outputs():
@@ -292,7 +305,9 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
         rows.append(dict(common, output="los", gain=g, gain_db=20 * math.log10(g) if g > 0 else -math.inf,
                          phase_deg=math.nan,
                          coherence=explained / total_var if total_var > 0 else math.nan,
-                         output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var))
+                         output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var,
+                         harmonic_amplitude=math.hypot(*(r["harmonic_amplitude"] for r in parts)),
+                         drift_amplitude=math.hypot(*(r["drift_amplitude"] for r in parts))))
     return rows
 
 
@@ -317,10 +332,160 @@ def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
 
 def _gain_row(common: dict, output: str, G: complex, y: np.ndarray, Y: complex, t: np.ndarray, f: float,
               **extra) -> dict:
-    """A row of gain G for `output` whose samples over the window (times t) are y, fundamental Y at f."""
+    """A row of gain G for `output` whose samples over the window (times t) are y, fundamental Y at f,
+    with the window's own measures of linearity (linearity_measures)."""
+    harmonics, drift = linearity_measures(y, common["measure_periods"])
     return dict(common, output=output, gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
                 phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=power_fraction(y, t, f),
-                output_amplitude=abs(Y), output_mean=float(np.mean(y)), output_variance=float(np.var(y)), **extra)
+                output_amplitude=abs(Y), output_mean=float(np.mean(y)), output_variance=float(np.var(y)),
+                harmonic_amplitude=harmonics, drift_amplitude=drift, **extra)
+
+
+# -- does a point describe a frequency response? ----------------------------------------------------------
+#
+# A sine dwell measures the frequency response of a linear, time-invariant system only if the output has
+# settled to a sine of the input's frequency about a fixed operating point, and it is the *linear
+# prediction's* frequency response only if the run stays at the operating point the prediction was made
+# at. Each point is checked against both, with one tolerance: the accuracy the linear prediction is held
+# to where it applies (the tests' 1 % and 1 deg; measured within 0.6 % and 0.32 deg up to 4 steps per
+# period, 5e-5 and 0.003 deg below). A point whose output departs from a steady sine by more than that, or
+# from the prediction by more, is not read to that accuracy as a frequency response. The reasons, in the
+# CSV's column `marks` (empty: a frequency response), docs/frequency_response.md, "Points that are not a
+# frequency response":
+#   harmonics   the output's power at 2f, 3f, ... (up to the Nyquist frequency), as an amplitude, over the
+#               fundamental's: a nonlinearity at work (the fundamental is then a describing function)
+#   drift       the output is not periodic over the window: the change of its fundamental from the first
+#               to the last measured period, or the change of its mean (as the error it puts on the
+#               fundamental's estimate, below), over the fundamental; needs 2 measured periods
+#   vs linear   a curve of the prediction's fidelity (no backlash, no dry friction) off the prediction
+#               by more than the tolerance in gain or phase
+#   operating point  the linear model at the window's gimbal angles (open loop: where gravity has moved
+#               an unbalanced payload) predicts a gain or phase off the prediction's by more than the
+#               tolerance: the prediction was made at a point the run is no longer at
+LINEARITY_TOLERANCE = 0.01          # relative, of the fundamental's amplitude (gain ratio - 1)
+PHASE_TOLERANCE_DEG = 1.0
+
+
+def linearity_measures(y: np.ndarray, periods: int) -> tuple[float, float]:
+    """(harmonic amplitude, drift amplitude) of the samples y over a window of `periods` whole periods of
+    the fundamental (equally spaced samples, not necessarily a whole number per period), both in y's unit,
+    to be compared with the fundamental's amplitude |Y|.
+
+    harmonic amplitude: sqrt(sum over k >= 2 of |Y_k|^2), Y_k the window's single-bin DFT at k f (the bins
+    k * periods of the window's FFT, up to the Nyquist bin), single-sided amplitudes like Y.
+    drift amplitude: y fitted by least squares over the window with its harmonics and a mean and a
+    fundamental that both change linearly in time, m0 + m1 tau + Re((X0 + X1 tau) exp(j w t)), tau from
+    -1/2 to 1/2 over the window. The larger of |X1| (periods - 1) / periods, the change of the fundamental from the first to
+    the last measured period's centre (the response still settling), and |m1| / (pi periods), the error a
+    ramp of the mean by m1 over the window puts on the single-bin DFT (a ramp's Fourier coefficient at
+    the periods-th harmonic). NaN with fewer than 2 periods (a change within one period is not told from
+    a harmonic)."""
+    y = np.asarray(y, float)
+    n = len(y)
+    amplitudes = np.abs(np.fft.rfft(y - y.mean())) * (2.0 / n)
+    if n % 2 == 0:
+        amplitudes[-1] /= 2   # the Nyquist bin is not doubled in a single-sided amplitude
+    harmonic = float(np.sqrt(np.sum(amplitudes[2 * periods::periods] ** 2)))
+    if periods < 2:
+        return harmonic, math.nan
+    phase = 2 * math.pi * periods * np.arange(n) / n   # w t over the window
+    tau = (np.arange(n) - (n - 1) / 2) / n
+    basis = np.column_stack([np.ones(n), tau, np.cos(phase), np.sin(phase), tau * np.cos(phase), tau * np.sin(phase)])
+    # fitted together with every harmonic: tau sin(w t) is not orthogonal to sin(k w t) over the window, so
+    # a steady harmonic left out would read as a changing fundamental. The harmonics' DFT bins are an
+    # orthogonal basis, so fitting y and the basis with those bins removed is that joint least squares.
+    (_, mean_slope, _, _, cos_slope, sin_slope), *_ = np.linalg.lstsq(
+        _without_harmonics(basis, periods), _without_harmonics(y, periods), rcond=None)
+    amplitude_change = abs(complex(cos_slope, -sin_slope)) * (periods - 1) / periods
+    return harmonic, max(amplitude_change, abs(mean_slope) / (math.pi * periods))
+
+
+def _without_harmonics(x: np.ndarray, periods: int) -> np.ndarray:
+    """x (along its first axis, a window of `periods` whole periods) with its DFT bins at 2f, 3f, ...
+    removed: the orthogonal projection off the harmonics of f."""
+    n = x.shape[0]
+    spectrum = np.fft.rfft(x, axis=0)
+    spectrum[2 * periods::periods] = 0
+    return np.fft.irfft(spectrum, n, axis=0)
+
+
+def linearity_marks(row: dict, predicted: complex | None = None, operating_point_change: complex | None = None,
+                    operating_point: str = "") -> list[str]:
+    """The reasons (module comment above LINEARITY_TOLERANCE) why `row` is not a frequency response to the
+    tolerance: [] if it is. `predicted`: the linear prediction's G at the row's frequency, for a row of the
+    prediction's fidelity; `operating_point_change`: the linear model's G at the window's operating point
+    (described by `operating_point`) over its G at the prediction's point, at the row's frequency."""
+    reasons = []
+    amplitude = row["output_amplitude"]
+    if amplitude > 0:
+        if row.get("harmonic_amplitude", 0) > LINEARITY_TOLERANCE * amplitude:
+            reasons.append(f"harmonics {100 * row['harmonic_amplitude'] / amplitude:.3g} %")
+        drift = row.get("drift_amplitude", math.nan)
+        if drift > LINEARITY_TOLERANCE * amplitude:
+            reasons.append(f"drift {100 * drift / amplitude:.3g} %")
+    elif row.get("output_variance", 0) > 0:   # an output that moves, but not at all at f
+        reasons.append("no fundamental")
+    if predicted is not None:
+        mismatch = _mismatch(row["gain"], row["phase_deg"], predicted)
+        if mismatch:
+            reasons.append(f"vs linear {mismatch}")
+    if operating_point_change is not None:
+        change = _mismatch(abs(operating_point_change), math.degrees(np.angle(operating_point_change)), 1.0)
+        if change:
+            reasons.append(f"operating point {operating_point}: linear there {change}")
+    return reasons
+
+
+def _mismatch(gain: float, phase_deg: float, predicted: complex) -> str:
+    """'' when gain and phase (NaN: none) are within the tolerance of `predicted`, else the departure in
+    dB and deg."""
+    if predicted == 0 or gain == 0:
+        return "" if gain == abs(predicted) else "against an exact zero"
+    ratio = gain / abs(predicted)
+    phase = math.nan if math.isnan(phase_deg) else (phase_deg - math.degrees(np.angle(predicted)) + 180) % 360 - 180
+    if abs(ratio - 1) <= LINEARITY_TOLERANCE and not abs(phase) > PHASE_TOLERANCE_DEG:
+        return ""
+    return f"{20 * math.log10(ratio):+.3g} dB" + ("" if math.isnan(phase) else f" {phase:+.3g} deg")
+
+
+def mark_rows(rows: list[dict], prediction_curve=lambda curve: False, predicted=None,
+              operating_point_change=None) -> None:
+    """Writes row['marks'] (linearity_marks joined by '; ', '' for a frequency response) into every
+    measured row. `prediction_curve(curve)`: whether the curve has the prediction's fidelity;
+    `predicted(output, frequency_hz)`: the prediction's complex G, or None where it has none;
+    `operating_point_change(row)`: (the linear model's G at the row's window operating point over the
+    prediction's, its description) or None."""
+    for row in rows:
+        if row.get("curve") == LINEAR_CURVE:
+            continue
+        G = predicted(row["output"], row["frequency_hz"]) if predicted and prediction_curve(row.get("curve", "")) \
+            else None
+        change = operating_point_change(row) if operating_point_change else None
+        row["marks"] = "; ".join(linearity_marks(row, G, *(change or (None, ""))))
+
+
+def marks_summary(rows: list[dict]) -> str | None:
+    """One line: per simulated curve how many of its points are not a frequency response, with the
+    reasons counted; None when every checked point is one."""
+    by_curve: dict = {}
+    for row in rows:
+        if row.get("curve") != LINEAR_CURVE and "marks" in row:
+            by_curve.setdefault(row["curve"], []).append(row)
+    if not any(r["marks"] for points in by_curve.values() for r in points):
+        return None
+    parts = []
+    for curve, points in by_curve.items():
+        marked = [r for r in points if r["marks"]]
+        counts: dict = {}
+        for row in marked:
+            for reason in row["marks"].split("; "):
+                key = next(k for k in ("harmonics", "drift", "vs linear", "operating point", reason)
+                           if reason.startswith(k))
+                counts[key] = counts.get(key, 0) + 1
+        why = ", ".join(f"{key} {count}" for key, count in counts.items())
+        parts.append(f"{curve or 'simulated'} {len(marked)} of {len(points)}" + (f" ({why})" if why else ""))
+    return (f"not a frequency response to {100 * LINEARITY_TOLERANCE:g} % and {PHASE_TOLERANCE_DEG:g} deg "
+            f"(CSV column marks, grey in the plot; docs/frequency_response.md): " + "; ".join(parts))
 
 
 def _injection_rows(common: dict, sig: dict, window: slice, t: np.ndarray, f: float, axis: str, D: complex) -> list:
@@ -435,7 +600,8 @@ def sweep(scene, fmu_path, frequencies, excitation: Excitation, dwell: Dwell = D
 
 COLUMNS = ["curve", "input", "output", "requested_hz", "frequency_hz", "gain", "gain_db", "phase_deg", "coherence",
            "input_amplitude", "output_amplitude", "output_mean", "output_variance", "current_limited_fraction", "samples_per_period",
-           "settle_s", "measure_periods"]
+           "settle_s", "measure_periods", "harmonic_amplitude", "drift_amplitude", "alpha_mean_deg", "beta_mean_deg",
+           "marks"]
 
 
 def write_csv(rows: list[dict], path) -> None:
@@ -459,8 +625,9 @@ GAIN_RANGE_DB = 120.0   # the gain axis spans at most this far below the largest
 
 def read_sea_estimate(path, f_min: float, f_max: float, scale: dict | None = None) -> list:
     """The isolation a sea-state run estimated (`gimbal2axis run` writes <scene>_isolation.csv) as
-    overlay curves for plot_bode: (label, frequency, gain, coherence) per payload axis, between f_min
-    and f_max. `scale` {axis name: factor} puts a per-axis ratio on the dwell's scale (the dwell divides
+    overlay curves for plot_bode: (label, frequency, gain, coherence, known) per payload axis, between
+    f_min and f_max; `known`: the bins whose gain the run knows to spectra.H1_RANDOM_ERROR (the CSV's
+    `<axis>_coherent`; all, from a CSV of an older version without that column). `scale` {axis name: factor} puts a per-axis ratio on the dwell's scale (the dwell divides
     by the carrier's rate about one carrier axis, the sea estimate by its rate about the payload axis)."""
     import pathlib
 
@@ -480,8 +647,12 @@ def read_sea_estimate(path, f_min: float, f_max: float, scale: dict | None = Non
         factor = (scale or {}).get(axis, 1.0)
         label = f"sea-state run: {output} / carrier rate about payload axis" + (
             f" x {factor:.3g} (dwell's scale)" if factor != 1.0 else "")
-        curves.append((label, f[keep], np.atleast_1d(data[f"{axis}_gain"])[keep] * factor,
-                       np.atleast_1d(data[f"{axis}_coherence"])[keep]))
+        gain = np.atleast_1d(data[f"{axis}_gain"])[keep] * factor
+        known = np.ones(gain.shape, bool)
+        if f"{axis}_coherent" in data.dtype.names:
+            known = np.atleast_1d(data[f"{axis}_coherent"])[keep] == 1
+            label += f" ({int((~known).sum())} of {known.size} bins of low coherence dotted)"
+        curves.append((label, f[keep], gain, np.atleast_1d(data[f"{axis}_coherence"])[keep], known))
     if not curves:
         raise ValueError(f"--sea-estimate {path}: no elevation_gain or cross_elevation_gain column")
     return curves
@@ -495,8 +666,8 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
     is drawn on the floor as a downward triangle and counted in the legend; its value is in the CSV.
     `lines` (linear_lines) are drawn as thin continuous lines under the points; the linear model's rows
     among `rows` are then not drawn again as points. `sea` (read_sea_estimate): the isolation estimated
-    from a sea-state run, thin grey lines in the gain panel and its magnitude-squared coherence in the
-    third."""
+    from a sea-state run, thin grey lines in the gain panel (dotted where its coherence is too low to know
+    the gain) and its magnitude-squared coherence in the third."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -509,7 +680,7 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
     finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
     for _, _, G, *_ in lines or []:
         finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
-    for _, _, gain, _ in sea or []:   # the sea's bins set the gain axis too: none is put on a floor it did not need
+    for _, _, gain, *_ in sea or []:   # the sea's bins set the gain axis too: none is put on a floor it did not need
         finite_gains += [20 * math.log10(g) for g in gain if np.isfinite(g) and g > 0]
     top = max(finite_gains) if finite_gains else 0.0
     floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
@@ -532,25 +703,37 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
         g = np.array([r["gain_db"] for r in cr], float)
         p = np.array([r["phase_deg"] for r in cr], float)
         c = np.array([r["coherence"] for r in cr], float)
+        marked = np.array([bool(r.get("marks")) for r in cr])
         label = f"{curve}: {output}" if curve else output
         low = ~(np.isfinite(g) & (g >= floor))
         if low.any():
             label += f" ({low.sum()} below {floor:.0f} dB: on the floor)"
-        line, = ax_g.semilogx(f, np.where(low, floor, g), style, marker=marker, ms=size, mfc="none", label=label)
+        if marked.any():
+            label += f" ({marked.sum()} of {len(cr)} not a frequency response: grey)"
+        shown_g = np.where(low, floor, g)
+        line, = ax_g.semilogx(f, shown_g, style, marker=marker, ms=size, mfc="none", label=label)
         if low.any():
             ax_g.semilogx(f[low], np.full(low.sum(), floor), "v", color=line.get_color(), ms=9)
         kw = dict(color=line.get_color(), linestyle=style, marker=marker, ms=size, mfc="none")
+        # a point that is not a frequency response (column marks) is filled grey over its hollow marker
+        grey = dict(linestyle="none", marker=marker, ms=size, color="0.55", mfc="0.75", zorder=3)
+        ax_g.semilogx(f[marked], shown_g[marked], **grey)
         finite = np.isfinite(p)
         if finite.any():
             unwrapped = np.degrees(np.unwrap(np.radians(p[finite])))
             ax_p.semilogx(f[finite], unwrapped, **kw)
+            ax_p.semilogx(f[finite][marked[finite]], unwrapped[marked[finite]], **grey)
         ax_c.semilogx(f, c, **kw)
-    for index, (label, f, gain, coherence) in enumerate(sea or []):
+        ax_c.semilogx(f[marked], c[marked], **grey)
+    for index, (label, f, gain, coherence, known) in enumerate(sea or []):
         color = ["0.45", "0.7"][index % 2]
         with np.errstate(divide="ignore"):
             db = 20 * np.log10(gain)
         low = ~(np.isfinite(db) & (db >= floor))
-        ax_g.semilogx(f, np.where(low, floor, db), "-", color=color, lw=0.8,
+        shown = np.where(low, floor, db)
+        # a bin whose gain the run does not know (low coherence) is dotted, one it knows solid
+        ax_g.semilogx(f, shown, ":", color=color, lw=0.6)
+        ax_g.semilogx(f, np.where(known, shown, np.nan), "-", marker=".", ms=4, color=color, lw=0.9,
                       label=label + (f" ({low.sum()} bins below {floor:.0f} dB: on the floor)" if low.any() else ""))
         ax_c.semilogx(f, coherence, "-", color=color, lw=0.8, label=f"{label.split(':')[0]}: magnitude-squared coherence")
     if sea:

@@ -24,38 +24,47 @@ import pathlib
 import sys
 import time
 
-import numpy as np
-
 from ..errors import SceneError
-from ..fmu import FMU
 from ..locations import fmu_path
-from ..master import real_outputs, run
-from ..scene import load_scene
-from ..scene.controllers import Replay
 from .defaults import scene_file
 
 SUMMARY = "CPU time of the scene runner's loop: the FMU alone, the master's own cost per step"
 PROG = "gimbal2axis bench"
 DEFAULT_SCENE = pathlib.Path("scenes", "ship_stabilization.toml")   # relative to the current directory
 LOOPS = ("compiled", "python")
+EXIT_STATUSES = {0: "done", 1: "a replay did not reproduce its run's outputs: the figures would not compare the "
+                                "same work, none are written",
+                 2: "refused: an argument, the scene, the FMU, or an --out that cannot be written",
+                 130: "interrupted (SIGINT, Ctrl-C)"}
 
 
 def loop_cpu(scene, fmu, compiled: bool, controller=None):
     """CPU seconds of the run's loop, of the whole run (with the base motion evaluated up front and
     the set points), and the result."""
+    from ..master import run
+
     before = time.process_time()
     result = run(scene, fmu, compiled=compiled, controller=controller)
     return result.loop_cpu_time, time.process_time() - before, result
 
 
 def same_outputs(a, b, fmu) -> bool:
+    import numpy as np
+
+    from ..master import real_outputs
+
     return all(np.array_equal(a.signals[name], b.signals[name]) for name in real_outputs(fmu))
 
 
 def measure(scene, fmu, repeat: int) -> dict:
-    """Best-of-`repeat` CPU seconds: 'run_<loop>', 'whole_<loop>' and 'replay_<loop>' per loop; None
-    when a replay did not reproduce its run."""
-    best: dict = {}
+    """Best-of-`repeat` CPU seconds: 'run_<loop>', 'whole_<loop>' and 'replay_<loop>' per loop, and
+    'spread_<key>_<loop>' the largest minus the smallest of the repeats (the noise of the machine);
+    None when a replay did not reproduce its run."""
+    import numpy as np
+
+    from ..scene.controllers import Replay
+
+    samples: dict = {}
     for _ in range(repeat):
         for loop in LOOPS:
             cpu, whole, result = loop_cpu(scene, fmu, loop == "compiled")
@@ -64,8 +73,19 @@ def measure(scene, fmu, repeat: int) -> dict:
             if not same_outputs(result, replayed, fmu):
                 return None
             for key, value in (("run", cpu), ("whole", whole), ("replay", replay)):
-                best[f"{key}_{loop}"] = min(best.get(f"{key}_{loop}", np.inf), value)
+                samples.setdefault(f"{key}_{loop}", []).append(value)
+    best = {key: min(values) for key, values in samples.items()}
+    best.update({f"spread_{key}": max(values) - min(values) for key, values in samples.items()})
     return best
+
+
+def cost_text(cost_us: float, noise_us: float) -> str:
+    """A per-step cost that is the difference of two measured times: said as a number only when it
+    stands out of the noise (the spread between repeats of the two). A negative difference, the run
+    faster than its replay, is noise by definition: the run does all the replay does and more."""
+    if cost_us <= noise_us:
+        return f"below the noise ({cost_us:+.2f} us per step measured, the repeats spread over {noise_us:.2f})"
+    return f"{cost_us:.2f} us per step (+- {noise_us:.2f})"
 
 
 def add_arguments(parser) -> None:
@@ -92,6 +112,10 @@ def execute(args) -> int:
         args.command_parser.error(f"--repeat {args.repeat}: need at least 1")
     if args.scene is not None and args.scene_option is not None and args.scene != args.scene_option:
         args.command_parser.error(f"two scenes, {args.scene} and --scene {args.scene_option}: give one")
+    # here, not at the top: `gimbal2axis --help` does without numpy and fmpy
+    from ..fmu import FMU
+    from ..scene import load_scene
+
     try:
         scene = load_scene(scene_file(args.scene or args.scene_option, DEFAULT_SCENE, "the scene: gimbal2axis bench "
                                                                                      "SCENE.toml"))
@@ -115,12 +139,17 @@ def execute(args) -> int:
                 "motion and the set points of the whole run, evaluated before the loop, are in whole_run_cpu_s only",
     }
     for loop in LOOPS:
+        # the differences' noise: the repeats' spread of each of the two times subtracted
+        own_noise = (best[f"spread_run_{loop}"] + best["spread_replay_compiled"]) * per_step
+        alone_noise = (best[f"spread_replay_{loop}"] + best["spread_replay_compiled"]) * per_step
         figures[loop] = {
             "loop_cpu_s": best[f"run_{loop}"], "real_time_factor_cpu": args.stop_time / best[f"run_{loop}"],
             "whole_run_cpu_s": best[f"whole_{loop}"],
             "replay_cpu_s": best[f"replay_{loop}"],
             "master_own_us_per_step": (best[f"run_{loop}"] - best["replay_compiled"]) * per_step,
+            "master_own_noise_us_per_step": own_noise,
             "loop_alone_us_per_step": (best[f"replay_{loop}"] - best["replay_compiled"]) * per_step,
+            "loop_alone_noise_us_per_step": alone_noise,
         }
     out = pathlib.Path(args.out)
     try:
@@ -135,8 +164,11 @@ def execute(args) -> int:
           f"{figures['fmu_alone_real_time_factor']:.0f}x real time, {figures['fmu_us_per_step']:.2f} us per step")
     for loop in LOOPS:
         f = figures[loop]
+        alone = "the reference" if loop == "compiled" else cost_text(f["loop_alone_us_per_step"],
+                                                                     f["loop_alone_noise_us_per_step"])
         print(f"  {loop + ' loop':<28} {f['loop_cpu_s']:.3f} s = {f['real_time_factor_cpu']:.0f}x real time; master's own "
-              f"{f['master_own_us_per_step']:.2f} us per step (the loop alone, without the controller: {f['loop_alone_us_per_step']:.2f}); "
+              f"{cost_text(f['master_own_us_per_step'], f['master_own_noise_us_per_step'])} (the loop alone, without "
+              f"the controller: {alone}); "
               f"whole run {f['whole_run_cpu_s']:.3f} s")
     print(f"wrote {out}")
     return 0

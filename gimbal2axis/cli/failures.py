@@ -1,14 +1,15 @@
 """How a command ends when its work fails: one line on stderr naming the command, and an exit
 status, never a traceback for what the user can fix.
 
-Exit statuses (the same for every command; `gimbal2axis run` uses all of them):
+Exit statuses (the same meaning for every subcommand, each listing those it uses in its --help, built
+by exit_status_help from the subcommand's EXIT_STATUSES, else DEFAULT_EXIT_STATUSES):
   0    done
-  1    --check: the scene's requirements are not met
-  2    refused: an argument, the scene, the output directory, a run that cannot fit
-  3    the run failed part-way (the FMU refused a step, the controller raised); what it recorded up
+  1    ran, but a requirement (run --check) or a case (sweep), a check (bench) failed
+  2    refused: an argument, the scene, the output directory, a run that cannot fit; nothing done
+  3    run: failed part-way (the FMU refused a step, the controller raised); what it recorded up
        to the last good step is written, marked partial
   130  interrupted (SIGINT, Ctrl-C: 128 + 2); a run keeps what it recorded, marked partial
-  143  terminated (SIGTERM: 128 + 15); likewise
+  143  terminated (SIGTERM: 128 + 15); run and sweep keep what they finished
 """
 from __future__ import annotations
 
@@ -18,9 +19,23 @@ from contextlib import contextmanager
 
 from ..errors import SceneError
 
+EXIT_DONE, EXIT_FAILED_CHECK = 0, 1
 EXIT_ERROR, EXIT_FAILED_PARTIAL, EXIT_INTERRUPTED, EXIT_TERMINATED = 2, 3, 130, 143
+# What a subcommand without an EXIT_STATUSES of its own ends with.
+DEFAULT_EXIT_STATUSES = {EXIT_DONE: "done",
+                         EXIT_ERROR: "refused: an argument, an input file, or an output that cannot be written",
+                         EXIT_INTERRUPTED: "interrupted (SIGINT, Ctrl-C)"}
 # master.Stop.kind -> the exit status of a run that ended that way
 EXIT_FOR_STOP = {"failed": EXIT_FAILED_PARTIAL, "interrupted": EXIT_INTERRUPTED, "terminated": EXIT_TERMINATED}
+
+
+def exit_status_help(statuses: dict) -> str:
+    """The `exit status:` block of a subcommand's --help: {status: meaning}, one entry each."""
+    import textwrap
+
+    return "exit status:\n" + "\n".join(
+        textwrap.fill(meaning, 88, initial_indent=f"  {status:<5}", subsequent_indent=" " * 7)
+        for status, meaning in sorted(statuses.items()))
 
 
 class Terminated(Exception):

@@ -19,14 +19,19 @@ PID controller (gimbal2axis.analysis.isolation_prediction; for another controlle
 settle, the command says so and measures without it). loop-gain also prints the predicted crossover,
 phase and gain margins.
 
+Every simulated point is checked: harmonics and drift of its output over the window, and against the
+linear prediction (the "no backlash, no dry friction" points) and its operating point (open loop: the
+window's gimbal angles); the points that are not a frequency response to 1 % and 1 deg get their
+reasons in the CSV's column marks, a grey marker in the plot and a count in one printed line, and
+open-loop points measured away from the prediction's operating point (an unbalanced payload falling)
+a warning (docs/frequency_response.md, "Points that are not a frequency response").
+
 Writes <out>/<name>.csv (every point of every curve) and <out>/<name>.png (Bode plots).
 Frequencies run in parallel on Dask (a local cluster of --workers, or --scheduler), or --serial.
 Each frequency is snapped so that --measure-periods periods are a whole number of the scene's steps h;
 a frequency left with fewer than 4 steps per period (above 1/(4 h): 250 Hz at 1 ms) is refused before
 anything runs: closer to the Nyquist frequency 1/(2 h) the samples alias and the measurement leaves the
 linear prediction (docs/frequency_response.md).
-
-Exit status: 0 written, 2 refused (an argument, a --set name, the scene, the output directory).
 
   gimbal2axis freqresp isolation --axis roll --fmin 0.1 --fmax 100 --points 13
   gimbal2axis freqresp open-loop --axis 1 --amplitude 1 --serial
@@ -40,15 +45,15 @@ import sys
 import time
 import warnings
 
-from ..analysis import frequency_response as fr
 from ..errors import SceneError
 from ..locations import fmu_path
-from ..scene import load_scene
 from .defaults import scene_file
 from .failures import run_reporting_failures
 
 SUMMARY = "frequency responses by sine dwell: open loop, isolation, loop gain, with the linear prediction"
 PROG = "gimbal2axis freqresp"
+EXIT_STATUSES = {0: "written", 2: "refused: an argument, a --set name, the scene, the output directory",
+                 130: "interrupted (SIGINT, Ctrl-C)"}   # listed at the end of --help
 DEFAULT_SCENE = pathlib.Path("scenes", "ship_stabilization.toml")   # relative to the current directory
 
 
@@ -108,6 +113,8 @@ def check_frequencies(frequencies, scene, dwell) -> None:
     """Refuses, before anything runs, a frequency the scene's step cannot resolve, named as the option
     that asked for it: the highest of the log-spaced frequencies is --fmax, and it has the fewest steps
     per period (the snapped step count falls with the frequency), so it is the one to check."""
+    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
+
     fr.check_resolvable([max(frequencies)], scene.step_size, dwell, what="--fmax")
 
 
@@ -121,6 +128,7 @@ def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
     text to print (or None): open loop, the plant's G(jw) (analysis.linearization); isolation and loop
     gain, the sampled-data closed loop of the scene's PID controller (analysis.isolation_prediction),
     the loop gain with its predicted margins. All without backlash and dry friction."""
+    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
     from ..fmu import FMU
 
     with FMU(fmu_path) as fmu:
@@ -167,6 +175,7 @@ def dwell_scale(scene, axis: str) -> dict:
 def measured_margins(rows: list[dict]) -> list[str]:
     """A line per simulated curve: the margins of its loop_gain points (interpolated between the dwell's
     frequencies, so only as fine as its grid; a point of low coherence may place a crossing anywhere)."""
+    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
     from ..analysis.isolation_prediction import stability_margins
 
     lines = []
@@ -178,6 +187,72 @@ def measured_margins(rows: list[dict]) -> list[str]:
              for r in points]
         lines.append(f"{curve}, from its {len(points)} points: {stability_margins(f, L).describe()}")
     return lines
+
+
+NO_BACKLASH = "no backlash, no dry friction"   # the curve of the linear prediction's fidelity (with ", <amplitude>")
+
+
+def check_points(rows: list[dict], scene, fmu_file, excitation, with_prediction: bool) -> None:
+    """Marks the points that are not a frequency response (fr.mark_rows): harmonics and drift of every
+    simulated point; with the prediction, the "no backlash, no dry friction" points against it, and in
+    open loop every point's operating point (the window's gimbal angles) against the prediction's."""
+    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
+
+    if not with_prediction:
+        fr.mark_rows(rows)
+        return
+    predicted = {(r["output"], r["frequency_hz"]): complex(r["gain"]) if math.isnan(r["phase_deg"]) else
+                 r["gain"] * complex(math.cos(math.radians(r["phase_deg"])), math.sin(math.radians(r["phase_deg"])))
+                 for r in rows if r["curve"] == fr.LINEAR_CURVE}
+    changes = operating_point_changes(rows, scene, fmu_file, excitation) if excitation.kind == "voltage" else {}
+    fr.mark_rows(rows, lambda curve: curve.startswith(NO_BACKLASH),
+                 lambda output, f: predicted.get((output, f)),
+                 lambda row: changes.get((row["curve"], row["frequency_hz"], row["output"])))
+
+
+def operating_point_changes(rows: list[dict], scene, fmu_file, excitation) -> dict:
+    """{(curve, frequency, output): (G of the linear model at the window's mean alpha and beta over G at the
+    prediction's point, 'beta 5 -> -123 deg')} of every open-loop point: the prediction is made at the
+    scene's initial angles, and on a fixed base gravity moves an unbalanced payload away from them while the
+    dwell settles. Linearized without backlash and dry friction as the prediction (1 ms each)."""
+    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
+    from ..analysis import linearization
+    from ..fmu import FMU
+
+    changes = {}
+    with FMU(fmu_file) as fmu:
+        start = fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY)
+        reference = linearization.linearize(start)
+        for row in rows:
+            if row["curve"] == fr.LINEAR_CURVE or row["output"] not in reference.outputs:
+                continue
+            alpha, beta = math.radians(row["alpha_mean_deg"]), math.radians(row["beta_mean_deg"])
+            # the rotors follow their loads there (start_values), not the angles the scene may give them
+            initial = {k: v for k, v in scene.initial.items() if k not in ("alpha_m", "beta_m")}
+            moved_scene = scene.with_changes(initial={**initial, "alpha": alpha, "beta": beta})
+            moved = linearization.linearize(fr.linear_point(moved_scene, fmu, excitation, fr.LINEAR_FIDELITY))
+            f = [row["frequency_hz"]]
+            G0 = complex(reference.frequency_response(f, excitation.input_signal, row["output"])[0])
+            G = complex(moved.frequency_response(f, excitation.input_signal, row["output"])[0])
+            if G0 != 0:
+                changes[(row["curve"], row["frequency_hz"], row["output"])] = (
+                    G / G0, f"beta {math.degrees(start['beta']):.3g} -> {row['beta_mean_deg']:.3g} deg")
+    return changes
+
+
+def operating_point_hint(rows: list[dict]) -> str | None:
+    """Why open-loop points left the prediction's operating point, when some did (the payload falls)."""
+    moved = [r for r in rows if "operating point" in r.get("marks", "")]
+    if not moved:
+        return None
+    first = moved[0]
+    measured = [r for r in rows if "marks" in r]
+    return (f"{len(moved)} of {len(measured)} points were measured away from the linear prediction's operating "
+            f"point (e.g. {first['curve']}, {first['output']} at {first['frequency_hz']:.3g} Hz: "
+            f"{next(m for m in first['marks'].split('; ') if m.startswith('operating point'))}): on the fixed base "
+            f"and without a controller, gravity turns a payload whose centre of mass is off the elevation axis "
+            f"while the dwell settles; balance it (--set \"body2.d_bd[2]=0\" --set \"body2.d_bd[3]=0\") to "
+            f"measure the plant where it is linearized (docs/frequency_response.md)")
 
 
 def add_arguments(parser) -> None:
@@ -227,6 +302,10 @@ def execute(args) -> int:
 
 
 def measure_and_write(args) -> int:
+    # here, not at the top: --help does without numpy and fmpy
+    from ..analysis import frequency_response as fr
+    from ..scene import load_scene
+
     check_arguments(args)
     fmu = fmu_path(args.fmu)
     with warnings.catch_warnings():
@@ -271,7 +350,7 @@ def measure_and_write(args) -> int:
     if not args.linear_only:
         variants.append(("full model", None))
     if not args.full_only:
-        variants.append(("no backlash, no dry friction", fr.LINEAR_FIDELITY))
+        variants.append((NO_BACKLASH, fr.LINEAR_FIDELITY))
     lines, predict_rows = None, None
     if not args.no_linear:
         try:
@@ -298,6 +377,7 @@ def measure_and_write(args) -> int:
             close_client(client, cluster)
     if predict_rows is not None:
         rows += predict_rows(rows)
+    check_points(rows, scene, fmu, excitation, predict_rows is not None)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
@@ -319,6 +399,12 @@ def measure_and_write(args) -> int:
     if excitation.kind == "injection":
         for line in measured_margins(rows):
             print(line)
+    print(fr.marks_summary(rows) or f"every point is a frequency response to {100 * fr.LINEARITY_TOLERANCE:g} % and "
+          f"{fr.PHASE_TOLERANCE_DEG:g} deg (no harmonics, no drift" + (", on the linear prediction)" if predict_rows
+                                                                      else ")"))
+    hint = operating_point_hint(rows)
+    if hint:
+        print(f"{PROG}: warning: {hint}", file=sys.stderr)
     simulated = len({r["frequency_hz"] for r in rows if r["curve"] != fr.LINEAR_CURVE})
     runs = len(excitations) * len(variants)
     print(f"{simulated} frequencies x {runs} simulated curve{'s' if runs != 1 else ''} ({len(rows)} CSV rows: "

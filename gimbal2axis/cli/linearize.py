@@ -14,8 +14,6 @@ where one of them is identically zero because of a mode the model holds in at th
 by dry friction, a gear in its backlash gap, a limited current, a clamped voltage), naming the setting
 that frees it: the linear model holds within those modes (docs/linearization.md).
 
-Exit status: 0 written (warnings or not), 2 refused (an argument, a name, the scene, the output).
-
   # the rigid azimuth axis with a quasi-static motor, without dry friction, on a fixed base: from
   # u_R1 to alpha_dot a first-order lag, 0.206 rad/s per V, its pole at -26.2 1/s (4.18 Hz)
   gimbal2axis linearize --set gear1.model=0 --set motor1.model=0 --set dry_friction=false \\
@@ -30,17 +28,15 @@ import pathlib
 import sys
 import warnings
 
-import numpy as np
-
-from ..analysis import linearization
 from ..analysis.names import did_you_mean
 from ..errors import SceneError
 from ..locations import fmu_path
-from ..scene import load_scene
 from .failures import run_reporting_failures
 
 SUMMARY = "linearize the model at an operating point: A, B, C, D, poles, Bode plots"
 PROG = "gimbal2axis linearize"
+EXIT_STATUSES = {0: "written (warnings or not)", 2: "refused: an argument, a name, the scene, the output",
+                 130: "interrupted (SIGINT, Ctrl-C)"}   # listed at the end of --help
 
 
 def parse_assignments(assignments: list[str]) -> dict:
@@ -59,6 +55,8 @@ def parse_assignments(assignments: list[str]) -> dict:
 
 def scene_point(scene_path: str, fmu_file, at_time: float | None, overrides: dict, build_dir: str | None = None):
     """The linear model of the scene's operating point: its start values, or where its run is at `at_time`."""
+    from ..analysis import linearization   # here, not at the top: --help does without numpy
+    from ..scene import load_scene
     from ..fmu import FMU
     from ..master import Plan, run
     from ..scene import start_values
@@ -117,6 +115,7 @@ def parse_pair(pair: str) -> tuple[str, str]:
 
 def write_bode(model, pairs: list[tuple[str, str]], stem: pathlib.Path, f_min: float, f_max: float) -> list[pathlib.Path]:
     import matplotlib
+    import numpy as np   # here, not at the top: --help does without numpy
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -183,6 +182,8 @@ def execute(args) -> int:
 
 
 def linearize_and_write(args) -> int:
+    from ..analysis import linearization   # here, not at the top: --help does without numpy
+
     overrides = parse_assignments(args.set)
     if args.at_time is not None and args.scene is None:
         raise SceneError("--at-time needs --scene: the run that reaches the operating point")

@@ -9,12 +9,9 @@ cumulative RMS per axis), <out>/<name>.png (the figure) and <out>/<name>.csv (th
 """
 import pathlib
 
-from ..fmu import FMU
 from ..locations import fmu_path
-from ..report import load_comparison, run_comparison, write_page
-from ..report.comparison import table_rows
 from .defaults import scene_file
-from .failures import EXIT_ERROR, run_reporting_failures
+from .failures import run_reporting_failures
 from .run import check_output_directory
 
 SUMMARY = "compare gyro grades and direct/indirect stabilization on a scene: one HTML page"
@@ -23,13 +20,14 @@ DEFAULT_COMPARISON = pathlib.Path("reports", "gyro_grades_and_schemes.toml")
 
 
 def add_arguments(parser) -> None:
-    parser.epilog = f"Errors go to stderr, one line. Exit status: 0 done, {EXIT_ERROR} refused or failed."
+    parser.epilog = "Errors go to stderr, one line each."
     parser.add_argument("comparison", nargs="?", default=None,
                         help=f"the comparison file (default: {DEFAULT_COMPARISON} in the current directory)")
     parser.add_argument("--fmu", default=None,
                         help="the FMU (default: $GIMBAL2AXIS_FMU, else the build the package was configured with)")
     parser.add_argument("--out", default="results", help="directory for the page, created if missing (default: results/)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("--quiet", action="store_true",
+                        help="print nothing but errors and warnings (no progress bars, table or list of files)")
 
 
 def execute(args) -> int:
@@ -37,6 +35,11 @@ def execute(args) -> int:
 
 
 def _report(args) -> int:
+    # here, not at the top: `gimbal2axis --help` does without numpy, fmpy and matplotlib
+    from ..fmu import FMU
+    from ..report import load_comparison, run_comparison, write_page
+    from ..report.comparison import table_rows
+
     comparison = load_comparison(scene_file(args.comparison, DEFAULT_COMPARISON,
                                             "the comparison file: gimbal2axis report FILE.toml"))
     out = pathlib.Path(args.out)
@@ -45,6 +48,8 @@ def _report(args) -> int:
         results = run_comparison(comparison, fmu, progress=not args.quiet)
     rows = table_rows(results)
     paths = write_page(comparison, results, rows, out)
+    if args.quiet:
+        return 0
     for row in rows:
         spread = f" +- {row['los_rms_spread_mrad']:.2g}" if row["runs"] > 1 else ""
         print(f"{row['case']}: LOS error RMS {row['los_rms_mrad']:.4g}{spread} mrad over {row['runs']} run(s), "

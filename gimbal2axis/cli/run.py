@@ -2,10 +2,11 @@
 
 An fmpy master steps the FMU with the scene's controller in the loop (the voltage computed from the
 sensors at one communication point is applied over the step after the next) and writes, as the run
-goes, <out>/<scene>.parquet (every recorded signal at every step, SI units) and <out>/<scene>.csv
-(the same at the scene's output interval), then <out>/<scene>.png (plots) and <out>/<scene>_run.json
-(complete or partial), where <scene> is the scene file's name without .toml; then it prints a summary
-line (line-of-sight error, wall time, real-time factor, events, requirements).
+goes, <out>/<scene>.parquet (every recorded signal at every step, SI units, each field's unit in the
+schema) and <out>/<scene>.csv (the same at the scene's output interval, each column headed `name
+[unit]`: `time [s]`, `alpha [rad]`), then <out>/<scene>.png (plots) and <out>/<scene>_run.json
+(complete or partial), where <scene> is the scene file's name without .toml; then, unless --quiet, it
+prints a summary line (line-of-sight error, wall time, real-time factor, events, requirements).
 """
 import math
 import os
@@ -16,16 +17,19 @@ import warnings
 
 from ..errors import SceneError, SceneWarning
 from ..locations import fmu_path
-from ..master import run_scene_file
-from ..master.master import STOP_KINDS, StopRequest
-from ..scene import load_scene
 from .defaults import scene_file
-from .failures import (EXIT_ERROR, EXIT_FAILED_PARTIAL, EXIT_FOR_STOP, EXIT_INTERRUPTED, EXIT_TERMINATED,
-                       run_reporting_failures, signals_end_the_run)
+from .failures import (EXIT_DONE, EXIT_ERROR, EXIT_FAILED_CHECK, EXIT_FAILED_PARTIAL, EXIT_FOR_STOP, EXIT_INTERRUPTED,
+                       EXIT_TERMINATED, run_reporting_failures, signals_end_the_run)
 
 SUMMARY = "run a scene file: CSV, plots and a summary line"
 PROG = "gimbal2axis run"
 DEFAULT_SCENE = pathlib.Path("scenes", "free_swing.toml")   # relative to the current directory
+EXIT_STATUSES = {EXIT_DONE: "done", EXIT_FAILED_CHECK: "done, and --check found the scene's requirements not met",
+                 EXIT_ERROR: "refused: the scene, an option or the output directory (a run too long for the disk "
+                             "included); nothing run",
+                 EXIT_FAILED_PARTIAL: "the run failed part-way: the results up to the last good step are written, "
+                                      "marked partial",
+                 EXIT_INTERRUPTED: "interrupted (SIGINT, Ctrl-C): likewise", EXIT_TERMINATED: "terminated (SIGTERM): likewise"}
 
 
 def show_warning(message, category, filename, lineno, file=None, line=None):
@@ -41,6 +45,9 @@ def check_stop_time(stop_time: float, scene) -> None:
     if not math.isfinite(stop_time) or stop_time <= 0:
         raise SceneError(f"--stop-time must be a positive number of seconds, got {stop_time:g}")
     steps = stop_time / scene.step_size
+    if round(steps) < 1:   # 0 steps would be a run of nothing that reports success
+        raise SceneError(f"--stop-time {stop_time:g} s is shorter than one step of the scene (step_size "
+                         f"{scene.step_size:g} s): give at least {scene.step_size:g} s")
     if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
         raise SceneError(f"--stop-time {stop_time:g} is not a whole number of steps of the scene's step_size "
                          f"({scene.step_size:g} s)")
@@ -67,10 +74,7 @@ def check_output_directory(out: pathlib.Path, stem: str) -> None:
 
 def add_arguments(parser) -> None:
     parser.epilog = ("Warnings (a scene that runs, but probably not as meant) and errors go to stderr, one line\n"
-                     f"each. Exit status: 0 done, 1 --check found unmet requirements, {EXIT_ERROR} the scene or an\n"
-                     f"option was refused (a run too long for the disk included), {EXIT_FAILED_PARTIAL} the run failed "
-                     f"part-way,\n{EXIT_INTERRUPTED} interrupted (SIGINT, Ctrl-C), {EXIT_TERMINATED} terminated "
-                     "(SIGTERM). A run that stops early writes\nwhat it computed up to its last good step, marked "
+                     "each. A run that stops early writes what it computed up to its last good step, marked\n"
                      "partial in <scene>_run.json and the summary.")
     parser.add_argument("scene", nargs="?", default=None,
                         help=f"the scene file (default: {DEFAULT_SCENE} in the current directory, the "
@@ -81,12 +85,16 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", default="results",
                         help="directory for the CSV and PNG, created if missing (default: results/ in the current "
                              "directory); files of the same scene are overwritten")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--quiet", action="store_true",
+                        help="print nothing but errors and warnings (no progress bar, summary or list of files)")
     parser.add_argument("--stop-time", type=float, default=None, metavar="T",
                         help="end the run at T seconds instead of the scene's stop_time, before or after it (a whole "
                              "number of steps)")
     parser.add_argument("--check", action="store_true",
                         help="exit with status 1 when the scene's [requirements] are not met")
+    parser.add_argument("--traceback", action="store_true",
+                        help="when a user controller raises, print its Python traceback on stderr after the one-line "
+                             "error (which names the class, file and line)")
 
 
 def execute(args) -> int:
@@ -95,6 +103,11 @@ def execute(args) -> int:
 
 
 def _run(args) -> int:
+    # here, not at the top: `gimbal2axis --help` and the other subcommands do without numpy and fmpy
+    from ..master import run_scene_file
+    from ..master.master import STOP_KINDS, StopRequest
+    from ..scene import load_scene
+
     scene_path = scene_file(args.scene, DEFAULT_SCENE, "the scene file: gimbal2axis run SCENE.toml")
     scene = load_scene(scene_path)
     if args.stop_time is not None:
@@ -109,20 +122,30 @@ def _run(args) -> int:
                                                         stop_time=args.stop_time, keep_partial=True, stop=stop,
                                                         stream=True)
     except SceneError as exc:
+        if stop.kind is None and args.traceback and getattr(exc, "details", None):   # a user controller's
+            print(f"{PROG}: error: {exc}\n{exc.details}", end="", file=sys.stderr)
+            return EXIT_ERROR
         if stop.kind is None:
             raise
         # stopped before the first communication point (nothing recorded, nothing written)
         print(f"{PROG}: {STOP_KINDS[stop.kind]} before the run started: {exc}", file=sys.stderr)
         return EXIT_FOR_STOP[stop.kind]
-    print(result.summary())
-    print(f"wrote {csv_path}, {csv_path.with_suffix('.parquet')} and {png_path}")
+    if not args.quiet:
+        print(result.summary())
+        print(f"wrote {csv_path}, {csv_path.with_suffix('.parquet')} and {png_path}")
     if result.stopped is not None:
         stopped = result.stopped
         kept = (f"the results for [0, {stopped.time:g}] s are in {csv_path} and .parquet, marked partial in "
                 f"{csv_path.with_name(scene.name + '_run.json')}")
         if stopped.kind == "failed":   # the reason says where and why
             print(f"{PROG}: error: {stopped.reason}; {kept}", file=sys.stderr)
+            if args.traceback and stopped.details:   # a user controller's exception
+                print(stopped.details, end="", file=sys.stderr)
         else:
             print(f"{PROG}: {stop.reason} at t = {stopped.time:g} s; {kept}", file=sys.stderr)
         return EXIT_FOR_STOP[stopped.kind]
-    return 1 if args.check and result.requirement_failures() else 0
+    failures = result.requirement_failures() if args.check else []
+    if failures:   # also when --quiet: the reason for exit status 1
+        print(f"{PROG}: requirements not met: {'; '.join(failures)}", file=sys.stderr)
+        return EXIT_FAILED_CHECK
+    return EXIT_DONE

@@ -14,11 +14,19 @@ import sys
 
 from ..errors import SceneError
 from ..locations import fmu_path
-from ..sweep import SweepError, SweepOptions, run_sweep
-from ..sweep.runner import Stopped
 
 SUMMARY = "run a parameter sweep or Monte Carlo study of a scene on Dask"
 PROG = "gimbal2axis sweep"
+EXIT_STATUSES = {
+    0: "every case of the sweep ran to the end (status ok)",
+    1: "some cases failed: their rows in the table have status = failed, the error in the column 'message' and "
+       "the FMU's log in 'fmu_log'",
+    2: "nothing ran: the scene, the sweep file or the options were refused (a misspelt parameter name, a scheduler "
+       "that does not answer, an --out that cannot be written, a table of the same name from a sweep over other "
+       "parameters, ...)",
+    130: "interrupted by Ctrl-C (SIGINT): the cases finished so far are kept",
+    143: "terminated (SIGTERM): likewise",
+}
 
 EPILOG = """\
 sweep file:
@@ -27,22 +35,14 @@ sweep file:
   (gear1.k_s); a 'cases' limit; optional stop_time and metrics_from_s. The format in full:
   docs/sweeps.md in the repository, and gimbal2axis/sweep/spec.py.
 
-exit status:
-  0  every case of the sweep ran to the end (status ok)
-  1  some cases failed: their rows in the table have status = failed, the error in
-     the column 'message' and the FMU's log in 'fmu_log'
-  2  nothing ran: the scene, the sweep file or the options were refused
-     (a misspelt parameter name, a scheduler that does not answer, an --out
-     that cannot be written, a table of the same name from a sweep over other
-     parameters, ...)
-  130, 143  interrupted by Ctrl-C or SIGTERM: the cases finished so far are kept
-
 example:
   gimbal2axis sweep scenes/ship_stabilization.toml sweeps/gains_1000.toml --workers 2
 """
 
 
 def _terminated(signum, frame):
+    from ..sweep.runner import Stopped
+
     raise Stopped("terminated (SIGTERM)")
 
 
@@ -60,7 +60,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--fmu", default=None,
                         help="the FMU to run (default $GIMBAL2AXIS_FMU, else the build the package was configured "
                              "with)")
-    parser.add_argument("--quiet", action="store_true", help="no progress counter (warnings are still shown)")
+    parser.add_argument("--quiet", action="store_true",
+                        help="print nothing but errors and warnings (no progress counter, no summary)")
     parser.add_argument("--serial", action="store_true", help="no Dask: run the cases one after the other in this "
                                                               "process")
     parser.add_argument("--threads", action="store_true",
@@ -76,6 +77,10 @@ def execute(args) -> int:
         args.command_parser.error("--workers must be >= 1")
     if not args.save_every >= 0:   # also refuses nan
         args.command_parser.error("--save-every must be >= 0 seconds")
+    # here, not at the top: Dask, pyarrow and matplotlib are for this subcommand only
+    from ..sweep import SweepError, SweepOptions, run_sweep
+    from ..sweep.runner import Stopped
+
     signal.signal(signal.SIGTERM, _terminated)
     try:
         options = SweepOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
@@ -90,12 +95,13 @@ def execute(args) -> int:
             print(f"\nsweep: {str(exc) or 'interrupted'}", file=sys.stderr)
         return 128 + (signal.SIGTERM if isinstance(exc, Stopped) else signal.SIGINT)
     total = outcome.ran + outcome.skipped
-    print(f"{total} cases ({outcome.ran} run, {outcome.skipped} already done): {total - outcome.failed} ok, "
-          f"{outcome.failed} failed; {outcome.wall_time:.1f} s")
-    print(f"wrote {outcome.parquet}, {outcome.csv} and {outcome.png}")
+    if not args.quiet:
+        print(f"{total} cases ({outcome.ran} run, {outcome.skipped} already done): {total - outcome.failed} ok, "
+              f"{outcome.failed} failed; {outcome.wall_time:.1f} s")
+        print(f"wrote {outcome.parquet}, {outcome.csv} and {outcome.png}")
     if not outcome.failed:
         return 0
-    for r in [r for r in outcome.rows if r.get("status") != "ok"][:3]:
+    for r in [r for r in outcome.rows if r.get("status") != "ok"][:3]:   # errors: shown under --quiet too
         print(f"  failed case {r['case']} ({r['case_id']}): {r['message'].splitlines()[0][:200]}")
     before = (f" ({outcome.failed_before} of them from an earlier run; --redo failed runs them again)"
               if outcome.failed_before else "")

@@ -10,18 +10,14 @@ docs/systems.md says what each engine gives and how it differs from `gimbal2axis
 import pathlib
 
 from ..errors import SceneError
-from ..scene import load_scene
-from ..system.from_scene import ship_system
-from ..system.osp import write_osp
-from ..system.ssp import write_ssp
-from .failures import EXIT_ERROR, run_reporting_failures
+from .failures import run_reporting_failures
 
 SUMMARY = "write a scene as a system of FMUs: OSP system structure (libcosim) and SSP archive"
 PROG = "gimbal2axis system"
 
 
 def add_arguments(parser) -> None:
-    parser.epilog = f"Errors go to stderr, one line. Exit status: 0 done, {EXIT_ERROR} refused or failed."
+    parser.epilog = "Errors go to stderr, one line each."
     parser.add_argument("scene", help="the scene file (a sea state, a built-in controller, delay_steps = 1)")
     parser.add_argument("--build-dir", default="build",
                         help="where the three FMUs were built (default: build/ in the current directory)")
@@ -29,6 +25,12 @@ def add_arguments(parser) -> None:
 
 
 def _write(args) -> int:
+    # here, not at the top: `gimbal2axis --help` does without numpy and fmpy
+    from ..scene import load_scene
+    from ..system.from_scene import ship_system
+    from ..system.osp import write_osp
+    from ..system.ssp import write_ssp
+
     scene = load_scene(args.scene)
     system = ship_system(scene, pathlib.Path(args.build_dir))
     out = pathlib.Path(args.out)

@@ -37,6 +37,7 @@ class CompiledLoop:
         rows = 0 if chunked else plan.n + 1
         self.u_cmd = np.zeros((rows, 2))
         self.refs = np.full((rows, 2), np.nan)
+        self.u_asked = np.zeros((rows, 2))   # the controller's outputs before its clamp
         m = self.loop = native.struct("GimbalMasterLoop")()
         m.component = slave.component
         for name in ("get_real", "get_integer", "set_real", "do_step"):
@@ -44,7 +45,7 @@ class CompiledLoop:
         m.real_vrs, m.mode_vrs, m.input_vrs = (a.ctypes.data for a in self.vr_arrays)
         m.real_count, m.mode_count, m.input_count = (len(a) for a in self.vr_arrays)
         m.rec_real, m.rec_mode, m.inputs = plan.rec_real.ctypes.data, plan.rec_mode.ctypes.data, plan.inputs.ctypes.data
-        m.u_cmd, m.refs = self.u_cmd.ctypes.data, self.refs.ctypes.data
+        m.u_cmd, m.refs, m.u_asked = self.u_cmd.ctypes.data, self.refs.ctypes.data, self.u_asked.ctypes.data
         m.h, m.n, m.delay = plan.h, plan.n, plan.delay
         m.i_alpha, m.i_beta = plan.i_alpha, plan.i_beta
         m.i_gyro[:] = plan.i_gyro
@@ -65,6 +66,7 @@ class CompiledLoop:
         m.rec_real, m.rec_mode, m.inputs = (_shifted(a, first) for a in (plan.rec_real, plan.rec_mode, plan.inputs))
         m.u_cmd = _shifted(plan.u_cmd, first - plan.delay)
         m.refs = _shifted(plan.refs, first)
+        m.u_asked = _shifted(plan.u_asked, first)
         source = plan.sensors.state
         m.sensors.gyro_noise, m.sensors.carrier_rate = source.gyro_noise, source.carrier_rate
         m.sensors.gyro.error = source.gyro.error

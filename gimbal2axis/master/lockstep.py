@@ -20,7 +20,7 @@ context.cases = N; context.u_limit is a pair of (N,) arrays and context.target a
 where the cases differ in them, else as in a single run.
 
 A case whose FMU call fails, or whose voltages are not finite, ends as failed with the message a
-single run (master.run) gives, and drops out: its instance takes no more steps and its row of the
+single run (master.run) gives (the voltages before the clamp recorded as u_R1_asked, u_R2_asked), and drops out: its instance takes no more steps and its row of the
 arrays passed to step() keeps its last measurements (its voltages are ignored). An exception in
 the user's step() or reset(), or voltages of the wrong shape, fail all cases still running.
 Results: per case a RunResult as master.run returns it (loop = 'lockstep'), or the SceneError.
@@ -34,7 +34,8 @@ import numpy as np
 
 from ..scene import controllers
 from ..errors import SceneError
-from .master import FMUCallFailed, Plan, RawCalls, failure_message, initialize, recorded_signals
+from .master import (FMUCallFailed, Plan, RawCalls, clamp_count, failure_error, failure_message, initialize,
+                     recorded_signals)
 from .results import RunResult
 from ..scene.scene import Scene, parameter_value
 
@@ -48,7 +49,7 @@ def user_class(scene: Scene):
     spec = scene.controller_spec
     if spec.get("type") != "python":
         return None
-    cls = controllers._load_class(spec, scene.path.parent)
+    cls, _ = controllers.load_user_class(spec, scene.path.parent)
     return cls if getattr(cls, "batch", False) is True else None
 
 
@@ -117,8 +118,14 @@ class _Case:
         self.attitude_rows, self.rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
 
     def fail(self, exc: Exception):
-        self.error = exc if isinstance(exc, SceneError) else \
-            SceneError(failure_message(self.scene, self.plan, exc, self.log))
+        """Ends the case with the SceneError of `exc` (a ControllerError, naming the scene, when the
+        user's class is the culprit)."""
+        if isinstance(exc, controllers.ControllerError):
+            self.error = failure_error(failure_message(self.scene, self.plan, exc, self.log), exc)
+        elif isinstance(exc, SceneError):
+            self.error = exc
+        else:
+            self.error = SceneError(failure_message(self.scene, self.plan, exc, self.log))
 
 
 def run_lockstep(scenes: list, fmu, instances: list | None = None) -> list:
@@ -163,7 +170,9 @@ def run_lockstep(scenes: list, fmu, instances: list | None = None) -> list:
         if case.error is not None:
             outcomes[case.index] = case.error
             continue
-        result = RunResult(case.scene, recorded_signals(case.plan), wall / len(cases), case.plan.t_end)
+        signals = recorded_signals(case.plan)
+        result = RunResult(case.scene, signals, wall / len(cases), case.plan.t_end)
+        result.voltage_clamp = clamp_count(signals)
         result.loop_cpu_time = cpu / len(cases)   # the batch's set-up and loop, shared out evenly
         result.loop = "lockstep"
         result.batch_size = len(cases)
@@ -174,22 +183,15 @@ def run_lockstep(scenes: list, fmu, instances: list | None = None) -> list:
 def _make_user(cases: list):
     first = cases[0].scene
     spec = first.controller_spec
-    cls = user_class(first)
-    label = f"{cls.__module__}.{cls.__qualname__}"
+    cls, path = controllers.load_user_class(spec, first.path.parent)
+    label = controllers.class_label(cls, path)
     options = merge_options([case.scene.controller_spec.get("options", {}) for case in cases])
-    try:
-        user = cls(**options)
-    except TypeError as exc:
-        raise SceneError(f"[controller] {label}({', '.join(options)}): {exc}") from None
-    for method in ("reset", "step"):
-        if not callable(getattr(user, method, None)):
-            raise SceneError(f"[controller] {label} has no method {method}(); a controller class needs "
-                             "reset(context) and step(t, measurements)")
+    user = controllers.build_user(cls, label, path, options)
     u_limit = tuple(_per_case([case.u_limit[j] for case in cases]) for j in (0, 1))
     target = None if first.target is None else _per_case([case.scene.target for case in cases])
     context = controllers.ControllerContext(first.step_size, u_limit, target, int(spec.get("delay_steps", 1)),
                                             first.name, cases=len(cases))
-    return user, label, context
+    return user, label, path, context
 
 
 def _fail_all(alive: list, exc: Exception):
@@ -211,8 +213,11 @@ def _run(cases: list) -> None:
     if not alive:
         return
     try:
-        user, label, context = _make_user(cases)
-        user.reset(context)
+        user, label, path, context = _make_user(cases)
+        try:
+            user.reset(context)
+        except Exception as exc:
+            raise controllers.user_exception(label, "reset()", exc, path, 0.0) from None
     except Exception as exc:   # a SceneError as it is; others as master.run reports them, at t = 0
         return _fail_all(alive, exc)
     first = cases[0].plan
@@ -226,7 +231,8 @@ def _run(cases: list) -> None:
               case.plan.rec_real, case.plan.inputs, None if case.plan.sensors.ideal else case.plan.sensors.measure,
               case.plan.i_alpha, case.plan.i_beta, case.plan.i_gyro, case.plan.i_joint_rates, case.attitude_rows,
               case.rate_rows,
-              case.plan.u_cmd, case.plan.refs, case.u_limit[0], case.u_limit[1], rows[case.position])
+              case.plan.u_cmd, case.plan.refs, case.u_limit[0], case.u_limit[1], rows[case.position],
+              case.plan.u_asked)
              for case in alive]
     isfinite, array, Measurements = math.isfinite, np.array, controllers.Measurements
     for k in range(n + 1):
@@ -235,7 +241,7 @@ def _run(cases: list) -> None:
         for slot in slots:
             (case, plan, component, get_real, real_refs, real_count, real_row, real_stride, get_integer, mode_refs,
              mode_count, mode_row, mode_stride, _, _, _, _, _, _, rec_real, _, measure, i_alpha, i_beta, (g1, g2, g3),
-             (i_alpha_dot, i_beta_dot), attitude_rows, rate_rows, _, _, _, _, row) = slot
+             (i_alpha_dot, i_beta_dot), attitude_rows, rate_rows, _, _, _, _, row, _) = slot
             plan.k = k
             if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
                 case.fail(FMUCallFailed("fmi2GetReal"))
@@ -259,23 +265,29 @@ def _run(cases: list) -> None:
         m = Measurements(array([r[0] for r in rows]), array([r[1] for r in rows]), array([r[2] for r in rows]),
                          array([r[3] for r in rows]), array([r[4] for r in rows]))
         try:
-            voltages = controllers.batch_voltages(label, t, user.step(t, m), count).tolist()
+            try:
+                returned = user.step(t, m)
+            except Exception as exc:
+                raise controllers.user_exception(label, "step()", exc, path, t) from None
+            voltages = controllers.batch_voltages(label, t, returned, count).tolist()
             references = controllers.batch_reference(label, user, count).tolist()
         except Exception as exc:
             return _fail_all([slot[0] for slot in slots], exc)
         failed = []
         for slot in slots:
             (case, plan, component, _, _, _, _, _, _, _, _, _, _, set_real, input_refs, input_count, input_row,
-             input_stride, do_step, _, inputs, _, _, _, _, _, _, _, u_cmd, refs, limit1, limit2, _) = slot
+             input_stride, do_step, _, inputs, _, _, _, _, _, _, _, u_cmd, refs, limit1, limit2, _, u_asked) = slot
             position = case.position
             u1, u2 = voltages[position]
             if not (isfinite(u1) and isfinite(u2)):
-                case.fail(SceneError(f"{label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite"))
+                case.fail(controllers.ControllerError(f"{label}: step() at t = {t:.6g} s returned ({u1}, {u2}): "
+                                                      "the voltages must be finite"))
                 failed.append(slot)
                 continue
             u = (min(max(u1, -limit1), limit1), min(max(u2, -limit2), limit2))
             u_cmd.append(u)
             refs.append(tuple(references[position]))
+            u_asked.append((u1, u2))
             if k == n:
                 continue
             applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)

@@ -21,6 +21,7 @@ from . import compiled_loop
 from ..scene.base_motion import INPUTS as BASE_INPUTS
 from ..errors import SceneError
 from ..fmu import FMU
+from ..scene.controllers import AXES, ControllerError
 from ..progress import Progress
 from .results import RunResult
 from ..scene.scene import Scene, check_against_fmu, parameter_value, start_values
@@ -42,6 +43,7 @@ class Stop:
     kind: str       # a key of STOP_KINDS
     time: float     # s
     reason: str     # one line
+    details: str | None = None   # a user controller's traceback (gimbal2axis run --traceback), else None
 
 
 class StopRequest:
@@ -116,7 +118,8 @@ class Plan:
         self.inputs = np.zeros((self.n + 1, len(self.input_vrs)))
         if not self.motion.fixed:
             self.inputs[:, 2:] = self.base
-        self.u_cmd, self.refs = [], []  # lists: appending costs less than writing a numpy row
+        # lists: appending costs less than writing a numpy row; u_asked: the controller's outputs before its clamp
+        self.u_cmd, self.refs, self.u_asked = [], [], []
         self.k = 0                      # the step reached (for the message of a failure)
         self.rows = 0                   # communication points recorded whole (rows 0 .. rows - 1)
 
@@ -193,7 +196,7 @@ def step_loop(slave, plan: Plan, bar: Progress, stop: StopRequest | None = None)
     # Python floats: reading them per step costs less than indexing numpy rows
     attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
     i_alpha, i_beta, i_gyro, (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, plan.i_joint_rates
-    u_cmd, refs = plan.u_cmd, plan.refs
+    u_cmd, refs, u_asked = plan.u_cmd, plan.refs, plan.u_asked
     zero = (0.0, 0.0)
     stop = stop or StopRequest()   # nobody can ask: one attribute read per step all the same
     try:
@@ -212,6 +215,7 @@ def step_loop(slave, plan: Plan, bar: Progress, stop: StopRequest | None = None)
             u = controller(t, h, alpha, beta, gyro, attitude_rows[k], rate_rows[k], step=k)
             u_cmd.append(u)
             refs.append(controller.reference)
+            u_asked.append(controller.asked)
             applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
             if k == n:
                 break
@@ -249,7 +253,7 @@ def compiled_step_loop(slave, plan: Plan, bar: Progress, stop: StopRequest | Non
         plan.rows = plan.k + (failure.function in ("fmi2SetReal", "fmi2DoStep"))
         raise
     finally:
-        plan.u_cmd, plan.refs = loop.u_cmd, loop.refs
+        plan.u_cmd, plan.refs, plan.u_asked = loop.u_cmd, loop.refs, loop.u_asked
 
 
 def choose_loop(controller, compiled: bool | None) -> str:
@@ -269,13 +273,53 @@ def choose_loop(controller, compiled: bool | None) -> str:
 
 def failure_message(scene: Scene, plan: Plan, exc: Exception, log: list | None) -> str:
     """The message of a run stopped by `exc` at step plan.k, with the FMU's last log messages."""
-    if isinstance(exc, SceneError):   # the controller's own words (a user controller's nonsense)
+    if isinstance(exc, ControllerError):   # the user's controller raised or returned nonsense: its culprit
+        return f"{scene.name}: {exc}"
+    if isinstance(exc, SceneError):
         return str(exc)
     if not isinstance(exc, FMUCallFailed) and not type(exc).__module__.startswith("fmpy"):
-        # a user controller (or its sensors) raised: say what, not "the FMU failed"
-        return f"{scene.name}: the controller raised at t = {plan.k * plan.h:.6g} s: {type(exc).__name__}: {exc}"
+        # neither the FMU nor the user's code (a ControllerError, above): the runner's own sensors or loop
+        return f"{scene.name}: the scene runner failed at t = {plan.k * plan.h:.6g} s: {type(exc).__name__}: {exc}"
     details = "; ".join(map(str, (log or [])[-5:])) or "no log message"
     return f"{scene.name}: the FMU failed at t = {plan.k * plan.h:.6g} s ({exc}): {details}"
+
+
+class ClampCount:
+    """How often the controller's voltages were clamped to +-U_L, per axis, accumulated over a run
+    (or its chunks): the steps whose applied command differs from what the controller asked, of all
+    steps, and the largest |voltage| asked on that axis."""
+
+    def __init__(self):
+        self.clamped, self.steps, self.max_asked = [0, 0], 0, [0.0, 0.0]
+
+    def add(self, asked: np.ndarray, commanded: np.ndarray) -> None:
+        """`asked`, `commanded`: (rows, 2), the controller's outputs before and after the clamp."""
+        self.steps += len(asked)
+        for axis in (0, 1):
+            self.clamped[axis] += int(np.count_nonzero(asked[:, axis] != commanded[:, axis]))
+            if len(asked):
+                self.max_asked[axis] = max(self.max_asked[axis], float(np.max(np.abs(asked[:, axis]))))
+
+    def summary(self) -> str | None:
+        """"voltage clamped on 1,234 of 60,000 steps (azimuth), max asked 1e+06 V; ..." or None when
+        nothing was clamped."""
+        parts = [f"voltage clamped on {self.clamped[axis]:,} of {self.steps:,} steps ({AXES[axis]}), max asked "
+                 f"{self.max_asked[axis]:.4g} V" for axis in (0, 1) if self.clamped[axis]]
+        return "; ".join(parts) or None
+
+
+def clamp_count(signals: dict) -> ClampCount:
+    """The ClampCount of a run's recorded signals (recorded_signals)."""
+    count = ClampCount()
+    count.add(np.column_stack([signals["u_R1_asked"], signals["u_R2_asked"]]),
+              np.column_stack([signals["u_R1_cmd"], signals["u_R2_cmd"]]))
+    return count
+
+
+def failure_error(message: str, exc: Exception) -> SceneError:
+    """The SceneError of a failed run with `message` (failure_message); a ControllerError, keeping
+    the traceback of the user's exception, when the user's controller is the culprit."""
+    return ControllerError(message, exc.details) if isinstance(exc, ControllerError) else SceneError(message)
 
 
 def recorded_signals(plan: Plan, rows: int | None = None) -> dict:
@@ -285,6 +329,7 @@ def recorded_signals(plan: Plan, rows: int | None = None) -> dict:
     rows = plan.n + 1 if rows is None else rows
     u_cmd = np.array(plan.u_cmd, dtype=float).reshape(-1, 2)[:rows]
     refs = np.array(plan.refs, dtype=float).reshape(-1, 2)[:rows]
+    u_asked = np.array(plan.u_asked, dtype=float).reshape(-1, 2)[:rows]
     # Applied over [t_k, t_k+1]: the command of `delay` steps before (0 V until the first is due).
     u_applied = np.zeros_like(u_cmd)
     u_applied[plan.delay:] = u_cmd[:len(u_cmd) - plan.delay]
@@ -293,7 +338,8 @@ def recorded_signals(plan: Plan, rows: int | None = None) -> dict:
     signals.update({name: plan.rec_real[:rows, j] for j, name in enumerate(plan.real_names)})
     signals.update({name: plan.rec_mode[:rows, j].astype(float) for j, name in enumerate(plan.mode_names)})
     signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0],
-                    "u_R2_cmd": u_cmd[:, 1], "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
+                    "u_R2_cmd": u_cmd[:, 1], "u_R1_asked": u_asked[:, 0], "u_R2_asked": u_asked[:, 1],
+                    "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
     signals.update({name: plan.base[:rows, j] for j, name in enumerate(BASE_INPUTS)})
     signals["heave"] = plan.motion.position(times)[:, 2]
     return signals
@@ -332,6 +378,8 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
         try:
             initialize(slave, scene, fmu, plan)
             plan.controller.start(plan.h, scene.name)
+        except ControllerError as exc:   # the user's reset() raised
+            raise failure_error(failure_message(scene, plan, exc, log), exc) from None
         except SceneError:
             raise
         except Exception as exc:   # refused at initialization: the scene, not the run
@@ -341,8 +389,8 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
         except Exception as exc:   # a refused FMI call, fmpy raising on fmi2Error / fmi2Discard, the controller
             message = failure_message(scene, plan, exc, log)
             if not keep_partial or plan.rows == 0:
-                raise SceneError(message) from None
-            stopped = Stop("failed", (plan.rows - 1) * plan.h, message)
+                raise failure_error(message, exc) from None
+            stopped = Stop("failed", (plan.rows - 1) * plan.h, message, getattr(exc, "details", None))
         if stopped is None and plan.rows < plan.n + 1:
             if plan.rows == 0:
                 raise SceneError(f"{scene.name}: {stop.reason} before the first communication point: nothing "
@@ -356,7 +404,9 @@ def run(scene: Scene, fmu: FMU, progress: bool = False, stop_time: float | None 
             slave.freeInstance()
     wall, loop_cpu = time.perf_counter() - wall0, time.process_time() - cpu0
     end = plan.t_end if stopped is None else stopped.time
-    result = RunResult(scene, recorded_signals(plan, plan.rows), wall, end)
+    signals = recorded_signals(plan, plan.rows)
+    result = RunResult(scene, signals, wall, end)
+    result.voltage_clamp = clamp_count(signals)
     result.loop_cpu_time = loop_cpu  # set-up, initialization and the loop; not the base motion's evaluation
     result.loop = loop
     result.stopped = stopped

@@ -12,6 +12,8 @@ import textwrap
 
 import numpy as np
 
+from . import spectra
+
 DEG = 180.0 / math.pi
 # The error angle between two unit vectors of doubles is exact to ~1e-15 rad: below 1e-12 rad
 # (1e-9 mrad) it is zero (a run that starts on target), and a log axis down to there would squash
@@ -99,16 +101,16 @@ def draw_los_error(ax, result, t: np.ndarray, values: np.ndarray) -> None:
 def figure(result, limits: dict | None = None):
     """The figure of a run (matplotlib, Agg). `limits`: optional {signal: value} drawn as dashed
     +-lines (i_L, eta)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # a Figure of its own, drawn by Agg when saved: pyplot (its backends and figure managers) is not needed
+    from matplotlib.figure import Figure
 
     s, scene = result.signals, result.scene
     panels = default_panels(result)
     panels.update(scene.plot)
     limits = limits or {}
     t = s["time"]
-    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(12, 1.9 * len(panels) + 0.8), squeeze=False)
+    fig = Figure(figsize=(12, 1.9 * len(panels) + 0.8))
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)
     for ax, (panel, names) in zip(axes[:, 0], panels.items()):
         units = set()
         for name in names:
@@ -143,12 +145,7 @@ def figure(result, limits: dict | None = None):
 
 def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
     """Writes the PNG of `figure(result, limits)`."""
-    fig = figure(result, limits)
-    import matplotlib.pyplot as plt
-    try:
-        fig.savefig(path, dpi=100)
-    finally:
-        plt.close(fig)
+    figure(result, limits).savefig(path, dpi=100)   # no pyplot figure to close: it goes with its last reference
 
 
 def spectrum_figure(result):
@@ -158,16 +155,15 @@ def spectrum_figure(result):
     against the carrier's rate about the same payload axis) and its coherence. None without a target.
     The 0-Hz bin has no place on a log axis: its value is in the legend (and the CSV), and it is in
     every cumulative RMS. The y limits are matplotlib's from every drawn value: nothing is clipped."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure   # as in figure(): no pyplot
 
     found = result.los_spectra()
     if not found:
         return None
     isolation = result.isolation_estimates()
     rows = 2 + (2 if isolation else 0)
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(10, 2.6 * rows + 0.8), squeeze=False)
+    fig = Figure(figsize=(10, 2.6 * rows + 0.8))
+    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)
     axes = axes[:, 0]
     for index, (name, spectrum) in enumerate(found.items()):
         f, psd = spectrum.frequency, spectrum.psd * 1e6
@@ -198,14 +194,26 @@ def spectrum_figure(result):
             f = estimate.frequency
             gain = np.abs(estimate.response)
             shown = (f > 0) & np.isfinite(gain) & (gain > 0)
-            axes[2].loglog(f[shown], gain[shown], lw=0.9, color=f"C{index + 2}",
-                           label=f"los.omega[{i}] / carrier rate about payload axis {i} ({ISOLATION_LABELS[i]})")
+            # bins whose H1 is not known to spectra.H1_RANDOM_ERROR (low coherence: the carrier has no energy
+            # there, or the gyro something else) are drawn light grey: the gain there is the estimate's noise
+            known = shown & estimate.coherent
+            axes[2].loglog(f[shown], gain[shown], lw=0.7, color="0.8",
+                           label=None if index else f"coherence < {estimate.coherence_bound:.2g}: gain not known "
+                                                    f"(random error > {spectra.H1_RANDOM_ERROR:.0%})")
+            axes[2].loglog(f[shown], np.where(known, gain, np.nan)[shown], lw=0.9, marker=".", ms=3,
+                           color=f"C{index + 2}",
+                           label=f"los.omega[{i}] / carrier rate about payload axis {i} ({ISOLATION_LABELS[i]}): "
+                                 f"{known.sum()} of {shown.sum()} bins known")
             axes[3].semilogx(f[f > 0], estimate.coherence[f > 0], lw=0.9, color=f"C{index + 2}",
                              label=f"{ISOLATION_LABELS[i]}")
+        axes[3].axhline(estimate.coherence_bound, color="k", lw=0.8, ls="--",
+                        label=f"{estimate.coherence_bound:.2g}: below, |H1| has more than {spectra.H1_RANDOM_ERROR:.0%} "
+                              f"random error ({estimate.averages:.3g} independent averages)")
         axes[3].axhline(1.0 / max(estimate.segments, 1), color="gray", lw=0.7, ls=":",
                         label=f"1/segments = {1.0 / max(estimate.segments, 1):.2g} (no relation reads about this)")
-        axes[2].set_title(f"isolation from this run: H1 estimate, {estimate.resolution:g} Hz resolution, "
-                          f"{estimate.segments} segment(s)", fontsize="small")
+        t = result.window_bounds()
+        axes[2].set_title(f"isolation from this run over [{t[0]:g}, {t[-1]:g}] s: H1 estimate, "
+                          f"{estimate.resolution:g} Hz resolution, {estimate.segments} segment(s)", fontsize="small")
         axes[2].set_ylabel("|H1| LOS rate /\ncarrier rate", fontsize="small")
         axes[3].set_ylabel("coherence", fontsize="small")
     for ax in axes:
@@ -227,9 +235,5 @@ def plot_spectrum(result, path: pathlib.Path) -> bool:
     fig = spectrum_figure(result)
     if fig is None:
         return False
-    import matplotlib.pyplot as plt
-    try:
-        fig.savefig(path, dpi=100)
-    finally:
-        plt.close(fig)
+    fig.savefig(path, dpi=100)
     return True

@@ -9,7 +9,7 @@ import pathlib
 import numpy as np
 
 from ..scene import geometry
-from . import spectra
+from . import spectra, units
 
 # Per-axis signed pointing errors (line of sight minus target) [rad]: cross-elevation (the azimuth
 # error times cos of the target's elevation, an angle across the line of sight) and elevation.
@@ -167,14 +167,17 @@ class RunResult:
             with np.errstate(divide="ignore"):
                 gain_db = 20 * np.log10(np.abs(estimate.response))
             columns += [carrier, np.abs(estimate.response), gain_db, np.degrees(np.angle(estimate.response)),
-                        estimate.coherence]
-            names += [f"{axis}_carrier_psd", f"{axis}_gain", f"{axis}_gain_db", f"{axis}_phase_deg", f"{axis}_coherence"]
+                        estimate.coherence, estimate.random_error, estimate.coherent.astype(int)]
+            names += [f"{axis}_carrier_psd", f"{axis}_gain", f"{axis}_gain_db", f"{axis}_phase_deg", f"{axis}_coherence",
+                      f"{axis}_gain_random_error", f"{axis}_coherent"]
         t = self.window_bounds()
         comment = (f"# H1 estimate of los.omega[i] against the carrier's inertial rate about the same payload axis "
                    f"(i = 1 elevation, 3 cross-elevation) over [{t[0]:g}, {t[-1]:g}] s: {spectra.WINDOW} window, "
                    f"{spectra.OVERLAP:.0%} overlap, {first.resolution:g} Hz resolution, {first.segments} segment(s); "
                    f"coherence from {first.segments} segments is about {1 / max(first.segments, 1):.2g} where "
-                   f"nothing is related")
+                   f"nothing is related; coherent = 1 where the gain's random error (1 sigma, Bendat & Piersol, "
+                   f"{first.averages:.3g} independent averages) is at most {spectra.H1_RANDOM_ERROR:.0%}, i.e. the "
+                   f"coherence is at least {first.coherence_bound:.3g}: elsewhere the gain is not known")
         np.savetxt(path, np.column_stack(columns), delimiter=",", header=comment + "\n" + ",".join(names),
                    comments="", fmt="%.10g")
         return True
@@ -204,7 +207,7 @@ class RunResult:
         if rows[-1] != len(self.signals["time"]) - 1:
             rows = np.append(rows, len(self.signals["time"]) - 1)
         data = np.column_stack([np.asarray(self.signal(n), dtype=float)[rows] for n in names])
-        np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.12g")
+        np.savetxt(path, data, delimiter=",", header=units.csv_header(names), comments="", fmt="%.12g")
 
     def summary(self) -> str:
         s = self.signals
@@ -218,7 +221,9 @@ class RunResult:
                         f"wall ({rtf:.1f}x real time)")
         if self.has_target:
             m = self.los_metrics()
-            window = f" from {m['from_s']:g} s" if m["from_s"] > 0 else ""
+            # the window the RMS and max were taken over as it was, not as asked: a run that ends before the
+            # requirements' from_s is measured over the whole run (metrics_window)
+            window = " over [{:g}, {:g}] s".format(*self.window_bounds())
             parts.append(f"LOS error final {m['final'] * 1e3:.4g} mrad, RMS{window} {m['rms'] * 1e3:.4g} mrad "
                          f"(max {m['max'] * 1e3:.4g} mrad)")
         else:
@@ -229,12 +234,14 @@ class RunResult:
             spectrum = next(iter(self.los_spectra().values()), None)
             resolution = f"{spectrum.resolution:g} Hz resolution" if spectrum else "no spectrum"
             rms = self.band_rms()
-            m = self.los_metrics()
-            window = f" from {m['from_s']:g} s" if m["from_s"] > 0 else ""
+            window = " over [{:g}, {:g}] s".format(*self.window_bounds())
             parts.append(f"LOS RMS by band{window} ({resolution}): " + ", ".join(
                 f"{name} [{lo:g}, {hi:g}) Hz {rms[name] * 1e3:.4g} mrad" for name, (lo, hi) in bands.items()))
         if self.final("events.total") is not None:
             parts.append(f"{int(self.final('events.total'))} events")
+        clamp = getattr(self, "voltage_clamp", None)   # master.ClampCount, set by the run
+        if clamp is not None and clamp.summary():
+            parts.append(clamp.summary())
         if self.scene.requirements and self.has_target:
             failures = self.requirement_failures()
             if self.window_start() >= self.stop_time:

@@ -1,5 +1,6 @@
 """Spectra of a run's signals: Welch power spectral density, cumulative RMS over frequency, RMS in
-a band, and the H1 transfer estimate with its coherence. Pure functions of numpy arrays.
+a band, and the H1 transfer estimate with its coherence and the coherence below which its random error
+exceeds H1_RANDOM_ERROR. Pure functions of numpy arrays.
 
 Conventions (docs/jitter.md):
 
@@ -24,6 +25,15 @@ import numpy as np
 
 WINDOW = "hann"
 OVERLAP = 0.5
+
+
+def hann_window(n: int) -> np.ndarray:
+    """scipy.signal.get_window(WINDOW, n), the periodic Hann window welch uses, computed as scipy
+    computes it (bit for bit: tests/test_package_layout.py) without importing scipy.signal, which
+    takes 0.5 s: `gimbal2axis run` needs the window and nothing else of it."""
+    if n == 1:
+        return np.ones(1)
+    return (0.5 + 0.5 * np.cos(np.linspace(-np.pi, np.pi, n + 1)))[:n]
 
 
 @dataclass(frozen=True)
@@ -94,6 +104,43 @@ def band_rms(frequency: np.ndarray, density: np.ndarray, resolution: float, f_lo
     return float(math.sqrt(np.sum(np.asarray(density)[band_mask(frequency, f_lo, f_hi)]) * resolution))
 
 
+# The random error an H1 estimate is read to: 1 sigma of 10 % in gain (0.8 dB) and, the same expression,
+# 0.1 rad (5.7 deg) in phase. A choice of accuracy, not a property of the data: the isolation is read
+# in dB over decades, where 0.8 dB is below what the eye separates on the plot, while an estimate with
+# a larger error is one the plot would show as a gain it does not know. Bins whose estimate is worse are
+# masked (coherence_bound).
+H1_RANDOM_ERROR = 0.1
+
+
+def independent_segments(segments: int, segment: int) -> float:
+    """The number of independent averages that `segments` Welch segments of `segment` samples (WINDOW,
+    OVERLAP) are worth: overlapping segments are correlated, and the variance of the averaged estimate is
+    (1 / K) (1 + 2 (K - 1) / K rho^2), rho the window's overlap correlation sum(w[i] w[i + step]) /
+    sum(w^2) (Welch 1967; Hann at 50 %: rho = 0.167, so K segments are worth about 0.95 K)."""
+    if segments < 1:
+        return 0.0
+    window = hann_window(segment)
+    step = segment - int(segment * OVERLAP)
+    rho = float(np.dot(window[:segment - step], window[step:]) / np.dot(window, window)) if step < segment else 0.0
+    return segments / (1 + 2 * (segments - 1) / segments * rho * rho)
+
+
+def h1_random_error(coherence, averages: float) -> np.ndarray:
+    """The normalized random error (1 sigma) of the H1 gain, and in radians of its phase, at the given
+    magnitude-squared coherence from `averages` independent averages (Bendat & Piersol, Random Data,
+    eq. 9.52 and 9.73): sqrt(1 - coherence) / (sqrt(coherence) sqrt(2 averages)); inf at coherence 0,
+    nan where the coherence is."""
+    coherence = np.asarray(coherence, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.sqrt(1 - coherence) / np.sqrt(coherence * 2 * max(averages, 0.0))
+
+
+def coherence_bound(averages: float, relative_error: float = H1_RANDOM_ERROR) -> float:
+    """The magnitude-squared coherence below which h1_random_error exceeds `relative_error`:
+    1 / (1 + 2 averages relative_error^2) (e.g. 46 Hann segments at 50 %: 0.54; 10: 0.84; 2: 0.96)."""
+    return 1.0 / (1.0 + 2.0 * averages * relative_error ** 2)
+
+
 @dataclass(frozen=True)
 class TransferEstimate:
     frequency: np.ndarray       # Hz
@@ -101,14 +148,38 @@ class TransferEstimate:
     coherence: np.ndarray       # magnitude-squared coherence, 0..1
     resolution: float           # Hz
     segments: int
+    segment: int = 0            # samples per segment (0: unknown, then the segments count as independent)
+
+    @property
+    def averages(self) -> float:
+        """The independent averages the segments are worth (independent_segments)."""
+        return independent_segments(self.segments, self.segment) if self.segment else float(self.segments)
+
+    @property
+    def random_error(self) -> np.ndarray:
+        """h1_random_error per bin: the 1-sigma relative error of |H1| (and in rad of its phase)."""
+        return h1_random_error(self.coherence, self.averages)
+
+    @property
+    def coherence_bound(self) -> float:
+        """The coherence below which a bin's H1 has more than H1_RANDOM_ERROR of random error."""
+        return coherence_bound(self.averages)
+
+    @property
+    def coherent(self) -> np.ndarray:
+        """The bins whose H1 is known to H1_RANDOM_ERROR (False where the coherence is nan). None from a
+        single segment: its coherence is 1 by construction (|S_xy|^2 = S_xx S_yy for one periodogram)."""
+        if self.segments < 2:
+            return np.zeros(self.coherence.shape, dtype=bool)
+        return np.nan_to_num(self.coherence, nan=-1.0) >= self.coherence_bound
 
 
 def transfer_estimate(x, y, sample_rate: float, resolution_hz: float) -> TransferEstimate:
     """The H1 estimate of the transfer from input `x` to output `y`, H1 = S_xy / S_xx (unbiased by
     noise on the output), and the magnitude-squared coherence |S_xy|^2 / (S_xx S_yy), both by Welch
     with the PSD's window, overlap and mean removal. Where the input has no power (S_xx = 0) H1 is nan.
-    Coherence from K segments is biased up by about 1/K where there is no relation: trust H1 where the
-    coherence is well above that."""
+    Coherence from K segments is biased up by about 1/K where there is no relation; the estimate's
+    `coherent` bins are those whose H1 has at most H1_RANDOM_ERROR of random error (coherence_bound)."""
     from scipy import signal
 
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -124,7 +195,7 @@ def transfer_estimate(x, y, sample_rate: float, resolution_hz: float) -> Transfe
         response = np.where(s_xx > 0, s_xy / s_xx, np.nan)
         coherence = np.where((s_xx > 0) & (s_yy > 0), np.abs(s_xy) ** 2 / (s_xx * s_yy), np.nan)
     return TransferEstimate(frequency, response, np.clip(coherence, 0.0, 1.0), sample_rate / segment,
-                            segment_count(x.size, segment))
+                            segment_count(x.size, segment), segment)
 
 
 class WelchAccumulator:
@@ -138,14 +209,12 @@ class WelchAccumulator:
     `samples`: how many will be fed; `pairs`: the (x, y) whose cross spectrum is wanted."""
 
     def __init__(self, sample_rate: float, resolution_hz: float, samples: int, means: dict, pairs=()):
-        from scipy import signal
-
         if samples < 2:
             raise ValueError(f"need at least 2 samples, got {samples}")
         self.sample_rate, self.samples, self.means = sample_rate, samples, dict(means)
         self.segment = min(segment_length(sample_rate, resolution_hz), samples)
         self.step = self.segment - int(self.segment * OVERLAP)
-        self.window = signal.get_window(WINDOW, self.segment)
+        self.window = hann_window(self.segment)
         self.scale = 1.0 / (sample_rate * np.sum(self.window * self.window))
         self.pairs = list(pairs)
         self.pending = {name: np.empty(0) for name in self.means}
@@ -191,4 +260,4 @@ class WelchAccumulator:
             response = np.where(s_xx > 0, s_xy / s_xx, np.nan)
             coherence = np.where((s_xx > 0) & (s_yy > 0), np.abs(s_xy) ** 2 / (s_xx * s_yy), np.nan)
         return TransferEstimate(self.frequency, response, np.clip(coherence, 0.0, 1.0), self.sample_rate / self.segment,
-                                self.segments)
+                                self.segments, self.segment)

@@ -37,9 +37,10 @@ from ..fmu import FMU
 from ..progress import Progress
 from ..scene.base_motion import INPUTS as BASE_INPUTS
 from ..scene.scene import Scene, check_against_fmu, parameter_value
-from . import compiled_loop, spectra
-from .master import (FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records, failure_message,
-                     initialize)
+from . import compiled_loop, spectra, units
+from ..scene.controllers import ControllerError
+from .master import (ClampCount, FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records,
+                     failure_error, failure_message, initialize)
 from .results import AXIS_ERRORS, CARRIER_RATES, ISOLATION_AXES, RunResult
 
 # Communication points per chunk: 2^14 rows of ~60 doubles are 7.9 MB of record, some 50 MB with
@@ -79,6 +80,7 @@ class StreamPlan:
         # the commands: `delay` rows of the chunk before, then this chunk's (the delayed voltage reads back)
         self.u_cmd = np.zeros((self.delay + rows, 2))
         self.refs = np.full((rows, 2), np.nan)
+        self.u_asked = np.zeros((rows, 2))   # the controller's outputs before its clamp
         self.sensor_stream = self.sensors.stream(self.n + 1, self.h)
         self.k, self.rows = 0, 0   # the step reached; the points recorded whole (as Plan's)
         self.first = 0
@@ -111,7 +113,8 @@ class StreamPlan:
         signals.update({name: self.rec_real[:count, j].copy() for j, name in enumerate(self.real_names)})
         signals.update({name: self.rec_mode[:count, j].astype(float) for j, name in enumerate(self.mode_names)})
         signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0].copy(),
-                        "u_R2_cmd": u_cmd[:, 1].copy(), "alpha_ref": self.refs[:count, 0].copy(),
+                        "u_R2_cmd": u_cmd[:, 1].copy(), "u_R1_asked": self.u_asked[:count, 0].copy(),
+                        "u_R2_asked": self.u_asked[:count, 1].copy(), "alpha_ref": self.refs[:count, 0].copy(),
                         "beta_ref": self.refs[:count, 1].copy()})
         signals.update({name: self.base[:count, j] for j, name in enumerate(BASE_INPUTS)})
         signals["heave"] = self.motion.position_rows(self.first, count, self.h)[:, 2]
@@ -134,7 +137,7 @@ def python_chunk(slave, calls: RawCalls, plan: StreamPlan, first: int, last: int
     h, n, delay = plan.h, plan.n, plan.delay
     attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
     i_alpha, i_beta, i_gyro, (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, plan.i_joint_rates
-    u_cmd, refs = plan.u_cmd, plan.refs
+    u_cmd, refs, u_asked = plan.u_cmd, plan.refs, plan.u_asked
     zero = (0.0, 0.0)
     recorded = first
     try:
@@ -153,6 +156,7 @@ def python_chunk(slave, calls: RawCalls, plan: StreamPlan, first: int, last: int
             u = controller(t, h, alpha, beta, gyro, attitude_rows[row], rate_rows[row], step=k)
             u_cmd[delay + row] = u
             refs[row] = controller.reference
+            u_asked[row] = controller.asked
             recorded = k + 1
             applied = u if delay == 0 else (u_cmd[row] if k >= delay else zero)
             if k == n:
@@ -248,9 +252,9 @@ class RecordFiles:
             table = pa.table({name: columns[name] for name in self.names})
             # no dictionary encoding: it took 60 % of the write's time and finds nothing to share in
             # measured signals; snappy still saves a fifth to a quarter of the size
-            self.writer = pq.ParquetWriter(self.parquet_path, table.schema, use_dictionary=False)
+            self.writer = pq.ParquetWriter(self.parquet_path, units.with_units(table.schema), use_dictionary=False)
             self.csv = open(self.csv_path, "w")
-            self.csv.write(",".join(self.names) + "\n")
+            self.csv.write(units.csv_header(self.names) + "\n")
         else:
             table = pa.table({name: columns[name] for name in self.names})
         self.writer.write_table(table, row_group_size=len(table))
@@ -347,11 +351,12 @@ def size_text(size: float) -> str:
 
 
 def column_count(plan: StreamPlan, scene: Scene) -> int:
-    """The record's signals: time, outputs, modes, commands and set points, base inputs and heave,
+    """The record's signals: time, outputs, modes, commands (applied, commanded, asked) and set points, base
+    inputs and heave,
     and the derived line-of-sight signals (RunResult)."""
     derived = 5 + (len(AXIS_ERRORS) if scene.target_spec is not None else 0) + \
         (len(CARRIER_RATES) if not plan.motion.fixed else 0)
-    return 1 + len(plan.real_names) + len(plan.mode_names) + 6 + len(BASE_INPUTS) + 1 + derived
+    return 1 + len(plan.real_names) + len(plan.mode_names) + 8 + len(BASE_INPUTS) + 1 + derived
 
 
 def check_fits(plan: StreamPlan, scene: Scene, out: pathlib.Path) -> None:
@@ -505,12 +510,15 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     slave = fmu.instantiate(scene.name, log)
     bar = Progress(plan.t_end, enabled=progress)
     stopped, decimator = None, None
+    clamp = ClampCount()
     try:
         plan.load_chunk(0, plan.chunk_rows)
         wall0 = time.perf_counter()
         try:
             initialize(slave, scene, fmu, plan)
             plan.controller.start(plan.h, scene.name)
+        except ControllerError as exc:   # the user's reset() raised
+            raise failure_error(failure_message(scene, plan, exc, log), exc) from None
         except SceneError:
             raise
         except Exception as exc:
@@ -539,6 +547,7 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
                 columns = _derived_columns(scene, plan.chunk_signals(recorded), not plan.motion.fixed)
                 files.append(first, columns)
                 metrics.add(columns)
+                clamp.add(plan.u_asked[:recorded], plan.u_cmd[plan.delay:plan.delay + recorded])
                 if decimator is None:
                     decimator = Decimator(plot_names(scene, list(columns)), plan.t_end, plan.n + 1)
                 decimator.add(columns)
@@ -546,8 +555,8 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
             if failure is not None:
                 message = failure_message(scene, plan, failure, log)
                 if plan.rows == 0:
-                    raise SceneError(message)
-                stopped = Stop("failed", (plan.rows - 1) * plan.h, message)
+                    raise failure_error(message, failure)
+                stopped = Stop("failed", (plan.rows - 1) * plan.h, message, getattr(failure, "details", None))
                 break
             if recorded < count:
                 if plan.rows == 0:
@@ -588,4 +597,5 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     result.stopped, result.requested_stop_time = stopped, status["stop_time_s"]
     result.loop, result.parquet_path, result.csv_path = loop_kind, files.parquet_path, files.csv_path
     result.status = status
+    result.voltage_clamp = clamp
     return result

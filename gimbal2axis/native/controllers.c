@@ -19,7 +19,8 @@ int gimbal_controller_kind(const char* name) {
     return -1;
 }
 
-static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double ref_rate) {
+/* The axis' voltage, clamped to +-u_limit; the value before the clamp goes to *asked. */
+static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double ref_rate, double* asked) {
     if (p->has_prev) {
         const double raw = (e - p->e_prev) / h;
         p->derivative += (h / (p->d_filter_s + h)) * (raw - p->derivative);
@@ -31,6 +32,7 @@ static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double
     }
     const double u = p->kp * e + p->ki * p->integral + p->kd * p->derivative - p->k_gyro * rate + p->k_ff * ref_rate;
     p->saturated = u > p->u_limit ? 1 : (u < -p->u_limit ? -1 : 0);
+    *asked = u;
     return py_min(py_max(u, -p->u_limit), p->u_limit);
 }
 
@@ -55,6 +57,7 @@ static void state_feedback(GimbalController* c, double h, double alpha, double b
         for (int j = 0; j < 4; ++j) sum = sum + c->gain[4 * i + j] * x[j];
         const double v = -sum + c->state_ki[i] * c->state_integral[i];
         const double limited = py_min(py_max(v, -c->u_limit[i]), c->u_limit[i]);
+        c->asked[i] = v;
         if (c->state_ki[i] != 0.0 && limited == v) c->state_integral[i] += -x[i] * h; /* only when unsaturated */
         u[i] = limited;
     }
@@ -64,10 +67,12 @@ void gimbal_controller_step(GimbalController* c, long k, double h, const double 
                             double u[2], double reference[2]) {
     if (c->kind == kNone) {
         u[0] = c->voltage[0], u[1] = c->voltage[1];
+        c->asked[0] = u[0], c->asked[1] = u[1];
         return;
     }
     if (c->kind == kReplay) {
         u[0] = c->replayed[2 * k], u[1] = c->replayed[2 * k + 1];
+        c->asked[0] = u[0], c->asked[1] = u[1];
         return;
     }
     const double alpha = measured[0], beta = measured[1];
@@ -84,8 +89,8 @@ void gimbal_controller_step(GimbalController* c, long k, double h, const double 
        sight (secant correction, bounded near the zenith). */
     const double w_az = measured[4] / py_max(cos(beta), 0.2), w_el = measured[2];
     if (c->kind == kPid) {
-        u[0] = axis_pid(&c->axis[0], r[0] - alpha, w_az, h, r_dot[0]);
-        u[1] = axis_pid(&c->axis[1], r[1] - beta, w_el, h, r_dot[1]);
+        u[0] = axis_pid(&c->axis[0], r[0] - alpha, w_az, h, r_dot[0], &c->asked[0]);
+        u[1] = axis_pid(&c->axis[1], r[1] - beta, w_el, h, r_dot[1], &c->asked[1]);
         return;
     }
     state_feedback(c, h, alpha, beta, w_az, w_el, r, u);

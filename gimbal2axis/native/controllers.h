@@ -4,7 +4,8 @@
  * benchmark driver and the C scene driver.
  *
  * Called once per communication point with the measurements at t_k (after the sensors) and the set
- * points; returns the voltages (u_R1, u_R2), saturated at +-u_limit like a DAC. Axis 0 is the azimuth
+ * points; returns the voltages (u_R1, u_R2), saturated at +-u_limit like a DAC (the values before
+ * the saturation in `asked`). Axis 0 is the azimuth
  * (alpha, motor 1), axis 1 the elevation (beta, motor 2). Every operation and its order is fixed
  * (Python's min/max semantics, sums in order; built with -ffp-contract=off): results keep the bits
  * they were recorded with (tests/golden), whichever loop runs them. */
@@ -41,7 +42,10 @@ GIMBAL_STRUCT(GimbalSetPoints, GIMBAL_SET_POINTS_FIELDS)
     ARRAY(double, state_integral, double, 2) ARRAY(double, prev_angle, double, 2)                     \
     FIELD(int, rate_from_encoder, int) FIELD(int, has_prev_angle, int)                                \
     FIELD(const double*, replayed, pointer) /* replay: (n + 1) x 2 voltages */                        \
-    FIELD(GimbalSetPoints, set_points, GimbalSetPoints)
+    FIELD(GimbalSetPoints, set_points, GimbalSetPoints)                                               \
+    /* the last step's voltages before the clamp to +-u_limit (u itself where nothing clamps): */     \
+    /* what the controller asked, recorded beside u so that a run can count and report the clamp */  \
+    ARRAY(double, asked, double, 2)
 GIMBAL_STRUCT(GimbalController, GIMBAL_CONTROLLER_FIELDS)
 
 #ifdef __cplusplus

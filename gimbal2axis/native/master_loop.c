@@ -20,6 +20,7 @@ int gimbal_master_loop(GimbalMasterLoop* m, long first, long last) {
         gimbal_sensors_measure(&m->sensors, k, measured);
         double* u = m->u_cmd + 2 * k;
         gimbal_controller_step(&m->controller, k, m->h, measured, NULL, u, m->refs + 2 * k);
+        if (m->u_asked) m->u_asked[2 * k] = m->controller.asked[0], m->u_asked[2 * k + 1] = m->controller.asked[1];
         if (k == m->n) break;
         /* The voltage applied over [t_k, t_k+1]: the command of `delay` steps before, 0 V until one is due. */
         double* row = m->inputs + k * m->input_count;

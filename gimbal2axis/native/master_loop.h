@@ -33,6 +33,7 @@ typedef int (*GimbalDoStepCall)(void* component, double t, double h, int no_set_
     FIELD(double*, rec_real, pointer) FIELD(int*, rec_mode, pointer) FIELD(double*, inputs, pointer)       \
     FIELD(double*, u_cmd, pointer)  /* (n + 1) x 2: the controller's outputs */                           \
     FIELD(double*, refs, pointer)   /* (n + 1) x 2: the set points, for the record (NaN without) */       \
+    FIELD(double*, u_asked, pointer) /* (n + 1) x 2: the controller's outputs before its clamp, or NULL */ \
     FIELD(double, h, double) FIELD(long, n, long) FIELD(long, delay, long)                                 \
     /* columns of rec_real the sensors read */                                                            \
     FIELD(long, i_alpha, long) FIELD(long, i_beta, long) ARRAY(long, i_gyro, long, 3)                      \

@@ -9,6 +9,27 @@
 #include <string.h>
 
 enum { MINIMUM_ROWS = 4 };
+/* The most bytes of the file a message quotes (a cell, a column name): a message stays one readable
+ * line whatever the file holds. The file's content is quoted only once its header has a 'time'
+ * column, i.e. once it is recognisably a recording: any other file is refused without a word of it. */
+enum { EXCERPT_BYTES = 80 };
+
+/* A bounded quote of text[0 .. length): print it as "%.*s%s" with (length, suffix). */
+typedef struct {
+    int length;
+    char suffix[48];
+} Excerpt;
+
+static Excerpt excerpt_of(const char* text, size_t length) {
+    Excerpt excerpt = {(int)length, ""};
+    if (length > EXCERPT_BYTES) {
+        size_t cut = EXCERPT_BYTES;
+        while (cut > 0 && ((unsigned char)text[cut] & 0xC0) == 0x80) --cut; /* not inside a UTF-8 character */
+        excerpt.length = (int)cut;
+        snprintf(excerpt.suffix, sizeof excerpt.suffix, "\xE2\x80\xA6(%zu bytes)", length);
+    }
+    return excerpt;
+}
 
 typedef struct {
     const char* start;
@@ -177,9 +198,9 @@ int gimbal_csv_table_column(const GimbalCsvTable* table, const char* name) {
 static int read_header(const Line* header, GimbalCsvTable* table, char* message, size_t size) {
     if (memchr(header->start, ';', header->length) != NULL && memchr(header->start, ',', header->length) == NULL)
         return refuse(message, size,
-                      "line %ld is separated by semicolons ('%.*s'); the file must be comma-separated with '.' as the "
-                      "decimal point (save it as CSV with ',' separators)",
-                      header->number, (int)header->length, header->start);
+                      "line %ld (the header) is separated by semicolons; the file must be comma-separated with '.' as "
+                      "the decimal point (save it as CSV with ',' separators)",
+                      header->number);
     const size_t columns = count_cells(header->start, header->length);
     if (columns > 100000) return refuse(message, size, "line %ld (the header) has %zu columns", header->number, columns);
     table->names = calloc(columns, sizeof(char*));
@@ -191,24 +212,28 @@ static int read_header(const Line* header, GimbalCsvTable* table, char* message,
         size_t length;
         next_cell(header->start, header->length, &position, &name, &length);
         strip(&name, &length, 1);
-        if (length == 0)
-            return refuse(message, size, "line %ld (the header): column %zu has no name", header->number, k + 1);
         table->names[k] = malloc(length + 1);
         if (table->names[k] == NULL) return -1;
         memcpy(table->names[k], name, length);
         table->names[k][length] = '\0';
-        for (size_t j = 0; j < k; ++j)
-            if (strcmp(table->names[j], table->names[k]) == 0)
-                return refuse(message, size, "line %ld (the header): column '%s' appears twice", header->number,
-                              table->names[k]);
     }
+    /* Before anything that quotes the header: without a 'time' column the file is not a recording
+     * (a wrong path, say), and what it holds is none of the message's business. */
     table->time_column = gimbal_csv_table_column(table, "time");
-    if (table->time_column < 0) {
-        int written = snprintf(message, size, "no 'time' column in the header (line %ld: ", header->number);
-        for (int k = 0; k < table->columns && written >= 0 && (size_t)written < size; ++k)
-            written += snprintf(message + written, size - (size_t)written, "%s%s", k > 0 ? ", " : "", table->names[k]);
-        if (written >= 0 && (size_t)written < size) snprintf(message + written, size - (size_t)written, ")");
-        return 1;
+    if (table->time_column < 0)
+        return refuse(message, size,
+                      "not a recorded motion: its header (line %ld, the first that is not a comment) has no 'time' "
+                      "column (expected a comma-separated header row such as 'time,gamma', then rows of numbers)",
+                      header->number);
+    for (size_t k = 0; k < columns; ++k) {
+        if (table->names[k][0] == '\0')
+            return refuse(message, size, "line %ld (the header): column %zu has no name", header->number, k + 1);
+        for (size_t j = 0; j < k; ++j)
+            if (strcmp(table->names[j], table->names[k]) == 0) {
+                const Excerpt name = excerpt_of(table->names[k], strlen(table->names[k]));
+                return refuse(message, size, "line %ld (the header): column '%.*s%s' appears twice", header->number,
+                              name.length, table->names[k], name.suffix);
+            }
     }
     return 0;
 }
@@ -228,14 +253,19 @@ static int read_row(const Line* line, long row, GimbalCsvTable* table, char* mes
         strip(&cell, &length, 0);
         const int parsed = parse_number(cell, length, &values[k]);
         if (parsed < 0) return -1;
-        if (parsed > 0 && length == 0)
-            return refuse(message, size, "line %ld (data row %ld), column '%s' is empty", line->number, row, table->names[k]);
+        if (parsed > 0 && length == 0) {
+            const Excerpt name = excerpt_of(table->names[k], strlen(table->names[k]));
+            return refuse(message, size, "line %ld (data row %ld), column '%.*s%s' is empty", line->number, row,
+                          name.length, table->names[k], name.suffix);
+        }
+        if (parsed == 0 && isfinite(values[k])) continue;
+        const Excerpt name = excerpt_of(table->names[k], strlen(table->names[k]));
+        const Excerpt text = excerpt_of(cell, length);
         if (parsed > 0)
-            return refuse(message, size, "line %ld (data row %ld), column '%s' is not a number: '%.*s'", line->number, row,
-                          table->names[k], (int)length, cell);
-        if (!isfinite(values[k]))
-            return refuse(message, size, "line %ld (data row %ld), column '%s' is '%.*s', not a finite number",
-                          line->number, row, table->names[k], (int)length, cell);
+            return refuse(message, size, "line %ld (data row %ld), column '%.*s%s' is not a number: '%.*s%s'",
+                          line->number, row, name.length, table->names[k], name.suffix, text.length, cell, text.suffix);
+        return refuse(message, size, "line %ld (data row %ld), column '%.*s%s' is '%.*s%s', not a finite number",
+                      line->number, row, name.length, table->names[k], name.suffix, text.length, cell, text.suffix);
     }
     return 0;
 }

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import SceneError, check_keys, number, positive
+from ..errors import SceneError, check_keys, excerpt, number, positive, shown
 
 # 2-s segments: fine enough to separate the sea's band (below 1 Hz) from the loop's and the gears'
 # (several Hz up), coarse enough that a 10-s window averages 9 segments and a 60-s one 59.
@@ -38,7 +38,7 @@ def parse(table: dict, step_size: float) -> AnalysisSettings:
     """The settings of an [analysis] table (empty: the defaults, no bands); SceneError for anything
     that cannot be meant."""
     if not isinstance(table, dict):
-        raise SceneError("'analysis' must be a table ([analysis])")
+        raise SceneError(f"'analysis' must be a table ([analysis]), got {shown(table)}")
     check_keys("analysis", table, KEYS)
     nyquist = 0.5 / step_size
     resolution = positive("analysis.psd_resolution_hz", table.get("psd_resolution_hz", DEFAULT_RESOLUTION_HZ))
@@ -56,11 +56,11 @@ def parse(table: dict, step_size: float) -> AnalysisSettings:
 
 
 def _band(name: str, value, nyquist: float) -> tuple[float, float]:
-    where = f"analysis.bands.{name}"
+    where = f"analysis.bands.{excerpt(name)}"
     if not name.replace("_", "").isalnum():
         raise SceneError(f"{where}: a band's name may hold letters, digits and '_' only (it names a sweep column)")
     if not (isinstance(value, list) and len(value) == 2):
-        raise SceneError(f"{where} must be [f_lo, f_hi] in Hz, got {value!r}")
+        raise SceneError(f"{where} must be [f_lo, f_hi] in Hz, got {shown(value)}")
     f_lo, f_hi = number(f"{where}[0]", value[0]), number(f"{where}[1]", value[1])
     if f_lo < 0:
         raise SceneError(f"{where} = [{f_lo:g}, {f_hi:g}]: f_lo must be >= 0 Hz")

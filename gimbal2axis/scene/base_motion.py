@@ -17,7 +17,8 @@ import weakref
 import numpy as np
 
 from .. import native
-from ..errors import SceneError, check_keys as _check_keys, positive as _positive
+from ..errors import (SceneError, check_keys as _check_keys, choice, integer, non_negative, number, positive as _positive,
+                      shown)
 
 INPUTS = ["base.delta", "base.psi", "base.gamma",
           "base.delta_dot", "base.psi_dot", "base.gamma_dot",
@@ -28,6 +29,7 @@ INPUTS = ["base.delta", "base.psi", "base.gamma",
 # scene axis name -> (index of the angle / translation, is an angle)
 ANGLE_AXES = {"pitch": 0, "yaw": 1, "roll": 2}           # delta, psi, gamma
 TRANSLATION_AXES = {"sway": 0, "surge": 1, "heave": 2}   # x_G, y_G, z_G: the bow along y, as roll is about y
+MOTION_KINDS = ("fixed", "sinusoids", "sea_state", "recorded")
 SEA_STATE_DEFAULTS = {"components": 100, "seed": 1}    # of a [base_motion] sea state that does not say
 DEFAULT_GAMMA = 3.3                                     # JONSWAP's mean peak enhancement
 
@@ -317,7 +319,7 @@ def _sine_terms(axis: str, spec, angle: bool):
     unit = "amplitude_deg" if angle else "amplitude_m"
     for item in specs:
         if not isinstance(item, dict):
-            raise SceneError(f"base_motion.{axis}: expected a table or a list of tables")
+            raise SceneError(f"base_motion.{axis}: expected a table or a list of tables, got {shown(item)}")
         _check_keys(f"base_motion.{axis}", item, {unit, "period_s", "frequency_hz", "phase_deg"} | (
             {"offset_deg"} if angle else set()))
         if unit not in item:
@@ -326,25 +328,27 @@ def _sine_terms(axis: str, spec, angle: bool):
             raise SceneError(f"base_motion.{axis}: give exactly one of 'period_s' and 'frequency_hz'")
         f = 1.0 / _positive(f"base_motion.{axis}.period_s", item["period_s"]) if "period_s" in item else \
             _positive(f"base_motion.{axis}.frequency_hz", item["frequency_hz"])
-        a = float(item[unit])
+        a = number(f"base_motion.{axis}.{unit}", item[unit])
         amplitude.append(math.radians(a) if angle else a)
         omega.append(2.0 * math.pi * f)
-        phase.append(math.radians(float(item.get("phase_deg", 0.0))))
-    offset = sum(math.radians(float(item.get("offset_deg", 0.0))) for item in specs) if angle else 0.0
+        phase.append(math.radians(number(f"base_motion.{axis}.phase_deg", item.get("phase_deg", 0.0))))
+    offset = sum(math.radians(number(f"base_motion.{axis}.offset_deg", item.get("offset_deg", 0.0)))
+                 for item in specs) if angle else 0.0
     return (np.array(amplitude), np.array(omega), np.array(phase)), offset
 
 
 def _velocity(spec: dict) -> tuple:
     v = spec.get("velocity_m_s", [0.0, 0.0, 0.0])
-    if not (isinstance(v, list) and len(v) == 3 and all(isinstance(x, (int, float)) for x in v)):
-        raise SceneError("base_motion.velocity_m_s must be a list of 3 numbers (constant velocity of point a in G)")
-    return tuple(float(x) for x in v)
+    if not (isinstance(v, list) and len(v) == 3):
+        raise SceneError(f"base_motion.velocity_m_s must be a list of 3 numbers (constant velocity of point a in G), "
+                         f"got {shown(v)}")
+    return tuple(number(f"base_motion.velocity_m_s[{i}]", x) for i, x in enumerate(v))
 
 
 def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
     """Builds the base motion of a scene's [base_motion] table (absent = fixed base)."""
     spec = dict(spec or {"type": "fixed"})
-    kind = spec.get("type", "fixed")
+    kind = choice("base_motion.type", spec.get("type", "fixed"), MOTION_KINDS)
     axes = set(ANGLE_AXES) | set(TRANSLATION_AXES)
     if kind == "fixed":
         _check_keys("base_motion", spec, {"type"})
@@ -361,12 +365,8 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
         return Sinusoids(angle_terms, translation_terms, offsets, _velocity(spec))
     if kind == "sea_state":
         _check_keys("base_motion", spec, {"type", "velocity_m_s", "components", "seed"} | axes)
-        components = spec.get("components", SEA_STATE_DEFAULTS["components"])
-        seed = spec.get("seed", SEA_STATE_DEFAULTS["seed"])
-        if not isinstance(components, int) or isinstance(components, bool) or components < 1:
-            raise SceneError("base_motion.components must be a positive integer")
-        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-            raise SceneError("base_motion.seed must be an integer >= 0")
+        components = integer("base_motion.components", spec.get("components", SEA_STATE_DEFAULTS["components"]), 1)
+        seed = integer("base_motion.seed", spec.get("seed", SEA_STATE_DEFAULTS["seed"]), 0)
         angle_terms, translation_terms, offsets = {}, {}, {}
         for index, name in enumerate(["pitch", "yaw", "roll", "surge", "sway", "heave"]):
             if name not in spec:
@@ -375,26 +375,30 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
             angle = name in ANGLE_AXES
             unit = "significant_amplitude_deg" if angle else "significant_amplitude_m"
             if not isinstance(item, dict):
-                raise SceneError(f"base_motion.{name}: expected a table")
+                raise SceneError(f"base_motion.{name}: expected a table, got {shown(item)}")
             _check_keys(f"base_motion.{name}", item, {unit, "peak_period_s", "gamma", "components"})
             for key in (unit, "peak_period_s"):
                 if key not in item:
                     raise SceneError(f"base_motion.{name}: missing '{key}'")
-            amplitude = float(item[unit])
-            gamma = float(item.get("gamma", DEFAULT_GAMMA))
+            # every value the kernel would refuse (sea_state_components), refused here by its key
+            amplitude = non_negative(f"base_motion.{name}.{unit}", item[unit])
+            gamma = number(f"base_motion.{name}.gamma", item.get("gamma", DEFAULT_GAMMA))
             if gamma < 1.0:
-                raise SceneError(f"base_motion.{name}.gamma (JONSWAP peak enhancement) must be >= 1 (1 = Pierson-Moskowitz)")
+                raise SceneError(f"base_motion.{name}.gamma = {gamma:g} (JONSWAP peak enhancement) must be >= 1 "
+                                 "(1 = Pierson-Moskowitz)")
             terms = sea_state_components(math.radians(amplitude) if angle else amplitude,
                                          _positive(f"base_motion.{name}.peak_period_s", item["peak_period_s"]),
-                                         gamma, int(item.get("components", components)), seed, index)
+                                         gamma, integer(f"base_motion.{name}.components",
+                                                        item.get("components", components), 1), seed, index)
             if angle:
                 angle_terms[ANGLE_AXES[name]] = terms
             else:
                 translation_terms[TRANSLATION_AXES[name]] = terms
         return SeaState(angle_terms, translation_terms, offsets, _velocity(spec))
-    if kind == "recorded":
-        _check_keys("base_motion", spec, {"type", "file"})
-        if "file" not in spec:
-            raise SceneError("base_motion: type 'recorded' needs 'file' (a CSV path relative to the scene file)")
-        return Recorded((scene_dir / spec["file"]).resolve())
-    raise SceneError(f"base_motion.type must be one of 'fixed', 'sinusoids', 'sea_state', 'recorded'; got {kind!r}")
+    # kind == "recorded"
+    _check_keys("base_motion", spec, {"type", "file"})
+    if "file" not in spec:
+        raise SceneError("base_motion: type 'recorded' needs 'file' (a CSV path relative to the scene file)")
+    if not isinstance(spec["file"], str) or not spec["file"]:
+        raise SceneError(f"base_motion.file must be a path (a string), got {shown(spec['file'])}")
+    return Recorded((scene_dir / spec["file"]).resolve())

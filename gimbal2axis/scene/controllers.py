@@ -19,16 +19,19 @@ its state in the kernel's struct (`state`), which the compiled loop copies.
 from __future__ import annotations
 
 import ctypes
-import importlib
 import importlib.util
 import inspect
 import math
+import numbers
 import pathlib
 import sys
+from math import isfinite
+
+import numpy as np
 
 from . import geometry
 from .. import native
-from ..errors import SceneError, check_keys, number
+from ..errors import SceneError, check_keys, did_you_mean, number, shown
 from .references import Reference
 from .setpoints import plan_set_points
 
@@ -74,6 +77,12 @@ class Controller:
                                                None if set_point is None else self._set_point, self._u,
                                                self._reference)
         return buffer[9], buffer[10]
+
+    @property
+    def asked(self) -> tuple:
+        """The last step's voltages before the clamp to +-u_limit (the kernel's)."""
+        asked = self.state.asked
+        return asked[0], asked[1]
 
     def start(self, step_size: float, scene_name: str) -> None:
         """Called by the master before every run (the built-in controllers need nothing)."""
@@ -215,19 +224,47 @@ class Replay(Controller):
     kind = "replay"
 
     def __init__(self, voltages, u_limit=(math.inf, math.inf)):
-        import numpy as np
-
         super().__init__(u_limit=u_limit)
         self.voltages = np.ascontiguousarray(voltages, dtype=float)
         self.state.replayed = self.voltages.ctypes.data
 
 
+# The measurements a user controller's step() gets, in this order (Measurements' attributes): name,
+# unit, shape (a single run; a batch class gets a leading axis of N cases), and what the values are.
+# The one definition: Measurements' slots, docs/controller_api.md (scripts/controller_api_page.py).
+MEASUREMENT_FIELDS = (
+    ("alpha", "rad", "()", "azimuth encoder angle: the yoke (body 1, motor 1) about the azimuth axis z0"),
+    ("beta", "rad", "()", "elevation encoder angle: the payload (body 2, motor 2) about the elevation axis x1"),
+    ("gyro", "rad/s", "(3,)", "(w1, w2, w3): the payload's inertial angular velocity in frame 2 from its gyro "
+                              "(los.omega): w1 about the elevation axis, w2 about the line of sight, w3 the "
+                              "cross-elevation rate (about z2); "
+                              "gyro_axis_rates turns them into the rates that move the line of sight"),
+    ("base_attitude", "rad", "(3,)", "(delta, psi, gamma): the carrier's attitude from its IMU, in this order "
+                                     "pitch (delta, about x_G), yaw (psi, about the pitched z), roll (gamma, about "
+                                     "y0): not roll, pitch, yaw (docs/physics.md, section 2); zeros on a fixed "
+                                     "base"),
+    ("base_rates", "rad/s", "(3,)", "(delta_dot, psi_dot, gamma_dot): the rates of base_attitude, same order"),
+)
+
+# What reset(context) is told about the run (ControllerContext's attributes): name, unit, meaning.
+CONTEXT_FIELDS = (
+    ("step_size", "s", "the communication step h: step() is called at t_k = k h"),
+    ("u_limit", "V", "(U_L1, U_L2): the motors' voltage limits; the master clamps step()'s voltages to +-U_L "
+                     "(counted, and recorded as u_R1_asked / u_R1_cmd)"),
+    ("target", "-", "the line-of-sight target, a unit vector in frame G, or None when the scene has no [target]"),
+    ("delay_steps", "-", "steps between a voltage's computation and its application (1: computed at t_k, "
+                         "applied over [t_k+1, t_k+2])"),
+    ("scene_name", "-", "the scene's name (its file name without .toml)"),
+    ("cases", "-", "how many cases step() gets at once: 1 in a single run; N for a batch class in lockstep, "
+                   "where u_limit is a pair of (N,) arrays and target an (N, 3) array if they differ between "
+                   "the cases"),
+)
+
+
 class Measurements:
-    """What the controller sees at t_k, after the sensor models: the encoder angles alpha, beta
-    [rad]; gyro = (w1, w2, w3), the payload's inertial angular velocity in frame 2 [rad/s] (w1 about
-    the elevation axis, w3 the cross-elevation rate; gyro_axis_rates turns them into the rates that
-    move the line of sight); the carrier attitude (delta, psi, gamma) [rad] and its rates [rad/s]."""
-    __slots__ = ("alpha", "beta", "gyro", "base_attitude", "base_rates")
+    """What the controller sees at t_k, after the sensor models (MEASUREMENT_FIELDS: names, units,
+    shapes, order)."""
+    __slots__ = tuple(name for name, *_ in MEASUREMENT_FIELDS)
 
     def __init__(self, alpha, beta, gyro, base_attitude, base_rates):
         self.alpha, self.beta = alpha, beta
@@ -235,55 +272,114 @@ class Measurements:
 
 
 class ControllerContext:
-    """What a user controller's reset() is told about the run: the communication step h [s], the
-    motors' voltage limits (U_L1, U_L2) [V], the target direction in G (or None), the delay of the
-    voltages in steps, the scene's name, and `cases`: how many cases step() gets at once (1 for a
-    single run; N for a batch class run in lockstep, where u_limit is a pair of (N,) arrays and the
-    target an (N, 3) array if they differ between the cases: see gimbal2axis/master/lockstep.py)."""
-    __slots__ = ("step_size", "u_limit", "target", "delay_steps", "scene_name", "cases")
+    """What a user controller's reset() is told about the run (CONTEXT_FIELDS)."""
+    __slots__ = tuple(name for name, *_ in CONTEXT_FIELDS)
 
     def __init__(self, step_size, u_limit, target, delay_steps, scene_name, cases=1):
         self.step_size, self.u_limit, self.target = step_size, tuple(u_limit), target
         self.delay_steps, self.scene_name, self.cases = delay_steps, scene_name, cases
 
 
+class ControllerError(SceneError):
+    """A user controller that raised or returned what is not two voltages: the run's failure is
+    the controller's, not the FMU's. The message is one line naming the class, the user's file
+    and line; `details` holds the Python traceback (gimbal2axis run --traceback prints it)."""
+
+    def __init__(self, message: str, details: str | None = None):
+        super().__init__(message)
+        self.details = details
+
+
+def user_exception(label: str, call: str, exc: BaseException, path: pathlib.Path | None,
+                   t: float | None = None) -> ControllerError:
+    """The ControllerError of an exception raised in the user's `call` ("step()", "reset()", ...)
+    at time t: its class and message, and where in the user's file it was raised."""
+    import traceback
+
+    text = str(exc)
+    when = "" if t is None else f" at t = {t:.6g} s"
+    message = f"{label}: {call} raised {type(exc).__name__}{': ' + text if text else ''}{when}{raised_where(exc, path)}"
+    # the traceback from the user's code on: its first frame is the call here, the runner's own
+    tb = exc.__traceback__.tb_next if exc.__traceback__ is not None and exc.__traceback__.tb_next else exc.__traceback__
+    return ControllerError(message, "".join(traceback.format_exception(type(exc), exc, tb)))
+
+
+def raised_where(exc: BaseException, path: pathlib.Path | None) -> str:
+    """" (<file>:<line>, in <function>)" of the innermost frame of exc's traceback in the user's
+    file `path` (the user's line that failed, also when a library it called raised), else of the
+    innermost frame; "" without a traceback."""
+    import traceback
+
+    frames = traceback.extract_tb(exc.__traceback__)
+    resolved = path.resolve() if path is not None else None
+    mine = [f for f in frames if resolved is not None and pathlib.Path(f.filename).resolve() == resolved]
+    if mine:   # the file as the scene names it
+        return f" ({path}:{mine[-1].lineno}, in {mine[-1].name})"
+    return f" ({frames[-1].filename}:{frames[-1].lineno}, in {frames[-1].name})" if frames else ""
+
+
+def _is_real(value) -> bool:
+    """A real number: int, float or numpy's, not bool (True is not a voltage), str or None."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def scalar_voltages(label: str, t: float, u) -> tuple[float, float]:
+    """The voltages a (scalar) user controller's step() returned: exactly two finite real numbers,
+    as a tuple, a list or an array of shape (2,); anything else is refused, naming the class, the
+    time and what was returned. (Called every step: the common case, two floats, checks fastest.)"""
+    kind = type(u)
+    if (kind is tuple or kind is list) and len(u) == 2:
+        u1, u2 = u
+    elif kind is np.ndarray and u.shape == (2,) and u.dtype.kind in "fiu":
+        u1, u2 = u.tolist()
+    else:
+        what = f"an array of shape {u.shape}" if isinstance(u, np.ndarray) else repr(u)
+        raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {what}; it must return (u_R1, u_R2), "
+                              "two finite numbers in V")
+    if not (type(u1) is float or _is_real(u1)) or not (type(u2) is float or _is_real(u2)):
+        raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {u!r}; the voltages must be numbers "
+                              "(not strings, booleans or None)")
+    u1, u2 = float(u1), float(u2)
+    if not (isfinite(u1) and isfinite(u2)):
+        raise ControllerError(f"{label}: step() at t = {t:.6g} s returned ({u1}, {u2}): the voltages must be finite")
+    return u1, u2
+
+
 def batch_voltages(label: str, t: float, u, cases: int):
     """The voltages a batch class's step() returned, as an (N, 2) float array: an array of shape
-    (N, 2), or a tuple/list (u_R1, u_R2) of two arrays of shape (N,) (or scalars, for all cases).
-    Anything else is refused with a message naming the class."""
-    import numpy as np
-
+    (N, 2), or a tuple/list (u_R1, u_R2) of two arrays of shape (N,) (or scalars, for all cases), of
+    real numbers (not strings, booleans or None). Anything else is refused (ControllerError) with a
+    message naming the class, the time and what was returned. Finiteness is the caller's, per case."""
     if type(u) is np.ndarray and u.shape == (cases, 2) and u.dtype == np.float64:
         return u
+    what = None
     try:
         if isinstance(u, (tuple, list)) and len(u) == 2:
             try:   # the common case first: two (N,) arrays
-                pair = np.array(u, dtype=float)
-                if pair.shape == (2, cases):
-                    return pair.T
+                pair = np.array(u)
+                if pair.shape == (2, cases) and pair.dtype.kind in "fiu":
+                    return pair.T.astype(float)
             except ValueError:
                 pass
-            columns = [np.asarray(c, dtype=float) for c in u]
-            if all(c.shape in ((), (cases,)) for c in columns):
-                return np.column_stack([np.broadcast_to(c, (cases,)) for c in columns])
-            shape = f"({', '.join(str(c.shape) for c in columns)})"
+            columns = [np.asarray(c) for c in u]
+            if all(c.shape in ((), (cases,)) and c.dtype.kind in "fiu" for c in columns):
+                return np.column_stack([np.broadcast_to(c.astype(float), (cases,)) for c in columns])
+            what = "(" + ", ".join(f"shape {c.shape} of {c.dtype.name}" for c in columns) + ")"
         else:
-            array = np.asarray(u, dtype=float)
-            if array.shape == (cases, 2):
-                return array
-            shape = str(array.shape)
+            array = np.asarray(u)
+            if array.shape == (cases, 2) and array.dtype.kind in "fiu":
+                return array.astype(float)
+            what = f"shape {array.shape} of {array.dtype.name}"
     except (TypeError, ValueError):
-        shape = repr(u)
-    raise SceneError(f"{label}.step(t = {t:.6g}) returned {shape}; a batch controller (batch = True) must return "
-                     f"the voltages as an array of shape ({cases}, 2) or as (u_R1, u_R2), two arrays of shape "
-                     f"({cases},)")
+        pass
+    raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {what or repr(u)}; a batch controller (batch = True) "
+                          f"must return the voltages as numbers, an array of shape ({cases}, 2) or (u_R1, u_R2), "
+                          f"two arrays of shape ({cases},)")
 
 
 def batch_reference(label: str, user, cases: int):
     """A batch class's `reference` as an (N, 2) float array (NaN if it sets none): a pair
     (alpha_ref, beta_ref) of (N,) arrays or scalars."""
-    import numpy as np
-
     reference = getattr(user, "reference", None)
     if reference is None:
         return np.full((cases, 2), math.nan)
@@ -299,7 +395,7 @@ def batch_reference(label: str, user, cases: int):
         first, second = reference
         return np.column_stack([np.broadcast_to(np.asarray(c, dtype=float), (cases,)) for c in (first, second)])
     except (TypeError, ValueError):
-        raise SceneError(f"{label}.reference must be (alpha_ref, beta_ref), two arrays of shape ({cases},) or "
+        raise ControllerError(f"{label}: self.reference must be (alpha_ref, beta_ref), two arrays of shape ({cases},) or "
                          f"numbers; got {reference!r}") from None
 
 
@@ -308,39 +404,37 @@ class UserController(Controller):
 
         [controller]
         type = "python"
-        module = "my_controller.py"     # a file (relative to the scene file) or an importable module
-        class = "MyController"
+        file = "my_controller.py"       # a Python file, relative to the scene file (or `module =`)
+        class = "MyController"          # a class defined in that file
         options = { kp = 40.0 }         # keyword arguments of the class
 
-    The class needs two methods:
+    The file is code that runs with the user's rights: only a .py file the scene names is loaded,
+    never an importable module, and the class is checked (defined in that file, with callable
+    reset and step) before it is built. The class needs two methods:
         reset(self, context)            # before every run (a ControllerContext)
         step(self, t, measurements)     # at every communication point t_k -> (u_R1, u_R2) [V]
     and may set `self.reference = (alpha_ref, beta_ref)` for the record. The master applies the
-    voltages with the scene's delay and saturates them at +-U_L like a DAC; a voltage that is not a
-    finite number stops the run with a message naming the class.
+    voltages with the scene's delay and saturates them at +-U_L like a DAC (`asked`: the voltages
+    before that clamp, recorded as u_R1_asked, u_R2_asked). Two values that are not finite real
+    numbers, or an exception in the user's code, stop the run with a ControllerError naming the
+    class, the file and the line.
 
     A class with the class attribute `batch = True` is written for N cases at once (arrays; a
     sweep runs its cases in lockstep, gimbal2axis/master/lockstep.py). In a single run like this one it is
     built with the options as given, and step() gets arrays of one case: alpha, beta of shape (1,),
     gyro, base_attitude, base_rates of shape (1, 3); it returns (1, 2) voltages (batch_voltages)."""
     kind = "python"
+    asked = (math.nan, math.nan)   # Controller's property, here the instance's own (set by __call__)
 
     def __init__(self, spec: dict, target, u_limit, base_dir: pathlib.Path | None):
         super().__init__(u_limit=u_limit)
         self.target = target
-        cls = _load_class(spec, base_dir)
+        cls, self.path = load_user_class(spec, base_dir)
+        self.label = class_label(cls, self.path)
         options = spec.get("options", {})
         if not isinstance(options, dict):
             raise SceneError("[controller] options must be a table of keyword arguments")
-        self.label = f"{cls.__module__}.{cls.__qualname__}"
-        try:
-            self.user = cls(**options)
-        except TypeError as exc:
-            raise SceneError(f"[controller] {self.label}({', '.join(options)}): {exc}") from None
-        for method in ("reset", "step"):
-            if not callable(getattr(self.user, method, None)):
-                raise SceneError(f"[controller] {self.label} has no method {method}(); a controller class needs "
-                                 "reset(context) and step(t, measurements)")
+        self.user = build_user(cls, self.label, self.path, options)
         self.delay_steps = int(spec.get("delay_steps", 1))
         self.batch = getattr(cls, "batch", False) is True
 
@@ -348,67 +442,117 @@ class UserController(Controller):
         """None: the user's class computes the voltages, in Python."""
 
     def start(self, step_size: float, scene_name: str) -> None:
-        self.user.reset(ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name))
+        context = ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name)
+        try:
+            self.user.reset(context)
+        except Exception as exc:
+            raise user_exception(self.label, "reset()", exc, self.path, 0.0) from None
 
     def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
         if self.batch:
-            return self._call_batch_of_one(t, alpha, beta, gyro, base_attitude, base_rates)
-        u = self.user.step(t, Measurements(alpha, beta, gyro, base_attitude, base_rates))
-        try:
-            u1, u2 = float(u[0]), float(u[1])
-        except (TypeError, ValueError, IndexError):
-            raise SceneError(f"{self.label}.step(t = {t:.6g}) returned {u!r}; it must return (u_R1, u_R2) in V") from None
-        if not (math.isfinite(u1) and math.isfinite(u2)):
-            raise SceneError(f"{self.label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite")
-        self.reference = getattr(self.user, "reference", (math.nan, math.nan))
+            u1, u2 = self._call_batch_of_one(t, alpha, beta, gyro, base_attitude, base_rates)
+        else:
+            try:
+                u = self.user.step(t, Measurements(alpha, beta, gyro, base_attitude, base_rates))
+            except Exception as exc:
+                raise user_exception(self.label, "step()", exc, self.path, t) from None
+            u1, u2 = scalar_voltages(self.label, t, u)
+            self.reference = getattr(self.user, "reference", (math.nan, math.nan))
+        self.asked = (u1, u2)
         return self.clamp(u1, 0), self.clamp(u2, 1)
 
     def _call_batch_of_one(self, t, alpha, beta, gyro, base_attitude, base_rates):
-        import numpy as np
-
         m = Measurements(np.array([alpha]), np.array([beta]), np.array([gyro], dtype=float),
                          np.array([base_attitude], dtype=float), np.array([base_rates], dtype=float))
-        u1, u2 = batch_voltages(self.label, t, self.user.step(t, m), 1)[0].tolist()
+        try:
+            u = self.user.step(t, m)
+        except Exception as exc:
+            raise user_exception(self.label, "step()", exc, self.path, t) from None
+        u1, u2 = batch_voltages(self.label, t, u, 1)[0].tolist()
         if not (math.isfinite(u1) and math.isfinite(u2)):
-            raise SceneError(f"{self.label}.step(t = {t:.6g}) returned ({u1}, {u2}): the voltages must be finite")
+            raise ControllerError(f"{self.label}: step() at t = {t:.6g} s returned ({u1}, {u2}): the voltages must be "
+                                  "finite")
         self.reference = tuple(batch_reference(self.label, self.user, 1)[0].tolist())
-        return self.clamp(u1, 0), self.clamp(u2, 1)
+        return u1, u2
 
 
-def _load_class(spec: dict, base_dir: pathlib.Path | None):
-    module_name, class_name = spec.get("module"), spec.get("class")
-    if not isinstance(module_name, str) or not isinstance(class_name, str):
-        raise SceneError("[controller] type = 'python' needs module = '<file.py or module>' and class = '<name>'")
-    candidates = [pathlib.Path(module_name)]
-    if base_dir is not None and not candidates[0].is_absolute():
-        candidates.insert(0, base_dir / module_name)
-    path = next((c for c in candidates if c.suffix == ".py" and c.is_file()), None)
+def class_label(cls, path: pathlib.Path) -> str:
+    """How messages name a user controller class: the class and the user's file."""
+    return f"{cls.__qualname__} ({path})"
+
+
+def build_user(cls, label: str, path: pathlib.Path, options: dict):
+    """The user's object, cls(**options); an exception in its __init__ is the controller's."""
     try:
-        if path is not None:
-            unique = f"gimbal_user_controller_{abs(hash(str(path.resolve())))}"
-            module = sys.modules.get(unique)
-            if module is None:
-                loader_spec = importlib.util.spec_from_file_location(unique, path)
-                module = importlib.util.module_from_spec(loader_spec)
-                loader_spec.loader.exec_module(module)
-                sys.modules[unique] = module
-        elif module_name.endswith(".py"):
-            raise SceneError(f"[controller] module file '{module_name}' not found (looked in "
-                             f"{', '.join(str(c) for c in candidates)})")
-        else:
-            module = importlib.import_module(module_name)
-    except SceneError:
-        raise
-    except Exception as exc:  # the user's module failed to import: say where
-        raise SceneError(f"[controller] importing '{module_name}' failed: {type(exc).__name__}: {exc}") from None
-    cls = getattr(module, class_name, None)
+        return cls(**options)
+    except Exception as exc:
+        if isinstance(exc, TypeError) and exc.__traceback__ is not None and exc.__traceback__.tb_next is None:
+            # raised by the call itself, not inside __init__: the options do not fit its signature
+            raise SceneError(f"[controller] {label}: the options ({', '.join(options) or 'none'}) do not fit its "
+                             f"__init__: {exc}") from None
+        raise user_exception(label, "__init__()", exc, path) from None
+
+
+def controller_file(spec: dict, base_dir: pathlib.Path | None) -> pathlib.Path:
+    """The user controller's file a [controller] table names (`file =`, or `module =` of older
+    scenes): a .py file, relative to the scene's folder (base_dir) unless absolute. Anything else,
+    an importable module name included, is refused before anything is loaded."""
+    if "file" in spec and "module" in spec:
+        raise SceneError("[controller] has both file and module: give the controller's .py file once, as file = ...")
+    key = "file" if "file" in spec else "module"
+    name = spec.get(key)
+    if not isinstance(name, str) or not isinstance(spec.get("class"), str):
+        raise SceneError("[controller] type = 'python' needs file = '<controller file>.py' (relative to the scene) "
+                         "and class = '<name of a class defined in it>'")
+    path = pathlib.Path(name)
+    if path.suffix != ".py":
+        raise SceneError(f"[controller] {key} = {name!r} is not a .py file: a user controller is a Python file, "
+                         "given as a path relative to the scene (file = \"my_controller.py\"); modules are not "
+                         "imported")
+    if base_dir is not None and not path.is_absolute():
+        path = base_dir / path
+    if not path.is_file():
+        raise SceneError(f"[controller] {key} = {name!r}: controller file {path} not found (a path relative to the "
+                         "scene file)")
+    return path
+
+
+def load_user_class(spec: dict, base_dir: pathlib.Path | None):
+    """(class, file) of a user controller: the file (controller_file) is run as a module of its own
+    and the class taken from it, refused unless it is a class defined in that file (not imported
+    into it) with callable reset and step. Nothing of the class runs here."""
+    path = controller_file(spec, base_dir)
+    class_name = spec["class"]
+    module_name = f"gimbal_user_controller_{abs(hash(str(path.resolve())))}"
+    module = sys.modules.get(module_name)
+    if module is None:
+        loader_spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(loader_spec)
+        try:
+            loader_spec.loader.exec_module(module)
+        except Exception as exc:  # the user's file failed to load: say where
+            raise user_exception(f"[controller] {path}", "loading", exc, path) from None
+        sys.modules[module_name] = module
+    cls = vars(module).get(class_name)
+    if cls is None:
+        defined = sorted(name for name, value in vars(module).items()
+                         if inspect.isclass(value) and value.__module__ == module_name)
+        raise SceneError(f"[controller] {path} has no class '{class_name}' (classes defined there: "
+                         f"{', '.join(defined) or 'none'})")
     if not inspect.isclass(cls):
-        raise SceneError(f"[controller] '{module_name}' has no class '{class_name}'")
-    return cls
+        raise SceneError(f"[controller] '{class_name}' in {path} is a {type(cls).__name__}, not a class")
+    if cls.__module__ != module_name:
+        raise SceneError(f"[controller] class '{class_name}' is imported into {path} (from {cls.__module__}), not "
+                         "defined there: a controller class must be defined in the scene's controller file")
+    for method in ("reset", "step"):
+        if not callable(getattr(cls, method, None)):
+            raise SceneError(f"[controller] {class_label(cls, path)} has no method {method}(); a controller class "
+                             "needs reset(context) and step(t, measurements)")
+    return cls, path
 
 
-CONTROLLER_KEYS = {"type", "delay_steps", "reference", "voltage_V", "K", "ki", "rate_source", "module", "class",
-                   "options"} | set(AXES)
+CONTROLLER_KEYS = {"type", "delay_steps", "reference", "voltage_V", "K", "ki", "rate_source", "file", "module",
+                   "class", "options"} | set(AXES)
 
 
 def make_controller(spec: dict | None, target, u_limit, base_dir: pathlib.Path | None = None) -> Controller:
@@ -433,6 +577,7 @@ def make_controller(spec: dict | None, target, u_limit, base_dir: pathlib.Path |
             check_keys(f"controller.{axis}", spec.get(axis, {}), {"reference"})
         return StateFeedback(spec, target, u_limit)
     if kind == "python":
-        check_keys("controller", spec, {"type", "delay_steps", "module", "class", "options"})
+        check_keys("controller", spec, {"type", "delay_steps", "file", "module", "class", "options"})
         return UserController(spec, target, u_limit, base_dir)
-    raise SceneError(f"[controller] type must be 'none', 'pid', 'state_feedback' or 'python', got {kind!r}")
+    raise SceneError(f"[controller] type must be 'none', 'pid', 'state_feedback' or 'python', got {shown(kind)}"
+                     f"{did_you_mean(kind, ('none', 'pid', 'state_feedback', 'python'))}")

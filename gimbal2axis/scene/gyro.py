@@ -23,9 +23,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
-from ..errors import SceneError, check_keys, number
+from ..errors import SceneError, check_keys, number, shown
 
 GYRO_KEYS = {"angle_random_walk_deg_rt_h", "bias_instability_deg_h", "bias_correlation_time_s",
              "rate_random_walk_deg_h_rt_h", "bias_deg_h", "scale_factor_error_ppm", "misalignment_mrad",
@@ -83,7 +82,7 @@ class GyroModel:
         self.quantum = math.radians(_non_negative(key("quantization_deg_s"), spec.get("quantization_deg_s", 0.0)))
         delay = spec.get("delay_samples", 0)
         if isinstance(delay, bool) or not isinstance(delay, int) or not 0 <= delay <= MAX_DELAY:
-            raise SceneError(f"{key('delay_samples')} must be an integer in [0, {MAX_DELAY}], got {delay!r}")
+            raise SceneError(f"{key('delay_samples')} must be an integer in [0, {MAX_DELAY}], got {shown(delay)}")
         self.delay = delay
 
     def axes(self) -> np.ndarray:
@@ -96,6 +95,8 @@ class GyroModel:
     def filter(self, h: float):
         """(A, B, C, D, settled) of the bandwidth's low-pass w_n^2 / (s^2 + 2 zeta w_n s + w_n^2)
         discretized with a first-order hold at step h; settled: the state of a unit constant input."""
+        from scipy import signal   # here, not at the top: 0.5 s to import, for a gyro with a bandwidth only
+
         w_n = 2.0 * math.pi * self.bandwidth
         continuous = (np.array([[0.0, 1.0], [-w_n ** 2, -2.0 * self.damping * w_n]]), np.array([[0.0], [w_n ** 2]]),
                       np.array([[1.0, 0.0]]), np.array([[0.0]]))
@@ -116,6 +117,8 @@ class GyroModel:
 
     def error_table(self, h: float, count: int, rng: np.random.Generator) -> np.ndarray | None:
         """The stochastic errors and the bias of `count` samples (count x 3, rad/s), or None."""
+        from scipy import signal   # here, not at the top: 0.5 s to import, for a noisy gyro only
+
         table = np.zeros((count, 3))
         drawn = False
         if self.angle_random_walk > 0:
@@ -191,6 +194,8 @@ class GyroErrorStream:
         if self.gyro.angle_random_walk > 0:
             table += self.arw[0].normal(0.0, self.arw[1], (count, 3))
         for process in self.flicker:
+            from scipy import signal   # here, not at the top: 0.5 s to import, for a gyro with bias instability only
+
             driving = process[0].normal(0.0, 1.0, (count, 3))
             filtered, process[3] = signal.lfilter(process[1], process[2], driving, axis=0, zi=process[3])
             table += filtered

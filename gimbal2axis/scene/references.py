@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from ..errors import SceneError, check_keys, number, positive
+from ..errors import SceneError, check_keys, did_you_mean, number, positive, shown
 
 KINDS = {
     "constant": {"value_deg"},
@@ -18,8 +18,10 @@ KINDS = {
 class Reference:
     def __init__(self, where: str, spec: dict):
         kind = spec.get("type")
-        if kind not in KINDS:
-            raise SceneError(f"[{where}] reference type must be one of {sorted(KINDS) + ['target']}, got {kind!r}")
+        if not isinstance(kind, str) or kind not in KINDS:
+            known = sorted(KINDS) + ["target"]
+            raise SceneError(f"[{where}] reference type must be one of {known}, got {shown(kind)}"
+                             f"{did_you_mean(kind, known)}")
         check_keys(where, spec, KINDS[kind] | {"type"})
         self.kind = kind
         p = {key: number(f"{where}.{key}", value) for key, value in spec.items() if key != "type"}

@@ -11,8 +11,9 @@ file's name), description, stop_time [s], step_size [s] (communication step), ou
   [imbalance]     payload_offset_mm, azimuth_housing_offset_mm: [x, y, z] in mm, the centre of mass
                   of the payload from point b in frame 2 (body2.d_bd) and of the azimuth housing in
                   frame 1 (body1.d_bc); merged into the parameters (one table per parameter)
-  [initial]       start values of the FMU's states (alpha, beta_m, i_R1, ...), SI units; a rotor
-                  angle/rate not given follows its load through the gear (alpha_m = N1 alpha, ...)
+  [initial]       start values of the FMU's states (alpha, beta_m, i_R1, ...), SI units; an angle
+                  also as NAME_deg in degrees (beta_deg = 30), not both; alpha and beta within half a
+                  turn; a rotor angle/rate not given follows its load through the gear (alpha_m = N1 alpha)
   [base_motion]   type = "fixed" | "sinusoids" | "sea_state" | "recorded" (base_motion.py)
   [target]        azimuth_deg, elevation_deg: the fixed inertial direction the line of sight should
                   hold (geometry.py); start_on_target = true starts the gimbal pointing at it
@@ -25,8 +26,15 @@ file's name), description, stop_time [s], step_size [s] (communication step), ou
   [analysis]      optional: psd_resolution_hz, isolation_resolution_hz and [analysis.bands] of the
                   line-of-sight error's spectrum (analysis.py, docs/jitter.md)
 
-Validation has two levels: `load_scene` checks everything a file alone can say; `check_against_fmu`
-checks the FMU variable names, causalities and types (the FMU's model description is the truth).
+Units: a key ending in _deg is in degrees (_deg_s degrees per second, _mm millimetres), a key without a
+unit suffix in SI units, angles in radians, as the FMU's names are. An angle in radians beyond what
+can be meant (a start angle beyond half a turn) is refused with the value in degrees too, since it is
+most likely degrees given without the suffix.
+
+Validation has two levels: `load_scene` checks everything a file alone can say (each value's type,
+finiteness and range, by its key); `check_against_fmu` checks the FMU variable names, causalities and
+types (the FMU's model description is the truth). Names are looked up with close-match suggestions,
+and what the user wrote is quoted as a bounded excerpt (errors.excerpt).
 A scene that runs, but likely not as meant (no controller, a motor the controller leaves at 0 V, a
 moving-base model with no base motion), loads with a SceneWarning per finding (Python's warnings
 module, so it shows on stderr; the list is also Scene.warnings).
@@ -43,7 +51,8 @@ import numpy as np
 from . import analysis, geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
-from ..errors import SceneError, SceneWarning, check_keys, number, positive, read_toml
+from ..errors import (SceneError, SceneWarning, boolean, check_keys, did_you_mean, excerpt, is_number_text, number,
+                      positive, read_toml, shown)
 from ..fmu import FIDELITY, FMU, enumeration_items
 from .sensors import Sensors
 from .setpoints import target_direction
@@ -51,6 +60,13 @@ from .setpoints import target_direction
 TOP_KEYS = {"name", "description", "stop_time", "step_size", "output_interval", "fidelity", "parameters",
             "imbalance", "initial", "base_motion", "target", "controller", "sensors", "requirements", "test",
             "plot", "analysis"}
+
+# [initial] angles that may be given in degrees as NAME_deg; the FMU's own names are radians.
+ANGLE_STATES = ("alpha", "beta", "alpha_m", "beta_m", "theta_b1", "theta_b2")
+# The load angles have no end stops (no bounds in model_core/include/gimbal/real_variables.def): a start
+# beyond half a turn is the same pose as one within it, so a value beyond pi rad is degrees without the
+# suffix, not a pose.
+HALF_TURN_ANGLES = ("alpha", "beta")
 
 # [imbalance]: a centre-of-mass offset in millimetres -> the FMU's vector parameter (metres, frame of
 # its body; docs/physics.md section 1).
@@ -122,8 +138,49 @@ class Scene:
 def _table(raw: dict, key: str, flatten: bool = False) -> dict:
     value = raw.get(key, {})
     if not isinstance(value, dict):
-        raise SceneError(f"'{key}' must be a table ([{key}])")
+        raise SceneError(f"'{key}' must be a table ([{key}]), got {shown(value)}")
     return _flatten(value) if flatten else value
+
+
+def _scalar_values(where: str, table: dict) -> dict:
+    """[parameters] and [fidelity] hold numbers and true/false (the FMU's Real, Integer, Enumeration
+    and Boolean variables): anything else is refused by its key before the FMU is opened."""
+    for name, value in table.items():
+        if isinstance(value, bool) or (isinstance(value, (int, float)) and math.isfinite(value)):
+            continue
+        if isinstance(value, list):   # an FMU vector is one scalar variable per component
+            hint = f' (one value per FMU variable: "{excerpt(name)}[1]" = ..., "{excerpt(name)}[2]" = ...)'
+        elif isinstance(value, str):
+            hint = " (a string: write the number without quotes)" if is_number_text(value) else \
+                " (an Enumeration such as gear1.model by its integer value)"
+        else:
+            hint = ""
+        raise SceneError(f"{where}.{excerpt(name)} must be a finite number or true/false, got {shown(value)}{hint}")
+    return table
+
+
+
+def initial_in_radians(initial: dict) -> dict:
+    """[initial] with every NAME_deg turned into the FMU's NAME in radians; refuses an angle given both
+    ways and a load angle beyond half a turn (with the value in degrees, the likely mistake)."""
+    values = {}
+    for name, value in initial.items():
+        where = f"initial.{excerpt(name)}"
+        value = number(where, value)
+        base = name[:-len("_deg")] if name.endswith("_deg") else None
+        if base in ANGLE_STATES:
+            if base in initial:
+                raise SceneError(f"initial.{base} and initial.{name} are the same angle (radians, degrees): give one")
+            if base in HALF_TURN_ANGLES and abs(value) > 180.0:
+                raise SceneError(f"{where} = {value:g} deg is beyond ±180 deg: a start angle beyond half a turn is "
+                                 f"the same pose as {math.remainder(value, 360.0):g} deg")
+            values[base] = math.radians(value)
+            continue
+        if name in HALF_TURN_ANGLES and abs(value) > math.pi:
+            raise SceneError(f"{where} = {value:g} rad ({math.degrees(value):.0f} deg) is beyond ±{math.pi:.4f} rad "
+                             f"(half a turn); a bare angle is in radians: did you mean {name}_deg = {value:g}?")
+        values[name] = value
+    return values
 
 
 def _flatten(table: dict, prefix: str = "") -> dict:
@@ -147,7 +204,7 @@ def _imbalance_parameters(table: dict, parameters: dict) -> dict:
             continue
         offset = table[key]
         if not (isinstance(offset, list) and len(offset) == 3):
-            raise SceneError(f"imbalance.{key} must be [x, y, z] in mm, got {offset!r}")
+            raise SceneError(f"imbalance.{key} must be [x, y, z] in mm, got {shown(offset)}")
         for component, value in enumerate(offset, start=1):
             name = f"{vector}[{component}]"
             if name in parameters:
@@ -168,26 +225,34 @@ def load_scene(path: pathlib.Path | str) -> Scene:
                 raise SceneError(f"missing required key '{key}'")
         title = raw.get("name", path.stem)
         if not isinstance(title, str) or not title.strip():
-            raise SceneError("'name' (the title of the plot) must be a non-empty string")
+            raise SceneError(f"'name' (the title of the plot) must be a non-empty string, got {shown(title)}")
+        description = raw.get("description", "")
+        if not isinstance(description, str):
+            raise SceneError(f"'description' must be a string, got {shown(description)}")
         step = positive("step_size", raw["step_size"])
         target = raw.get("target")
         if target is not None:
+            target = _table(raw, "target")
             check_keys("target", target, {"azimuth_deg", "elevation_deg", "start_on_target"})
             target = {"azimuth_deg": number("target.azimuth_deg", target.get("azimuth_deg", 0.0)),
                       "elevation_deg": number("target.elevation_deg", target.get("elevation_deg", 0.0)),
-                      "start_on_target": bool(target.get("start_on_target", False))}
-        parameters = _table(raw, "parameters", True)
+                      "start_on_target": boolean("target.start_on_target", target.get("start_on_target", False))}
+        parameters = _scalar_values("parameters", _table(raw, "parameters", True))
         parameters.update(_imbalance_parameters(_table(raw, "imbalance"), parameters))
-        scene = Scene(path=path, name=path.stem, title=title, description=str(raw.get("description", "")),
+        scene = Scene(path=path, name=path.stem, title=title, description=description,
                       stop_time=positive("stop_time", raw["stop_time"]), step_size=step,
                       output_interval=positive("output_interval", raw.get("output_interval", step)),
-                      fidelity=_table(raw, "fidelity", True), parameters=parameters,
+                      fidelity=_scalar_values("fidelity", _table(raw, "fidelity", True)), parameters=parameters,
                       initial=_table(raw, "initial", True), base_motion_spec=_table(raw, "base_motion"),
                       target_spec=target, controller_spec=_table(raw, "controller"),
                       sensors_spec=_table(raw, "sensors"), requirements=_table(raw, "requirements"),
                       test=_table(raw, "test"), plot=_table(raw, "plot"),
                       analysis_spec=_table(raw, "analysis"), raw=raw)
         _validate(scene)
+        # as written in the file; a run shortened later (--stop-time, a sweep) may end before from_s
+        if scene.requirements.get("from_s", 0.0) >= scene.stop_time:
+            raise SceneError(f"requirements.from_s = {scene.requirements['from_s']:g} s is not before stop_time = "
+                             f"{scene.stop_time:g} s: the bounds would hold over no time")
         analysis.check_window(scene.analysis, scene.stop_time, float(scene.requirements.get("from_s", 0.0)))
     except SceneError as exc:
         raise SceneError(f"{path}: {exc}") from None
@@ -198,16 +263,25 @@ def load_scene(path: pathlib.Path | str) -> Scene:
 
 
 def _validate(scene: Scene) -> None:
+    # again here: with_changes (a sweep, --stop-time) brings values load_scene has not seen
+    for key in ("stop_time", "step_size", "output_interval"):
+        positive(key, getattr(scene, key))
+    if scene.n_steps < 1:
+        raise SceneError(f"stop_time = {scene.stop_time:g} s is shorter than one step (step_size = "
+                         f"{scene.step_size:g} s): the run would have no step")
     if abs(scene.n_steps * scene.step_size - scene.stop_time) > 1e-9 * scene.stop_time:
-        raise SceneError("stop_time must be a whole number of steps")
+        raise SceneError(f"stop_time = {scene.stop_time:g} s must be a whole number of steps of step_size = "
+                         f"{scene.step_size:g} s")
     ratio = scene.output_interval / scene.step_size
     if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
-        raise SceneError("output_interval must be a whole multiple of step_size")
-    unknown = set(scene.fidelity) - set(FIDELITY)
+        raise SceneError(f"output_interval = {scene.output_interval:g} s must be a whole multiple of step_size = "
+                         f"{scene.step_size:g} s")
+    unknown = sorted(set(scene.fidelity) - set(FIDELITY))
     if unknown:
-        raise SceneError(f"[fidelity]: unknown switch(es) {sorted(unknown)}; known: {FIDELITY}")
-    for name, value in scene.initial.items():   # whether each is a state: check_against_fmu
-        number(f"initial.{name}", value)
+        raise SceneError(f"[fidelity]: unknown switch {shown(unknown[0])}{did_you_mean(unknown[0], FIDELITY)}; "
+                         f"known: {', '.join(FIDELITY)}")
+    # whether each is a state: check_against_fmu
+    scene.initial = initial_in_radians(scene.initial)
     overlap = sorted(set(scene.fidelity) & set(scene.parameters))
     if overlap:
         # start_values would let [parameters] win without a word
@@ -241,6 +315,9 @@ def _validate(scene: Scene) -> None:
     check_keys("requirements", scene.requirements, {"los_rms_max_mrad", "los_final_max_mrad", "from_s"})
     for key, value in scene.requirements.items():
         positive(f"requirements.{key}", value) if key != "from_s" else number("requirements.from_s", value)
+    if scene.requirements.get("from_s", 0.0) < 0:
+        raise SceneError(f"requirements.from_s = {scene.requirements['from_s']:g} s must be >= 0 (the bounds hold "
+                         "from then to the end of the run)")
     if scene.requirements and scene.target_spec is None:
         raise SceneError("[requirements] on the line of sight need a [target]")
     check_keys("test", scene.test, {"stop_time"})
@@ -248,7 +325,7 @@ def _validate(scene: Scene) -> None:
         positive("test.stop_time", scene.test["stop_time"])
     for panel, names in scene.plot.items():
         if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
-            raise SceneError(f"[plot] {panel} must be a list of signal names")
+            raise SceneError(f"[plot] {excerpt(panel)} must be a list of signal names, got {shown(names)}")
     settings = scene.analysis
     if settings.bands and scene.target_spec is None:
         raise SceneError("[analysis.bands] of the line-of-sight error need a [target]")
@@ -290,7 +367,7 @@ def _check_controller(spec: dict) -> list[str]:
                              f"({AXIS_MOTOR[axis]}) gets 0 V")
                 continue
             if not isinstance(table, dict):
-                raise SceneError(f"[controller] '{axis}' must be a table ([controller.{axis}]), got {table!r}")
+                raise SceneError(f"[controller] '{axis}' must be a table ([controller.{axis}]), got {shown(table)}")
             for key, why in WHY_NOT_NEGATIVE.items():
                 value = table.get(key, 0.0)
                 if _is_number(value) and value < 0:
@@ -301,7 +378,7 @@ def _check_controller(spec: dict) -> list[str]:
     elif kind == "state_feedback":
         K, ki = spec.get("K"), spec.get("ki", [0.0, 0.0])
         if not (isinstance(ki, list) and len(ki) == 2):
-            raise SceneError(f"controller.ki must be [ki of u_R1, ki of u_R2], got {ki!r}")
+            raise SceneError(f"controller.ki must be [ki of u_R1, ki of u_R2], got {shown(ki)}")
         if not (isinstance(K, list) and len(K) == 2 and all(isinstance(row, list) and len(row) == 4 for row in K)):
             return found
         for i, axis in enumerate(AXIS_MOTOR):
@@ -321,23 +398,32 @@ def _check_controller(spec: dict) -> list[str]:
 
 def check_against_fmu(scene: Scene, fmu: FMU) -> None:
     """Refuses FMU variable names the FMU does not have, wrong causalities and wrong value types."""
+    parameters = [name for name, v in fmu.variables.items() if v.causality in ("parameter", "structuralParameter")]
     try:
+        for where, table in (("fidelity", scene.fidelity), ("parameters", scene.parameters)):
+            for name in table:   # named here with the close matches, before fmu.check quotes it whole
+                if not fmu.has(name):
+                    hint = did_you_mean(name, parameters) or "; is the FMU older than the scene?"
+                    raise SceneError(f"[{where}] '{excerpt(name)}' is not a variable of {fmu.path} (its "
+                                     f"modelDescription.xml is the truth){hint}")
         fmu.check("fidelity", scene.fidelity, {"parameter", "structuralParameter"})
         fmu.check("parameters", scene.parameters, {"parameter", "structuralParameter"})
         for name in scene.initial:
             if name not in fmu.states:
-                raise SceneError(f"[initial]: '{name}' is not a state (states: {fmu.states})")
+                raise SceneError(f"[initial]: '{excerpt(name)}' is not a state (states: {fmu.states})"
+                                 f"{did_you_mean(name, fmu.states + [a + '_deg' for a in ANGLE_STATES])}")
         fmu.check("initial", scene.initial, {"output", "local"})
         names = {n for names in scene.plot.values() for n in names}
-        for name in names:
+        for name in sorted(names):
             if not fmu.has(name) and name not in DERIVED_SIGNALS:
-                raise SceneError(f"[plot] '{name}' is neither an FMU variable nor a signal of the runner "
-                                 f"({sorted(DERIVED_SIGNALS)})")
+                raise SceneError(f"[plot] '{excerpt(name)}' is neither an FMU variable nor a signal of the runner "
+                                 f"({sorted(DERIVED_SIGNALS)}){did_you_mean(name, list(fmu.variables) + sorted(DERIVED_SIGNALS))}")
     except SceneError as exc:
         raise SceneError(f"{scene.path}: {exc}") from None
 
 
-DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
+DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "u_R1_asked", "u_R2_asked",
+                   "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
                    "los_azimuth", "los_elevation", "heave", "los_error_xel", "los_error_el",
                    "base.omega2[1]", "base.omega2[2]", "base.omega2[3]"} | {f"base.{n}" for n in (
                        "delta", "psi", "gamma", "delta_dot", "psi_dot", "gamma_dot",

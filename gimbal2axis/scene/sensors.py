@@ -29,19 +29,13 @@ import numpy as np
 
 from .. import native
 from . import geometry
-from ..errors import SceneError, check_keys, number
+from ..errors import SceneError, check_keys, choice, integer, non_negative, number, shown
 from .gyro import GyroErrorStream, GyroModel, error_draws
 
 KEYS = {"encoder_resolution_deg", "encoder_offset_deg", "gyro_noise_deg_s", "imu_attitude_noise_deg", "seed",
         "stabilization", "joint_rate", "gyro"}
 SCHEMES = ("direct", "indirect")
 JOINT_RATES = ("tachometer", "encoder_difference")
-
-
-def _choice(where: str, value, allowed: tuple) -> str:
-    if value not in allowed:
-        raise SceneError(f"{where} must be one of {', '.join(repr(a) for a in allowed)}, got {value!r}")
-    return value
 
 
 def carrier_rate(base: np.ndarray, h: float | None = None) -> np.ndarray:
@@ -65,21 +59,21 @@ class Sensors:
     def __init__(self, spec: dict | None):
         spec = spec or {}
         check_keys("sensors", spec, KEYS)
-        self.resolution = np.radians(number("sensors.encoder_resolution_deg", spec.get("encoder_resolution_deg", 0.0)))
+        self.resolution = np.radians(non_negative("sensors.encoder_resolution_deg", spec.get("encoder_resolution_deg", 0.0)))
         offset = spec.get("encoder_offset_deg", 0.0)
         if isinstance(offset, list) and len(offset) != 2:
             raise SceneError(f"sensors.encoder_offset_deg must be a number or [alpha, beta], got {len(offset)} numbers")
         offsets = offset if isinstance(offset, list) else [offset, offset]
         self.encoder_offset = [math.radians(number(f"sensors.encoder_offset_deg[{i}]", v)) for i, v in enumerate(offsets)]
-        self.gyro_noise = np.radians(number("sensors.gyro_noise_deg_s", spec.get("gyro_noise_deg_s", 0.0)))
-        self.imu_noise = np.radians(number("sensors.imu_attitude_noise_deg", spec.get("imu_attitude_noise_deg", 0.0)))
-        self.scheme = _choice("sensors.stabilization", spec.get("stabilization", "direct"), SCHEMES)
-        self.joint_rate = _choice("sensors.joint_rate", spec.get("joint_rate", "tachometer"), JOINT_RATES)
+        self.gyro_noise = np.radians(non_negative("sensors.gyro_noise_deg_s", spec.get("gyro_noise_deg_s", 0.0)))
+        self.imu_noise = np.radians(non_negative("sensors.imu_attitude_noise_deg", spec.get("imu_attitude_noise_deg", 0.0)))
+        self.scheme = choice("sensors.stabilization", spec.get("stabilization", "direct"), SCHEMES)
+        self.joint_rate = choice("sensors.joint_rate", spec.get("joint_rate", "tachometer"), JOINT_RATES)
         gyro_spec = spec.get("gyro")
         if gyro_spec is not None and not isinstance(gyro_spec, dict):
-            raise SceneError("[sensors] gyro must be a table ([sensors.gyro])")
+            raise SceneError(f"[sensors] gyro must be a table ([sensors.gyro]), got {shown(gyro_spec)}")
         self.gyro = None if gyro_spec is None else GyroModel(gyro_spec)
-        self.seed = int(spec.get("seed", 0))
+        self.seed = integer("sensors.seed", spec.get("seed", 0), 0)
         self.rng = np.random.default_rng(self.seed)
         self.ideal = (self.resolution == 0 and self.gyro_noise == 0 and self.imu_noise == 0 and self.gyro is None
                       and self.scheme == "direct" and not any(self.encoder_offset))

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-from ..errors import SceneError
+from ..errors import SceneError, shown
 from .base_motion import DEFAULT_GAMMA, SEA_STATE_DEFAULTS
 
 DEGREES_OF_FREEDOM = ("pitch", "yaw", "roll", "surge", "sway", "heave")
@@ -22,7 +22,7 @@ def ship_motion_fmu_parameters(scene) -> dict:
         raise SceneError("a recorded [base_motion] is the ship-motion FMU's String parameter recording_file "
                          "(recording_parameters), not a set of numbers: this builds a sea state only")
     if spec.get("type") != "sea_state":
-        raise SceneError(f"the ship-motion FMU makes a sea state: [base_motion] type = {spec.get('type', 'fixed')!r} "
+        raise SceneError(f"the ship-motion FMU makes a sea state: [base_motion] type = {shown(spec.get('type', 'fixed'))} "
                          "is not in it")
     scene.base_motion()   # the scene's own checks, with their messages
     components = spec.get("components", SEA_STATE_DEFAULTS["components"])
@@ -48,6 +48,6 @@ def recording_parameters(scene) -> dict:
     and the file's absolute path (recording_file, a String: set it with fmi2SetString)."""
     spec = scene.base_motion_spec or {}
     if spec.get("type") != "recorded":
-        raise SceneError(f"[base_motion] type = {spec.get('type', 'fixed')!r} is not a recording")
+        raise SceneError(f"[base_motion] type = {shown(spec.get('type', 'fixed'))} is not a recording")
     motion = scene.base_motion()   # the scene's own checks, with their messages
     return {"motion": 1, "recording_file": str(motion.path)}

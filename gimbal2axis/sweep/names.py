@@ -12,9 +12,9 @@ from __future__ import annotations
 import difflib
 
 from ..scene import base_motion, controllers, gyro, references, sensors
-from ..errors import SceneError
+from ..errors import LONGEST_NAME_TO_MATCH, SceneError, excerpt, shown
 from ..fmu import FIDELITY
-from ..scene.scene import check_against_fmu
+from ..scene.scene import ANGLE_STATES, check_against_fmu
 
 from .spec import FLAT_SECTIONS, NESTED_SECTIONS, SweepError, apply_case, parse_name
 
@@ -53,6 +53,7 @@ def valid_names(scene, fmu) -> list[str]:
     names += [f"parameters.{p}" for p in parameters if p not in FIDELITY]
     names += [f"fidelity.{f}" for f in FIDELITY]
     names += [f"initial.{s}" for s in fmu.states]
+    names += [f"initial.{s}_deg" for s in fmu.states if s in ANGLE_STATES]
     for section, attr in NESTED_SECTIONS.items():
         names += _leaf_paths(getattr(scene, attr) or {}, section)
     names += [f"controller.{k}" for k in sorted(controllers.CONTROLLER_KEYS - LIST_KEYS - {"options"})
@@ -76,6 +77,8 @@ def valid_names(scene, fmu) -> list[str]:
 
 def suggestions(name: str, candidates: list[str], n: int = 3) -> list[str]:
     """The closest candidates by spelling; failing those, the names beside it (same prefix)."""
+    if len(name) > LONGEST_NAME_TO_MATCH:   # no name is that long; difflib would take long to say so
+        return []
     close = difflib.get_close_matches(name, candidates, n=n, cutoff=0.6)
     if close:
         return close
@@ -105,7 +108,7 @@ def resolve_names(sweep, scene, fmu) -> tuple[dict, list[str]]:
         if section == "fmu":
             section = "fidelity" if name in FIDELITY else "parameters"
             if not fmu.has(name):
-                problems.append(f"'{name}' is neither a path into the scene (parameters., fidelity., initial., "
+                problems.append(f"'{excerpt(name)}' is neither a path into the scene (parameters., fidelity., initial., "
                                 f"controller., base_motion., sensors., target., stop_time) nor a variable of "
                                 f"{fmu.path.name}" + did_you_mean(name, candidates))
                 continue
@@ -114,18 +117,20 @@ def resolve_names(sweep, scene, fmu) -> tuple[dict, list[str]]:
             continue
         v = fmu.variables.get(variable)
         if section == "initial":
+            if variable.endswith("_deg") and variable.removesuffix("_deg") in ANGLE_STATES:
+                variable = variable.removesuffix("_deg")   # the angle in degrees (load_scene converts it)
             if variable not in fmu.states:
-                problems.append(f"'{name}': '{variable}' is not a state of the FMU (states: {', '.join(fmu.states)})"
+                problems.append(f"'{excerpt(name)}': '{excerpt(variable)}' is not a state of the FMU (states: {', '.join(fmu.states)})"
                                 + did_you_mean(name, candidates))
         elif v is None:
-            problems.append(f"'{name}': '{variable}' is not a variable of {fmu.path.name}"
+            problems.append(f"'{excerpt(name)}': '{excerpt(variable)}' is not a variable of {fmu.path.name}"
                             + did_you_mean(name, candidates))
         elif v.causality not in PARAMETER_CAUSALITIES:
             hint = f"; its start value is swept as 'initial.{variable}'" if variable in fmu.states else ""
-            what = f"'{name}'" if name == variable else f"'{name}': '{variable}'"
+            what = f"'{excerpt(name)}'" if name == variable else f"'{excerpt(name)}': '{excerpt(variable)}'"
             problems.append(f"{what} is not a parameter of the FMU (causality {v.causality}){hint}")
         elif section == "fidelity" and variable not in FIDELITY:
-            problems.append(f"'{name}': '{variable}' is not a structural switch ({', '.join(FIDELITY)}); "
+            problems.append(f"'{excerpt(name)}': '{excerpt(variable)}' is not a structural switch ({', '.join(FIDELITY)}); "
                             f"sweep it as 'parameters.{variable}'")
     if problems:
         raise SweepError(f"{sweep.path}: " + "\n  ".join(["parameter names refused, no case was run:"] + problems))
@@ -167,11 +172,11 @@ def check_cases_accepted(scene, sweep, fmu, resolved: dict, cases: list, candida
         if all(error is not None for error in tried.values()):
             first = next(iter(tried.values()))
             if name in candidates:
-                problems.append(f"'{name}' = {', '.join(values)} is refused: {first}")
+                problems.append(f"'{excerpt(name)}' = {', '.join(excerpt(v) for v in values)} is refused: {first}")
             else:
-                problems.append(f"'{name}' is not a name the scene accepts: {first}"
+                problems.append(f"'{excerpt(name)}' is not a name the scene accepts: {first}"
                                 + did_you_mean(name, candidates))
     if not problems:   # refused only in combination: show the first case as it is
-        problems.append(f"case 0 ({', '.join(f'{k} = {v!r}' for k, v in cases[0].values.items())}): "
+        problems.append(f"case 0 ({', '.join(f'{excerpt(k)} = {shown(v)}' for k, v in cases[0].values.items())}): "
                         f"{cases[0].error.removeprefix('invalid case: ')}")
     raise SweepError(where + ":\n  " + "\n  ".join(problems))

@@ -30,7 +30,9 @@ random stream (seeded by `seed` and its name), so adding a parameter or raising 
 leaves the draws of the others, and the cases already run, unchanged.
 
 Parameter names (paths into the scene):
-  parameters.<FMU name>, fidelity.<FMU name>, initial.<state>   the scene's flat tables
+  parameters.<FMU name>, fidelity.<FMU name>, initial.<state>   the scene's flat tables (an angle state
+                                also as initial.<state>_deg, in degrees: it replaces the scene's angle
+                                in either unit)
   controller.<key>[.<key>...]   the scene's [controller] (e.g. controller.azimuth.kp; list items
                                 by index: controller.K.0.2)
   base_motion.<key>[...]        e.g. base_motion.seed, base_motion.roll.significant_amplitude_deg
@@ -52,7 +54,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SceneError, positive, read_toml
+from ..errors import SceneError, did_you_mean, excerpt, positive, read_toml, shown
 from ..scene.scene import Scene
 
 TOP_KEYS = {"name", "description", "cases", "seed", "samples", "stop_time", "metrics_from_s", "grid", "random"}
@@ -163,32 +165,44 @@ def _plain(value):
 def _grid_values(name: str, spec) -> list:
     if isinstance(spec, list):
         if not spec:
-            raise SweepError(f"[grid] '{name}': empty list")
+            raise SweepError(f"[grid] '{excerpt(name)}': empty list")
         return [_plain(v) for v in spec]
     if isinstance(spec, dict) and len(spec) == 1:
         (kind, args), = spec.items()
         if kind in ("linspace", "geomspace") and isinstance(args, list) and len(args) == 3:
             a, b, n = args
-            if not (isinstance(n, int) and n >= 1):
-                raise SweepError(f"[grid] '{name}': {kind} = [start, stop, count], count a positive integer")
+            _finite_numbers(f"[grid] '{excerpt(name)}': {kind}", [a, b])
+            if not (isinstance(n, int) and not isinstance(n, bool) and n >= 1):
+                raise SweepError(f"[grid] '{excerpt(name)}': {kind} = [start, stop, count], count a positive integer")
             if kind == "geomspace" and not (a > 0 and b > 0):
-                raise SweepError(f"[grid] '{name}': geomspace needs positive bounds")
+                raise SweepError(f"[grid] '{excerpt(name)}': geomspace needs positive bounds")
             return [float(v) for v in getattr(np, kind)(float(a), float(b), n)]
-    raise SweepError(f"[grid] '{name}': expected a list of values, {{ linspace = [a, b, n] }} or "
-                     f"{{ geomspace = [a, b, n] }}, got {spec!r}")
+    raise SweepError(f"[grid] '{excerpt(name)}': expected a list of values, {{ linspace = [a, b, n] }} or "
+                     f"{{ geomspace = [a, b, n] }}, got {shown(spec)}")
+
+
+def _finite_numbers(where: str, values: list) -> None:
+    """Grid and distribution bounds: numbers a case could be given, refused here, not case by case."""
+    for value in values:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise SweepError(f"{where}: {shown(value)} is not a finite number")
 
 
 def _check_distribution(name: str, spec) -> dict:
     if not (isinstance(spec, dict) and len(spec) == 1 and next(iter(spec)) in DISTRIBUTIONS):
-        raise SweepError(f"[random] '{name}': expected one of {{ uniform = [a, b] }}, {{ loguniform = [a, b] }}, "
-                         f"{{ normal = [mean, std] }}, {{ integers = [low, high] }}, {{ choice = [values] }}; got {spec!r}")
+        raise SweepError(f"[random] '{excerpt(name)}': expected one of {{ uniform = [a, b] }}, {{ loguniform = [a, b] }}, "
+                         f"{{ normal = [mean, std] }}, {{ integers = [low, high] }}, {{ choice = [values] }}; got {shown(spec)}")
     (kind, args), = spec.items()
     if not isinstance(args, list) or (kind != "choice" and len(args) != 2) or not args:
-        raise SweepError(f"[random] '{name}': {kind} needs " + ("a non-empty list" if kind == "choice" else "[a, b]"))
+        raise SweepError(f"[random] '{excerpt(name)}': {kind} needs " + ("a non-empty list" if kind == "choice" else "[a, b]"))
+    if kind != "choice":
+        _finite_numbers(f"[random] '{excerpt(name)}': {kind}", args)
+    if kind == "normal" and args[1] < 0:
+        raise SweepError(f"[random] '{excerpt(name)}': normal = [mean, std] needs std >= 0, got {args[1]:g}")
     if kind == "loguniform" and not (args[0] > 0 and args[1] > 0):
-        raise SweepError(f"[random] '{name}': loguniform needs positive bounds")
+        raise SweepError(f"[random] '{excerpt(name)}': loguniform needs positive bounds")
     if kind == "integers" and not all(isinstance(v, int) and not isinstance(v, bool) for v in args):
-        raise SweepError(f"[random] '{name}': integers needs integer bounds")
+        raise SweepError(f"[random] '{excerpt(name)}': integers needs integer bounds")
     return spec
 
 
@@ -215,7 +229,8 @@ def load_sweep(path: pathlib.Path | str) -> Sweep:
     try:
         unknown = set(raw) - TOP_KEYS
         if unknown:
-            raise SweepError(f"unknown key(s) {sorted(unknown)}; allowed: {sorted(TOP_KEYS)}")
+            raise SweepError(f"unknown key(s) {[excerpt(key) for key in sorted(unknown)[:5]]}"
+                             f"{did_you_mean(sorted(unknown)[0], sorted(TOP_KEYS))}; allowed: {sorted(TOP_KEYS)}")
         for key in ("grid", "random"):
             if not isinstance(raw.get(key, {}), dict):
                 raise SweepError(f"'{key}' must be a table ([{key}])")
@@ -238,8 +253,11 @@ def load_sweep(path: pathlib.Path | str) -> Sweep:
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise SweepError("'seed' must be a non-negative integer")
         for key in ("stop_time", "metrics_from_s"):
-            if key in raw and (isinstance(raw[key], bool) or not isinstance(raw[key], (int, float)) or raw[key] < 0):
-                raise SweepError(f"'{key}' must be a non-negative number")
+            value = raw.get(key, 0.0)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0 <= value < math.inf):
+                raise SweepError(f"'{key}' must be a finite number >= 0, got {shown(value)}")
+        if raw.get("stop_time", 1.0) == 0:
+            raise SweepError("'stop_time' must be positive: every case ends there")
         name = raw.get("name", path.stem)
         if not isinstance(name, str) or not name.replace("_", "").replace("-", "").isalnum():
             raise SweepError("'name' must be a string of letters, digits, '_' and '-' (it names the result files)")
@@ -272,11 +290,11 @@ def parse_name(name: str) -> tuple[str, list]:
         return "stop_time", []
     if head in FLAT_SECTIONS:
         if not rest:
-            raise SweepError(f"'{name}': give the variable, e.g. {head}.gear1.k_s")
+            raise SweepError(f"'{excerpt(name)}': give the variable, e.g. {head}.gear1.k_s")
         return head, [rest]
     if head in NESTED_SECTIONS:
         if not rest:
-            raise SweepError(f"'{name}': give the key, e.g. {head}.<key>")
+            raise SweepError(f"'{excerpt(name)}': give the key, e.g. {head}.<key>")
         return head, [int(k) if k.isdigit() else k for k in rest.split(".")]
     return "fmu", [name]
 
@@ -286,16 +304,16 @@ def _set_nested(table, path: list, value, name: str):
     for key in path[:-1]:
         if isinstance(node, list):
             if not (isinstance(key, int) and key < len(node)):
-                raise SceneError(f"'{name}': no item {key} in the list")
+                raise SceneError(f"'{excerpt(name)}': no item {key} in the list")
             node = node[key]
         else:
             node = node.setdefault(key, {})
     last = path[-1]
     if isinstance(node, list):
         if not (isinstance(last, int) and last < len(node)):
-            raise SceneError(f"'{name}': no item {last} in the list")
+            raise SceneError(f"'{excerpt(name)}': no item {last} in the list")
     elif not isinstance(node, dict):
-        raise SceneError(f"'{name}': {'.'.join(map(str, path[:-1]))} is not a table")
+        raise SceneError(f"'{excerpt(name)}': {'.'.join(map(str, path[:-1]))} is not a table")
     node[last] = value
 
 
@@ -310,6 +328,12 @@ def apply_case(scene: Scene, resolved: dict, case: dict, stop_time: float | None
             changes["stop_time"] = positive("stop_time", value)
         elif section in FLAT_SECTIONS:
             table = changes.setdefault(section, dict(getattr(scene, section)))
+            if section == "initial":
+                # beta_deg replaces the scene's beta (which load_scene made of its beta_deg), and the other
+                # way round: the same angle in both units would be refused
+                name_in_other_unit = path[0].removesuffix("_deg") if path[0].endswith("_deg") else path[0] + "_deg"
+                if f"initial.{name_in_other_unit}" not in case:
+                    table.pop(name_in_other_unit, None)
             table[path[0]] = value
         else:
             attr = NESTED_SECTIONS[section]
