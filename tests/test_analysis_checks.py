@@ -163,3 +163,26 @@ def test_coherence_is_a_fraction_whatever_the_signal_and_frequency():
     X = fr.fundamental(x, t, 100.0)
     assert fr.power_fraction(x, t, 100.0) == pytest.approx(abs(X) ** 2 / 2 / np.var(x), rel=1e-12)
     assert fr.power_fraction(x, t, 100.0) == pytest.approx(4 / (4 + 0.25), rel=1e-12)
+
+
+def test_linearize_set_takes_angles_by_the_scene_formats_rule():
+    """--set follows docs/scenes.md's rule for angles: NAME_deg is degrees, a bare angle radians, a start
+    alpha or beta beyond half a turn refused as the degrees it most likely is (issue 34)."""
+    import math
+
+    from gimbal2axis.cli.linearize import parse_assignments
+    from gimbal2axis.errors import SceneError
+
+    assert parse_assignments(["beta_deg=30", "alpha=0.25", "gear1.model=0"]) == {
+        "beta": math.radians(30.0), "alpha": 0.25, "gear1.model": 0.0}
+    for refused, said in ((["beta=30"], "did you mean beta_deg = 30"), (["beta=0.1", "beta_deg=3"], "give one"),
+                          (["alpha_deg=270"], "beyond ±180 deg")):
+        with pytest.raises(SceneError, match=said):
+            parse_assignments(refused)
+
+
+def test_linearize_refuses_a_degree_sized_radian_angle_in_one_line(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "gimbal2axis", "linearize", "--set", "beta=30",
+                           "--out", str(tmp_path / "l.npz")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert "beta = 30 rad (1719 deg)" in done.stderr and not (tmp_path / "l.npz").exists()

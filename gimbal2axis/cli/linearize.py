@@ -50,7 +50,24 @@ def parse_assignments(assignments: list[str]) -> dict:
             values[name.strip()] = True if low == "true" else False if low == "false" else float(text)
         except ValueError:
             raise SceneError(f"--set {item!r}: {text!r} is not a number, true or false") from None
-    return values
+    return angles_in_radians(values)
+
+
+def angles_in_radians(values: dict) -> dict:
+    """The scene format's rule for angles (docs/scenes.md, Units) on the command line too: NAME_deg is
+    degrees, a bare angle radians, and a start alpha or beta beyond half a turn is refused as the
+    degrees it most likely is."""
+    from ..scene.scene import ANGLE_STATES, initial_in_radians
+
+    def is_angle(name: str) -> bool:
+        return name in ANGLE_STATES or (name.endswith("_deg") and name[:-len("_deg")] in ANGLE_STATES)
+
+    angles = {name: value for name, value in values.items() if is_angle(name)}
+    try:
+        converted = initial_in_radians(angles)
+    except SceneError as exc:
+        raise SceneError(f"--set: {str(exc).replace('initial.', '')}") from None
+    return {**{name: value for name, value in values.items() if not is_angle(name)}, **converted}
 
 
 def scene_point(scene_path: str, fmu_file, at_time: float | None, overrides: dict, build_dir: str | None = None):
