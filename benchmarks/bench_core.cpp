@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 
 using namespace gimbal;
 

@@ -30,10 +30,10 @@
 #include <string>
 #include <vector>
 
-#include "controllers.h"
 #include "fmi2Functions.h"
-#include "set_points.h"
-#include "sum_of_sines.h"
+#include "gimbal_kernel/controllers.h"
+#include "gimbal_kernel/set_points.h"
+#include "gimbal_kernel/sum_of_sines.h"
 
 // ------------------------------------------------------------------------------------------------
 // Heap allocation counting (interposition of the C allocator)
@@ -322,7 +322,7 @@ void check(fmi2Status status, const char* what) {
 
 // ------------------------------------------------------------------------------------------------
 // Sea-state base motion: per axis q(t) = sum_i A_i sin(w_i t + phi_i), rates and accelerations
-// exact. The sums are the C kernel's (gimbal2axis/native/sum_of_sines.h), the scene runner's: rows
+// exact. The sums are the C kernel's (c_kernel/include/gimbal_kernel/sum_of_sines.h), the scene runner's: rows
 // are evaluated a block at a time, when the step reaches the next block.
 // ------------------------------------------------------------------------------------------------
 struct SeaState {
@@ -406,7 +406,7 @@ void gimbal_angles_for(const double target[3], double delta, double psi, double 
 }
 
 // PD on each axis about the IK set points, with the payload gyro as the rate signal: the kernel's
-// PID (gimbal2axis/native/controllers.h, the scene runner's) with kp and k_gyro only. Its rates:
+// PID (c_kernel/include/gimbal_kernel/controllers.h, the scene runner's) with kp and k_gyro only. Its rates:
 // elevation = los.omega[1], azimuth = los.omega[3] / cos(beta) (secant correction).
 struct Controller {
     static constexpr double kp[2] = {300.0, 640.0};  // V/rad

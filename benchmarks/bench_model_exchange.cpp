@@ -27,7 +27,7 @@
 
 #include "fmi2Functions.h"
 #include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 #include "gimbal/model/variable_groups.hpp"
 
 using namespace gimbal;

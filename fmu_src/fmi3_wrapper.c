@@ -3,8 +3,9 @@
  *
  * Value references (docs/fmi_interfaces.md): a Float64 is the core's Real of the same reference, an
  * Int32 or Enumeration the core's Integer at FMI3_INTEGER_BASE + its reference, a Boolean the core's
- * Boolean at FMI3_BOOLEAN_BASE + its reference; FMI3_EVENT_INDICATORS is the Float64 array of the 36
- * event indicators and FMI3_TIME the independent variable. Enumerations are accessed with
+ * Boolean at FMI3_BOOLEAN_BASE + its reference; FMI3_TIME is the independent variable and the 36 event
+ * indicators are scalar Float64 locals from FMI3_FIRST_EVENT_INDICATOR on (scalars, not one array: a host
+ * without array support reads each Float64 as one value). Enumerations are accessed with
  * fmi3GetInt64/fmi3SetInt64, as FMI 3.0 says; the model has no other types.
  *
  * Co-Simulation handles every mode change inside fmi3DoStep; an importer that allows an early return
@@ -24,7 +25,7 @@
 #include "host_fp_environment.h"
 #include "common/communication_point.h"
 
-enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_EVENT_INDICATORS = 3000, FMI3_TIME = 3001 };
+enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_TIME = 3001, FMI3_FIRST_EVENT_INDICATOR = 3002 };
 _Static_assert(sizeof(fmi3ValueReference) == sizeof(unsigned), "value references are passed to the core as unsigned");
 
 typedef enum {
@@ -257,6 +258,11 @@ static fmi3Status exit_initialization(Instance3* i) {
 typedef enum { KIND_FLOAT64, KIND_INT32, KIND_ENUMERATION, KIND_BOOLEAN } Kind;
 static const char* const kKindName[] = {"Float64", "Int32", "Enumeration (fmi3GetInt64/fmi3SetInt64)", "Boolean"};
 
+/* One of the 36 scalar event indicators (no core variable: the core computes them all at once). */
+static int is_event_indicator(fmi3ValueReference vr) {
+    return vr >= FMI3_FIRST_EVENT_INDICATOR && vr < FMI3_FIRST_EVENT_INDICATOR + GIMBAL_EVENT_INDICATORS;
+}
+
 /* The core's type and reference of an FMI 3 value reference, or 0 (with *info unset). */
 static int core_variable(fmi3ValueReference vr, Kind* kind, unsigned* core_vr, GimbalVariableInfo* info) {
     if (vr < FMI3_INTEGER_BASE && gimbal_variable_info(GIMBAL_REAL, vr, info)) {
@@ -268,7 +274,7 @@ static int core_variable(fmi3ValueReference vr, Kind* kind, unsigned* core_vr, G
         *kind = info->declared_type[0] != '\0' ? KIND_ENUMERATION : KIND_INT32, *core_vr = vr - FMI3_INTEGER_BASE;
         return 1;
     }
-    if (vr >= FMI3_BOOLEAN_BASE && vr < FMI3_EVENT_INDICATORS &&
+    if (vr >= FMI3_BOOLEAN_BASE && vr < FMI3_TIME &&
         gimbal_variable_info(GIMBAL_BOOLEAN, vr - FMI3_BOOLEAN_BASE, info)) {
         *kind = KIND_BOOLEAN, *core_vr = vr - FMI3_BOOLEAN_BASE;
         return 1;
@@ -303,13 +309,13 @@ static int check_access(Instance3* i, const char* f, int set, Kind kind, const f
         Kind actual;
         unsigned core_vr;
         GimbalVariableInfo info;
-        if (kind == KIND_FLOAT64 && (vr[k] == FMI3_EVENT_INDICATORS || vr[k] == FMI3_TIME) && !set) {
-            expected += vr[k] == FMI3_EVENT_INDICATORS ? GIMBAL_EVENT_INDICATORS : 1;
+        if (kind == KIND_FLOAT64 && (is_event_indicator(vr[k]) || vr[k] == FMI3_TIME) && !set) {
+            ++expected;
             continue;
         }
         if (!core_variable(vr[k], &actual, &core_vr, &info)) {
             say(i, fmi3Error, "logStatusError", "%s: value reference %u is not a variable of this FMU%s", f, (unsigned)vr[k],
-                vr[k] == FMI3_EVENT_INDICATORS || vr[k] == FMI3_TIME ? " that can be set" : "");
+                is_event_indicator(vr[k]) || vr[k] == FMI3_TIME ? " that can be set" : "");
             return 0;
         }
         if (actual != kind) {
@@ -332,22 +338,27 @@ static int check_access(Instance3* i, const char* f, int set, Kind kind, const f
 
 static fmi3Status get_float64(Instance3* i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
     if (!check_access(i, "fmi3GetFloat64", 0, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
-    size_t at = 0;
+    fmi3Float64 indicators[GIMBAL_EVENT_INDICATORS];
+    int indicators_read = 0; /* the core hands out all 36 at once: read them once per call */
     for (size_t k = 0; k < nvr; ++k) {
         fmi3Status status = fmi3OK;
         if (vr[k] == FMI3_TIME) {
-            values[at++] = i->time;
+            values[k] = i->time;
             continue;
         }
-        if (vr[k] == FMI3_EVENT_INDICATORS) {
-            if (!i->model_exchange) { /* Co-Simulation locates the events itself: no indicator is exposed */
-                for (int z = 0; z < GIMBAL_EVENT_INDICATORS; ++z) values[at + z] = 1.0;
-            } else {
-                status = from_core(gimbal_core_get_event_indicators(i->core, values + at));
+        if (is_event_indicator(vr[k])) {
+            if (!indicators_read) {
+                if (!i->model_exchange) { /* Co-Simulation locates the events itself: no indicator is exposed */
+                    for (int z = 0; z < GIMBAL_EVENT_INDICATORS; ++z) indicators[z] = 1.0;
+                } else {
+                    status = from_core(gimbal_core_get_event_indicators(i->core, indicators));
+                    if (status > fmi3Warning) return status;
+                }
+                indicators_read = 1;
             }
-            at += GIMBAL_EVENT_INDICATORS;
+            values[k] = indicators[vr[k] - FMI3_FIRST_EVENT_INDICATOR];
         } else {
-            status = from_core(gimbal_core_get_real(i->core, vr[k], &values[at++]));
+            status = from_core(gimbal_core_get_real(i->core, vr[k], &values[k]));
         }
         if (status > fmi3Warning) return status;
     }

@@ -14,7 +14,8 @@ Layout, and the one direction imports go (tests/test_package_layout.py refuses a
      -> scene                scene files, base motion, references, controllers, sensors, geometry
      -> fmu                  the FMU wrapper, an FMU kept per worker
      -> errors, version, progress, native, locations    leaves: error types, the version, progress bars, the C kernels
-                                               (native/*.c, the extension gimbal2axis.native._native),
+                                               (the extension gimbal2axis.native._native, compiled from
+                                               the repository's c_kernel/),
                                                where the build is
 
 A module imports from its own subpackage and from the layers below it, never from above or from its

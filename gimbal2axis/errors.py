@@ -23,6 +23,15 @@ class SceneWarning(UserWarning):
     """A scene that runs, but probably not as its author meant; the message names the key."""
 
 
+class FMUCallFailed(Exception):
+    """An FMI call of a run's loop (the Python loops or the compiled one) that returned fmi2Discard or
+    fmi2Error; `function` names it. Here, below every loop, so that none imports another for it."""
+
+    def __init__(self, function: str):
+        super().__init__(f"{function} returned fmi2Discard or fmi2Error")
+        self.function = function
+
+
 def excerpt(text: str, limit: int = EXCERPT_CHARS) -> str:
     """`text` itself when short, else its first `limit` characters and '…(N characters)'."""
     text = str(text)

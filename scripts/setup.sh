@@ -65,14 +65,16 @@ fi
 # The project's own package, gimbal2axis/ (pyproject.toml), with its command `gimbal2axis`, installed
 # editable: .venv imports it from this checkout, so the command, the tests, the notebook's kernel and the
 # sweeps' worker processes always run the working tree's code (a copy in site-packages would go stale
-# at the first edit; its C kernels, an extension, are rebuilt here when their sources change).
+# at the first edit; its C kernels, an extension compiled from c_kernel/, are rebuilt here when their
+# sources change).
 # --no-deps: its dependencies are requirements-run.txt, installed above.
 # Looked up (not imported) with -I: not fooled by the current directory or PYTHONPATH.
 package_marker="$venv/.package-installed"
 if ! "$venv/bin/python" -I -c "import importlib.util as u, sys
 sys.exit(not u.find_spec('gimbal2axis'))" >/dev/null 2>&1 || [ ! -x "$venv/bin/gimbal2axis" ] ||
    [ "$repo/pyproject.toml" -nt "$package_marker" ] || [ "$repo/requirements-run.txt" -nt "$package_marker" ] ||
-   [ "$repo/setup.py" -nt "$package_marker" ] || [ -n "$(find "$repo/gimbal2axis/native" -newer "$package_marker" 2>/dev/null)" ] ||
+   [ "$repo/setup.py" -nt "$package_marker" ] ||
+   [ -n "$(find "$repo/c_kernel" "$repo/gimbal2axis/native" -newer "$package_marker" 2>/dev/null)" ] ||
    [ "$repo/CMakeLists.txt" -nt "$package_marker" ] ||   # the package's version is the CMake project's
    ! ls "$repo"/gimbal2axis/native/_native*.so >/dev/null 2>&1; then
   echo "[setup] installing the project's Python package (gimbal2axis, its command and C kernels) into .venv, editable"

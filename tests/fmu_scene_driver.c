@@ -11,10 +11,10 @@
  *
  * The scene: 3 s in steps of 1 ms at the default parameters (full fidelity, backlash in both gears),
  * the carrier rolling, pitching, yawing and heaving (sinusoids with their exact derivatives, set at
- * each step start; the scene runner's sums of sinusoids, gimbal2axis/native/sum_of_sines.h), and a PD
+ * each step start; the scene runner's sums of sinusoids, c_kernel/include/gimbal_kernel/sum_of_sines.h), and a PD
  * loop that slews the gimbal to fixed angles (0.1 rad azimuth, -0.05 rad elevation) against that
  * motion with the payload gyro as its rate signal (the scene runner's PID,
- * gimbal2axis/native/controllers.h, with kp and k_gyro): the voltages saturate at first and the
+ * c_kernel/include/gimbal_kernel/controllers.h, with kp and k_gyro): the voltages saturate at first and the
  * current limiters and backlash stops switch. Every 10th step writes a CSV row of outputs and
  * voltages.
  *
@@ -50,10 +50,10 @@ static void* find_symbol(Library library, const char* name) { return dlsym(libra
 static void close_library(Library library) { dlclose(library); }
 #endif
 
-#include "controllers.h"
 #include "fmi2Functions.h"
 #include "fmi3Functions.h"
-#include "sum_of_sines.h"
+#include "gimbal_kernel/controllers.h"
+#include "gimbal_kernel/sum_of_sines.h"
 
 /* Value references: the position in the FMU's variable tables (the same tables it is built from). */
 enum {

@@ -250,12 +250,15 @@ struct Fuzzer {
         switch (pick(14)) {
             case 0: call("fmi3GetFloat64(NULL)", [&] { return api.getFloat64(instance, &kBeta, 1, nullptr, 1); }); break;
             case 1: call("fmi3GetFloat64(wrong count)", [&] { return api.getFloat64(instance, &kBeta, 1, values, 2); }); break;
-            case 2: {
-                const fmi3ValueReference vr = chance(0.5) ? kIndicators : kTime;
+            case 2: {  // the 36 scalar event indicators (consecutive value references) and time, in one call
+                fmi3ValueReference vrs[kEventIndicators + 1];
+                for (size_t z = 0; z < kEventIndicators; ++z) vrs[z] = kIndicators + static_cast<fmi3ValueReference>(z);
+                vrs[kEventIndicators] = kTime;
+                const size_t count = chance(0.5) ? kEventIndicators + 1 : 1 + random() % kEventIndicators;
                 if (call("fmi3GetFloat64(indicators/time)", [&] {
-                        return api.getFloat64(instance, &vr, 1, values, vr == kIndicators ? kEventIndicators : 1);
+                        return api.getFloat64(instance, vrs + kEventIndicators + 1 - count, count, values, count);
                     }) <= fmi3Warning)
-                    finite(values, vr == kIndicators ? kEventIndicators : 1, "fmi3GetFloat64");
+                    finite(values, count, "fmi3GetFloat64");
                 break;
             }
             case 3: {
@@ -426,7 +429,7 @@ int main(int argc, char** argv) {
     for (auto it = std::sregex_iterator(xml.begin(), xml.end(), variable); it != std::sregex_iterator(); ++it)
         vr[(*it)[2]] = static_cast<fmi3ValueReference>(std::stoul((*it)[3]));
     const char* needed[] = {"beta", "u_R1", "base.gamma_dot", "i_R1", "gear1.model", "solver.steps", "dry_friction",
-                            "event_indicators", "time", "der(alpha_dot)"};
+                            "event_indicators[1]", "time", "der(alpha_dot)"};
     for (const char* name : needed)
         if (vr.count(name) == 0 || token.empty()) {
             std::fprintf(stderr, "fuzz_fmi3: %s is not the FMI 3.0 model description of this FMU (%s)\n", argv[2], name);
@@ -434,7 +437,7 @@ int main(int argc, char** argv) {
         }
     kBeta = vr["beta"], kUR1 = vr["u_R1"], kBaseGammaDot = vr["base.gamma_dot"], kIR1 = vr["i_R1"];
     kGearModel = vr["gear1.model"], kSolverSteps = vr["solver.steps"], kDryFriction = vr["dry_friction"];
-    kIndicators = vr["event_indicators"], kTime = vr["time"], kDerAlphaDot = vr["der(alpha_dot)"];
+    kIndicators = vr["event_indicators[1]"], kTime = vr["time"], kDerAlphaDot = vr["der(alpha_dot)"];
     Fuzzer::g_token = token.c_str();
 #define LOAD(field, name) load(library, api.field, name)
     LOAD(instantiateModelExchange, "fmi3InstantiateModelExchange");

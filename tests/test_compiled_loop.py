@@ -1,4 +1,4 @@
-"""The compiled communication loop (gimbal2axis/native/master_loop.c) against the Python loop
+"""The compiled communication loop (c_kernel/src/master_loop.c) against the Python loop
 (master.step_loop): for every built-in controller, sensor model and delay, the two runs must agree
 to the bit in every recorded signal; and a failing FMU call must stop both with the same message.
 

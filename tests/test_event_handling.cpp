@@ -37,9 +37,9 @@ public:
 };
 
 void chattering_guard_engages_after_the_limit_and_only_then() {
-    IntegratorSettings settings;  // 50 changes, each within 1 ns, hold for 1 us
+    EventHandlingSettings settings;  // 50 changes, each within 1 ns, hold for 1 us
     std::vector<std::string> said;
-    const HybridIntegrator::MessageSink sink = [&said](const std::string& m) { said.push_back(m); };
+    const MessageSink sink = [&said](const std::string& m) { said.push_back(m); };
     ChatteringMemory memory;
     double t = 1.0;
     bool engaged = false;
@@ -70,9 +70,9 @@ void chattering_guard_engages_after_the_limit_and_only_then() {
 
 void a_guard_left_on_zero_is_decided_by_where_it_goes() {
     Floor floor;
-    IntegratorSettings settings;
+    EventHandlingSettings settings;
     std::vector<std::string> said;
-    const HybridIntegrator::MessageSink sink = [&said](const std::string& m) { said.push_back(m); };
+    const MessageSink sink = [&said](const std::string& m) { said.push_back(m); };
     GuardSettling settling;
     double x[2] = {0.0, -1.0};  // at the floor, moving down, free: it would fall through
     double derivative[2], guards[1];

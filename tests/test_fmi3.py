@@ -150,12 +150,13 @@ def test_enumerations_are_int64_and_other_types_are_refused(fmu3):
             s.setFloat64([vr(fmu3, "beta")], [float("nan")])
         assert any("fmi3SetFloat64: beta = nan refused" in m for _, _, m in log)
         with pytest.raises(FMICallException):
-            s.setFloat64([vr(fmu3, "event_indicators")], [0.0])
+            s.setFloat64([vr(fmu3, "event_indicators[1]")], [0.0])
         steps = vr(fmu3, "solver.steps")
         assert steps >= 1000 and s.getInt32([steps]) == [0]
         s.exitInitializationMode()
         assert s.getFloat64([vr(fmu3, "time")]) == [0.0]
-        assert len(s.getFloat64([vr(fmu3, "event_indicators")], nValues=36)) == 36
+        indicators = [vr(fmu3, f"event_indicators[{k}]") for k in range(1, 37)]
+        assert s.getFloat64(indicators + [vr(fmu3, "time")]) == [1.0] * 36 + [0.0]  # Co-Simulation: no indicator
     finally:
         s.freeInstance()
 
@@ -350,3 +351,40 @@ def test_ecos_a_second_host_runs_the_fmi_3_fmu_bit_for_bit(gimbal_fmu, fmu3, sce
                    inputs=None if inputs is None else (lambda t, _latest: inputs(t)))
     ref = np.column_stack([ref[n][1:] for n in ECOS_OUTPUTS])
     assert got.shape == ref.shape and np.array_equal(got, ref)
+
+
+def test_a_host_without_arrays_records_every_variable(gimbal_fmu, fmu3, tmp_path):
+    """ecos reads every Float64 as one value and its CSV writer records all variables by default, locals
+    too: the FMU must have no array among them (docs/fmi_interfaces.md). With the 36 event indicators
+    as one array each of its reads failed and the file held zeros; as 36 scalars it records the run:
+    the angles are fmpy's (FMI 2.0 FMU) to the CSV's 6 decimals, every indicator 1 (Co-Simulation)."""
+    from test_other_masters import START, import_ecospy
+
+    import_ecospy()
+    from ecospy import EcosSimulation, EcosSimulationStructure
+
+    steps = 50
+    structure = EcosSimulationStructure()
+    structure.add_model("gimbal", str(fmu3[0]))
+    assert structure.add_parameter_set("start", {f"gimbal::{n}": float(v) for n, v in START.items()})
+    simulation = EcosSimulation(structure=structure, step_size=1e-3)
+    structure.free()
+    result = tmp_path / "ecos.csv"
+    try:
+        simulation.add_csv_writer(str(result))
+        assert simulation.init(parameter_set="start")
+        simulation.step(steps)
+        simulation.terminate()
+    finally:
+        simulation.free()
+    header, *rows = [line.split(", ") for line in result.read_text().splitlines()]
+    columns = {name.removeprefix("gimbal::").rsplit("[", 1)[0]: j for j, name in enumerate(header)}  # "...[REAL]"
+    table = np.array(rows, dtype=float)
+    assert table.shape == (steps + 1, len(header))
+    indicators = [f"event_indicators[{k}]" for k in range(1, 37)]
+    assert set(indicators) <= set(columns)
+    assert np.all(table[1:, [columns[name] for name in indicators]] == 1.0)
+    ref = simulate(gimbal_fmu, steps * 1e-3, 1e-3, start_values=START, outputs=["alpha", "beta", "alpha_m"])
+    for name in ("alpha", "beta", "alpha_m"):
+        assert np.max(np.abs(table[:, columns[name]] - ref[name])) < 1e-6, name
+    assert np.ptp(ref["alpha"]) > 1e-3   # the run moves: a file of start values would not pass

@@ -1,7 +1,7 @@
 """The FMI 3.0 model description (build/fmi3/modelDescription.xml, from the same variable tables as
 FMI 2.0's): valid against the FMI 3.0 schema and fmpy's checks, and the same variables under the
 value-reference rule of docs/fmi_interfaces.md (Real as in FMI 2.0, Integer 1000 +, Boolean 2000 +;
-the 36 event indicators one Float64 array at 3000; time at 3001)."""
+time at 3001; the 36 event indicators scalar Float64 locals from 3002 on), and no array variable."""
 from __future__ import annotations
 
 import pathlib
@@ -50,7 +50,15 @@ def test_the_same_variables_under_the_value_reference_rule(descriptions):
         if v.type == "Enumeration":
             assert w.declaredType.name == v.declaredType.name
             assert [(i.name, i.value) for i in w.declaredType.items] == [(i.name, i.value) for i in v.declaredType.items]
-    assert len(fmi3.modelVariables) == len(fmi2.modelVariables) + 2  # time and the event indicators
+    assert len(fmi3.modelVariables) == len(fmi2.modelVariables) + 1 + 36  # time and the event indicators
+
+
+def test_no_variable_is_an_array(descriptions):
+    """A host without array support (ecos: tests/test_fmi3.py) reads every variable as one value: the
+    FMU has none with a <Dimension>, the event indicators included (docs/fmi_interfaces.md)."""
+    _, fmi3, path = descriptions
+    assert [v.name for v in fmi3.modelVariables if v.dimensions] == []
+    assert "<Dimension" not in path.read_text()
 
 
 def test_states_indicators_and_dependencies_are_fmi_2s(descriptions):
@@ -59,7 +67,9 @@ def test_states_indicators_and_dependencies_are_fmi_2s(descriptions):
     assert [d.variable.derivative.name for d in fmi3.derivatives] == [d.variable.derivative.name for d in fmi2.derivatives]
     assert fmi3.numberOfContinuousStates == fmi2.numberOfContinuousStates == 17
     assert fmi3.numberOfEventIndicators == fmi2.numberOfEventIndicators == 36
-    assert [e.variable.name for e in fmi3.eventIndicators] == ["event_indicators"]
+    assert [e.variable.name for e in fmi3.eventIndicators] == [f"event_indicators[{k}]" for k in range(1, 37)]
+    assert [e.variable.valueReference for e in fmi3.eventIndicators] == list(range(3002, 3038))
+    assert {(e.variable.causality, e.variable.variability) for e in fmi3.eventIndicators} == {("local", "continuous")}
     for mine, theirs in ((fmi3.outputs, fmi2.outputs), (fmi3.derivatives, fmi2.derivatives)):
         assert [u.variable.name for u in mine] == [u.variable.name for u in theirs]
         for a, b in zip(mine, theirs):

@@ -1,5 +1,5 @@
 """The datasheet gyro and the indirect stabilization scheme (gimbal2axis/scene/gyro.py, sensors.py,
-gimbal2axis/native/gyro.c, sensors.c): each term against what it must be by definition, checked by
+c_kernel/src/gyro.c, sensors.c): each term against what it must be by definition, checked by
 means the model does not use (allantools' Allan deviation, scipy's continuous-time simulation, the
 FMU's own los.omega)."""
 import math

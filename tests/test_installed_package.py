@@ -1,5 +1,6 @@
-"""The package as a user installs it: a wheel built from the sources, installed into a fresh virtual
-environment (neither the source tree nor the repository's editable install on its path), and its command
+"""The package as a user installs it: a wheel built from an sdist of the sources (so the sdist carries
+everything the build reads, the C kernel's sources and headers in c_kernel/ included), installed into a
+fresh virtual environment (neither the source tree nor the repository's editable install on its path), and its command
 run from a scratch directory: `--help` of the command and of each subcommand, one line on stderr and exit
 status 2 for a bad argument, `python -m gimbal2axis`, and a short run of a scene."""
 import os
@@ -8,12 +9,16 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import tarfile
 
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-# What building the wheel reads: the package, its build description and what its metadata names.
-BUILD_INPUTS = ["pyproject.toml", "setup.py", "CMakeLists.txt", "README.md", "LICENSE", "requirements-run.txt"]
+# What building the sdist reads: the package, the C kernel it compiles, its build description and what
+# its metadata names.
+BUILD_INPUTS = ["pyproject.toml", "setup.py", "MANIFEST.in", "CMakeLists.txt", "README.md", "LICENSE",
+                "requirements-run.txt"]
+BUILD_INPUT_FOLDERS = ["gimbal2axis", "c_kernel"]
 SUBCOMMANDS = ["run", "sweep", "linearize", "freqresp", "bench"]
 BAD_ARGUMENTS = {
     "run": ["--stop-time", "soon"],
@@ -40,10 +45,20 @@ def installed(tmp_path_factory) -> dict:
     sources.mkdir()
     for name in BUILD_INPUTS:
         shutil.copy2(REPO / name, sources / name)
-    shutil.copytree(REPO / "gimbal2axis", sources / "gimbal2axis",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.so", "build_locations.json"))
+    for name in BUILD_INPUT_FOLDERS:
+        shutil.copytree(REPO / name, sources / name,
+                        ignore=shutil.ignore_patterns("__pycache__", "*.so", "build_locations.json"))
+    # The sdist through setuptools' PEP 517 backend (what `python -m build --sdist` calls), then the
+    # wheel from the unpacked sdist alone: a file the sdist leaves out fails the build here.
+    sdists = work / "sdists"
+    built = subprocess.run([sys.executable, "-c", "import sys; from setuptools import build_meta; "
+                                                  "print(build_meta.build_sdist(sys.argv[1]))", str(sdists)],
+                           cwd=sources, check=True, capture_output=True, text=True, timeout=300)
+    with tarfile.open(sdists / built.stdout.splitlines()[-1]) as archive:
+        archive.extractall(work / "unpacked", filter="data")
+    unpacked = next((work / "unpacked").iterdir())
     wheels = work / "wheels"
-    subprocess.run([sys.executable, "-m", "pip", "wheel", str(sources), "--no-deps", "--no-build-isolation", "-q",
+    subprocess.run([sys.executable, "-m", "pip", "wheel", str(unpacked), "--no-deps", "--no-build-isolation", "-q",
                     "-w", str(wheels)], check=True, capture_output=True, text=True, timeout=300)
     wheel = next(wheels.glob("gimbal2axis-*.whl"))
 

@@ -9,7 +9,7 @@
 
 #include "check.hpp"
 #include "gimbal/model/gimbal_model.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,4 +1,4 @@
-"""The C kernel (gimbal2axis/native/) against independent plain-Python references of the same
+"""The C kernel (c_kernel/, imported as gimbal2axis.native) against independent plain-Python references of the same
 equations, written out here: the built-in controllers (PID with every term, state feedback with
 gyro and encoder rates), the sensors, the prepared set points' 2 pi branch, the sums of sinusoids.
 The Python side sets the kernel's structs through the ctypes view it builds from the kernel's

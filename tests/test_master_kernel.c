@@ -6,10 +6,10 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "controllers.h"
-#include "gyro.h"
-#include "sensors.h"
-#include "sum_of_sines.h"
+#include "gimbal_kernel/controllers.h"
+#include "gimbal_kernel/gyro.h"
+#include "gimbal_kernel/sensors.h"
+#include "gimbal_kernel/sum_of_sines.h"
 
 static int failures = 0;
 #define CHECK(condition)                                                  \

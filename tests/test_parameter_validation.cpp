@@ -6,7 +6,7 @@
 #include <string>
 
 #include "check.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 
 using namespace gimbal;
 

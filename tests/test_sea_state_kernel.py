@@ -1,4 +1,4 @@
-"""The sea state's components in C (gimbal2axis/native/numpy_random.c, sea_state.c) against the numpy
+"""The sea state's components in C (c_kernel/src/numpy_random.c, sea_state.c) against the numpy
 code that made them before (kept here as the reference): numpy's default_rng([seed, index]) draws bit
 for bit, the frequencies and phases bit for bit, the amplitudes bit for bit against the same
 arithmetic done with libm's exp and pow (Python's math module), and within a few units in the last

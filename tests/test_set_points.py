@@ -1,4 +1,4 @@
-"""The target's set points from the C kernel (gimbal2axis/native/set_points.c), which the scene runner and
+"""The target's set points from the C kernel (c_kernel/src/set_points.c), which the scene runner and
 the controller FMU share, against an independent numpy form of the same inverse kinematics: equal
 to rounding (numpy may take SIMD sin/cos/atan2/hypot that differ from libm in the last bit; the
 rate, a difference over 1e-6 s, magnifies that by 1e6)."""

@@ -7,7 +7,7 @@
 
 #include "check.hpp"
 #include "gimbal/model/gimbal_model.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 #include "gimbal/switching_elements/element_registry.hpp"
 
 using namespace gimbal;

@@ -1,7 +1,8 @@
 """The ship scene as a system of three FMUs (ship motion, gimbal, controller; gimbal2axis/system/):
-written as an OSP system structure and run in libcosim, written as an SSP archive and run in FMPy's SSP
-support, both against the scene runner (`gimbal2axis run`), the reference. The tolerances and why
+written as an OSP system structure and run in libcosim, written as an SSP archive and run in libcosim's
+SSP loader and in FMPy's SSP support, all against the scene runner (`gimbal2axis run`), the reference. The tolerances and why
 they differ per engine: docs/systems.md."""
+import dataclasses
 import math
 import pathlib
 import xml.etree.ElementTree as ET
@@ -12,7 +13,7 @@ import pytest
 
 from gimbal2axis import SceneError, load_scene, run
 from gimbal2axis.scene import geometry
-from gimbal2axis.system.engines import run_fmpy_ssp, run_libcosim
+from gimbal2axis.system.engines import run_fmpy_ssp, run_libcosim, run_libcosim_ssp
 from gimbal2axis.system.from_scene import ship_system
 from gimbal2axis.system.osp import write_osp
 from gimbal2axis.system.ssp import write_ssp
@@ -88,13 +89,68 @@ def test_a_structural_switch_libcosim_cannot_set_is_refused(scene, build_dir, tm
         write_osp(ship_system(rigid, build_dir, stop_time=STOP), tmp_path / "osp")
 
 
+SSD = "{http://ssp-standard.org/SSP1/SystemStructureDescription}"
+SSC = "{http://ssp-standard.org/SSP1/SystemStructureCommon}"
+
+
+def annotation(element, kind):
+    """The <ssc:Annotation type=kind> among the <ssd:Annotations> of an SSD element."""
+    found = [a for a in element.findall(f"{SSD}Annotations/{SSC}Annotation") if a.get("type") == kind]
+    assert len(found) == 1, f"{element.tag} has {len(found)} annotations of type {kind}"
+    return found[0]
+
+
+def test_the_ssd_states_the_step_and_the_system_type_in_the_importers_annotations(scene, system, tmp_path):
+    """OMSimulator reads the system's type (a fixed-step master: co-simulation) and its step from
+    `org.openmodelica` on the system, libcosim its algorithm and base step from
+    `com.opensimulationplatform` on the DefaultExperiment; each component binds its own start values."""
+    archive = write_ssp(system, tmp_path / "ship.ssp")
+    with zipfile.ZipFile(archive) as contents:
+        root = ET.fromstring(contents.read("SystemStructure.ssd"))
+        names = set(contents.namelist())
+    oms = "{https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd}"
+    master = annotation(root.find(f"{SSD}System"), "org.openmodelica").find(
+        f"{oms}Annotations/{oms}SimulationInformation/{oms}FixedStepMaster")
+    assert master is not None and master.get("description") == "oms-ma"
+    assert float(master.get("stepSize")) == scene.step_size
+    experiment = root.find(f"{SSD}DefaultExperiment")
+    assert float(experiment.get("stopTime")) == STOP
+    osp = "{http://opensimulationplatform.com/SSP/OSPAnnotations}"
+    algorithm = annotation(experiment, "com.opensimulationplatform").find(f"{osp}Algorithm/{osp}FixedStepAlgorithm")
+    assert float(algorithm.get("baseStepSize")) == scene.step_size
+    for element in root.iter(f"{SSD}Component"):
+        [binding] = element.findall(f"{SSD}ParameterBindings/{SSD}ParameterBinding")
+        assert binding.get("source") == f"resources/{element.get('name')}.ssv" and binding.get("source") in names
+
+
+def test_libcosim_runs_the_ssp_archive_on_the_step_it_states_as_the_scene_runner(scene, system, reference, tmp_path):
+    """A second SSP engine: libcosim's own SSP loader, given no step (it takes the archive's)."""
+    archive = write_ssp(system, tmp_path / "ship.ssp")
+    steps = int(round(STOP / scene.step_size))
+    got = run_libcosim_ssp(archive, "gimbal", GIMBAL, steps)
+    assert np.allclose(got["time"], np.arange(1, steps + 1) * scene.step_size, rtol=0, atol=1e-12)
+    # the same computation as the OSP structure's (test above)
+    for name in ("alpha", "beta"):
+        assert np.max(np.abs(got[name] - reference[name])) < 1e-12, name
+    assert got["u_R1"][0] == 0.0 and np.max(np.abs(got["u_R1"][1:] - reference["u_R1"][:-1])) < 1e-8
+    assert np.max(np.abs(los_error(scene, got["alpha"], got["beta"]) - reference["los_error"])) < 1e-12
+
+
+def test_libcosim_takes_its_step_from_the_archive(system, tmp_path):
+    """The step libcosim's SSP loader runs is the archive's: the same system stated with 2 ms steps is
+    stepped at 2 ms. (Without the annotation libcosimpy 0.0.6 has no algorithm and crashes the process.)"""
+    archive = write_ssp(dataclasses.replace(system, step=2e-3), tmp_path / "two_ms.ssp")
+    got = run_libcosim_ssp(archive, "gimbal", ["alpha"], 5)
+    assert np.allclose(got["time"], np.arange(1, 6) * 2e-3, rtol=0, atol=1e-12)
+
+
 def test_fmpy_runs_the_ssp_archive_with_the_start_transient_of_its_zero_connections(scene, system, reference,
                                                                                     tmp_path):
     archive = write_ssp(system, tmp_path / "ship.ssp")
     from fmpy.ssp.ssd import read_ssd
     read_ssd(str(archive), validate=True)   # against the SSP 1.0 schema
     with zipfile.ZipFile(archive) as contents:
-        assert {"SystemStructure.ssd", "resources/parameters.ssv", "resources/Gimbal2Axis.fmu"} <= set(contents.namelist())
+        assert {"SystemStructure.ssd", "resources/gimbal.ssv", "resources/Gimbal2Axis.fmu"} <= set(contents.namelist())
     got = run_fmpy_ssp(archive, "gimbal", GIMBAL, scene.step_size, STOP)
     steps = len(reference["alpha"])
     got = {name: values[:steps] for name, values in got.items()}
@@ -124,8 +180,8 @@ def test_names_with_xml_characters_make_valid_structures(scene, build_dir, tmp_p
     ssd = ET.fromstring(zipfile.ZipFile(write_ssp(named, tmp_path / "awkward.ssp")).read("SystemStructure.ssd"))
     assert ssd.get("name") == awkward
     assert [element.get("name") for element in ssd.iter() if element.tag.endswith("}System")] == [awkward]
-    parameters = ET.fromstring(zipfile.ZipFile(tmp_path / "awkward.ssp").read("resources/parameters.ssv"))
-    assert parameters.get("name") == awkward
+    parameters = ET.fromstring(zipfile.ZipFile(tmp_path / "awkward.ssp").read("resources/gimbal.ssv"))
+    assert parameters.get("name") == f"{awkward}.gimbal"
     osp = ET.parse(write_osp(named, tmp_path / "osp")).getroot()
     assert {element.get("name") for element in osp.iter() if element.tag.endswith("}Simulator")} == \
         {component.name for component in named.components}

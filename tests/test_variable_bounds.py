@@ -1,5 +1,5 @@
 """The min and max of modelDescription.xml against what the FMU enforces (the parameter validation,
-model_core/src/simulation/parameter_validation.cpp): a value just outside a bound is refused with fmi2Error at
+model_core/src/simulation/parameter_building.cpp): a value just outside a bound is refused with fmi2Error at
 fmi2ExitInitializationMode, naming the variable; the bound itself is accepted (FMI's bounds are
 inclusive). The same for the items of every Enumeration. And the other way round: each parameter
 rule the validation applies to one variable alone is declared as a bound."""

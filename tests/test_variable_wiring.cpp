@@ -21,7 +21,7 @@
 #include "gimbal/hybrid_system/gimbal_hybrid_system.hpp"
 #include "gimbal/simulation/gimbal_instance.hpp"
 #include "gimbal/integrators/integrator.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 
 using namespace gimbal;
 

@@ -1,9 +1,9 @@
-#include "controllers.h"
+#include "gimbal_kernel/controllers.h"
 
 #include <math.h>
 #include <string.h>
 
-#include "set_points.h"
+#include "gimbal_kernel/set_points.h"
 
 enum { kNone = 0, kPid = 1, kStateFeedback = 2, kReplay = 3 };
 

@@ -1,4 +1,4 @@
-#include "cubic_spline.h"
+#include "gimbal_kernel/cubic_spline.h"
 
 #include <math.h>
 #include <stdlib.h>

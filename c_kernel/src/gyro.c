@@ -1,4 +1,4 @@
-#include "gyro.h"
+#include "gimbal_kernel/gyro.h"
 
 #include <math.h>
 #include <stddef.h>

@@ -1,14 +1,14 @@
 /* The layout table of the kernel's structs (layout.h), made from the same field lists as their
  * declarations. */
-#include "layout.h"
+#include "gimbal_kernel/layout.h"
 
 #include <stddef.h>
 #include <string.h>
 
-#include "controllers.h"
-#include "gyro.h"
-#include "master_loop.h"
-#include "sensors.h"
+#include "gimbal_kernel/controllers.h"
+#include "gimbal_kernel/gyro.h"
+#include "gimbal_kernel/master_loop.h"
+#include "gimbal_kernel/sensors.h"
 
 typedef struct {
     const char* structure;

@@ -1,4 +1,4 @@
-#include "master_loop.h"
+#include "gimbal_kernel/master_loop.h"
 
 enum { kFailedNothing = 0, kFailedGetReal = 1, kFailedGetInteger = 2, kFailedSetReal = 3, kFailedDoStep = 4 };
 

@@ -1,4 +1,4 @@
-#include "numpy_random.h"
+#include "gimbal_kernel/numpy_random.h"
 
 /* SeedSequence's hash and mix constants (numpy/random/bit_generator.pyx). */
 enum { kPoolSize = 4, kXShift = 16 };

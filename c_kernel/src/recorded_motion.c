@@ -1,12 +1,12 @@
-#include "recorded_motion.h"
+#include "gimbal_kernel/recorded_motion.h"
 
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "cubic_spline.h"
-#include "recorded_motion_csv.h"
+#include "gimbal_kernel/cubic_spline.h"
+#include "gimbal_kernel/recorded_motion_csv.h"
 
 /* At most: 3 angles, 3 given rates, 3 given accelerations, 3 positions. */
 enum { MAXIMUM_SPLINES = 12 };

@@ -1,4 +1,4 @@
-#include "recorded_motion_csv.h"
+#include "gimbal_kernel/recorded_motion_csv.h"
 
 #include <ctype.h>
 #include <locale.h>

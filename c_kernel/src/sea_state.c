@@ -1,8 +1,8 @@
-#include "sea_state.h"
+#include "gimbal_kernel/sea_state.h"
 
 #include <math.h>
 
-#include "numpy_random.h"
+#include "gimbal_kernel/numpy_random.h"
 
 static const double kPi = 3.141592653589793;
 

@@ -1,4 +1,4 @@
-#include "sensors.h"
+#include "gimbal_kernel/sensors.h"
 
 #include <math.h>
 #include <stddef.h>

@@ -1,4 +1,4 @@
-#include "set_points.h"
+#include "gimbal_kernel/set_points.h"
 
 #include <math.h>
 

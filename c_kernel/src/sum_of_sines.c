@@ -1,4 +1,4 @@
-#include "sum_of_sines.h"
+#include "gimbal_kernel/sum_of_sines.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "set_points.h"
+#include "gimbal_kernel/set_points.h"
 
 enum { kKindNone = 0, kKindPid = 1, kKindStateFeedback = 2 };
 

@@ -1,5 +1,5 @@
 /* The controller FMU's model: its variables' values, and the C kernel's sensors and controller
- * (gimbal2axis/native/) that the scene runner's compiled loop runs, stepped once per communication
+ * (c_kernel/) that the scene runner's compiled loop runs, stepped once per communication
  * point. No FMI here: fmi2_controller.c is the interface around it. */
 #ifndef GIMBAL_CONTROLLER_MODEL_H
 #define GIMBAL_CONTROLLER_MODEL_H
@@ -7,8 +7,8 @@
 #include <stddef.h>
 
 #include "controller_variables.h"
-#include "controllers.h"
-#include "sensors.h"
+#include "gimbal_kernel/controllers.h"
+#include "gimbal_kernel/sensors.h"
 
 typedef struct {
     double real[REAL_COUNT];

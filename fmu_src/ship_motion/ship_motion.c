@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "sea_state.h"
+#include "gimbal_kernel/sea_state.h"
 
 const char* const kShipDofNames[SHIP_MOTION_DOFS] = {"pitch", "yaw", "roll", "surge", "sway", "heave"};
 

@@ -1,5 +1,5 @@
 /* The ship's motion as the scenes' sea state makes it (gimbal2axis/scene/base_motion.py, type
- * "sea_state"), from the same C kernel (gimbal2axis/native/sea_state.h, sum_of_sines.h): per degree of
+ * "sea_state"), from the same C kernel (c_kernel/include/gimbal_kernel/sea_state.h, sum_of_sines.h): per degree of
  * freedom a JONSWAP sum of sinusoids, evaluated on the grid t_k = k h from t = 0, row by row as the
  * scene runner's motion.sample(times) evaluates it, so that row k has the same bits. No FMI here. */
 #ifndef SHIP_MOTION_H
@@ -7,7 +7,7 @@
 
 #include <stddef.h>
 
-#include "sum_of_sines.h"
+#include "gimbal_kernel/sum_of_sines.h"
 
 /* The degrees of freedom in the order whose index seeds each one's generator (default_rng([seed,
  * index])), as base_motion.py numbers them. */

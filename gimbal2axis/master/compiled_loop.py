@@ -1,4 +1,4 @@
-"""The compiled communication loop (gimbal2axis/native/master_loop.c) for the built-in controllers,
+"""The compiled communication loop (c_kernel/src/master_loop.c) for the built-in controllers,
 through ctypes.
 
 It does what master.step_loop does with a built-in controller, with the same kernel for the
@@ -13,6 +13,7 @@ import ctypes
 import numpy as np
 
 from .. import native
+from ..errors import FMUCallFailed
 from ..scene.controllers import PID, Controller, Replay, StateFeedback
 
 
@@ -77,6 +78,5 @@ class CompiledLoop:
         failed = self.library.gimbal_master_loop(ctypes.addressof(self.loop), first, last)
         self.plan.k = self.loop.failed_step
         if failed:
-            from .master import FMUCallFailed
             name = self.library.gimbal_master_loop_call_name(failed)
             raise FMUCallFailed(name.decode() if name else f"call {failed}")

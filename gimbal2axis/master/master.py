@@ -19,18 +19,12 @@ import numpy as np
 
 from . import compiled_loop
 from ..scene.base_motion import INPUTS as BASE_INPUTS
-from ..errors import SceneError
+from ..errors import FMUCallFailed, SceneError  # FMUCallFailed: also importable from here, as before
 from ..fmu import FMU
 from ..scene.controllers import AXES, ControllerError
 from ..progress import Progress
 from .results import RunResult
 from ..scene.scene import Scene, check_against_fmu, parameter_value, start_values
-
-class FMUCallFailed(Exception):
-    def __init__(self, function: str):
-        super().__init__(f"{function} returned fmi2Discard or fmi2Error")
-        self.function = function
-
 
 # How a run ended before its stop time (Stop.kind), in the words of the summary line.
 STOP_KINDS = {"failed": "failed", "interrupted": "interrupted (SIGINT)", "terminated": "terminated (SIGTERM)"}

@@ -1,5 +1,5 @@
-"""The C kernel (gimbal2axis/native/*.c, built by `pip install -e .` as the extension
-gimbal2axis.native._native), loaded once through ctypes: the built-in controllers (scene/controllers.py)
+"""The C kernel (the repository's c_kernel/src/*.c, built by `pip install -e .` with module.c as the
+extension gimbal2axis.native._native), loaded once through ctypes: the built-in controllers (scene/controllers.py)
 and their set points toward a target (scene/setpoints.py), the sensors (scene/sensors.py), the sums of
 sinusoids of the base motions, the sea state's components and the recorded motion's splines
 (scene/base_motion.py) and the compiled

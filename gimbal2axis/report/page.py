@@ -100,7 +100,7 @@ def write_page(comparison, results: list, rows: list[dict], out: pathlib.Path) -
     first = results[0][1][0]
     spectrum = next(iter(first.los_spectra().values()))
     notes = (f"Scene {html.escape(scene.path.name)}, {comparison.stop_time:g} s at a {scene.step_size:g} s step; "
-             f"metrics from {first.window_start():g} s. PSD: Welch, Hann window, 50 % overlap, "
+             f"metrics over [{first.window_bounds()[0]:g}, {first.window_bounds()[1]:g}] s. PSD: Welch, Hann window, 50 % overlap, "
              f"{spectrum.resolution:.3g} Hz bins, {spectrum.segments} segments; the mean (static offset) is "
              f"removed first and given in the table. The same sea and encoders in every case; each case runs "
              f"{comparison.repeats} time(s), its sensors' seed moved on by 1 each time: the table gives the means "

@@ -75,7 +75,7 @@ class _SumOfSines(BaseMotion):
         self.offsets = offsets        # angle axis index -> offset [rad]
         self.velocity = np.asarray(velocity, dtype=float)
 
-    # A uniform time grid is the C kernel's (gimbal2axis/native/sum_of_sines.c: blockwise, its bits
+    # A uniform time grid is the C kernel's (c_kernel/src/sum_of_sines.c: blockwise, its bits
     # independent of threads and of how many rows are asked for); other times (a single instant,
     # an irregular grid) are evaluated directly here, sin and cos of every entry.
     _CHUNK_ROWS = 8192   # bounds the memory of the direct evaluation's (rows x components) arrays
@@ -227,7 +227,7 @@ def sea_state_components(significant_amplitude: float, peak_period: float, gamma
     (significant amplitude = mean of the highest third of the amplitudes = 2 sigma for a narrow-band
     Gaussian process). Frequencies: one per equal bin of [band[0], band[1]] * omega_peak, at a random
     place in its bin (so the sum does not repeat); phases uniform; both drawn from numpy's
-    default_rng([seed, index]) sequence. Computed by the C kernel (native/sea_state.c), which the
+    default_rng([seed, index]) sequence. Computed by the C kernel (c_kernel/src/sea_state.c), which the
     ship-motion FMU shares: the same parameters give the same bits in both."""
     kernel = native.kernel()
     entropy = seed_words(seed, index)
@@ -247,7 +247,7 @@ class Recorded(BaseMotion):
     `_dot` and `_ddot` [rad/s, rad/s2], x, y, z [m] of point a in G. Missing derivatives come from a
     C2 cubic spline through the samples (not-a-knot ends, as scipy's CubicSpline), so attitude, rates
     and accelerations stay consistent; absent quantities are 0. The C kernel reads, checks and splines
-    the file (native/recorded_motion.c: anything else is refused with the file, line and column), the
+    the file (c_kernel/src/recorded_motion.c: anything else is refused with the file, line and column), the
     one the ship-motion FMU reads a recording with, so both give the same bits."""
     kind = "recorded"
 

@@ -12,7 +12,7 @@ Rate signals: the payload gyro los.omega (frame 2) gives the inertial rate about
 axis, w[1], and the cross-elevation rate w[3]; w[3] / cos(beta) is the azimuth rate that moves
 the line of sight (secant correction). On a fixed base these equal beta_dot and alpha_dot.
 
-The built-in controllers' arithmetic is the C kernel's (gimbal2axis/native/controllers.c), one
+The built-in controllers' arithmetic is the C kernel's (c_kernel/src/controllers.c), one
 implementation for the Python loop (through ctypes, here) and the compiled loop: each object keeps
 its state in the kernel's struct (`state`), which the compiled loop copies.
 """

@@ -1,5 +1,5 @@
 """A rate gyro from its datasheet ([sensors.gyro] of a scene): what each figure means, its unit, its
-check, and the numbers the C kernel's gyro (gimbal2axis/native/gyro.h) runs on: the axes matrix,
+check, and the numbers the C kernel's gyro (c_kernel/include/gimbal_kernel/gyro.h) runs on: the axes matrix,
 the discrete bandwidth filter and the table of stochastic errors of a whole run.
 
 Stochastic terms (IEEE Std 952 conventions; the Allan deviation sigma(tau) of a gyro at rest):
@@ -29,7 +29,7 @@ from ..errors import SceneError, check_keys, number, shown
 GYRO_KEYS = {"angle_random_walk_deg_rt_h", "bias_instability_deg_h", "bias_correlation_time_s",
              "rate_random_walk_deg_h_rt_h", "bias_deg_h", "scale_factor_error_ppm", "misalignment_mrad",
              "bandwidth_hz", "damping", "quantization_deg_s", "delay_samples"}
-MAX_DELAY = 16                 # gimbal2axis/native/gyro.h GIMBAL_GYRO_MAX_DELAY
+MAX_DELAY = 16                 # c_kernel/include/gimbal_kernel/gyro.h GIMBAL_GYRO_MAX_DELAY
 FLICKER_SPACING = math.sqrt(10.0)
 DEFAULT_BIAS_CORRELATION_TIME = 1000.0   # s: the Allan deviation stays flat up to a few hundred s
 FLICKER_SHORTEST_SAMPLES = 10            # shorter correlation times are white noise at this rate

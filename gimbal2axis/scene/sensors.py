@@ -19,7 +19,7 @@
 The noise of a whole run is drawn before it (`prepare`), in a fixed order (the older white gyro
 noise, the IMU's, then the datasheet gyro's terms), so that the controller's set points can be
 computed up front and the compiled loop reads the same numbers as the Python one. The sensors
-themselves are the C kernel's (gimbal2axis/native/sensors.c, gyro.c), for both loops."""
+themselves are the C kernel's (c_kernel/src/sensors.c, gyro.c), for both loops."""
 from __future__ import annotations
 
 import ctypes

@@ -9,7 +9,7 @@ principal value: each step takes the 2 pi branch nearest the measured azimuth (t
 controllers.c, for both loops), so a gimbal that has turned a full circle keeps tracking without a
 jump.
 
-The target's set points are the C kernel's (gimbal2axis/native/set_points.c), which the controller
+The target's set points are the C kernel's (c_kernel/src/set_points.c), which the controller
 FMU (docs/controller_fmu.md) runs too: libm's sin, cos, atan2 and hypot, where numpy may take SIMD
 routines that round differently in the last bit. `target_angles` stays numpy, vectorised over
 cases, for user controllers.

@@ -212,10 +212,13 @@ std::string bound(double value, Type type) {
 // ------------------------------------------------------------------------------------------ FMI 3.0
 // The same tables as FMI 3.0 model-description parts. FMI 3 has one value-reference space for all
 // types: a Real keeps its value reference, an Integer (Int32 or Enumeration) gets kFmi3IntegerBase +
-// its own, a Boolean kFmi3BooleanBase + its own (docs/fmi_interfaces.md). The 36 event indicators
-// are one Float64 array variable, `event_indicators`, the <EventIndicator> of <ModelStructure>.
-// The independent variable, which FMI 3.0 requires, is `time` (3001).
-constexpr unsigned kFmi3IntegerBase = 1000, kFmi3BooleanBase = 2000, kFmi3EventIndicators = 3000, kFmi3Time = 3001;
+// its own, a Boolean kFmi3BooleanBase + its own (docs/fmi_interfaces.md). The independent variable,
+// which FMI 3.0 requires, is `time` (3001). The 36 event indicators are 36 scalar Float64 locals,
+// `event_indicators[1]` .. `event_indicators[36]` at kFmi3FirstEventIndicator + 0 .. 35, each an
+// <EventIndicator> of <ModelStructure>: not one array, because a host without array support reads
+// every Float64 as one value (ecos records all variables, locals too, and an array among them made
+// each of its reads fail).
+constexpr unsigned kFmi3IntegerBase = 1000, kFmi3BooleanBase = 2000, kFmi3Time = 3001, kFmi3FirstEventIndicator = 3002;
 
 std::string vr_list(const std::vector<unsigned>& references) {
     std::string list;
@@ -279,12 +282,17 @@ int write_fmi3(char** paths) {
                 initial_unknowns << "    <InitialUnknown valueReference=\"" << vr << "\"/>\n";
         }
     }
-    variables << "    <Float64 name=\"event_indicators\" valueReference=\"" << kFmi3EventIndicators
-              << "\" causality=\"local\" variability=\"continuous\" initial=\"calculated\"\n"
-              << "      description=\"the guards of the switching elements, in the order of docs/model_exchange.md: gear 1 and 2 "
-                 "backlash (2 each), motor 1 and 2 voltage clamp, current limiter (2 each), dry friction of body1, rotor1, "
-                 "body2, rotor2 (6 each); constant 1 where the fidelity has no such element\">\n"
-              << "      <Dimension start=\"" << GIMBAL_EVENT_INDICATORS << "\"/>\n    </Float64>\n";
+    std::ostringstream event_indicators;
+    for (unsigned k = 0; k < GIMBAL_EVENT_INDICATORS; ++k) {
+        const unsigned vr = kFmi3FirstEventIndicator + k;
+        variables << "    <Float64 name=\"event_indicators[" << k + 1 << "]\" valueReference=\"" << vr
+                  << "\" causality=\"local\" variability=\"continuous\" initial=\"calculated\"\n"
+                  << "      description=\"guard " << k + 1 << " of the switching elements, in the order of docs/model_exchange.md: "
+                     "gear 1 and 2 backlash (2 each), motor 1 and 2 voltage clamp, current limiter (2 each), dry friction of "
+                     "body1, rotor1, body2, rotor2 (6 each); constant 1 where the fidelity has no such element, and in "
+                     "Co-Simulation\"/>\n";
+        event_indicators << "    <EventIndicator valueReference=\"" << vr << "\"/>\n";
+    }
     for (int k = 0; k < kContinuousStateCount; ++k) {
         std::vector<unsigned> dependencies;
         for (unsigned i : derivative_dependencies(k)) dependencies.push_back(i - 1);
@@ -313,8 +321,7 @@ int write_fmi3(char** paths) {
     }
     types << "  </TypeDefinitions>\n";
     std::ostringstream structure;
-    structure << outputs.str() << derivatives.str() << initial_unknowns.str()
-              << "    <EventIndicator valueReference=\"" << kFmi3EventIndicators << "\"/>\n";
+    structure << outputs.str() << derivatives.str() << initial_unknowns.str() << event_indicators.str();
     const std::string tolerance = number(kRealVariables[vr_solver_rtol].start);
     return write(paths[0], units.str()) && write(paths[1], variables.str()) && write(paths[2], structure.str()) &&
                    write(paths[3], types.str()) && write(paths[4], tolerance)

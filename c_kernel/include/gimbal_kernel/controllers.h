@@ -12,7 +12,7 @@
 #ifndef GIMBAL_KERNEL_CONTROLLERS_H
 #define GIMBAL_KERNEL_CONTROLLERS_H
 
-#include "layout.h"
+#include "gimbal_kernel/layout.h"
 
 /* One axis of the PID: u = kp e + ki int(e) + kd de/dt - k_gyro w + k_ff r_dot, de/dt a backward
  * difference through a first-order filter (time constant d_filter_s); anti-windup: the integral

@@ -15,7 +15,7 @@
 #ifndef GIMBAL_KERNEL_GYRO_H
 #define GIMBAL_KERNEL_GYRO_H
 
-#include "layout.h"
+#include "gimbal_kernel/layout.h"
 
 #define GIMBAL_GYRO_MAX_DELAY 16
 

@@ -14,9 +14,9 @@
 
 #include <stddef.h>
 
-#include "controllers.h"
-#include "layout.h"
-#include "sensors.h"
+#include "gimbal_kernel/controllers.h"
+#include "gimbal_kernel/layout.h"
+#include "gimbal_kernel/sensors.h"
 
 /* fmi2GetReal, fmi2GetInteger, fmi2SetReal and fmi2DoStep, as the FMU exports them. */
 typedef int (*GimbalArrayCall)(void* component, const unsigned* refs, size_t count, void* values);

@@ -13,8 +13,8 @@
 #ifndef GIMBAL_KERNEL_SENSORS_H
 #define GIMBAL_KERNEL_SENSORS_H
 
-#include "gyro.h"
-#include "layout.h"
+#include "gimbal_kernel/gyro.h"
+#include "gimbal_kernel/layout.h"
 
 #define GIMBAL_SENSORS_FIELDS(FIELD, ARRAY)                                                          \
     FIELD(double, encoder_resolution, double) /* rad; 0: the exact angle */                          \

@@ -5,8 +5,7 @@
 namespace gimbal {
 
 int switch_modes(HybridSystem& system, double time, double* state, const int* directions,
-                 const IntegratorSettings& settings, const HybridIntegrator::MessageSink& event_sink,
-                 double reported_time) {
+                 const EventHandlingSettings& settings, const MessageSink& event_sink, double reported_time) {
     const int changes = system.update_modes(time, state, directions);
     if (changes > 0 && settings.events_logged()) {
         std::ostringstream s;
@@ -19,8 +18,8 @@ int switch_modes(HybridSystem& system, double time, double* state, const int* di
     return changes;
 }
 
-bool record_mode_change(ChatteringMemory& memory, const IntegratorSettings& settings, double time, double resolution,
-                        const HybridIntegrator::MessageSink& event_sink, double reported_offset) {
+bool record_mode_change(ChatteringMemory& memory, const EventHandlingSettings& settings, double time,
+                        double resolution, const MessageSink& event_sink, double reported_offset) {
     const double window = std::max(settings.zeno_window, resolution);
     memory.rapid_events = time - memory.last_event_time <= window ? memory.rapid_events + 1 : 0;
     memory.last_event_time = time;

@@ -6,6 +6,13 @@
 // Events are found as sign changes of the event functions between accepted steps and located on the
 // dense output with the Illinois method; the system switches its modes at the root and the
 // integration goes on from there with the same step size. An input jump costs one right-hand side.
+//
+// One class, its parts in one file each beside this header:
+// - one_step_integrator.cpp: the driver (the current point, restarts, the adaptive loop and the
+//   real-time method's fixed grid of RODAS4 substeps);
+// - dormand_prince.cpp, rodas4.cpp: one step of each method, with its dense output;
+// - automatic_method_switch.cpp: the stiffness votes and the predicted-cost rule of method 4;
+// - event_location.cpp: the dense output at a time, the Illinois iteration, the switch at the root.
 #pragma once
 
 #include <cmath>
@@ -47,9 +54,16 @@ public:
 private:
     enum class StepResult { accepted, rejected, failed };
 
+    static constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+    // Step size control of both methods (E. Hairer's DOPRI5 and RODAS defaults).
+    static constexpr double kSafety = 0.9;
+    static constexpr double kPiBeta = 0.04;                       // DOPRI5's stabilized (PI) controller
+    static constexpr double kMaxGrowth = 10.0, kMaxShrink = 0.2;  // per step, after an accepted / a rejected step
+
     bool advance_steps(double end_time, double* state);
     // The parts of an adaptive step (advance_steps): its size, the attempt, what follows acceptance
-    // (inline: defined with GIMBAL_HOT_PART in one_step_integrator.cpp, the only place they are called).
+    // (inline: defined with GIMBAL_HOT_PART in one_step_integrator.cpp, the only place they are called;
+    // hold_ended and cut_at_hold_end, which the real-time substeps use too, at the end of this header).
     struct StepPlan {
         enum Kind { step, creep, failed } kind = step;  // creep: a few ulp left; failed: reported
         double h = 0.0;
@@ -87,6 +101,8 @@ private:
     bool crosses_a_guard();
     // Stops early once the estimate exceeds `enough`.
     double spectral_radius_estimate(double enough = std::numeric_limits<double>::infinity()) const;
+    // Automatic method: the work of a RODAS4 step over a Dormand-Prince step at this state size.
+    static double rosenbrock_cost_ratio(int state_size, bool analytic_jacobian);
     // Automatic method: RODAS4's predicted work per unit time over the explicit method's.
     double rosenbrock_over_explicit_cost(double accuracy_step, double stable_step) const;
     double explicit_stable_step(double lambda) const;
@@ -169,5 +185,19 @@ private:
     bool proposal_limited_ = false;    // ... held back by the growth bound or a rejection just before
     bool stop_at_mode_change_ = false; // advance_until_mode_change: return after the first one
 };
+
+// The chattering guard's hold ends at a step end, so that the modes are re-selected on time: t_new_
+// is moved back to it if it lies within the step (and not within `smallest` of its start).
+GIMBAL_HOT_PART bool OneStepIntegrator::cut_at_hold_end(double smallest) {
+    const double hold_end = memory_.chattering.dwell_until;
+    if (!(t_ < hold_end && hold_end < t_new_ && hold_end - t_ > smallest)) return false;
+    t_new_ = hold_end;
+    return true;
+}
+
+// Whether a chattering hold ended at the current point (the modes are then re-selected).
+GIMBAL_HOT_PART bool OneStepIntegrator::hold_ended() const {
+    return memory_.chattering.dwell_until > -1e300 && t_ >= memory_.chattering.dwell_until;
+}
 
 }  // namespace gimbal

@@ -232,13 +232,14 @@ bool SundialsIntegrator::advance(double end_time, double* state) {
         double before[64];
         const bool tracked = size_ <= 64;
         if (tracked) std::copy(state, state + size_, before);
-        const int changes = switch_modes(system_, reached, state, root_directions_.data(), settings_, event_sink_, reached);
+        const int changes = switch_modes(system_, reached, state, root_directions_.data(), settings_.event_handling,
+                                         event_sink_, reached);
         // A projection without a mode change (e.g. theta_b clamped back onto a stop) must not be lost.
         const bool projected = tracked && !std::equal(state, state + size_, before);
         totals_.events += changes;
         events_here += changes;
         // CVODE and ARKODE locate roots to about 100 ulp of the time: the window itself resolves them.
-        if (record_mode_change(chattering_, settings_, reached, 0.0, event_sink_)) ++totals_.zeno_holds;
+        if (record_mode_change(chattering_, settings_.event_handling, reached, 0.0, event_sink_)) ++totals_.zeno_holds;
         // New modes change the right-hand side: restart there, from the (possibly projected) state. A
         // root that changed nothing (a grazing touch) needs no restart: the integrator carries on.
         if ((changes > 0 || projected) && !restart(reached, state)) return false;

@@ -10,7 +10,7 @@
 
 #include "gimbal/simulation/instance_outputs.hpp"
 #include "gimbal/simulation/parameter_swap.hpp"
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 #include "gimbal/simulation/step_inputs.hpp"
 #include "gimbal/model/variable_groups.hpp"
 
@@ -324,7 +324,7 @@ std::unique_ptr<HybridIntegrator> GimbalInstance::make_integrator(GimbalHybridSy
         settings.event_iterations = kRealTimeEventIterations;
         settings.mode_changes_per_step = kRealTimeModeChangesPerSubstep * params.substeps;
     }
-    settings.events_logged = [this] { return log_filter_("logEvents"); };
+    settings.event_handling.events_logged = [this] { return log_filter_("logEvents"); };
     return HybridIntegrator::create(
         system, settings,
         [this](const std::string& message) {

@@ -104,10 +104,15 @@ void GimbalInstance::get_continuous_states(double* states) {
 void GimbalInstance::get_nominal_states(double* nominals) const {
     std::fill(nominals, nominals + kStateCount, 1.0);
     // The play is small against a radian: its own size is the scale its error is measured on.
-    // From the values as set: the host may ask before initialization.
-    const RealVariable half_backlash[2] = {vr_gear1_eta, vr_gear2_eta};
-    for (int axis = 0; axis < 2; ++axis)
-        if (reals_[half_backlash[axis]] > 0.0) nominals[kBacklash + axis] = reals_[half_backlash[axis]];
+    // From the built parameters, as everything else; before initialization there are none yet (the
+    // host may ask in Instantiated mode), and the values as set are what the build will copy:
+    // gear<j>.eta is a fixed parameter, read unchanged into GearParameters::half_backlash.
+    const RealVariable half_backlash_values[2] = {vr_gear1_eta, vr_gear2_eta};
+    for (int axis = 0; axis < 2; ++axis) {
+        const double half_backlash =
+            initialized() ? params_.gear[axis].half_backlash : reals_[half_backlash_values[axis]];
+        if (half_backlash > 0.0) nominals[kBacklash + axis] = half_backlash;
+    }
 }
 
 GimbalStatus GimbalInstance::preview_continuous(double* states, double* indicators) {

@@ -15,7 +15,7 @@
 #include <limits>
 #include <type_traits>
 
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 #include "gimbal/model/variable_groups.hpp"
 
 namespace gimbal {

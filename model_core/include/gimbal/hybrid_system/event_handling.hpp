@@ -5,31 +5,57 @@
 // - GuardSettling: guards left exactly on zero (a state projected onto a stop, a ramp starting on
 //   its clamp) get the side they leave to, and the modes are decided once more with it;
 // - the chattering guard: a run of mode changes that makes no progress in time holds the modes.
+//
+// Its settings and the chattering guard's memory live here too, not with the integrators: the host
+// of the continuous-time interface uses them without any integrator, and the integrators carry them
+// (IntegratorSettings::event_handling, IntegratorMemory::chattering) from this layer below theirs.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 
 #include "gimbal/hybrid_system/hybrid_system.hpp"
-#include "gimbal/integrators/integrator.hpp"
 
 namespace gimbal {
+
+// Where event and error messages go (the FMU's logger, a test's list).
+using MessageSink = std::function<void(const std::string&)>;
+
+struct EventHandlingSettings {
+    // Chattering guard: this many located roots in a row, each within `zeno_window` seconds of the
+    // previous one, freeze the event functions for `zeno_dwell` seconds; modes are then re-selected
+    // from the functions' signs. Switches further apart than the window (chatter below 1 GHz) are
+    // never affected. Absolute durations: results must not depend on where time starts.
+    int zeno_event_limit = 50;
+    double zeno_window = 1e-9;
+    double zeno_dwell = 1e-6;
+    // Whether anyone listens to event messages: they are only formatted (and allocated) if so.
+    std::function<bool()> events_logged = [] { return true; };
+};
+
+// The chattering guard's memory (record_mode_change).
+struct ChatteringMemory {
+    double last_event_time = -1e300;
+    int rapid_events = 0;
+    double dwell_until = -1e300;  // the modes are held before this time
+    bool holding() const { return dwell_until > -1e300; }
+};
 
 // Re-selects the modes at (time, state) (hybrid_system.hpp, update_modes) and, if any changed and
 // someone listens, sends "t = <reported_time>: n mode change(s): what" to the sink.
 int switch_modes(HybridSystem& system, double time, double* state, const int* directions,
-                 const IntegratorSettings& settings, const HybridIntegrator::MessageSink& event_sink,
-                 double reported_time);
+                 const EventHandlingSettings& settings, const MessageSink& event_sink, double reported_time);
 
-// The chattering guard (ChatteringMemory, integrator.hpp): settings.zeno_event_limit mode changes
-// in a row, each within max(settings.zeno_window, resolution) of the previous one (resolution: how
-// closely the integrator tells two event times apart), hold the modes for settings.zeno_dwell.
+// The chattering guard: settings.zeno_event_limit mode changes in a row, each within
+// max(settings.zeno_window, resolution) of the previous one (resolution: how closely the integrator
+// tells two event times apart), hold the modes for settings.zeno_dwell.
 // Records a mode change at `time`; true when it engages the hold (then memory.dwell_until is set and
 // the message says so, with `reported_offset` added to the times it names).
-bool record_mode_change(ChatteringMemory& memory, const IntegratorSettings& settings, double time, double resolution,
-                        const HybridIntegrator::MessageSink& event_sink, double reported_offset = 0.0);
+bool record_mode_change(ChatteringMemory& memory, const EventHandlingSettings& settings, double time,
+                        double resolution, const MessageSink& event_sink, double reported_offset = 0.0);
 
 // Settles the guards that sit exactly on zero at a point where the modes have just been decided.
 // Scratch space of fixed capacity: no allocation on the step path.

@@ -14,6 +14,7 @@
 #include <memory>
 #include <string>
 
+#include "gimbal/hybrid_system/event_handling.hpp"
 #include "gimbal/hybrid_system/hybrid_system.hpp"
 
 namespace gimbal {
@@ -65,23 +66,9 @@ struct IntegratorSettings {
     int substeps = 1;
     int event_iterations = 100;
     int mode_changes_per_step = 0;  // 0: no limit
-    // Chattering guard: this many located roots in a row, each within `zeno_window` seconds of the
-    // previous one, freeze the event functions for `zeno_dwell` seconds; modes are then re-selected
-    // from the functions' signs. Switches further apart than the window (chatter below 1 GHz) are
-    // never affected. Absolute durations: results must not depend on where time starts.
-    int zeno_event_limit = 50;
-    double zeno_window = 1e-9;
-    double zeno_dwell = 1e-6;
-    // Whether anyone listens to event messages: they are only formatted (and allocated) if so.
-    std::function<bool()> events_logged = [] { return true; };
-};
-
-// The chattering guard's memory (event_handling.hpp, record_mode_change).
-struct ChatteringMemory {
-    double last_event_time = -1e300;
-    int rapid_events = 0;
-    double dwell_until = -1e300;  // the modes are held before this time
-    bool holding() const { return dwell_until > -1e300; }
+    // The chattering guard's limits, and whether anyone listens to event messages (the same whoever
+    // integrates: hybrid_system/event_handling.hpp).
+    EventHandlingSettings event_handling;
 };
 
 // Everything a one-step integrator carries from one communication step to the next besides the state:
@@ -94,7 +81,7 @@ struct IntegratorMemory {
     int nonstiff_votes = 0;       // consecutive steps that voted the other way
     int last_step_rejected = 0;
     ChatteringMemory chattering;
-    // Automatic method, for the switch rule's predicted costs (one_step_integrator.cpp):
+    // Automatic method, for the switch rule's predicted costs (automatic_method_switch.cpp):
     double accuracy_step = 0.0;    // the last step seen limited by accuracy, not stability (0: none)
     double accuracy_time = 0.0;    // when it was seen
     double explicit_step = 0.0;    // the explicit method's last step at its stability limit (0: none)
@@ -106,7 +93,7 @@ struct IntegratorMemory {
 
 class HybridIntegrator {
 public:
-    using MessageSink = std::function<void(const std::string&)>;
+    using MessageSink = gimbal::MessageSink;  // hybrid_system/event_handling.hpp
 
     static std::unique_ptr<HybridIntegrator> create(HybridSystem& system, const IntegratorSettings& settings,
                                                     MessageSink error_sink, MessageSink event_sink);

@@ -1,6 +1,7 @@
-// One simulation instance: the variable values, the constant model built from them, the state, the
-// hybrid system and its integrator (Pinocchio-style split: ModelParameters is constant during a run,
-// the rest is per-run data).
+// One simulation instance: the variable values, the constant model built from them (params_, rebuilt
+// only at initialization and restore), the state, the hybrid system and its integrator, and the
+// continuous-time interface's event memory. One class holds them all: the constant model and the
+// per-run data are not (yet) separate objects.
 #pragma once
 
 #include <cstdint>
@@ -219,7 +220,7 @@ private:
     int integrated_count_ = 0;
     int integrated_state_[kContinuousStateCount] = {};  // index among the 17 states
     int integrated_slot_[kContinuousStateCount] = {};   // its slot in state_
-    IntegratorSettings event_settings_;  // the chattering guard's limits, and whether events are logged
+    EventHandlingSettings event_settings_;  // the chattering guard's limits, and whether events are logged
     std::int64_t zeno_holds_ = 0;
 };
 

@@ -1,7 +1,7 @@
 // An instance's FMU state (snapshot) as one table of fields (simulation/snapshot.cpp): every field's
 // name, type, count, place in the serialized bytes and the check it must pass. Saving, checking and
 // restoring all walk that table; adding a field is one row there (and where its value comes from and
-// goes to: GimbalInstance::gather_snapshot / restore), with a new format number.
+// goes to: GimbalInstance::save_run / rebuild_run, instance_snapshot.cpp), with a new format number.
 #pragma once
 
 #include <cstddef>

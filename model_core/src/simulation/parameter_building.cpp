@@ -1,4 +1,4 @@
-#include "gimbal/simulation/parameter_validation.hpp"
+#include "gimbal/simulation/parameter_building.hpp"
 
 #include "gimbal/integrators/integrator.hpp"
 #include "gimbal/model/variable_groups.hpp"
