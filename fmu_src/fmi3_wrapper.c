@@ -65,7 +65,7 @@ typedef struct {
     int stop_time_defined;
     FmuStateRegistry states;
     const char* calling; /* prefixes the core's messages */
-} Instance3;
+} GimbalFmi3Instance;
 
 static int category_index(const char* category) {
     for (int k = 0; k < LOG_CATEGORIES; ++k)
@@ -73,12 +73,12 @@ static int category_index(const char* category) {
     return -1;
 }
 
-static int enabled(const Instance3* i, const char* category) {
+static int enabled(const GimbalFmi3Instance* i, const char* category) {
     const int index = category_index(category);
     return (index >= 0 && i->category_enabled[index]) || i->category_enabled[LOG_CATEGORIES - 1];
 }
 
-static void say(const Instance3* i, fmi3Status status, const char* category, const char* format, ...) {
+static void log_to_host(const GimbalFmi3Instance* i, fmi3Status status, const char* category, const char* format, ...) {
     if (i == NULL || i->log == NULL) return;
     if (status < fmi3Discard && !enabled(i, category)) return;
     char text[1024];
@@ -91,13 +91,13 @@ static void say(const Instance3* i, fmi3Status status, const char* category, con
 
 static void core_log(void* context, GimbalStatus status, const char* category, const char* message) {
     static const fmi3Status kStatus[] = {fmi3OK, fmi3Warning, fmi3Discard, fmi3Error};
-    const Instance3* i = (const Instance3*)context;
-    if (i->calling != NULL) say(i, kStatus[status], category, "%s: %s", i->calling, message);
-    else say(i, kStatus[status], category, "%s", message);
+    const GimbalFmi3Instance* i = (const GimbalFmi3Instance*)context;
+    if (i->calling != NULL) log_to_host(i, kStatus[status], category, "%s: %s", i->calling, message);
+    else log_to_host(i, kStatus[status], category, "%s", message);
 }
 
 static int core_log_enabled(void* context, const char* category) {
-    const Instance3* i = (const Instance3*)context;
+    const GimbalFmi3Instance* i = (const GimbalFmi3Instance*)context;
     return i->log != NULL && enabled(i, category);
 }
 
@@ -124,24 +124,24 @@ static const char* state_name(State3 s) {
 }
 
 /* The state check of every function; names the function for the core's messages. */
-static int allowed(Instance3* i, const char* function, int states) {
+static int allowed(GimbalFmi3Instance* i, const char* function, int states) {
     if (i == NULL) return 0;
     if (i->state & states) {
         i->calling = function;
         return 1;
     }
-    say(i, fmi3Error, "logStatusError", "%s is not allowed in state '%s'", function, state_name(i->state));
+    log_to_host(i, fmi3Error, "logStatusError", "%s is not allowed in state '%s'", function, state_name(i->state));
     return 0;
 }
 
-static int not_null(Instance3* i, const char* function, const void* pointer, const char* argument) {
+static int not_null(GimbalFmi3Instance* i, const char* function, const void* pointer, const char* argument) {
     if (pointer != NULL) return 1;
-    say(i, fmi3Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
+    log_to_host(i, fmi3Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
     return 0;
 }
 
-static fmi3Status refuse(Instance3* i, const char* function, const char* why) {
-    if (i != NULL) say(i, fmi3Error, "logStatusError", "%s: %s", function, why);
+static fmi3Status refuse(GimbalFmi3Instance* i, const char* function, const char* why) {
+    if (i != NULL) log_to_host(i, fmi3Error, "logStatusError", "%s: %s", function, why);
     return fmi3Error;
 }
 
@@ -151,25 +151,25 @@ static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exc
                                 int early_return_allowed, fmi3Boolean loggingOn, fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
                                 const char* function) {
     if (log == NULL) return NULL; /* nowhere to say why */
-    Instance3 probe;
+    GimbalFmi3Instance probe;
     memset(&probe, 0, sizeof probe);
     probe.log = log;
     probe.environment = environment;
     if (name == NULL || name[0] == '\0') {
-        say(&probe, fmi3Error, "logStatusError", "%s: instanceName must be a non-empty string", function);
+        log_to_host(&probe, fmi3Error, "logStatusError", "%s: instanceName must be a non-empty string", function);
         return NULL;
     }
     if (token == NULL || strcmp(token, GIMBAL_GUID) != 0) {
-        say(&probe, fmi3Error, "logStatusError", "%s: instantiationToken '%s' does not match this FMU's '%s'", function,
+        log_to_host(&probe, fmi3Error, "logStatusError", "%s: instantiationToken '%s' does not match this FMU's '%s'", function,
             token != NULL ? token : "(null)", GIMBAL_GUID);
         return NULL;
     }
-    Instance3* i = (Instance3*)calloc(1, sizeof(Instance3));
+    GimbalFmi3Instance* i = (GimbalFmi3Instance*)calloc(1, sizeof(GimbalFmi3Instance));
     char* copy = (char*)malloc(strlen(name) + 1);
     if (i == NULL || copy == NULL) {
         free(i);
         free(copy);
-        say(&probe, fmi3Error, "logStatusError", "%s: out of memory", function);
+        log_to_host(&probe, fmi3Error, "logStatusError", "%s: out of memory", function);
         return NULL;
     }
     strcpy(copy, name);
@@ -187,7 +187,7 @@ static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exc
         i->core = NULL;
     }
     if (i->core == NULL) {
-        say(i, fmi3Error, "logStatusError", "%s: out of memory", function);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: out of memory", function);
         free(copy);
         free(i);
         return NULL;
@@ -196,7 +196,7 @@ static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exc
     return i;
 }
 
-static void free_instance(Instance3* i) {
+static void free_instance(GimbalFmi3Instance* i) {
     if (i == NULL) return;
     fmu_states_release_all(&i->states);
     gimbal_core_destroy(i->core);
@@ -204,7 +204,7 @@ static void free_instance(Instance3* i) {
     free(i);
 }
 
-static fmi3Status set_debug_logging(Instance3* i, fmi3Boolean on, size_t n, const fmi3String categories[]) {
+static fmi3Status set_debug_logging(GimbalFmi3Instance* i, fmi3Boolean on, size_t n, const fmi3String categories[]) {
     if (!allowed(i, "fmi3SetDebugLogging", S_ANY)) return fmi3Error;
     if (n == 0) {
         for (int k = 0; k < LOG_CATEGORIES; ++k) i->category_enabled[k] = on ? 1 : 0;
@@ -214,7 +214,7 @@ static fmi3Status set_debug_logging(Instance3* i, fmi3Boolean on, size_t n, cons
     for (size_t k = 0; k < n; ++k) {
         const int index = categories[k] != NULL ? category_index(categories[k]) : -1;
         if (index < 0) {
-            say(i, fmi3Error, "logStatusError", "fmi3SetDebugLogging: unknown log category '%s'",
+            log_to_host(i, fmi3Error, "logStatusError", "fmi3SetDebugLogging: unknown log category '%s'",
                 categories[k] != NULL ? categories[k] : "(null)");
             return fmi3Error;
         }
@@ -223,12 +223,12 @@ static fmi3Status set_debug_logging(Instance3* i, fmi3Boolean on, size_t n, cons
     return fmi3OK;
 }
 
-static fmi3Status enter_initialization(Instance3* i, fmi3Boolean tolerance_defined, fmi3Float64 tolerance,
+static fmi3Status enter_initialization(GimbalFmi3Instance* i, fmi3Boolean tolerance_defined, fmi3Float64 tolerance,
                                        fmi3Float64 start, fmi3Boolean stop_defined, fmi3Float64 stop) {
     const char* f = "fmi3EnterInitializationMode";
     if (!allowed(i, f, S_INSTANTIATED)) return fmi3Error;
     if (!isfinite(start) || (stop_defined && (!isfinite(stop) || stop < start))) {
-        say(i, fmi3Error, "logStatusError", "%s: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
+        log_to_host(i, fmi3Error, "logStatusError", "%s: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
             f, start, stop);
         return fmi3Error;
     }
@@ -241,11 +241,11 @@ static fmi3Status enter_initialization(Instance3* i, fmi3Boolean tolerance_defin
     return fmi3OK;
 }
 
-static fmi3Status exit_initialization(Instance3* i) {
+static fmi3Status exit_initialization(GimbalFmi3Instance* i) {
     if (!allowed(i, "fmi3ExitInitializationMode", S_INITIALIZATION)) return fmi3Error;
     const fmi3Status status = from_core(gimbal_core_initialize(i->core, i->time));
     if (status > fmi3Warning) {
-        say(i, fmi3Error, "logStatusError", "fmi3ExitInitializationMode: initialization refused; fix the values above and retry");
+        log_to_host(i, fmi3Error, "logStatusError", "fmi3ExitInitializationMode: initialization refused; fix the values above and retry");
         return fmi3Error;
     }
     /* Model Exchange, and Co-Simulation with Event Mode, start in event mode (FMI 3.0, 3.2 and 4.2). */
@@ -282,7 +282,7 @@ static int core_variable(fmi3ValueReference vr, Kind* kind, unsigned* core_vr, G
     return 0;
 }
 
-static int settable(const Instance3* i, const GimbalVariableInfo* info) {
+static int settable(const GimbalFmi3Instance* i, const GimbalVariableInfo* info) {
     if (i->state & (S_INSTANTIATED | S_INITIALIZATION))
         /* The rotors (initial="approx") stay settable in Initialization Mode as when they were "exact". */
         return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT ||
@@ -291,7 +291,7 @@ static int settable(const Instance3* i, const GimbalVariableInfo* info) {
 }
 
 /* The common checks of a getter or setter; `values` and the count of values must match the variables. */
-static int check_access(Instance3* i, const char* f, int set, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+static int check_access(GimbalFmi3Instance* i, const char* f, int set, Kind kind, const fmi3ValueReference vr[], size_t nvr,
                         const void* values, size_t nvalues) {
     if (!allowed(i, f, set ? S_SET : S_GET)) return 0;
     if (nvr == 0) return 1;
@@ -314,29 +314,29 @@ static int check_access(Instance3* i, const char* f, int set, Kind kind, const f
             continue;
         }
         if (!core_variable(vr[k], &actual, &core_vr, &info)) {
-            say(i, fmi3Error, "logStatusError", "%s: value reference %u is not a variable of this FMU%s", f, (unsigned)vr[k],
+            log_to_host(i, fmi3Error, "logStatusError", "%s: value reference %u is not a variable of this FMU%s", f, (unsigned)vr[k],
                 is_event_indicator(vr[k]) || vr[k] == FMI3_TIME ? " that can be set" : "");
             return 0;
         }
         if (actual != kind) {
-            say(i, fmi3Error, "logStatusError", "%s: %s is a%s %s variable", f, info.name,
+            log_to_host(i, fmi3Error, "logStatusError", "%s: %s is a%s %s variable", f, info.name,
                 actual == KIND_INT32 || actual == KIND_ENUMERATION ? "n" : "", kKindName[actual]);
             return 0;
         }
         if (set && !settable(i, &info)) {
-            say(i, fmi3Error, "logStatusError", "%s: %s cannot be set in state '%s'", f, info.name, state_name(i->state));
+            log_to_host(i, fmi3Error, "logStatusError", "%s: %s cannot be set in state '%s'", f, info.name, state_name(i->state));
             return 0;
         }
         ++expected;
     }
     if (nvalues != expected) {
-        say(i, fmi3Error, "logStatusError", "%s: nValues = %zu, but the variables hold %zu values", f, nvalues, expected);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: nValues = %zu, but the variables hold %zu values", f, nvalues, expected);
         return 0;
     }
     return 1;
 }
 
-static fmi3Status get_float64(Instance3* i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
+static fmi3Status get_float64(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
     if (!check_access(i, "fmi3GetFloat64", 0, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
     fmi3Float64 indicators[GIMBAL_EVENT_INDICATORS];
     int indicators_read = 0; /* the core hands out all 36 at once: read them once per call */
@@ -365,19 +365,19 @@ static fmi3Status get_float64(Instance3* i, const fmi3ValueReference vr[], size_
     return fmi3OK;
 }
 
-static fmi3Status set_float64(Instance3* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[], size_t n) {
+static fmi3Status set_float64(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[], size_t n) {
     if (!check_access(i, "fmi3SetFloat64", 1, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) { /* all or nothing */
         if (isfinite(values[k])) continue;
         GimbalVariableInfo info;
         gimbal_variable_info(GIMBAL_REAL, vr[k], &info);
-        say(i, fmi3Error, "logStatusError", "fmi3SetFloat64: %s = %g refused: values must be finite", info.name, values[k]);
+        log_to_host(i, fmi3Error, "logStatusError", "fmi3SetFloat64: %s = %g refused: values must be finite", info.name, values[k]);
         return fmi3Error;
     }
     return nvr == 0 ? fmi3OK : from_core(gimbal_core_set_reals(i->core, vr, nvr, values));
 }
 
-static fmi3Status get_integers(Instance3* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+static fmi3Status get_integers(GimbalFmi3Instance* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
                                void* values, size_t n, int wide) {
     if (!check_access(i, f, 0, kind, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
@@ -390,7 +390,7 @@ static fmi3Status get_integers(Instance3* i, const char* f, Kind kind, const fmi
     return fmi3OK;
 }
 
-static fmi3Status set_integers(Instance3* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+static fmi3Status set_integers(GimbalFmi3Instance* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
                                const void* values, size_t n, int wide) {
     if (!check_access(i, f, 1, kind, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
@@ -398,7 +398,7 @@ static fmi3Status set_integers(Instance3* i, const char* f, Kind kind, const fmi
         if (value < INT32_MIN || value > INT32_MAX) {
             GimbalVariableInfo info;
             gimbal_variable_info(GIMBAL_INTEGER, vr[k] - FMI3_INTEGER_BASE, &info);
-            say(i, fmi3Error, "logStatusError", "%s: %s = %lld lies outside the Int32 range", f, info.name, value);
+            log_to_host(i, fmi3Error, "logStatusError", "%s: %s = %lld lies outside the Int32 range", f, info.name, value);
             return fmi3Error;
         }
     }
@@ -410,7 +410,7 @@ static fmi3Status set_integers(Instance3* i, const char* f, Kind kind, const fmi
     return fmi3OK;
 }
 
-static fmi3Status get_boolean(Instance3* i, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
+static fmi3Status get_boolean(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
     if (!check_access(i, "fmi3GetBoolean", 0, KIND_BOOLEAN, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
         int value = 0;
@@ -421,7 +421,7 @@ static fmi3Status get_boolean(Instance3* i, const fmi3ValueReference vr[], size_
     return fmi3OK;
 }
 
-static fmi3Status set_boolean(Instance3* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[], size_t n) {
+static fmi3Status set_boolean(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[], size_t n) {
     if (!check_access(i, "fmi3SetBoolean", 1, KIND_BOOLEAN, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
         const fmi3Status status = from_core(gimbal_core_set_boolean(i->core, vr[k] - FMI3_BOOLEAN_BASE, values[k] ? 1 : 0));
@@ -431,11 +431,11 @@ static fmi3Status set_boolean(Instance3* i, const fmi3ValueReference vr[], size_
 }
 
 /* Types the model has no variables of: the state is checked, any value reference refused by name. */
-static fmi3Status no_such_type(Instance3* i, const char* f, int set, const fmi3ValueReference vr[], size_t nvr) {
+static fmi3Status no_such_type(GimbalFmi3Instance* i, const char* f, int set, const fmi3ValueReference vr[], size_t nvr) {
     if (!allowed(i, f, set ? S_SET : S_GET)) return fmi3Error;
     if (nvr == 0) return fmi3OK;
     if (!not_null(i, f, vr, "valueReferences")) return fmi3Error;
-    say(i, fmi3Error, "logStatusError", "%s: value reference %u: the model has no variable of this type", f, (unsigned)vr[0]);
+    log_to_host(i, fmi3Error, "logStatusError", "%s: value reference %u: the model has no variable of this type", f, (unsigned)vr[0]);
     return fmi3Error;
 }
 
@@ -443,13 +443,13 @@ static fmi3Status no_such_type(Instance3* i, const char* f, int set, const fmi3V
 
 static size_t record_size(void) { return sizeof(StateHeader) + gimbal_core_snapshot_size(); }
 
-static unsigned char* own_state(Instance3* i, const char* f, const void* state) {
+static unsigned char* own_state(GimbalFmi3Instance* i, const char* f, const void* state) {
     if (state == NULL) {
-        say(i, fmi3Error, "logStatusError", "%s: argument FMUState is a null pointer", f);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: argument FMUState is a null pointer", f);
         return NULL;
     }
     if (fmu_states_find(&i->states, state) < 0) {
-        say(i, fmi3Error, "logStatusError", "%s: FMUState %p is not an FMU state of instance '%s' (never handed out, or already freed)",
+        log_to_host(i, fmi3Error, "logStatusError", "%s: FMUState %p is not an FMU state of instance '%s' (never handed out, or already freed)",
             f, state, i->name);
         return NULL;
     }
@@ -463,7 +463,7 @@ static const FmuStateRules kStateRules = {
     S_FMU_STATE, S_RUNNING | S_TERMINATED, -1, 0, S_CONTINUOUS_TIME, S_STEP | S_STEP_DISCARDED, state_name_of,
 };
 
-static int valid_record(Instance3* i, const char* f, const unsigned char* record) {
+static int valid_record(GimbalFmi3Instance* i, const char* f, const unsigned char* record) {
     StateHeader header;
     memcpy(&header, record, sizeof header);
     char text[160];
@@ -474,13 +474,13 @@ static int valid_record(Instance3* i, const char* f, const unsigned char* record
         problem = fmu_state_model_problem(&header, &kStateRules, initialized, text, sizeof text);
     }
     if (problem != NULL) {
-        say(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: %s", f, problem);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: %s", f, problem);
         return 0;
     }
     return 1;
 }
 
-static fmi3Status get_fmu_state(Instance3* i, fmi3FMUState* out) {
+static fmi3Status get_fmu_state(GimbalFmi3Instance* i, fmi3FMUState* out) {
     const char* f = "fmi3GetFMUState";
     if (!allowed(i, f, S_FMU_STATE) || !not_null(i, f, out, "FMUState")) return fmi3Error;
     unsigned char* record = fmu_states_find(&i->states, *out) >= 0 ? (unsigned char*)*out : NULL;
@@ -489,7 +489,7 @@ static fmi3Status get_fmu_state(Instance3* i, fmi3FMUState* out) {
         record = (unsigned char*)calloc(1, record_size());
         if (record == NULL || !fmu_states_add(&i->states, record)) {
             free(record);
-            say(i, fmi3Error, "logStatusError", "%s: out of memory", f);
+            log_to_host(i, fmi3Error, "logStatusError", "%s: out of memory", f);
             return fmi3Error;
         }
     }
@@ -508,7 +508,7 @@ static fmi3Status get_fmu_state(Instance3* i, fmi3FMUState* out) {
     return fmi3OK;
 }
 
-static fmi3Status set_fmu_state(Instance3* i, fmi3FMUState state) {
+static fmi3Status set_fmu_state(GimbalFmi3Instance* i, fmi3FMUState state) {
     const char* f = "fmi3SetFMUState";
     if (!allowed(i, f, S_FMU_STATE | S_STEP_DISCARDED)) return fmi3Error;
     const unsigned char* record = own_state(i, f, state);
@@ -524,13 +524,13 @@ static fmi3Status set_fmu_state(Instance3* i, fmi3FMUState state) {
     return fmi3OK;
 }
 
-static fmi3Status free_fmu_state(Instance3* i, fmi3FMUState* state) {
+static fmi3Status free_fmu_state(GimbalFmi3Instance* i, fmi3FMUState* state) {
     const char* f = "fmi3FreeFMUState";
     if (!allowed(i, f, S_ANY)) return fmi3Error;
     if (state == NULL || *state == NULL) return fmi3OK;
     const long index = fmu_states_find(&i->states, *state);
     if (index < 0) {
-        say(i, fmi3Error, "logStatusError", "%s: *FMUState = %p is not an FMU state of instance '%s'; nothing was freed", f,
+        log_to_host(i, fmi3Error, "logStatusError", "%s: *FMUState = %p is not an FMU state of instance '%s'; nothing was freed", f,
             *state, i->name);
         return fmi3Error;
     }
@@ -539,40 +539,40 @@ static fmi3Status free_fmu_state(Instance3* i, fmi3FMUState* state) {
     return fmi3OK;
 }
 
-static fmi3Status serialized_size(Instance3* i, fmi3FMUState state, size_t* size) {
+static fmi3Status serialized_size(GimbalFmi3Instance* i, fmi3FMUState state, size_t* size) {
     const char* f = "fmi3SerializedFMUStateSize";
     if (!allowed(i, f, S_ANY) || own_state(i, f, state) == NULL || !not_null(i, f, size, "size")) return fmi3Error;
     *size = record_size();
     return fmi3OK;
 }
 
-static fmi3Status serialize(Instance3* i, fmi3FMUState state, fmi3Byte bytes[], size_t size) {
+static fmi3Status serialize(GimbalFmi3Instance* i, fmi3FMUState state, fmi3Byte bytes[], size_t size) {
     const char* f = "fmi3SerializeFMUState";
     if (!allowed(i, f, S_ANY)) return fmi3Error;
     const unsigned char* record = own_state(i, f, state);
     if (record == NULL || !not_null(i, f, bytes, "serializedState")) return fmi3Error;
     if (size < record_size()) {
-        say(i, fmi3Error, "logStatusError", "%s: size %zu is below the %zu bytes needed", f, size, record_size());
+        log_to_host(i, fmi3Error, "logStatusError", "%s: size %zu is below the %zu bytes needed", f, size, record_size());
         return fmi3Error;
     }
     fmu_state_serialize(record, record_size(), bytes);
     return fmi3OK;
 }
 
-static fmi3Status deserialize(Instance3* i, const fmi3Byte bytes[], size_t size, fmi3FMUState* out) {
+static fmi3Status deserialize(GimbalFmi3Instance* i, const fmi3Byte bytes[], size_t size, fmi3FMUState* out) {
     const char* f = "fmi3DeserializeFMUState";
     if (!allowed(i, f, S_ANY) || !not_null(i, f, bytes, "serializedState") || !not_null(i, f, out, "FMUState"))
         return fmi3Error;
     const char* problem = fmu_state_integrity_problem(bytes, size, record_size(), GIMBAL_GUID, STATE_MAGIC_FMI3);
     if (problem != NULL) {
-        say(i, fmi3Error, "logStatusError", "%s: the %zu bytes are refused: %s", f, size, problem);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: the %zu bytes are refused: %s", f, size, problem);
         return fmi3Error;
     }
     if (!valid_record(i, f, bytes)) return fmi3Error;
     void* record = malloc(size);
     if (record == NULL || !fmu_states_add(&i->states, record)) {
         free(record);
-        say(i, fmi3Error, "logStatusError", "%s: out of memory", f);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: out of memory", f);
         return fmi3Error;
     }
     memcpy(record, bytes, size);
@@ -582,7 +582,7 @@ static fmi3Status deserialize(Instance3* i, const fmi3Byte bytes[], size_t size,
 
 /* ---------------------------------------------------------------- derivatives */
 
-static fmi3Status directional_derivative(Instance3* i, const fmi3ValueReference unknowns[], size_t nu,
+static fmi3Status directional_derivative(GimbalFmi3Instance* i, const fmi3ValueReference unknowns[], size_t nu,
                                          const fmi3ValueReference knowns[], size_t nk, const fmi3Float64 seed[],
                                          size_t nseed, fmi3Float64 sensitivity[], size_t nsens) {
     const char* f = "fmi3GetDirectionalDerivative";
@@ -592,7 +592,7 @@ static fmi3Status directional_derivative(Instance3* i, const fmi3ValueReference 
         (nk > 0 && (!not_null(i, f, knowns, "knowns") || !not_null(i, f, seed, "seed"))))
         return fmi3Error;
     if (nseed != nk || nsens != nu) {
-        say(i, fmi3Error, "logStatusError", "%s: nSeed = %zu and nSensitivity = %zu must equal nKnowns = %zu and nUnknowns = %zu",
+        log_to_host(i, fmi3Error, "logStatusError", "%s: nSeed = %zu and nSensitivity = %zu must equal nKnowns = %zu and nUnknowns = %zu",
             f, nseed, nsens, nk, nu);
         return fmi3Error;
     }
@@ -633,22 +633,22 @@ static fmi3Status directional_derivative(Instance3* i, const fmi3ValueReference 
 
 /* ---------------------------------------------------------------- Model Exchange */
 
-static int me_vector(Instance3* i, const char* f, int states, const void* values, size_t given, size_t expected,
+static int me_vector(GimbalFmi3Instance* i, const char* f, int states, const void* values, size_t given, size_t expected,
                      const char* argument) {
     if (!allowed(i, f, states)) return 0;
     if (!i->model_exchange) {
-        say(i, fmi3Error, "logStatusError", "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation",
+        log_to_host(i, fmi3Error, "logStatusError", "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation",
             f, i->name);
         return 0;
     }
     if (given != expected) {
-        say(i, fmi3Error, "logStatusError", "%s: the count is %zu, but the model has %zu", f, given, expected);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: the count is %zu, but the model has %zu", f, given, expected);
         return 0;
     }
     return not_null(i, f, values, argument);
 }
 
-static fmi3Status update_discrete_states(Instance3* i, fmi3Boolean* need, fmi3Boolean* terminate, fmi3Boolean* nominals,
+static fmi3Status update_discrete_states(GimbalFmi3Instance* i, fmi3Boolean* need, fmi3Boolean* terminate, fmi3Boolean* nominals,
                                          fmi3Boolean* values, fmi3Boolean* next_defined, fmi3Float64* next) {
     const char* f = "fmi3UpdateDiscreteStates";
     if (!allowed(i, f, S_EVENT)) return fmi3Error;
@@ -671,7 +671,7 @@ static fmi3Status update_discrete_states(Instance3* i, fmi3Boolean* need, fmi3Bo
 
 /* ---------------------------------------------------------------- Co-Simulation */
 
-static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean* event, fmi3Boolean* terminate,
+static fmi3Status do_step(GimbalFmi3Instance* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean* event, fmi3Boolean* terminate,
                           fmi3Boolean* early, fmi3Float64* last) {
     const char* f = "fmi3DoStep";
     if (!allowed(i, f, S_STEP)) return fmi3Error;
@@ -681,18 +681,18 @@ static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolea
     *event = *terminate = *early = fmi3False;
     *last = i->time;
     if (!(h > 0.0) || !isfinite(h)) {
-        say(i, fmi3Error, "logStatusError", "%s: communicationStepSize = %g must be finite and > 0", f, h);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: communicationStepSize = %g must be finite and > 0", f, h);
         return fmi3Error;
     }
     /* The master's point becomes the FMU's time (common/communication_point.h). */
     if (!communication_point_matches(i->time, t, h)) {
-        say(i, fmi3Error, "logStatusError", "%s: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", f, t,
+        log_to_host(i, fmi3Error, "logStatusError", "%s: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", f, t,
             i->time);
         return fmi3Error;
     }
     const double end = t + h;
     if (i->stop_time_defined && communication_step_passes_stop_time(end, i->stop_time, h)) {
-        say(i, fmi3Error, "logStatusError", "%s: step to t = %.17g passes the stopTime %.17g", f, end, i->stop_time);
+        log_to_host(i, fmi3Error, "logStatusError", "%s: step to t = %.17g passes the stopTime %.17g", f, end, i->stop_time);
         return fmi3Error;
     }
     /* With early return allowed, the step ends right after the first mode change inside it: the
@@ -715,21 +715,22 @@ static fmi3Status do_step(Instance3* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolea
 
 /* ---------------------------------------------------------------- the exported functions */
 
-#define HOLD IN_FMU_FP_ENVIRONMENT /* host_fp_environment.h */
-#define I ((Instance3*)instance)
+/* Every entry runs in the FMU's own floating-point environment and restores the host's on the way out
+ * (IN_FMU_FP_ENVIRONMENT, host_fp_environment.h); OWN_INSTANCE is the host's opaque handle as ours. */
+#define OWN_INSTANCE ((GimbalFmi3Instance*)instance)
 
 const char* fmi3GetVersion(void) { return fmi3Version; }
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
                                const fmi3String categories[]) {
-    HOLD(fmi3Status, set_debug_logging(I, loggingOn, nCategories, categories));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_debug_logging(OWN_INSTANCE, loggingOn, nCategories, categories));
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath,
                                           fmi3Boolean visible, fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
     (void)resourcePath, (void)visible;
-    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 1, 0, 0, loggingOn, instanceEnvironment, logMessage,
+    IN_FMU_FP_ENVIRONMENT(fmi3Instance, instantiate(instanceName, instantiationToken, 1, 0, 0, loggingOn, instanceEnvironment, logMessage,
                                    "fmi3InstantiateModelExchange"));
 }
 
@@ -740,7 +741,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3LogMessageCallback logMessage, fmi3IntermediateUpdateCallback intermediateUpdate) {
     (void)resourcePath, (void)visible, (void)requiredIntermediateVariables, (void)nRequiredIntermediateVariables,
         (void)intermediateUpdate;
-    HOLD(fmi3Instance, instantiate(instanceName, instantiationToken, 0, eventModeUsed ? 1 : 0, earlyReturnAllowed ? 1 : 0,
+    IN_FMU_FP_ENVIRONMENT(fmi3Instance, instantiate(instanceName, instantiationToken, 0, eventModeUsed ? 1 : 0, earlyReturnAllowed ? 1 : 0,
                                    loggingOn, instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation"));
 }
 
@@ -760,34 +761,34 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
 void fmi3FreeInstance(fmi3Instance instance) {
     HostFpEnvironment host_environment;
     enter_fmu_fp(&host_environment);
-    free_instance(I);
+    free_instance(OWN_INSTANCE);
     leave_fmu_fp(&host_environment);
 }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    HOLD(fmi3Status, enter_initialization(I, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, enter_initialization(OWN_INSTANCE, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime));
 }
 
-fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { HOLD(fmi3Status, exit_initialization(I)); }
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, exit_initialization(OWN_INSTANCE)); }
 
-static fmi3Status enter_event_mode(Instance3* i) {
+static fmi3Status enter_event_mode(GimbalFmi3Instance* i) {
     if (!allowed(i, "fmi3EnterEventMode", i->model_exchange ? S_CONTINUOUS_TIME : S_STEP)) return fmi3Error;
     if (!i->model_exchange && !i->event_mode_used)
         return refuse(i, "fmi3EnterEventMode", "the instance was made with eventModeUsed = false");
     i->state = S_EVENT;
     return fmi3OK;
 }
-fmi3Status fmi3EnterEventMode(fmi3Instance instance) { HOLD(fmi3Status, enter_event_mode(I)); }
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, enter_event_mode(OWN_INSTANCE)); }
 
-static fmi3Status terminate(Instance3* i) {
+static fmi3Status terminate(GimbalFmi3Instance* i) {
     if (!allowed(i, "fmi3Terminate", S_RUNNING)) return fmi3Error;
     i->state = S_TERMINATED;
     return fmi3OK;
 }
-fmi3Status fmi3Terminate(fmi3Instance instance) { HOLD(fmi3Status, terminate(I)); }
+fmi3Status fmi3Terminate(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, terminate(OWN_INSTANCE)); }
 
-static fmi3Status reset(Instance3* i) {
+static fmi3Status reset(GimbalFmi3Instance* i) {
     if (!allowed(i, "fmi3Reset", S_ANY)) return fmi3Error;
     const fmi3Status status = from_core(gimbal_core_reset(i->core));
     if (status > fmi3Warning) {
@@ -799,46 +800,46 @@ static fmi3Status reset(Instance3* i) {
     i->state = S_INSTANTIATED;
     return fmi3OK;
 }
-fmi3Status fmi3Reset(fmi3Instance instance) { HOLD(fmi3Status, reset(I)); }
+fmi3Status fmi3Reset(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, reset(OWN_INSTANCE)); }
 
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
-    HOLD(fmi3Status, get_float64(I, vr, nvr, values, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_float64(OWN_INSTANCE, vr, nvr, values, n));
 }
 fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
                           size_t n) {
-    HOLD(fmi3Status, set_float64(I, vr, nvr, values, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_float64(OWN_INSTANCE, vr, nvr, values, n));
 }
 fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[], size_t n) {
-    HOLD(fmi3Status, get_integers(I, "fmi3GetInt32", KIND_INT32, vr, nvr, values, n, 0));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_integers(OWN_INSTANCE, "fmi3GetInt32", KIND_INT32, vr, nvr, values, n, 0));
 }
 fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[], size_t n) {
-    HOLD(fmi3Status, set_integers(I, "fmi3SetInt32", KIND_INT32, vr, nvr, values, n, 0));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_integers(OWN_INSTANCE, "fmi3SetInt32", KIND_INT32, vr, nvr, values, n, 0));
 }
 fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int64 values[], size_t n) {
-    HOLD(fmi3Status, get_integers(I, "fmi3GetInt64", KIND_ENUMERATION, vr, nvr, values, n, 1));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_integers(OWN_INSTANCE, "fmi3GetInt64", KIND_ENUMERATION, vr, nvr, values, n, 1));
 }
 fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int64 values[], size_t n) {
-    HOLD(fmi3Status, set_integers(I, "fmi3SetInt64", KIND_ENUMERATION, vr, nvr, values, n, 1));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_integers(OWN_INSTANCE, "fmi3SetInt64", KIND_ENUMERATION, vr, nvr, values, n, 1));
 }
 fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
-    HOLD(fmi3Status, get_boolean(I, vr, nvr, values, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_boolean(OWN_INSTANCE, vr, nvr, values, n));
 }
 fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
                           size_t n) {
-    HOLD(fmi3Status, set_boolean(I, vr, nvr, values, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_boolean(OWN_INSTANCE, vr, nvr, values, n));
 }
 
 #define NO_SUCH_GET(name, type)                                                                                 \
     fmi3Status fmi3Get##name(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, type values[],   \
                              size_t n) {                                                                        \
         (void)values, (void)n;                                                                                  \
-        HOLD(fmi3Status, no_such_type(I, "fmi3Get" #name, 0, vr, nvr));                                         \
+        IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3Get" #name, 0, vr, nvr));                                         \
     }
 #define NO_SUCH_SET(name, type)                                                                                 \
     fmi3Status fmi3Set##name(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const type values[], \
                              size_t n) {                                                                        \
         (void)values, (void)n;                                                                                  \
-        HOLD(fmi3Status, no_such_type(I, "fmi3Set" #name, 1, vr, nvr));                                         \
+        IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3Set" #name, 1, vr, nvr));                                         \
     }
 NO_SUCH_GET(Float32, fmi3Float32)
 NO_SUCH_SET(Float32, fmi3Float32)
@@ -860,24 +861,24 @@ NO_SUCH_SET(String, fmi3String)
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
                          fmi3Binary values[], size_t n) {
     (void)sizes, (void)values, (void)n;
-    HOLD(fmi3Status, no_such_type(I, "fmi3GetBinary", 0, vr, nvr));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3GetBinary", 0, vr, nvr));
 }
 fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const size_t sizes[],
                          const fmi3Binary values[], size_t n) {
     (void)sizes, (void)values, (void)n;
-    HOLD(fmi3Status, no_such_type(I, "fmi3SetBinary", 1, vr, nvr));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3SetBinary", 1, vr, nvr));
 }
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
     (void)values;
-    HOLD(fmi3Status, no_such_type(I, "fmi3GetClock", 0, vr, nvr));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3GetClock", 0, vr, nvr));
 }
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
     (void)values;
-    HOLD(fmi3Status, no_such_type(I, "fmi3SetClock", 1, vr, nvr));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3SetClock", 1, vr, nvr));
 }
 
 /* What this FMU does not offer, as its model description says: refused with the reason. */
-#define NOT_OFFERED(call, why) HOLD(fmi3Status, (I == NULL ? fmi3Error : refuse(I, call, why)))
+#define NOT_OFFERED(call, why) IN_FMU_FP_ENVIRONMENT(fmi3Status, (OWN_INSTANCE == NULL ? fmi3Error : refuse(OWN_INSTANCE, call, why)))
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t* n) {
     (void)vr, (void)n;
@@ -889,24 +890,24 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
     NOT_OFFERED("fmi3GetVariableDependencies", "the dependencies are in <ModelStructure> (no per-element dependencies)");
 }
 
-fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { HOLD(fmi3Status, get_fmu_state(I, FMUState)); }
-fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) { HOLD(fmi3Status, set_fmu_state(I, FMUState)); }
-fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { HOLD(fmi3Status, free_fmu_state(I, FMUState)); }
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { IN_FMU_FP_ENVIRONMENT(fmi3Status, get_fmu_state(OWN_INSTANCE, FMUState)); }
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) { IN_FMU_FP_ENVIRONMENT(fmi3Status, set_fmu_state(OWN_INSTANCE, FMUState)); }
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { IN_FMU_FP_ENVIRONMENT(fmi3Status, free_fmu_state(OWN_INSTANCE, FMUState)); }
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size) {
-    HOLD(fmi3Status, serialized_size(I, FMUState, size));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, serialized_size(OWN_INSTANCE, FMUState, size));
 }
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
-    HOLD(fmi3Status, serialize(I, FMUState, serializedState, size));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, serialize(OWN_INSTANCE, FMUState, serializedState, size));
 }
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
                                    fmi3FMUState* FMUState) {
-    HOLD(fmi3Status, deserialize(I, serializedState, size, FMUState));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, deserialize(OWN_INSTANCE, serializedState, size, FMUState));
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    HOLD(fmi3Status, directional_derivative(I, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed, sensitivity, nSensitivity));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, directional_derivative(OWN_INSTANCE, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed, sensitivity, nSensitivity));
 }
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                     const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
@@ -965,19 +966,19 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discrete
                                     fmi3Boolean* terminateSimulation, fmi3Boolean* nominalsOfContinuousStatesChanged,
                                     fmi3Boolean* valuesOfContinuousStatesChanged, fmi3Boolean* nextEventTimeDefined,
                                     fmi3Float64* nextEventTime) {
-    HOLD(fmi3Status, update_discrete_states(I, discreteStatesNeedUpdate, terminateSimulation,
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, update_discrete_states(OWN_INSTANCE, discreteStatesNeedUpdate, terminateSimulation,
                                             nominalsOfContinuousStatesChanged, valuesOfContinuousStatesChanged,
                                             nextEventTimeDefined, nextEventTime));
 }
 
-static fmi3Status enter_continuous_time_mode(Instance3* i) {
+static fmi3Status enter_continuous_time_mode(GimbalFmi3Instance* i) {
     if (!me_vector(i, "fmi3EnterContinuousTimeMode", S_EVENT, i, 0, 0, "instance")) return fmi3Error;
     i->state = S_CONTINUOUS_TIME;
     return fmi3OK;
 }
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { HOLD(fmi3Status, enter_continuous_time_mode(I)); }
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, enter_continuous_time_mode(OWN_INSTANCE)); }
 
-static fmi3Status completed_integrator_step(Instance3* i, fmi3Boolean* enter, fmi3Boolean* terminate) {
+static fmi3Status completed_integrator_step(GimbalFmi3Instance* i, fmi3Boolean* enter, fmi3Boolean* terminate) {
     const char* f = "fmi3CompletedIntegratorStep";
     if (!me_vector(i, f, S_CONTINUOUS_TIME, i, 0, 0, "instance") || !not_null(i, f, enter, "enterEventMode") ||
         !not_null(i, f, terminate, "terminateSimulation"))
@@ -988,84 +989,84 @@ static fmi3Status completed_integrator_step(Instance3* i, fmi3Boolean* enter, fm
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                        fmi3Boolean* enterEventMode, fmi3Boolean* terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    HOLD(fmi3Status, completed_integrator_step(I, enterEventMode, terminateSimulation));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, completed_integrator_step(OWN_INSTANCE, enterEventMode, terminateSimulation));
 }
 
-static fmi3Status set_time(Instance3* i, fmi3Float64 t) {
+static fmi3Status set_time(GimbalFmi3Instance* i, fmi3Float64 t) {
     if (!me_vector(i, "fmi3SetTime", S_EVENT | S_CONTINUOUS_TIME, i, 0, 0, "instance")) return fmi3Error;
     const fmi3Status status = from_core(gimbal_core_set_time(i->core, t));
     if (status <= fmi3Warning) i->time = t;
     return status;
 }
-fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) { HOLD(fmi3Status, set_time(I, time)); }
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) { IN_FMU_FP_ENVIRONMENT(fmi3Status, set_time(OWN_INSTANCE, time)); }
 
-static fmi3Status set_continuous_states(Instance3* i, const fmi3Float64 x[], size_t n) {
+static fmi3Status set_continuous_states(GimbalFmi3Instance* i, const fmi3Float64 x[], size_t n) {
     if (!me_vector(i, "fmi3SetContinuousStates", S_CONTINUOUS_TIME, x, n, GIMBAL_CONTINUOUS_STATES, "continuousStates"))
         return fmi3Error;
     return from_core(gimbal_core_set_continuous_states(i->core, x));
 }
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[], size_t n) {
-    HOLD(fmi3Status, set_continuous_states(I, continuousStates, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_continuous_states(OWN_INSTANCE, continuousStates, n));
 }
 
-static fmi3Status get_derivatives(Instance3* i, fmi3Float64 dx[], size_t n) {
+static fmi3Status get_derivatives(GimbalFmi3Instance* i, fmi3Float64 dx[], size_t n) {
     if (!me_vector(i, "fmi3GetContinuousStateDerivatives", S_EVALUATE, dx, n, GIMBAL_CONTINUOUS_STATES, "derivatives"))
         return fmi3Error;
     return from_core(gimbal_core_get_derivatives(i->core, dx));
 }
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t n) {
-    HOLD(fmi3Status, get_derivatives(I, derivatives, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_derivatives(OWN_INSTANCE, derivatives, n));
 }
 
-static fmi3Status get_event_indicators(Instance3* i, fmi3Float64 z[], size_t n) {
+static fmi3Status get_event_indicators(GimbalFmi3Instance* i, fmi3Float64 z[], size_t n) {
     if (!me_vector(i, "fmi3GetEventIndicators", S_INITIALIZATION | S_EVALUATE, z, n, GIMBAL_EVENT_INDICATORS,
                    "eventIndicators"))
         return fmi3Error;
     return from_core(gimbal_core_get_event_indicators(i->core, z));
 }
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t n) {
-    HOLD(fmi3Status, get_event_indicators(I, eventIndicators, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_event_indicators(OWN_INSTANCE, eventIndicators, n));
 }
 
-static fmi3Status get_continuous_states(Instance3* i, fmi3Float64 x[], size_t n) {
+static fmi3Status get_continuous_states(GimbalFmi3Instance* i, fmi3Float64 x[], size_t n) {
     if (!me_vector(i, "fmi3GetContinuousStates", S_INITIALIZATION | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
                    "continuousStates"))
         return fmi3Error;
     return from_core(gimbal_core_get_continuous_states(i->core, x));
 }
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t n) {
-    HOLD(fmi3Status, get_continuous_states(I, continuousStates, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_continuous_states(OWN_INSTANCE, continuousStates, n));
 }
 
-static fmi3Status get_nominals(Instance3* i, fmi3Float64 x[], size_t n) {
+static fmi3Status get_nominals(GimbalFmi3Instance* i, fmi3Float64 x[], size_t n) {
     if (!me_vector(i, "fmi3GetNominalsOfContinuousStates", S_INSTANTIATED | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
                    "nominals"))
         return fmi3Error;
     return from_core(gimbal_core_get_nominal_states(i->core, x));
 }
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t n) {
-    HOLD(fmi3Status, get_nominals(I, nominals, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_nominals(OWN_INSTANCE, nominals, n));
 }
 
-static fmi3Status count(Instance3* i, const char* f, size_t* n, size_t value) {
+static fmi3Status count(GimbalFmi3Instance* i, const char* f, size_t* n, size_t value) {
     if (!allowed(i, f, S_ANY) || !not_null(i, f, n, "count")) return fmi3Error;
     *n = value;
     return fmi3OK;
 }
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t* n) {
-    HOLD(fmi3Status, count(I, "fmi3GetNumberOfEventIndicators", n, GIMBAL_EVENT_INDICATORS));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, count(OWN_INSTANCE, "fmi3GetNumberOfEventIndicators", n, GIMBAL_EVENT_INDICATORS));
 }
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* n) {
-    HOLD(fmi3Status, count(I, "fmi3GetNumberOfContinuousStates", n, GIMBAL_CONTINUOUS_STATES));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, count(OWN_INSTANCE, "fmi3GetNumberOfContinuousStates", n, GIMBAL_CONTINUOUS_STATES));
 }
 
-static fmi3Status enter_step_mode(Instance3* i) {
+static fmi3Status enter_step_mode(GimbalFmi3Instance* i) {
     if (!allowed(i, "fmi3EnterStepMode", S_EVENT)) return fmi3Error;
     if (i->model_exchange) return refuse(i, "fmi3EnterStepMode", "a Model Exchange instance has no step mode");
     i->state = S_STEP;
     return fmi3OK;
 }
-fmi3Status fmi3EnterStepMode(fmi3Instance instance) { HOLD(fmi3Status, enter_step_mode(I)); }
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, enter_step_mode(OWN_INSTANCE)); }
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 orders[],
                                     fmi3Float64 values[], size_t n) {
@@ -1077,7 +1078,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean* eventHandlingNeeded,
                       fmi3Boolean* terminateSimulation, fmi3Boolean* earlyReturn, fmi3Float64* lastSuccessfulTime) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    HOLD(fmi3Status, do_step(I, currentCommunicationPoint, communicationStepSize, eventHandlingNeeded, terminateSimulation,
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, do_step(OWN_INSTANCE, currentCommunicationPoint, communicationStepSize, eventHandlingNeeded, terminateSimulation,
                              earlyReturn, lastSuccessfulTime));
 }
 
