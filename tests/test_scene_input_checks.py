@@ -13,20 +13,10 @@ import pytest
 
 from gimbal2axis import FMU, SceneError, check_against_fmu, load_scene
 from gimbal2axis.errors import EXCERPT_CHARS, excerpt
+from test_scene_messages import QUIET   # a scene that draws no warning
 
 GIMBAL2AXIS = [sys.executable, "-m", "gimbal2axis"]
 
-# draws no warning: a fixed base said twice, an explicit (open-loop) controller
-QUIET = """name = "quiet"
-stop_time = 0.01
-step_size = 1e-3
-[fidelity]
-"base.fixed" = true
-[base_motion]
-type = "fixed"
-[controller]
-type = "none"
-"""
 
 SEA_STATE = """name = "sea"
 stop_time = 0.01
