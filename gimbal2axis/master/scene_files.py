@@ -3,9 +3,12 @@
 interrupted or terminated keeps what it recorded up to its last whole communication point)."""
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import pathlib
 
+from ..errors import SceneError
 from ..fmu import FMU
 from ..scene.scene import load_scene, parameter_value
 from .master import run
@@ -22,6 +25,29 @@ def run_status(result, files: list[pathlib.Path]) -> dict:
             "files": [path.name for path in files]}
 
 
+@contextlib.contextmanager
+def only_writer(out: pathlib.Path, name: str):
+    """Holds `<out>/.<name>.run.lock` for the whole run, or refuses: two runs of one scene into one
+    folder would write the same files at once and mix them (a CSV of one run, a plot of the other, a
+    Parquet file of both). The lock is the operating system's (released when the process ends, however
+    it ends); its empty file stays, as the sweep store's does."""
+    handle = open(out / f".{name}.run.lock", "a+b")
+    try:
+        try:
+            if os.name == "nt":
+                import msvcrt
+                msvcrt.locking(handle.fileno(), msvcrt.LK_NBLCK, 1)
+            else:
+                import fcntl
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise SceneError(f"another gimbal2axis run is writing {name}'s files into {out}: wait for it to end or "
+                             f"give this one another --out (two runs into the same files would mix them)") from None
+        yield
+    finally:
+        handle.close()
+
+
 def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_time: float | None = None,
                    keep_partial: bool = False, stop=None, stream: bool = False):
     """Runs one scene file and writes <out>/<scene file's name>.csv and .png; with a target also
@@ -33,13 +59,19 @@ def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_t
 
     `stream`: the run is written as it goes (streaming.run_streamed: also <name>.parquet, memory
     bounded whatever the length; a run that stops early always keeps its partial record); else it
-    is held in memory (master.run) and written at the end."""
-    from .plotting import plot, plot_spectrum
-    from .streaming import run_streamed
-
+    is held in memory (master.run) and written at the end. A second run of the same scene into the
+    same folder while this one writes is refused (only_writer)."""
     scene = load_scene(scene_path)
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    with only_writer(out, scene.name):
+        return _run_and_write(scene, fmu_path, out, progress, stop_time, keep_partial, stop, stream)
+
+
+def _run_and_write(scene, fmu_path, out: pathlib.Path, progress, stop_time, keep_partial, stop, stream):
+    from .plotting import plot, plot_spectrum
+    from .streaming import run_streamed
+
     csv_path, png_path = out / f"{scene.name}.csv", out / f"{scene.name}.png"
     with FMU(fmu_path) as fmu:
         if stream:
