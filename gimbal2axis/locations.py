@@ -68,6 +68,15 @@ def fmu_path(given: str | os.PathLike | None = None) -> pathlib.Path:
                         f"repository (cmake -S . -B build; it records its FMU in {configured_file()})")
 
 
+def fmu_directory(given: str | os.PathLike | None = None) -> pathlib.Path:
+    """The build directory whose FMUs a system is made of: `given`, else the folder of the FMU that
+    fmu_path() finds (so `gimbal2axis system` run outside the repository finds the build that
+    configured the package, as `run` does)."""
+    if given is not None:
+        return pathlib.Path(given)
+    return fmu_path().parent
+
+
 def probe_library_path(build_dir: str | os.PathLike | None = None) -> pathlib.Path:
     """libgimbal_probe.so: in `build_dir`, else $GIMBAL2AXIS_PROBE_LIBRARY, else the configured one."""
     hint = "build it (cmake --build build --target gimbal_probe, or bash scripts/setup.sh)"

@@ -19,8 +19,9 @@ PROG = "gimbal2axis system"
 def add_arguments(parser) -> None:
     parser.epilog = "Errors go to stderr, one line each."
     parser.add_argument("scene", help="the scene file (a sea state, a built-in controller, delay_steps = 1)")
-    parser.add_argument("--build-dir", default="build",
-                        help="where the three FMUs were built (default: build/ in the current directory)")
+    parser.add_argument("--build-dir", default=None,
+                        help="where the three FMUs were built (default: the folder of the FMU that `run` finds: "
+                             "$GIMBAL2AXIS_FMU, else the build that configured the package)")
     parser.add_argument("--out", default="results/systems", help="directory to write into (default: results/systems/)")
 
 
@@ -30,9 +31,10 @@ def _write(args) -> int:
     from ..system.from_scene import ship_system
     from ..system.osp import write_osp
     from ..system.ssp import write_ssp
+    from ..locations import fmu_directory
 
     scene = load_scene(args.scene)
-    system = ship_system(scene, pathlib.Path(args.build_dir))
+    system = ship_system(scene, fmu_directory(args.build_dir))
     out = pathlib.Path(args.out)
     try:
         structure = write_osp(system, out / "osp")
