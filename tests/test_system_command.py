@@ -6,8 +6,6 @@ import subprocess
 import sys
 import zipfile
 
-
-
 from gimbal2axis.locations import FMU_ENVIRONMENT, fmu_directory
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
