@@ -5,7 +5,8 @@
 # one `cmake --build` makes the one FMU with both binaries, and the inner Ninja build tracks its own
 # sources (BUILD_ALWAYS only hands over to it; with nothing changed it does nothing).
 # Sets GIMBAL_BUILD_WIN64, GIMBAL_WIN64_DLL, GIMBAL_WIN64_FMI3_DLL (the FMI 3.0 binary) and
-# GIMBAL_WIN64_DRIVER (fmu_scene_driver.exe, for the tests) and GIMBAL_WIN64_SHIP_DLL (the ship-motion FMU's binary).
+# GIMBAL_WIN64_DRIVER (fmu_scene_driver.exe, for the tests), GIMBAL_WIN64_SHIP_DLL and
+# GIMBAL_WIN64_CONTROLLER_DLL (the ship-motion and controller FMUs' binaries).
 set(GIMBAL_BUILD_WIN64 OFF)
 if(GIMBAL_WIN64 STREQUAL "AUTO")
   find_program(GIMBAL_MINGW_CXX x86_64-w64-mingw32-g++)
@@ -31,6 +32,7 @@ set(GIMBAL_WIN64_DLL ${_win64_dir}/fmu_src/${MODEL_IDENTIFIER}.dll)
 set(GIMBAL_WIN64_DRIVER ${_win64_dir}/fmu_scene_driver.exe)
 set(GIMBAL_WIN64_FMI3_DLL ${_win64_dir}/fmi3/binary/${MODEL_IDENTIFIER}.dll)
 set(GIMBAL_WIN64_SHIP_DLL ${_win64_dir}/fmu_src/ship_motion/${SHIP_MODEL_IDENTIFIER}.dll)
+set(GIMBAL_WIN64_CONTROLLER_DLL ${_win64_dir}/fmu_src/controller/${CONTROLLER_MODEL_IDENTIFIER}.dll)
 ExternalProject_Add(gimbal_win64
   SOURCE_DIR ${PROJECT_SOURCE_DIR}
   BINARY_DIR ${_win64_dir}
@@ -42,4 +44,5 @@ ExternalProject_Add(gimbal_win64
     -DEigen3_DIR=${Eigen3_DIR}
   INSTALL_COMMAND ""
   BUILD_ALWAYS ON
-  BUILD_BYPRODUCTS ${GIMBAL_WIN64_DLL} ${GIMBAL_WIN64_DRIVER} ${GIMBAL_WIN64_FMI3_DLL} ${GIMBAL_WIN64_SHIP_DLL})
+  BUILD_BYPRODUCTS ${GIMBAL_WIN64_DLL} ${GIMBAL_WIN64_DRIVER} ${GIMBAL_WIN64_FMI3_DLL} ${GIMBAL_WIN64_SHIP_DLL}
+                   ${GIMBAL_WIN64_CONTROLLER_DLL})

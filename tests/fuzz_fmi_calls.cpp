@@ -167,6 +167,7 @@ struct Model {
     std::vector<const Variable*> real_parameters, real_inputs, real_outputs, real_all;
     std::vector<const Variable*> integer_all, boolean_all;
     unsigned max_vr[3] = {0, 0, 0};  // Real, Integer, Boolean: largest valid value reference
+    bool model_exchange = false;     // the FMU offers Model Exchange (the small FMUs are Co-Simulation only)
 };
 
 // Reads the attributes of the element whose name ends at pos; pos is left after the closing '>'.
@@ -209,6 +210,7 @@ bool read_model(const char* path, Model& model) {
     std::map<std::string, std::string> root;
     parse_attributes(text, pos, root);
     model.guid = root["guid"];
+    model.model_exchange = text.find("<ModelExchange") != std::string::npos;
 
     const std::string tag = "<ScalarVariable";
     while ((pos = text.find(tag, pos)) != std::string::npos) {
@@ -787,7 +789,8 @@ void do_instantiate(Sequence& s, bool valid) {
             case 4: type = 2, expect_valid = false, may_succeed = false; break;  // neither interface
             case 5:
                 type = static_cast<int>(r.integer(-5, 9));
-                if (type != fmi2CoSimulation && type != fmi2ModelExchange) expect_valid = may_succeed = false;
+                if (type != fmi2CoSimulation && !(type == fmi2ModelExchange && model.model_exchange))
+                    expect_valid = may_succeed = false;
                 break;
             case 6: guid = "{00000000-0000-0000-0000-000000000000}", expect_valid = may_succeed = false; break;
             case 7: guid_pointer = nullptr, guid = "(NULL)", expect_valid = may_succeed = false; break;
@@ -995,15 +998,20 @@ void do_step(Sequence& s, Instance* inst, bool valid) {
 
 // ---- values
 
+// One of `variables`, or nullptr when the FMU has none of them (the ship-motion FMU has no inputs).
+const Variable* pick_variable(Random& r, const std::vector<const Variable*>& variables) {
+    return variables.empty() ? nullptr : r.pick(variables);
+}
+
 std::vector<fmi2ValueReference> real_vrs(Random& r, size_t n, bool settable_only, std::vector<const Variable*>& vars) {
     std::vector<fmi2ValueReference> vr;
     for (size_t i = 0; i < n; ++i) {
         const double u = r.uniform(0.0, 1.0);
         const Variable* v = nullptr;
-        if (u < 0.45) v = r.pick(model.real_parameters);
-        else if (u < 0.78) v = r.pick(model.real_inputs);
-        else if (u < (settable_only ? 0.85 : 0.92)) v = r.pick(model.real_outputs);
-        else if (u < 0.93) v = r.pick(model.real_all);
+        if (u < 0.45) v = pick_variable(r, model.real_parameters);
+        else if (u < 0.78) v = pick_variable(r, model.real_inputs);
+        else if (u < (settable_only ? 0.85 : 0.92)) v = pick_variable(r, model.real_outputs);
+        else if (u < 0.93) v = pick_variable(r, model.real_all);
         if (v != nullptr) {
             vr.push_back(v->vr);
             vars.push_back(v);
@@ -1029,10 +1037,13 @@ void do_set_real(Sequence& s, Instance* inst, bool valid) {
     std::vector<fmi2Real> value;
     if (valid) {
         // What a well-behaved master sets in this phase: parameters before initialization, inputs after.
-        const bool parameters = inst != nullptr && (inst->phase == Phase::instantiated || inst->phase == Phase::initialization) &&
-                                r.chance(0.5);
+        const bool before_initialized =
+            inst != nullptr && (inst->phase == Phase::instantiated || inst->phase == Phase::initialization);
+        const bool parameters = before_initialized && (r.chance(0.5) || model.real_inputs.empty());
+        const std::vector<const Variable*>& settable = parameters ? model.real_parameters : model.real_inputs;
+        if (settable.empty()) n = 0;  // nothing this master could set now: an empty call
         for (size_t i = 0; i < n; ++i) {
-            const Variable* v = parameters ? r.pick(model.real_parameters) : r.pick(model.real_inputs);
+            const Variable* v = r.pick(settable);
             vr.push_back(v->vr);
             value.push_back(mild_value(r, *v));
         }
@@ -1328,8 +1339,10 @@ void do_derivatives(Sequence& s, Instance* inst, Function f) {
     std::vector<fmi2Real> a(n + 1, 1.0), b(n + 1, 0.0);
     std::vector<fmi2Integer> order(n + 1, 1);
     for (size_t i = 0; i < n; ++i) {
-        vr[i] = r.chance(0.5) ? r.pick(model.real_outputs)->vr : r.pick(model.real_inputs)->vr;
-        vr2[i] = r.chance(0.8) ? r.pick(model.real_inputs)->vr : invalid_vr(r, model.max_vr[0]);
+        const Variable* unknown = pick_variable(r, r.chance(0.5) ? model.real_outputs : model.real_inputs);
+        const Variable* known = r.chance(0.8) ? pick_variable(r, model.real_inputs) : nullptr;
+        vr[i] = unknown != nullptr ? unknown->vr : invalid_vr(r, model.max_vr[0]);
+        vr2[i] = known != nullptr ? known->vr : invalid_vr(r, model.max_vr[0]);
         a[i] = chaos_value(r, nullptr);
         order[i] = static_cast<fmi2Integer>(r.pick(std::vector<long long>{0, 1, 2, -1, INT_MAX}));
     }

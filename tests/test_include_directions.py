@@ -225,13 +225,13 @@ def test_the_extension_and_the_cmake_libraries_compile_the_same_kernel(build_tar
     ("c_kernel/include/gimbal_kernel/sensors.h", "#include <Python.h>"),   # CPython
     ("c_kernel/src/sea_state.c", '#  include "fmi2Functions.h"'),         # FMI
     ("c_kernel/src/gyro.c", '#include "../../gimbal2axis/native/module.c"'),   # the package
-    ("c_kernel/src/layout.c", '#include "../../fmu_src/fmu_instance.h"'),   # the wrappers
+    ("c_kernel/src/layout.c", '#include "../../fmu_src/fmi_layer/fmi_instance.h"'),   # the wrappers
     ("fmu_src/controller/controller_model.c", '#include "gimbal/model/gimbal_model.hpp"'),   # behind the C interface
     ("fmu_src/ship_motion/ship_motion.c", '#include "../../model_core/src/integrators/tableaus.hpp"'),
     ("model_core/src/simulation/c_api.cpp", '#include "gimbal_kernel/controllers.h"'),   # the kernel
-    ("model_core/include/gimbal/gimbal_c_api.h", '#include "../../../fmu_src/fmu_instance.h"'),   # the wrappers
-    ("model_core/src/simulation/c_api.cpp", "#include <fmu_instance.h>"),
-    ("gimbal2axis/native/module.c", '#include "../../fmu_src/fmu_instance.h"'),   # the package's glue, the wrappers
+    ("model_core/include/gimbal/gimbal_c_api.h", '#include "../../../fmu_src/fmi_layer/fmi_instance.h"'),   # the wrappers
+    ("model_core/src/simulation/c_api.cpp", "#include <fmu_state.h>"),
+    ("gimbal2axis/native/module.c", '#include "../../fmu_src/fmi_layer/fmi_instance.h"'),   # the package's glue, the wrappers
     ("gimbal2axis/native/module.c", '#include "gimbal/gimbal_c_api.h"'),         # and the core
 ])
 def test_the_check_refuses_a_wrong_include(every_target, build_dir, where, planted):

@@ -6,7 +6,8 @@
 # add_small_cosimulation_fmu_binary(<model identifier>
 #     SOURCES <the FMI wrapper's sources>... LIBRARIES <the model's libraries>...
 #     VARIABLE_TABLE <file> GUID_HEADER <name>_guid.h.in GUID_VARIABLE <variable>)
-# The shared library <model identifier> (no "lib" prefix): the wrapper with cosim_instance.c, linked
+# The shared library <model identifier> (no "lib" prefix): the wrapper over the FMI instance layer
+# (fmu_src/fmi_layer/) and its FMI 2.0 face, linked
 # as the gimbal's binary (fmu_src/CMakeLists.txt says why each option): only fmi2* exported, libgcc
 # inside, on Linux the C runtime's libm and libc its only shared libraries. Sets <variable> here and
 # in the caller's scope to the FMU's GUID, a name-based UUID of the identifier, the version and the
@@ -23,7 +24,9 @@ function(add_small_cosimulation_fmu_binary identifier)
   configure_file(${ARG_GUID_HEADER} ${PROJECT_BINARY_DIR}/generated/${_header} @ONLY)
 
   set(_common ${PROJECT_SOURCE_DIR}/fmu_src/common)
-  add_library(${identifier} SHARED ${ARG_SOURCES} ${_common}/cosim_instance.c)
+  set(_fmu_src ${PROJECT_SOURCE_DIR}/fmu_src)
+  add_library(${identifier} SHARED ${ARG_SOURCES} ${_fmu_src}/fmi_layer/fmi_instance.c ${_fmu_src}/fmi_layer/fmi2_face.c
+              ${_fmu_src}/fmu_state.c)
   target_include_directories(${identifier} PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_BINARY_DIR}/generated
                              ${PROJECT_SOURCE_DIR}/fmu_src ${_common})
   # No contraction into fused multiply-adds: the outputs are the bits the scene runner computes.

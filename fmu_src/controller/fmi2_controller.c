@@ -7,59 +7,65 @@
 #include <math.h>
 #include <stddef.h>
 
+#include <stdlib.h>
+
 #include "controller_guid.h"
-#include "communication_point.h"
 #include "controller_model.h"
-#include "cosim_instance.h"
-#include "fmi2Functions.h"
+#include "fmi_layer/fmi2_face.h"
 #include "host_fp_environment.h"
 
-enum { kAnyState = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED,
+enum { kAnyState = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR,
        kGetStates = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED,
        kSetStates = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE };
 
-typedef struct {
-    CosimInstance common; /* first: cosim_instantiate allocates the Instance around it */
-    double time, stop_time;
-    int stop_time_defined;
-    ControllerModel model;
-} Instance;
-_Static_assert(offsetof(Instance, common) == 0, "the CosimInstance must be the Instance's first member");
+typedef FmiInstance Instance;
+
+static ControllerModel* model_of(const Instance* instance) { return (ControllerModel*)instance->model_data; }
+
+/* ---------------------------------------------------------------- the model's table */
+
+static const char* const kLogCategories[] = {"logStatusError", "logAll"};
+
+static void* create_model(FmiInstance* instance) {
+    (void)instance;
+    ControllerModel* model = (ControllerModel*)malloc(sizeof(ControllerModel));
+    if (model != NULL) controller_model_reset(model);
+    return model;
+}
+
+/* canGetAndSetFMUstate is false: the FMU-state calls are refused before they reach the layer. */
+static const FmiModel kControllerModel = {
+    CONTROLLER_GUID, sizeof(FmiInstance), kLogCategories, (int)(sizeof kLogCategories / sizeof kLogCategories[0]), create_model, free,
+    NULL, NULL, NULL, NULL, NULL,
+};
 
 /* The instance when `function` may be called in its state; NULL (logged when it can be) otherwise. */
 static Instance* usable(fmi2Component c, const char* function, int states) {
     Instance* instance = (Instance*)c;
-    return instance != NULL && cosim_allowed(&instance->common, function, states) ? instance : NULL;
+    return fmi_allowed(instance, function, states) ? instance : NULL;
 }
 
 static int arrays_given(const Instance* instance, const char* function, size_t nvr, const void* vr, const void* value) {
-    return nvr == 0 || (cosim_not_null(&instance->common, function, vr, "vr") &&
-                        cosim_not_null(&instance->common, function, value, "value"));
+    return nvr == 0 || (fmi_not_null(instance, function, vr, "vr") && fmi_not_null(instance, function, value, "value"));
 }
 
 static fmi2Status refused(fmi2Component c, const char* function, const char* why) {
-    Instance* instance = (Instance*)c;
-    return cosim_refuse(instance != NULL ? &instance->common : NULL, "%s: %s", function, why);
+    return (fmi2Status)fmi_refuse((const Instance*)c, function, why);
 }
 
 /* ---------------------------------------------------------------- lifetime */
 
 static fmi2Component impl_Instantiate(fmi2String name, fmi2Type type, fmi2String guid, const fmi2CallbackFunctions* functions,
                                       fmi2Boolean logging_on) {
-    Instance* instance =
-        (Instance*)cosim_instantiate(sizeof(Instance), name, type, guid, CONTROLLER_GUID, functions, logging_on);
-    if (instance != NULL) controller_model_reset(&instance->model);
-    return instance;
+    return fmi2_instantiate(&kControllerModel, 0, name, type, guid, functions, logging_on);
 }
 
-static void impl_FreeInstance(fmi2Component c) {
-    Instance* instance = (Instance*)c;
-    if (instance != NULL) cosim_free(&instance->common);
-}
+static void impl_FreeInstance(fmi2Component c) { fmi_free_instance((Instance*)c); }
 
 static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t count, const fmi2String categories[]) {
     Instance* instance = (Instance*)c;
-    return instance != NULL ? cosim_set_debug_logging(&instance->common, on, count, categories) : fmi2Error;
+    if (instance == NULL) return fmi2Error;
+    return (fmi2Status)fmi_set_debug_logging(instance, "fmi2SetDebugLogging", on != fmi2False, count, categories);
 }
 
 /* ---------------------------------------------------------------- initialization and termination */
@@ -69,11 +75,8 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean tolerance_de
     (void)tolerance_defined, (void)tolerance; /* nothing is integrated */
     Instance* instance = usable(c, "fmi2SetupExperiment", STATE_INSTANTIATED);
     if (instance == NULL) return fmi2Error;
-    if (!isfinite(start) || (stop_defined && (!isfinite(stop) || stop < start))) {
-        cosim_log_error(&instance->common, "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
-                  start, stop);
+    if (!fmi_experiment_times_valid(instance, "fmi2SetupExperiment", start, stop_defined != fmi2False, stop))
         return fmi2Error;
-    }
     instance->time = start, instance->stop_time = stop, instance->stop_time_defined = stop_defined ? 1 : 0;
     return fmi2OK;
 }
@@ -81,7 +84,7 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean tolerance_de
 static fmi2Status impl_EnterInitializationMode(fmi2Component c) {
     Instance* instance = usable(c, "fmi2EnterInitializationMode", STATE_INSTANTIATED);
     if (instance == NULL) return fmi2Error;
-    instance->common.state = STATE_INITIALIZATION;
+    instance->state = STATE_INITIALIZATION;
     return fmi2OK;
 }
 
@@ -89,29 +92,29 @@ static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
     Instance* instance = usable(c, "fmi2ExitInitializationMode", STATE_INITIALIZATION);
     if (instance == NULL) return fmi2Error;
     char why[512];
-    if (!controller_model_check(&instance->model, why, sizeof why)) {
+    if (!controller_model_check(model_of(instance), why, sizeof why)) {
         /* still in initialization mode: the master may correct the parameter and retry */
-        cosim_log_error(&instance->common, "fmi2ExitInitializationMode: %s", why);
+        fmi_log_error(instance, "fmi2ExitInitializationMode: %s", why);
         return fmi2Error;
     }
-    controller_model_start(&instance->model);
-    instance->common.state = STATE_STEP_COMPLETE;
+    controller_model_start(model_of(instance));
+    instance->state = STATE_STEP_COMPLETE;
     return fmi2OK;
 }
 
 static fmi2Status impl_Terminate(fmi2Component c) {
     Instance* instance = usable(c, "fmi2Terminate", STATE_STEP_COMPLETE);
     if (instance == NULL) return fmi2Error;
-    instance->common.state = STATE_TERMINATED;
+    instance->state = STATE_TERMINATED;
     return fmi2OK;
 }
 
 static fmi2Status impl_Reset(fmi2Component c) {
     Instance* instance = usable(c, "fmi2Reset", kAnyState);
     if (instance == NULL) return fmi2Error;
-    controller_model_reset(&instance->model);
+    controller_model_reset(model_of(instance));
     instance->time = 0.0, instance->stop_time_defined = 0;
-    instance->common.state = STATE_INSTANTIATED;
+    instance->state = STATE_INSTANTIATED;
     return fmi2OK;
 }
 
@@ -119,7 +122,7 @@ static fmi2Status impl_Reset(fmi2Component c) {
 
 /* Which variables may be set now: inputs always; parameters before initialization ends. */
 static int settable(const Instance* instance, int parameter) {
-    return !parameter || (instance->common.state & (STATE_INSTANTIATED | STATE_INITIALIZATION));
+    return !parameter || (instance->state & (STATE_INSTANTIATED | STATE_INITIALIZATION));
 }
 
 static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
@@ -127,20 +130,20 @@ static fmi2Status impl_SetReal(fmi2Component c, const fmi2ValueReference vr[], s
     if (instance == NULL || !arrays_given(instance, "fmi2SetReal", nvr, vr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) { /* all checked before any is applied */
         if (vr[i] >= REAL_COUNT) {
-            cosim_log_error(&instance->common, "fmi2SetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
+            fmi_log_error(instance, "fmi2SetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
             return fmi2Error;
         }
         const ControllerReal* v = &kControllerReals[vr[i]];
         if (v->causality == OUTPUT || !settable(instance, v->causality == PARAMETER)) {
-            cosim_log_error(&instance->common, "fmi2SetReal: %s cannot be set in state '%s'", v->name, cosim_state_name(instance->common.state));
+            fmi_log_error(instance, "fmi2SetReal: %s cannot be set in state '%s'", v->name, instance->face->state_name(instance->state));
             return fmi2Error;
         }
         if (!isfinite(value[i])) {
-            cosim_log_error(&instance->common, "fmi2SetReal: %s = %g is not finite", v->name, value[i]);
+            fmi_log_error(instance, "fmi2SetReal: %s = %g is not finite", v->name, value[i]);
             return fmi2Error;
         }
     }
-    for (size_t i = 0; i < nvr; ++i) instance->model.real[vr[i]] = value[i];
+    for (size_t i = 0; i < nvr; ++i) model_of(instance)->real[vr[i]] = value[i];
     return fmi2OK;
 }
 
@@ -149,10 +152,10 @@ static fmi2Status impl_GetReal(fmi2Component c, const fmi2ValueReference vr[], s
     if (instance == NULL || !arrays_given(instance, "fmi2GetReal", nvr, vr, value)) return fmi2Error;
     for (size_t i = 0; i < nvr; ++i) {
         if (vr[i] >= REAL_COUNT) {
-            cosim_log_error(&instance->common, "fmi2GetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
+            fmi_log_error(instance, "fmi2GetReal: value reference %u is not a Real variable", (unsigned)vr[i]);
             return fmi2Error;
         }
-        value[i] = instance->model.real[vr[i]];
+        value[i] = model_of(instance)->real[vr[i]];
     }
     return fmi2OK;
 }
@@ -160,7 +163,7 @@ static fmi2Status impl_GetReal(fmi2Component c, const fmi2ValueReference vr[], s
 /* Integer and Boolean variables are all parameters, stored as int (fmi2Boolean is an int too). */
 static int* int_store(Instance* instance, int boolean, int* count) {
     *count = boolean ? BOOLEAN_COUNT : INTEGER_COUNT;
-    return boolean ? instance->model.boolean : instance->model.integer;
+    return boolean ? model_of(instance)->boolean : model_of(instance)->integer;
 }
 
 static const char* int_name(int boolean, fmi2ValueReference vr) {
@@ -170,7 +173,7 @@ static const char* int_name(int boolean, fmi2ValueReference vr) {
 static int int_reference_known(const Instance* instance, const char* function, fmi2ValueReference vr, int count,
                                int boolean) {
     if (vr < (unsigned)count) return 1;
-    cosim_log_error(&instance->common, "%s: value reference %u is not a%s variable", function, (unsigned)vr,
+    fmi_log_error(instance, "%s: value reference %u is not a%s variable", function, (unsigned)vr,
               boolean ? " Boolean" : "n Integer");
     return 0;
 }
@@ -184,8 +187,8 @@ static fmi2Status set_ints(fmi2Component c, const char* function, const fmi2Valu
     for (size_t i = 0; i < nvr; ++i) {
         if (!int_reference_known(instance, function, vr[i], count, boolean)) return fmi2Error;
         if (!settable(instance, 1)) {
-            cosim_log_error(&instance->common, "%s: %s cannot be set in state '%s'", function, int_name(boolean, vr[i]),
-                      cosim_state_name(instance->common.state));
+            fmi_log_error(instance, "%s: %s cannot be set in state '%s'", function, int_name(boolean, vr[i]),
+                      instance->face->state_name(instance->state));
             return fmi2Error;
         }
     }
@@ -212,22 +215,19 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boole
     (void)no_set_prior_state;
     Instance* instance = usable(c, "fmi2DoStep", STATE_STEP_COMPLETE);
     if (instance == NULL) return fmi2Error;
-    if (!(h > 0.0) || !isfinite(h)) {
-        cosim_log_error(&instance->common, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", h);
-        return fmi2Error;
-    }
-    /* The master's point becomes the FMU's time (communication_point.h). */
-    if (!communication_point_matches(instance->time, t, h)) {
-        cosim_log_error(&instance->common, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", t,
-                  instance->time);
-        return fmi2Error;
-    }
+    if (!fmi_step_valid(instance, "fmi2DoStep", t, h)) return fmi2Error;
     const double end = t + h;
-    if (instance->stop_time_defined && communication_step_passes_stop_time(end, instance->stop_time, h)) {
-        cosim_log_error(&instance->common, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end, instance->stop_time);
+    ControllerModel* model = model_of(instance);
+    controller_model_step(model, h);
+    /* A step far below the controller's sampling (h = 5e-324: its backward differences divide by h)
+     * or gains that overflow leave no usable command: the host gets an error, never a NaN voltage. */
+    for (int k = OUT_U_R1; k <= OUT_BETA_REF; ++k) {
+        if (isfinite(model->real[k])) continue;
+        fmi_log_error(instance, "fmi2DoStep: %s = %g after the step of %g s: the controller cannot continue (fmi2Reset)",
+                      kControllerReals[k].name, model->real[k], h);
+        instance->state = STATE_ERROR;
         return fmi2Error;
     }
-    controller_model_step(&instance->model, h);
     instance->time = end;
     return fmi2OK;
 }

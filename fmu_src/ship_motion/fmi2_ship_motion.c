@@ -16,10 +16,9 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
+#include <string.h>
 
-#include "communication_point.h"
-#include "cosim_instance.h"
-#include "fmi2Functions.h"
+#include "fmi_layer/fmi2_face.h"
 #include "gimbal_kernel/recorded_motion.h"
 #include "host_fp_environment.h"
 #include "recording_file.h"
@@ -28,7 +27,7 @@
 #include "ship_motion_variables.h"
 
 typedef struct {
-    CosimInstance common; /* first: cosim_instantiate allocates the Instance around it */
+    FmiInstance common; /* first: fmi_instantiate allocates the Instance around it */
     ShipMotionParameters parameters;
     char* recording_file;             /* the String parameter's value, the instance's copy */
     char* resources;                  /* the resources folder, NULL when fmuResourceLocation names none */
@@ -36,29 +35,49 @@ typedef struct {
     GimbalRecordedMotion* recording; /* motion = 1: the file's splines, once prepared */
     int prepared;       /* motion or recording holds what `parameters` say */
     double start_time;
-    double time;        /* the master's last communication point plus its step (communication_point.h) */
     double step;        /* 0 until the first doStep */
     long row;           /* the grid row of the current communication point */
     double outputs[SHIP_MOTION_OUTPUTS];
-    int stop_time_defined;
-    double stop_time;
     fmi2Status last_step_status;
 } Instance;
-_Static_assert(offsetof(Instance, common) == 0, "the CosimInstance must be the Instance's first member");
+_Static_assert(offsetof(Instance, common) == 0, "the FmiInstance must be the Instance's first member");
 
 /* Below this fraction of the grid's step, a step is the master's clock rounding (see impl_DoStep). */
 static const double kClockRoundingOfStep = 1e-6;
 
-#define REFUSE(instance, ...) return cosim_refuse(&(instance)->common, __VA_ARGS__)
+#define REFUSE(instance, ...)                               \
+    do {                                                    \
+        fmi_log_error(&(instance)->common, __VA_ARGS__);    \
+        return fmi2Error;                                   \
+    } while (0)
 
 /* NULL-safe: is `function` allowed in the instance's state (a mask of InstanceState)? */
 static int allowed(Instance* instance, const char* function, int states) {
-    return instance != NULL && cosim_allowed(&instance->common, function, states);
+    return instance != NULL && fmi_allowed(&instance->common, function, states);
 }
 
 static int not_null(Instance* instance, const char* function, const void* pointer, const char* argument) {
-    return cosim_not_null(&instance->common, function, pointer, argument);
+    return fmi_not_null(&instance->common, function, pointer, argument);
 }
+
+static char* copy_text(const char* text) {
+    char* copy = (char*)malloc(strlen(text) + 1);
+    if (copy != NULL) strcpy(copy, text);
+    return copy;
+}
+
+/* The model's fields follow the FmiInstance: fmi_instantiate allocates them, zeroed; the instance's
+ * own setup (its resources folder, the start values) is fmi2Instantiate's. */
+static void* model_fields(FmiInstance* instance) { return instance; }
+static void no_own_allocation(void* model) { (void)model; }
+
+static const char* const kLogCategories[] = {"logStatusError", "logAll"};
+
+/* canGetAndSetFMUstate is false: the FMU-state calls are refused before they reach the layer. */
+static const FmiModel kShipMotionModel = {
+    SHIP_MOTION_GUID, sizeof(Instance), kLogCategories, (int)(sizeof kLogCategories / sizeof kLogCategories[0]),
+    model_fields, no_own_allocation, NULL, NULL, NULL, NULL, NULL,
+};
 
 static const int kGetStates = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR;
 static const int kSetStates = STATE_INSTANTIATED | STATE_INITIALIZATION;
@@ -79,19 +98,19 @@ static fmi2Status prepare_recording(Instance* instance, const char* function) {
     const int status = gimbal_recorded_motion_read(text, length, &instance->recording, message, sizeof message);
     free(text);
     if (status != GIMBAL_RECORDED_MOTION_READ) {
-        cosim_log_error(&instance->common, "%s: recorded motion %s: %s", function, path, message);
+        fmi_log_error(&instance->common, "%s: recorded motion %s: %s", function, path, message);
         free(path);
         return fmi2Error;
     }
     const double start = gimbal_recorded_motion_start(instance->recording);
     const double end = gimbal_recorded_motion_end(instance->recording);
-    const double duration = instance->stop_time - instance->start_time;
-    if (start > 0.0 || (instance->stop_time_defined && end < duration)) {
-        if (instance->stop_time_defined)
-            cosim_log_error(&instance->common, "%s: recorded motion %s covers [%g, %g] s, not [0, %g] s",
+    const double duration = instance->common.stop_time - instance->start_time;
+    if (start > 0.0 || (instance->common.stop_time_defined && end < duration)) {
+        if (instance->common.stop_time_defined)
+            fmi_log_error(&instance->common, "%s: recorded motion %s covers [%g, %g] s, not [0, %g] s",
                         function, path, start, end, duration);
         else
-            cosim_log_error(&instance->common,
+            fmi_log_error(&instance->common,
                         "%s: recorded motion %s covers [%g, %g] s, not t = 0, where the outputs start", function, path,
                         start, end);
         free(path);
@@ -105,6 +124,19 @@ static fmi2Status prepare_recording(Instance* instance, const char* function) {
     return fmi2OK;
 }
 
+/* Parameters that pass their checks can still give no finite motion (amplitudes near the largest
+ * double, whose rates and accelerations overflow): the row is refused, naming the first output that
+ * is not finite, and the outputs keep their last values; the host never reads a NaN. */
+static int finite_row(Instance* instance, const double row[], const char* function, double time) {
+    for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) {
+        if (isfinite(row[k])) continue;
+        fmi_log_error(&instance->common, "%s: %s = %g at t = %.17g: the sea state's parameters give no finite motion",
+                      function, kShipRealVariables[k].name, row[k], time);
+        return 0;
+    }
+    return 1;
+}
+
 /* What the current parameters say (the sea state's components or the recording), and row 0 (the
  * outputs before the first step). */
 static fmi2Status prepare(Instance* instance, const char* function) {
@@ -115,8 +147,14 @@ static fmi2Status prepare(Instance* instance, const char* function) {
         REFUSE(instance, "%s: %s", function, message);
     if (ship_motion_prepare(&instance->motion, &instance->parameters, 0.0) != 0)
         REFUSE(instance, "%s: out of memory for the sea state's components", function);
+    double row[SHIP_MOTION_OUTPUTS];
+    ship_motion_row(&instance->motion, 0, row);
+    if (!finite_row(instance, row, function, instance->start_time)) {
+        ship_motion_release(&instance->motion);
+        return fmi2Error;
+    }
     instance->prepared = 1;
-    ship_motion_row(&instance->motion, 0, instance->outputs);
+    memcpy(instance->outputs, row, sizeof row);
     return fmi2OK;
 }
 
@@ -132,23 +170,25 @@ static void unprepare(Instance* instance) {
 static fmi2Status impl_SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                        const fmi2String categories[]) {
     Instance* instance = (Instance*)c;
-    return instance != NULL ? cosim_set_debug_logging(&instance->common, loggingOn, nCategories, categories) : fmi2Error;
+    if (instance == NULL) return fmi2Error;
+    return (fmi2Status)fmi_set_debug_logging(&instance->common, "fmi2SetDebugLogging", loggingOn != fmi2False, nCategories,
+                                             categories);
 }
 
 /* 0, or -1 when out of memory (the recording file's value then stays as it was). */
 static int reset_instance(Instance* instance) {
     unprepare(instance);
-    char* file = cosim_copy_text(kShipStringVariables[SHIP_STRING_RECORDING_FILE].start);
+    char* file = copy_text(kShipStringVariables[SHIP_STRING_RECORDING_FILE].start);
     if (file == NULL) return -1;
     free(instance->recording_file);
     instance->recording_file = file;
     ship_motion_start_parameters(&instance->parameters);
     instance->start_time = 0.0;
-    instance->time = 0.0;
+    instance->common.time = 0.0;
     instance->step = 0.0;
     instance->row = 0;
-    instance->stop_time_defined = 0;
-    instance->stop_time = 0.0;
+    instance->common.stop_time_defined = 0;
+    instance->common.stop_time = 0.0;
     instance->last_step_status = fmi2OK;
     for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) instance->outputs[k] = 0.0;
     instance->common.state = STATE_INSTANTIATED;
@@ -159,15 +199,15 @@ static fmi2Component impl_Instantiate(fmi2String instanceName, fmi2Type fmuType,
                                       fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
                                       fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)visible;
-    Instance* instance = (Instance*)cosim_instantiate(sizeof(Instance), instanceName, fmuType, fmuGUID, SHIP_MOTION_GUID,
-                                                      functions, loggingOn);
+    Instance* instance =
+        (Instance*)fmi2_instantiate(&kShipMotionModel, 0, instanceName, fmuType, fmuGUID, functions, loggingOn);
     if (instance == NULL) return NULL;
     /* No resources folder is no error here: only a relative recording_file needs one. */
     instance->resources = recording_resources_folder(fmuResourceLocation);
     if (reset_instance(instance) != 0) {
-        cosim_log_error(&instance->common, "fmi2Instantiate: out of memory");
+        fmi_log_error(&instance->common, "fmi2Instantiate: out of memory");
         free(instance->resources);
-        cosim_free(&instance->common);
+        fmi_free_instance(&instance->common);
         return NULL;
     }
     return instance;
@@ -179,7 +219,7 @@ static void impl_FreeInstance(fmi2Component c) {
     unprepare(instance);
     free(instance->recording_file);
     free(instance->resources);
-    cosim_free(&instance->common);
+    fmi_free_instance(&instance->common);
 }
 
 /* ---------------------------------------------------------------- initialization and termination */
@@ -190,13 +230,13 @@ static fmi2Status impl_SetupExperiment(fmi2Component c, fmi2Boolean toleranceDef
     (void)toleranceDefined;
     (void)tolerance; /* the motion is exact: no tolerance to meet */
     if (!allowed(instance, "fmi2SetupExperiment", STATE_INSTANTIATED)) return fmi2Error;
-    if (!isfinite(startTime) || (stopTimeDefined && (!isfinite(stopTime) || stopTime < startTime)))
-        REFUSE(instance, "fmi2SetupExperiment: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
-               startTime, stopTime);
+    if (!fmi_experiment_times_valid(&instance->common, "fmi2SetupExperiment", startTime, stopTimeDefined != fmi2False,
+                                    stopTime))
+        return fmi2Error;
     instance->start_time = startTime;
-    instance->time = startTime;
-    instance->stop_time_defined = stopTimeDefined ? 1 : 0;
-    instance->stop_time = stopTime;
+    instance->common.time = startTime;
+    instance->common.stop_time_defined = stopTimeDefined ? 1 : 0;
+    instance->common.stop_time = stopTime;
     return fmi2OK;
 }
 
@@ -213,7 +253,7 @@ static fmi2Status impl_ExitInitializationMode(fmi2Component c) {
     /* Refused parameters leave the instance in initialization mode: the master may correct them. */
     if (prepare(instance, "fmi2ExitInitializationMode") != fmi2OK) return fmi2Error;
     instance->row = 0;
-    instance->time = instance->start_time;
+    instance->common.time = instance->start_time;
     instance->common.state = STATE_STEP_COMPLETE;
     return fmi2OK;
 }
@@ -273,21 +313,21 @@ static fmi2Status impl_GetInteger(fmi2Component c, const fmi2ValueReference vr[]
 /* A value the variable's bounds (and those the XML cannot say: > min, finite) refuse, named; 0 if fine. */
 static int real_refused(Instance* instance, const char* function, fmi2ValueReference vr, double value) {
     if (vr >= SHIP_REAL_COUNT) {
-        cosim_log_error(&instance->common, "%s: value reference %u is not a Real variable", function,
+        fmi_log_error(&instance->common, "%s: value reference %u is not a Real variable", function,
                     (unsigned)vr);
         return 1;
     }
     const ShipRealVariable* variable = &kShipRealVariables[vr];
     if (variable->causality == SHIP_OUTPUT) {
-        cosim_log_error(&instance->common, "%s: %s is an output and cannot be set", function, variable->name);
+        fmi_log_error(&instance->common, "%s: %s is an output and cannot be set", function, variable->name);
         return 1;
     }
     if (!isfinite(value)) {
-        cosim_log_error(&instance->common, "%s: %s = %g must be finite", function, variable->name, value);
+        fmi_log_error(&instance->common, "%s: %s = %g must be finite", function, variable->name, value);
         return 1;
     }
     if (variable->min_exclusive ? !(value > variable->min) : !(value >= variable->min)) {
-        cosim_log_error(&instance->common, "%s: %s = %.17g must be %s %g", function, variable->name,
+        fmi_log_error(&instance->common, "%s: %s = %.17g must be %s %g", function, variable->name,
                     value, variable->min_exclusive ? ">" : ">=", variable->min);
         return 1;
     }
@@ -348,7 +388,7 @@ static fmi2Status impl_SetString(fmi2Component c, const fmi2ValueReference vr[],
             REFUSE(instance, "fmi2SetString: the value of %s is a null pointer", kShipStringVariables[vr[i]].name);
     }
     for (size_t i = 0; i < nvr; ++i) {
-        char* copy = cosim_copy_text(value[i]);
+        char* copy = copy_text(value[i]);
         if (copy == NULL) REFUSE(instance, "fmi2SetString: out of memory for %s", kShipStringVariables[vr[i]].name);
         free(instance->recording_file);
         instance->recording_file = copy;
@@ -368,27 +408,37 @@ static fmi2Status no_variables(Instance* instance, const char* function, int sta
 
 /* ---------------------------------------------------------------- stepping */
 
+/* fmi2DoStep of motion = 1: the recording's splines at the next row's time. */
+static fmi2Status step_recording(Instance* instance, double step, double end_time) {
+    /* The grid's time, not the master's: the motion starts at t = 0 whatever startTime is. */
+    const double motion_time = (double)(instance->row + 1) * step;
+    const double end = gimbal_recorded_motion_end(instance->recording);
+    if (motion_time > end + 1e-12 * fmax(1.0, fabs(end)) + 1e-6 * step)
+        REFUSE(instance, "fmi2DoStep: step to t = %.17g s (the recording's time %.17g s) passes the recording's end at %.17g s",
+               end_time, motion_time, end);
+    instance->step = step;
+    instance->row += 1;
+    instance->common.time = end_time;
+    gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
+    instance->last_step_status = fmi2OK;
+    return fmi2OK;
+}
+
 static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                               fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Instance* instance = (Instance*)c;
     (void)noSetFMUStatePriorToCurrentPoint;
     if (!allowed(instance, "fmi2DoStep", STATE_STEP_COMPLETE)) return fmi2Error;
-    if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
-        REFUSE(instance, "fmi2DoStep: communicationStepSize = %g must be finite and > 0", communicationStepSize);
-    /* The master's point becomes the FMU's time (communication_point.h); the outputs stay the rows of
-     * the grid, counted, whatever clock the master keeps. */
-    if (!communication_point_matches(instance->time, currentCommunicationPoint, communicationStepSize))
-        REFUSE(instance, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
-               currentCommunicationPoint, instance->time);
+    /* The master's point becomes the FMU's time; the outputs stay the rows of the grid, counted,
+     * whatever clock the master keeps. */
+    if (!fmi_step_valid(&instance->common, "fmi2DoStep", currentCommunicationPoint, communicationStepSize))
+        return fmi2Error;
     const double end_time = currentCommunicationPoint + communicationStepSize;
-    if (instance->stop_time_defined &&
-        communication_step_passes_stop_time(end_time, instance->stop_time, communicationStepSize))
-        REFUSE(instance, "fmi2DoStep: step to t = %.17g passes the stopTime %.17g", end_time, instance->stop_time);
     /* A master whose clock rounds differently from its step (an SSP engine that ends on its stop time
      * with a last step of 5e-11 s) takes a step far below the grid's: the clock's rounding, not a
      * step. The rows stay where they are; only the time follows the master. */
     if (instance->step != 0.0 && communicationStepSize < kClockRoundingOfStep * instance->step) {
-        instance->time = end_time;
+        instance->common.time = end_time;
         instance->last_step_status = fmi2OK;
         return fmi2OK;
     }
@@ -401,20 +451,7 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
                communicationStepSize, instance->step);
     const double step = instance->step != 0.0 ? instance->step : communicationStepSize;
     if (instance->row >= LONG_MAX - 1) REFUSE(instance, "fmi2DoStep: the grid's %ld rows are used up", instance->row);
-    if (instance->recording != NULL) {
-        /* The grid's time, not the master's: the motion starts at t = 0 whatever startTime is. */
-        const double motion_time = (double)(instance->row + 1) * step;
-        const double end = gimbal_recorded_motion_end(instance->recording);
-        if (motion_time > end + 1e-12 * fmax(1.0, fabs(end)) + 1e-6 * step)
-            REFUSE(instance, "fmi2DoStep: step to t = %.17g s (the recording's time %.17g s) passes the recording's end at %.17g s",
-                   end_time, motion_time, end);
-        instance->step = step;
-        instance->row += 1;
-        instance->time = end_time;
-        gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
-        instance->last_step_status = fmi2OK;
-        return fmi2OK;
-    }
+    if (instance->recording != NULL) return step_recording(instance, step, end_time);
     if (instance->step == 0.0) {
         if (ship_motion_set_step(&instance->motion, step) != 0) {
             instance->common.state = STATE_ERROR;
@@ -423,9 +460,16 @@ static fmi2Status impl_DoStep(fmi2Component c, fmi2Real currentCommunicationPoin
         }
         instance->step = step;
     }
+    double row[SHIP_MOTION_OUTPUTS];
+    ship_motion_row(&instance->motion, instance->row + 1, row);
+    if (!finite_row(instance, row, "fmi2DoStep", end_time)) {
+        instance->common.state = STATE_ERROR;
+        instance->last_step_status = fmi2Error;
+        return fmi2Error;
+    }
     instance->row += 1;
-    instance->time = end_time;
-    ship_motion_row(&instance->motion, instance->row, instance->outputs);
+    instance->common.time = end_time;
+    memcpy(instance->outputs, row, sizeof row);
     instance->last_step_status = fmi2OK;
     return fmi2OK;
 }
@@ -446,7 +490,7 @@ static fmi2Status impl_GetRealStatus(fmi2Component c, const fmi2StatusKind s, fm
         !not_null(instance, "fmi2GetRealStatus", value, "value"))
         return fmi2Error;
     if (s != fmi2LastSuccessfulTime) REFUSE(instance, "fmi2GetRealStatus: status kind %d is not a Real status", (int)s);
-    *value = instance->time;
+    *value = instance->common.time;
     return fmi2OK;
 }
 

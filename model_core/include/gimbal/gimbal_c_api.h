@@ -2,7 +2,7 @@
  * The core knows variables, physics and integration; the wrapper knows the FMI state machine.
  * No function lets a C++ exception out: each returns GIMBAL_ERROR (with a logged reason) instead.
  * The core speaks no interface's language: its messages name no FMI function, and the wrapper that
- * calls it prefixes the function it serves (fmu_src/fmi2_cosim.c, core_log).
+ * calls it prefixes the function it serves (fmu_src/gimbal_fmu/gimbal_model.c, core_log).
  * Every GimbalCore* argument must come from gimbal_core_create; NULL is refused. */
 #ifndef GIMBAL_C_API_H
 #define GIMBAL_C_API_H

@@ -1,33 +1,29 @@
-/* FMI 3.0 face of the core (Model Exchange and Co-Simulation), beside the FMI 2.0 one: the same core C
- * API (gimbal_c_api.h), the same checks and wording, FMI 3.0's state machine and types.
+/* The gimbal's FMI 3.0 face (Model Exchange and Co-Simulation), beside the FMI 2.0 one: FMI 3.0's state
+ * machine, types and value references over the FMI instance layer (fmi_layer/fmi_instance.h) and the
+ * core's C interface (gimbal_c_api.h).
  *
- * Value references (docs/fmi_interfaces.md): a Float64 is the core's Real of the same reference, an
- * Int32 or Enumeration the core's Integer at FMI3_INTEGER_BASE + its reference, a Boolean the core's
- * Boolean at FMI3_BOOLEAN_BASE + its reference; FMI3_TIME is the independent variable and the 36 event
- * indicators are scalar Float64 locals from FMI3_FIRST_EVENT_INDICATOR on (scalars, not one array: a host
- * without array support reads each Float64 as one value). Enumerations are accessed with
- * fmi3GetInt64/fmi3SetInt64, as FMI 3.0 says; the model has no other types.
+ * Value references: gimbal_model.h (FMI3_INTEGER_BASE ...). The event indicators are scalar Float64
+ * locals, not one array: a host without array support reads each Float64 as one value. Enumerations
+ * are accessed with fmi3GetInt64/fmi3SetInt64, as FMI 3.0 says; the model has no other types.
  *
  * Co-Simulation handles every mode change inside fmi3DoStep; an importer that allows an early return
  * gets the step back right after the first one (earlyReturn, and eventHandlingNeeded if it uses Event
  * Mode, where there is no discrete state left to update). */
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "fmi3Functions.h"
-#include "fmu_state.h"
-#include "gimbal_guid.h"
-#include "gimbal/gimbal_c_api.h"
+#include "gimbal_model.h"
 #include "host_fp_environment.h"
-#include "common/communication_point.h"
 
-enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_TIME = 3001, FMI3_FIRST_EVENT_INDICATOR = 3002 };
 _Static_assert(sizeof(fmi3ValueReference) == sizeof(unsigned), "value references are passed to the core as unsigned");
+_Static_assert((int)fmi3OK == (int)FMI_OK && (int)fmi3Warning == (int)FMI_WARNING &&
+                   (int)fmi3Discard == (int)FMI_DISCARD && (int)fmi3Error == (int)FMI_ERROR &&
+                   (int)fmi3Fatal == (int)FMI_FATAL,
+               "fmi3Status is the layer's status");
 
+/* The bits are those FMU-state records of the FMI 3.0 binary hold. */
 typedef enum {
     S_INSTANTIATED = 1 << 0,
     S_INITIALIZATION = 1 << 1,
@@ -46,71 +42,7 @@ typedef enum {
 #define S_FMU_STATE (S_INSTANTIATED | S_INITIALIZATION | S_RUNNING | S_TERMINATED)
 #define S_EVALUATE (S_EVENT | S_CONTINUOUS_TIME | S_TERMINATED | S_ERROR)
 
-enum { LOG_CATEGORIES = 6 };
-static const char* const kCategories[LOG_CATEGORIES] = {"logEvents", "logSolver", "logStatusWarning",
-                                                         "logStatusDiscard", "logStatusError", "logAll"};
-
-typedef struct {
-    fmi3LogMessageCallback log;
-    fmi3InstanceEnvironment environment;
-    char* name;
-    int model_exchange;
-    int event_mode_used;
-    int early_return_allowed;
-    GimbalCore* core;
-    State3 state;
-    int category_enabled[LOG_CATEGORIES];
-    double time;
-    double stop_time;
-    int stop_time_defined;
-    FmuStateRegistry states;
-    const char* calling; /* prefixes the core's messages */
-} GimbalFmi3Instance;
-
-static int category_index(const char* category) {
-    for (int k = 0; k < LOG_CATEGORIES; ++k)
-        if (strcmp(category, kCategories[k]) == 0) return k;
-    return -1;
-}
-
-static int enabled(const GimbalFmi3Instance* i, const char* category) {
-    const int index = category_index(category);
-    return (index >= 0 && i->category_enabled[index]) || i->category_enabled[LOG_CATEGORIES - 1];
-}
-
-static void log_to_host(const GimbalFmi3Instance* i, fmi3Status status, const char* category, const char* format, ...) {
-    if (i == NULL || i->log == NULL) return;
-    if (status < fmi3Discard && !enabled(i, category)) return;
-    char text[1024];
-    va_list args;
-    va_start(args, format);
-    vsnprintf(text, sizeof text, format, args);
-    va_end(args);
-    i->log(i->environment, status, category, text);
-}
-
-static void core_log(void* context, GimbalStatus status, const char* category, const char* message) {
-    static const fmi3Status kStatus[] = {fmi3OK, fmi3Warning, fmi3Discard, fmi3Error};
-    const GimbalFmi3Instance* i = (const GimbalFmi3Instance*)context;
-    if (i->calling != NULL) log_to_host(i, kStatus[status], category, "%s: %s", i->calling, message);
-    else log_to_host(i, kStatus[status], category, "%s", message);
-}
-
-static int core_log_enabled(void* context, const char* category) {
-    const GimbalFmi3Instance* i = (const GimbalFmi3Instance*)context;
-    return i->log != NULL && enabled(i, category);
-}
-
-static fmi3Status from_core(GimbalStatus status) {
-    switch (status) {
-        case GIMBAL_OK: return fmi3OK;
-        case GIMBAL_WARNING: return fmi3Warning;
-        case GIMBAL_DISCARD: return fmi3Discard;
-        default: return fmi3Error;
-    }
-}
-
-static const char* state_name(State3 s) {
+static const char* state_name(int s) {
     switch (s) {
         case S_INSTANTIATED: return "instantiated";
         case S_INITIALIZATION: return "initialization mode";
@@ -123,116 +55,63 @@ static const char* state_name(State3 s) {
     }
 }
 
-/* The state check of every function; names the function for the core's messages. */
-static int allowed(GimbalFmi3Instance* i, const char* function, int states) {
-    if (i == NULL) return 0;
-    if (i->state & states) {
-        i->calling = function;
-        return 1;
-    }
-    log_to_host(i, fmi3Error, "logStatusError", "%s is not allowed in state '%s'", function, state_name(i->state));
-    return 0;
+static void deliver(const FmiInstance* instance, FmiStatus status, const char* category, const char* message) {
+    ((fmi3LogMessageCallback)instance->logger)(instance->environment, (fmi3Status)status, category, message);
 }
 
-static int not_null(GimbalFmi3Instance* i, const char* function, const void* pointer, const char* argument) {
-    if (pointer != NULL) return 1;
-    log_to_host(i, fmi3Error, "logStatusError", "%s: argument %s is a null pointer", function, argument);
-    return 0;
+/* FMI 3.0's header records no step status; the interface an instance serves shows in its state. */
+static const FmiFace kFmi3Face = {
+    .deliver = deliver,
+    .logger_formats_message = 0,
+    .instantiated_state = S_INSTANTIATED,
+    .any_state = S_ANY,
+    .error_state = S_ERROR,
+    .before_initialized_states = S_INSTANTIATED | S_INITIALIZATION,
+    .state_name = state_name,
+    .state_magic = STATE_MAGIC_FMI3,
+    .state_rules = {S_FMU_STATE, S_RUNNING | S_TERMINATED, -1, 0, S_CONTINUOUS_TIME, S_STEP | S_STEP_DISCARDED,
+                    state_name},
+    .get_fmu_state = "fmi3GetFMUState",
+    .deserialize_fmu_state = "fmi3DeserializeFMUState",
+    .fmu_state_argument = "FMUState",
+};
+
+
+static fmi3Status refuse(FmiInstance* i, const char* function, const char* why) {
+    return (fmi3Status)fmi_refuse(i, function, why);
 }
 
-static fmi3Status refuse(GimbalFmi3Instance* i, const char* function, const char* why) {
-    if (i != NULL) log_to_host(i, fmi3Error, "logStatusError", "%s: %s", function, why);
-    return fmi3Error;
-}
+static fmi3Status from_core(GimbalStatus status) { return (fmi3Status)gimbal_status(status); }
 
 /* ---------------------------------------------------------------- lifetime */
 
 static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exchange, int event_mode_used,
-                                int early_return_allowed, fmi3Boolean loggingOn, fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
-                                const char* function) {
-    if (log == NULL) return NULL; /* nowhere to say why */
-    GimbalFmi3Instance probe;
+                                int early_return_allowed, fmi3Boolean loggingOn, fmi3InstanceEnvironment environment,
+                                fmi3LogMessageCallback log, const char* function) {
+    FmiInstance probe;
     memset(&probe, 0, sizeof probe);
-    probe.log = log;
+    probe.face = &kFmi3Face;
+    probe.model = &kGimbalModel;
+    probe.logger = (FmiHostLogger)log;
     probe.environment = environment;
-    if (name == NULL || name[0] == '\0') {
-        log_to_host(&probe, fmi3Error, "logStatusError", "%s: instanceName must be a non-empty string", function);
-        return NULL;
-    }
-    if (token == NULL || strcmp(token, GIMBAL_GUID) != 0) {
-        log_to_host(&probe, fmi3Error, "logStatusError", "%s: instantiationToken '%s' does not match this FMU's '%s'", function,
-            token != NULL ? token : "(null)", GIMBAL_GUID);
-        return NULL;
-    }
-    GimbalFmi3Instance* i = (GimbalFmi3Instance*)calloc(1, sizeof(GimbalFmi3Instance));
-    char* copy = (char*)malloc(strlen(name) + 1);
-    if (i == NULL || copy == NULL) {
-        free(i);
-        free(copy);
-        log_to_host(&probe, fmi3Error, "logStatusError", "%s: out of memory", function);
-        return NULL;
-    }
-    strcpy(copy, name);
-    i->log = log;
-    i->environment = environment;
-    i->name = copy;
-    i->model_exchange = model_exchange;
-    i->event_mode_used = event_mode_used;
-    i->early_return_allowed = early_return_allowed;
-    for (int k = 0; k < LOG_CATEGORIES; ++k) i->category_enabled[k] = loggingOn ? 1 : 0;
-    i->calling = function;
-    i->core = gimbal_core_create(core_log, core_log_enabled, i);
-    if (i->core != NULL && model_exchange && gimbal_core_use_continuous_time(i->core) != GIMBAL_OK) {
-        gimbal_core_destroy(i->core);
-        i->core = NULL;
-    }
-    if (i->core == NULL) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: out of memory", function);
-        free(copy);
-        free(i);
-        return NULL;
-    }
-    i->state = S_INSTANTIATED;
-    return i;
+    probe.name = (char*)name;
+    probe.model_exchange = model_exchange;
+    probe.event_mode_used = event_mode_used;
+    probe.early_return_allowed = early_return_allowed;
+    return fmi_instantiate(&probe, function, NULL, token, "instantiationToken", loggingOn ? 1 : 0);
 }
 
-static void free_instance(GimbalFmi3Instance* i) {
-    if (i == NULL) return;
-    fmu_states_release_all(&i->states);
-    gimbal_core_destroy(i->core);
-    free(i->name);
-    free(i);
+static fmi3Status set_debug_logging(FmiInstance* i, fmi3Boolean on, size_t n, const fmi3String categories[]) {
+    if (i == NULL) return fmi3Error;
+    return (fmi3Status)fmi_set_debug_logging(i, "fmi3SetDebugLogging", on ? 1 : 0, n, categories);
 }
 
-static fmi3Status set_debug_logging(GimbalFmi3Instance* i, fmi3Boolean on, size_t n, const fmi3String categories[]) {
-    if (!allowed(i, "fmi3SetDebugLogging", S_ANY)) return fmi3Error;
-    if (n == 0) {
-        for (int k = 0; k < LOG_CATEGORIES; ++k) i->category_enabled[k] = on ? 1 : 0;
-        return fmi3OK;
-    }
-    if (!not_null(i, "fmi3SetDebugLogging", categories, "categories")) return fmi3Error;
-    for (size_t k = 0; k < n; ++k) {
-        const int index = categories[k] != NULL ? category_index(categories[k]) : -1;
-        if (index < 0) {
-            log_to_host(i, fmi3Error, "logStatusError", "fmi3SetDebugLogging: unknown log category '%s'",
-                categories[k] != NULL ? categories[k] : "(null)");
-            return fmi3Error;
-        }
-        i->category_enabled[index] = on ? 1 : 0;
-    }
-    return fmi3OK;
-}
-
-static fmi3Status enter_initialization(GimbalFmi3Instance* i, fmi3Boolean tolerance_defined, fmi3Float64 tolerance,
+static fmi3Status enter_initialization(FmiInstance* i, fmi3Boolean tolerance_defined, fmi3Float64 tolerance,
                                        fmi3Float64 start, fmi3Boolean stop_defined, fmi3Float64 stop) {
     const char* f = "fmi3EnterInitializationMode";
-    if (!allowed(i, f, S_INSTANTIATED)) return fmi3Error;
-    if (!isfinite(start) || (stop_defined && (!isfinite(stop) || stop < start))) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: startTime = %g, stopTime = %g: times must be finite and stopTime >= startTime",
-            f, start, stop);
+    if (!fmi_allowed(i, f, S_INSTANTIATED) || !fmi_experiment_times_valid(i, f, start, stop_defined ? 1 : 0, stop))
         return fmi3Error;
-    }
-    const fmi3Status status = from_core(gimbal_core_set_master_tolerance(i->core, tolerance_defined ? 1 : 0, tolerance));
+    const fmi3Status status = from_core(gimbal_core_set_master_tolerance(gimbal_core_of(i), tolerance_defined ? 1 : 0, tolerance));
     if (status > fmi3Warning) return status;
     i->time = start;
     i->stop_time = stop;
@@ -241,11 +120,11 @@ static fmi3Status enter_initialization(GimbalFmi3Instance* i, fmi3Boolean tolera
     return fmi3OK;
 }
 
-static fmi3Status exit_initialization(GimbalFmi3Instance* i) {
-    if (!allowed(i, "fmi3ExitInitializationMode", S_INITIALIZATION)) return fmi3Error;
-    const fmi3Status status = from_core(gimbal_core_initialize(i->core, i->time));
+static fmi3Status exit_initialization(FmiInstance* i) {
+    if (!fmi_allowed(i, "fmi3ExitInitializationMode", S_INITIALIZATION)) return fmi3Error;
+    const fmi3Status status = from_core(gimbal_core_initialize(gimbal_core_of(i), i->time));
     if (status > fmi3Warning) {
-        log_to_host(i, fmi3Error, "logStatusError", "fmi3ExitInitializationMode: initialization refused; fix the values above and retry");
+        fmi_log_error(i, "fmi3ExitInitializationMode: initialization refused; fix the values above and retry");
         return fmi3Error;
     }
     /* Model Exchange, and Co-Simulation with Event Mode, start in event mode (FMI 3.0, 3.2 and 4.2). */
@@ -258,7 +137,7 @@ static fmi3Status exit_initialization(GimbalFmi3Instance* i) {
 typedef enum { KIND_FLOAT64, KIND_INT32, KIND_ENUMERATION, KIND_BOOLEAN } Kind;
 static const char* const kKindName[] = {"Float64", "Int32", "Enumeration (fmi3GetInt64/fmi3SetInt64)", "Boolean"};
 
-/* One of the 36 scalar event indicators (no core variable: the core computes them all at once). */
+/* One of the scalar event indicators (no core variable: the core computes them all at once). */
 static int is_event_indicator(fmi3ValueReference vr) {
     return vr >= FMI3_FIRST_EVENT_INDICATOR && vr < FMI3_FIRST_EVENT_INDICATOR + GIMBAL_EVENT_INDICATORS;
 }
@@ -282,64 +161,59 @@ static int core_variable(fmi3ValueReference vr, Kind* kind, unsigned* core_vr, G
     return 0;
 }
 
-static int settable(const GimbalFmi3Instance* i, const GimbalVariableInfo* info) {
-    if (i->state & (S_INSTANTIATED | S_INITIALIZATION))
-        /* The rotors (initial="approx") stay settable in Initialization Mode as when they were "exact". */
-        return info->causality == GIMBAL_INPUT || info->initial == GIMBAL_INITIAL_EXACT ||
-               info->initial == GIMBAL_INITIAL_APPROX;
-    return info->causality == GIMBAL_INPUT || (info->causality == GIMBAL_PARAMETER && info->variability == GIMBAL_TUNABLE);
+/* The master's inputs at every step: Float64 scalars all settable, found in one pass through the
+ * core's table (check_access's loop then names whatever this refused). */
+static int settable_reals(const FmiInstance* i, const fmi3ValueReference vr[], size_t nvr) {
+    for (size_t k = 0; k < nvr; ++k)
+        if (vr[k] >= FMI3_INTEGER_BASE) return 0;
+    const int initialized = !(i->state & (S_INSTANTIATED | S_INITIALIZATION));
+    return gimbal_first_unsettable(GIMBAL_REAL, (const unsigned*)vr, nvr, initialized) == nvr;
 }
 
-/* The common checks of a getter or setter; `values` and the count of values must match the variables. */
-static int check_access(GimbalFmi3Instance* i, const char* f, int set, Kind kind, const fmi3ValueReference vr[], size_t nvr,
-                        const void* values, size_t nvalues) {
-    if (!allowed(i, f, set ? S_SET : S_GET)) return 0;
-    if (nvr == 0) return 1;
-    if (!not_null(i, f, vr, "valueReferences") || !not_null(i, f, values, "values")) return 0;
-    if (set && kind == KIND_FLOAT64 && nvalues == nvr) {
-        /* The master's inputs at every step: one pass through the core's table (the loop below then
-         * names whatever it refused). */
-        int scalar_reals = 1;
-        for (size_t k = 0; k < nvr && scalar_reals; ++k) scalar_reals = vr[k] < FMI3_INTEGER_BASE;
-        const int initialized = !(i->state & (S_INSTANTIATED | S_INITIALIZATION));
-        if (scalar_reals && gimbal_first_unsettable(GIMBAL_REAL, (const unsigned*)vr, nvr, initialized) == nvr) return 1;
+/* One variable of a getter or setter of `kind`: 1 when it may be accessed so, else logged. */
+static int variable_accessible(FmiInstance* i, const char* f, int set, Kind kind, fmi3ValueReference vr) {
+    if (kind == KIND_FLOAT64 && (is_event_indicator(vr) || vr == FMI3_TIME) && !set) return 1;
+    Kind actual;
+    unsigned core_vr;
+    GimbalVariableInfo info;
+    if (!core_variable(vr, &actual, &core_vr, &info)) {
+        fmi_log_error(i, "%s: value reference %u is not a variable of this FMU%s", f, (unsigned)vr,
+            is_event_indicator(vr) || vr == FMI3_TIME ? " that can be set" : "");
+        return 0;
     }
-    size_t expected = 0;
-    for (size_t k = 0; k < nvr; ++k) {
-        Kind actual;
-        unsigned core_vr;
-        GimbalVariableInfo info;
-        if (kind == KIND_FLOAT64 && (is_event_indicator(vr[k]) || vr[k] == FMI3_TIME) && !set) {
-            ++expected;
-            continue;
-        }
-        if (!core_variable(vr[k], &actual, &core_vr, &info)) {
-            log_to_host(i, fmi3Error, "logStatusError", "%s: value reference %u is not a variable of this FMU%s", f, (unsigned)vr[k],
-                is_event_indicator(vr[k]) || vr[k] == FMI3_TIME ? " that can be set" : "");
-            return 0;
-        }
-        if (actual != kind) {
-            log_to_host(i, fmi3Error, "logStatusError", "%s: %s is a%s %s variable", f, info.name,
-                actual == KIND_INT32 || actual == KIND_ENUMERATION ? "n" : "", kKindName[actual]);
-            return 0;
-        }
-        if (set && !settable(i, &info)) {
-            log_to_host(i, fmi3Error, "logStatusError", "%s: %s cannot be set in state '%s'", f, info.name, state_name(i->state));
-            return 0;
-        }
-        ++expected;
+    if (actual != kind) {
+        fmi_log_error(i, "%s: %s is a%s %s variable", f, info.name,
+            actual == KIND_INT32 || actual == KIND_ENUMERATION ? "n" : "", kKindName[actual]);
+        return 0;
     }
-    if (nvalues != expected) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: nValues = %zu, but the variables hold %zu values", f, nvalues, expected);
+    if (set && !gimbal_variable_settable(i, &info)) {
+        fmi_log_error(i, "%s: %s cannot be set in state '%s'", f, info.name, state_name(i->state));
         return 0;
     }
     return 1;
 }
 
-static fmi3Status get_float64(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
+/* The common checks of a getter or setter; `values` and the count of values must match the variables
+ * (every variable of this FMU is a scalar). */
+static int check_access(FmiInstance* i, const char* f, int set, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+                        const void* values, size_t nvalues) {
+    if (!fmi_allowed(i, f, set ? S_SET : S_GET)) return 0;
+    if (nvr == 0) return 1;
+    if (!fmi_not_null(i, f, vr, "valueReferences") || !fmi_not_null(i, f, values, "values")) return 0;
+    if (set && kind == KIND_FLOAT64 && nvalues == nvr && settable_reals(i, vr, nvr)) return 1;
+    for (size_t k = 0; k < nvr; ++k)
+        if (!variable_accessible(i, f, set, kind, vr[k])) return 0;
+    if (nvalues != nvr) {
+        fmi_log_error(i, "%s: nValues = %zu, but the variables hold %zu values", f, nvalues, nvr);
+        return 0;
+    }
+    return 1;
+}
+
+static fmi3Status get_float64(FmiInstance* i, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[], size_t n) {
     if (!check_access(i, "fmi3GetFloat64", 0, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
     fmi3Float64 indicators[GIMBAL_EVENT_INDICATORS];
-    int indicators_read = 0; /* the core hands out all 36 at once: read them once per call */
+    int indicators_read = 0; /* the core hands out all of them at once: read them once per call */
     for (size_t k = 0; k < nvr; ++k) {
         fmi3Status status = fmi3OK;
         if (vr[k] == FMI3_TIME) {
@@ -351,38 +225,38 @@ static fmi3Status get_float64(GimbalFmi3Instance* i, const fmi3ValueReference vr
                 if (!i->model_exchange) { /* Co-Simulation locates the events itself: no indicator is exposed */
                     for (int z = 0; z < GIMBAL_EVENT_INDICATORS; ++z) indicators[z] = 1.0;
                 } else {
-                    status = from_core(gimbal_core_get_event_indicators(i->core, indicators));
+                    status = from_core(gimbal_core_get_event_indicators(gimbal_core_of(i), indicators));
                     if (status > fmi3Warning) return status;
                 }
                 indicators_read = 1;
             }
             values[k] = indicators[vr[k] - FMI3_FIRST_EVENT_INDICATOR];
         } else {
-            status = from_core(gimbal_core_get_real(i->core, vr[k], &values[k]));
+            status = from_core(gimbal_core_get_real(gimbal_core_of(i), vr[k], &values[k]));
         }
         if (status > fmi3Warning) return status;
     }
     return fmi3OK;
 }
 
-static fmi3Status set_float64(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[], size_t n) {
+static fmi3Status set_float64(FmiInstance* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[], size_t n) {
     if (!check_access(i, "fmi3SetFloat64", 1, KIND_FLOAT64, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) { /* all or nothing */
         if (isfinite(values[k])) continue;
         GimbalVariableInfo info;
         gimbal_variable_info(GIMBAL_REAL, vr[k], &info);
-        log_to_host(i, fmi3Error, "logStatusError", "fmi3SetFloat64: %s = %g refused: values must be finite", info.name, values[k]);
+        fmi_log_error(i, "fmi3SetFloat64: %s = %g refused: values must be finite", info.name, values[k]);
         return fmi3Error;
     }
-    return nvr == 0 ? fmi3OK : from_core(gimbal_core_set_reals(i->core, vr, nvr, values));
+    return nvr == 0 ? fmi3OK : from_core(gimbal_core_set_reals(gimbal_core_of(i), vr, nvr, values));
 }
 
-static fmi3Status get_integers(GimbalFmi3Instance* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+static fmi3Status get_integers(FmiInstance* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
                                void* values, size_t n, int wide) {
     if (!check_access(i, f, 0, kind, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
         int value = 0;
-        const fmi3Status status = from_core(gimbal_core_get_integer(i->core, vr[k] - FMI3_INTEGER_BASE, &value));
+        const fmi3Status status = from_core(gimbal_core_get_integer(gimbal_core_of(i), vr[k] - FMI3_INTEGER_BASE, &value));
         if (status > fmi3Warning) return status;
         if (wide) ((fmi3Int64*)values)[k] = value;
         else ((fmi3Int32*)values)[k] = value;
@@ -390,7 +264,7 @@ static fmi3Status get_integers(GimbalFmi3Instance* i, const char* f, Kind kind, 
     return fmi3OK;
 }
 
-static fmi3Status set_integers(GimbalFmi3Instance* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
+static fmi3Status set_integers(FmiInstance* i, const char* f, Kind kind, const fmi3ValueReference vr[], size_t nvr,
                                const void* values, size_t n, int wide) {
     if (!check_access(i, f, 1, kind, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
@@ -398,207 +272,130 @@ static fmi3Status set_integers(GimbalFmi3Instance* i, const char* f, Kind kind, 
         if (value < INT32_MIN || value > INT32_MAX) {
             GimbalVariableInfo info;
             gimbal_variable_info(GIMBAL_INTEGER, vr[k] - FMI3_INTEGER_BASE, &info);
-            log_to_host(i, fmi3Error, "logStatusError", "%s: %s = %lld lies outside the Int32 range", f, info.name, value);
+            fmi_log_error(i, "%s: %s = %lld lies outside the Int32 range", f, info.name, value);
             return fmi3Error;
         }
     }
     for (size_t k = 0; k < nvr; ++k) {
         const int value = (int)(wide ? ((const fmi3Int64*)values)[k] : ((const fmi3Int32*)values)[k]);
-        const fmi3Status status = from_core(gimbal_core_set_integer(i->core, vr[k] - FMI3_INTEGER_BASE, value));
+        const fmi3Status status = from_core(gimbal_core_set_integer(gimbal_core_of(i), vr[k] - FMI3_INTEGER_BASE, value));
         if (status > fmi3Warning) return status;
     }
     return fmi3OK;
 }
 
-static fmi3Status get_boolean(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
+static fmi3Status get_boolean(FmiInstance* i, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[], size_t n) {
     if (!check_access(i, "fmi3GetBoolean", 0, KIND_BOOLEAN, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
         int value = 0;
-        const fmi3Status status = from_core(gimbal_core_get_boolean(i->core, vr[k] - FMI3_BOOLEAN_BASE, &value));
+        const fmi3Status status = from_core(gimbal_core_get_boolean(gimbal_core_of(i), vr[k] - FMI3_BOOLEAN_BASE, &value));
         if (status > fmi3Warning) return status;
         values[k] = value != 0;
     }
     return fmi3OK;
 }
 
-static fmi3Status set_boolean(GimbalFmi3Instance* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[], size_t n) {
+static fmi3Status set_boolean(FmiInstance* i, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[], size_t n) {
     if (!check_access(i, "fmi3SetBoolean", 1, KIND_BOOLEAN, vr, nvr, values, n)) return fmi3Error;
     for (size_t k = 0; k < nvr; ++k) {
-        const fmi3Status status = from_core(gimbal_core_set_boolean(i->core, vr[k] - FMI3_BOOLEAN_BASE, values[k] ? 1 : 0));
+        const fmi3Status status = from_core(gimbal_core_set_boolean(gimbal_core_of(i), vr[k] - FMI3_BOOLEAN_BASE, values[k] ? 1 : 0));
         if (status > fmi3Warning) return status;
     }
     return fmi3OK;
 }
 
 /* Types the model has no variables of: the state is checked, any value reference refused by name. */
-static fmi3Status no_such_type(GimbalFmi3Instance* i, const char* f, int set, const fmi3ValueReference vr[], size_t nvr) {
-    if (!allowed(i, f, set ? S_SET : S_GET)) return fmi3Error;
+static fmi3Status no_such_type(FmiInstance* i, const char* f, int set, const fmi3ValueReference vr[], size_t nvr) {
+    if (!fmi_allowed(i, f, set ? S_SET : S_GET)) return fmi3Error;
     if (nvr == 0) return fmi3OK;
-    if (!not_null(i, f, vr, "valueReferences")) return fmi3Error;
-    log_to_host(i, fmi3Error, "logStatusError", "%s: value reference %u: the model has no variable of this type", f, (unsigned)vr[0]);
+    if (!fmi_not_null(i, f, vr, "valueReferences")) return fmi3Error;
+    fmi_log_error(i, "%s: value reference %u: the model has no variable of this type", f, (unsigned)vr[0]);
     return fmi3Error;
 }
 
 /* ---------------------------------------------------------------- FMU states */
 
-static size_t record_size(void) { return sizeof(StateHeader) + gimbal_core_snapshot_size(); }
-
-static unsigned char* own_state(GimbalFmi3Instance* i, const char* f, const void* state) {
-    if (state == NULL) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: argument FMUState is a null pointer", f);
-        return NULL;
-    }
-    if (fmu_states_find(&i->states, state) < 0) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: FMUState %p is not an FMU state of instance '%s' (never handed out, or already freed)",
-            f, state, i->name);
-        return NULL;
-    }
-    return (unsigned char*)state;
-}
-
-static const char* state_name_of(int32_t state) { return state_name((State3)state); }
-
-/* FMI 3.0's header records no step status; the interface an instance serves shows in its state. */
-static const FmuStateRules kStateRules = {
-    S_FMU_STATE, S_RUNNING | S_TERMINATED, -1, 0, S_CONTINUOUS_TIME, S_STEP | S_STEP_DISCARDED, state_name_of,
-};
-
-static int valid_record(GimbalFmi3Instance* i, const char* f, const unsigned char* record) {
-    StateHeader header;
-    memcpy(&header, record, sizeof header);
-    char text[160];
-    const char* problem = fmu_state_header_problem(&header, &kStateRules, i->model_exchange);
-    if (problem == NULL) {
-        int initialized = 0;
-        if (from_core(gimbal_core_check_snapshot(i->core, record + sizeof header, &initialized)) > fmi3Warning) return 0;
-        problem = fmu_state_model_problem(&header, &kStateRules, initialized, text, sizeof text);
-    }
-    if (problem != NULL) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: the FMU state is refused: %s", f, problem);
-        return 0;
-    }
-    return 1;
-}
-
-static fmi3Status get_fmu_state(GimbalFmi3Instance* i, fmi3FMUState* out) {
+static fmi3Status get_fmu_state(FmiInstance* i, fmi3FMUState* out) {
     const char* f = "fmi3GetFMUState";
-    if (!allowed(i, f, S_FMU_STATE) || !not_null(i, f, out, "FMUState")) return fmi3Error;
-    unsigned char* record = fmu_states_find(&i->states, *out) >= 0 ? (unsigned char*)*out : NULL;
-    const int fresh = record == NULL;
-    if (fresh) {
-        record = (unsigned char*)calloc(1, record_size());
-        if (record == NULL || !fmu_states_add(&i->states, record)) {
-            free(record);
-            log_to_host(i, fmi3Error, "logStatusError", "%s: out of memory", f);
-            return fmi3Error;
-        }
-    }
-    StateHeader header;
-    fmu_state_header_init(&header, STATE_MAGIC_FMI3, record_size(), GIMBAL_GUID);
-    header.state = (int32_t)i->state;
-    header.time = i->time;
-    header.stop_time = i->stop_time;
-    header.stop_time_defined = i->stop_time_defined;
-    if (from_core(gimbal_core_save(i->core, record + sizeof header)) > fmi3Warning) {
-        if (fresh) fmu_states_release(&i->states, fmu_states_find(&i->states, record));
-        return fmi3Error;
-    }
-    memcpy(record, &header, sizeof header);
-    *out = record;
-    return fmi3OK;
+    if (!fmi_allowed(i, f, S_FMU_STATE)) return fmi3Error;
+    return (fmi3Status)fmi_get_fmu_state(i, f, out);
 }
 
-static fmi3Status set_fmu_state(GimbalFmi3Instance* i, fmi3FMUState state) {
+static fmi3Status set_fmu_state(FmiInstance* i, fmi3FMUState state) {
     const char* f = "fmi3SetFMUState";
-    if (!allowed(i, f, S_FMU_STATE | S_STEP_DISCARDED)) return fmi3Error;
-    const unsigned char* record = own_state(i, f, state);
-    if (record == NULL || !valid_record(i, f, record)) return fmi3Error;
-    StateHeader header;
-    memcpy(&header, record, sizeof header);
-    const fmi3Status status = from_core(gimbal_core_restore(i->core, record + sizeof header));
-    if (status > fmi3Warning) return status;
-    i->state = (State3)header.state;
-    i->time = header.time;
-    i->stop_time = header.stop_time;
-    i->stop_time_defined = header.stop_time_defined;
-    return fmi3OK;
+    if (!fmi_allowed(i, f, S_FMU_STATE | S_STEP_DISCARDED)) return fmi3Error;
+    return (fmi3Status)fmi_set_fmu_state(i, f, state);
 }
 
-static fmi3Status free_fmu_state(GimbalFmi3Instance* i, fmi3FMUState* state) {
+static fmi3Status free_fmu_state(FmiInstance* i, fmi3FMUState* state) {
     const char* f = "fmi3FreeFMUState";
-    if (!allowed(i, f, S_ANY)) return fmi3Error;
-    if (state == NULL || *state == NULL) return fmi3OK;
-    const long index = fmu_states_find(&i->states, *state);
-    if (index < 0) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: *FMUState = %p is not an FMU state of instance '%s'; nothing was freed", f,
-            *state, i->name);
-        return fmi3Error;
-    }
-    fmu_states_release(&i->states, index);
-    *state = NULL;
-    return fmi3OK;
+    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
+    return (fmi3Status)fmi_free_fmu_state(i, f, state);
 }
 
-static fmi3Status serialized_size(GimbalFmi3Instance* i, fmi3FMUState state, size_t* size) {
+static fmi3Status serialized_size(FmiInstance* i, fmi3FMUState state, size_t* size) {
     const char* f = "fmi3SerializedFMUStateSize";
-    if (!allowed(i, f, S_ANY) || own_state(i, f, state) == NULL || !not_null(i, f, size, "size")) return fmi3Error;
-    *size = record_size();
-    return fmi3OK;
+    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
+    return (fmi3Status)fmi_serialized_fmu_state_size(i, f, state, size);
 }
 
-static fmi3Status serialize(GimbalFmi3Instance* i, fmi3FMUState state, fmi3Byte bytes[], size_t size) {
+static fmi3Status serialize(FmiInstance* i, fmi3FMUState state, fmi3Byte bytes[], size_t size) {
     const char* f = "fmi3SerializeFMUState";
-    if (!allowed(i, f, S_ANY)) return fmi3Error;
-    const unsigned char* record = own_state(i, f, state);
-    if (record == NULL || !not_null(i, f, bytes, "serializedState")) return fmi3Error;
-    if (size < record_size()) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: size %zu is below the %zu bytes needed", f, size, record_size());
-        return fmi3Error;
-    }
-    fmu_state_serialize(record, record_size(), bytes);
-    return fmi3OK;
+    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
+    return (fmi3Status)fmi_serialize_fmu_state(i, f, state, bytes, size);
 }
 
-static fmi3Status deserialize(GimbalFmi3Instance* i, const fmi3Byte bytes[], size_t size, fmi3FMUState* out) {
+static fmi3Status deserialize(FmiInstance* i, const fmi3Byte bytes[], size_t size, fmi3FMUState* out) {
     const char* f = "fmi3DeserializeFMUState";
-    if (!allowed(i, f, S_ANY) || !not_null(i, f, bytes, "serializedState") || !not_null(i, f, out, "FMUState"))
-        return fmi3Error;
-    const char* problem = fmu_state_integrity_problem(bytes, size, record_size(), GIMBAL_GUID, STATE_MAGIC_FMI3);
-    if (problem != NULL) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: the %zu bytes are refused: %s", f, size, problem);
-        return fmi3Error;
-    }
-    if (!valid_record(i, f, bytes)) return fmi3Error;
-    void* record = malloc(size);
-    if (record == NULL || !fmu_states_add(&i->states, record)) {
-        free(record);
-        log_to_host(i, fmi3Error, "logStatusError", "%s: out of memory", f);
-        return fmi3Error;
-    }
-    memcpy(record, bytes, size);
-    *out = record;
-    return fmi3OK;
+    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
+    return (fmi3Status)fmi_deserialize_fmu_state(i, f, bytes, size, out);
 }
 
 /* ---------------------------------------------------------------- derivatives */
 
-static fmi3Status directional_derivative(GimbalFmi3Instance* i, const fmi3ValueReference unknowns[], size_t nu,
+/* The arguments of fmi3GetDirectionalDerivative: pointers, counts, finite seeds, and a point where
+ * the derivatives are offered; logged naming the culprit. */
+static int directional_arguments_valid(FmiInstance* i, const char* f, const fmi3ValueReference unknowns[], size_t nu,
+                                       const fmi3ValueReference knowns[], size_t nk, const fmi3Float64 seed[],
+                                       size_t nseed, const fmi3Float64 sensitivity[], size_t nsens) {
+    if ((nu > 0 && (!fmi_not_null(i, f, unknowns, "unknowns") || !fmi_not_null(i, f, sensitivity, "sensitivity"))) ||
+        (nk > 0 && (!fmi_not_null(i, f, knowns, "knowns") || !fmi_not_null(i, f, seed, "seed"))))
+        return 0;
+    if (nseed != nk || nsens != nu) {
+        fmi_log_error(i, "%s: nSeed = %zu and nSensitivity = %zu must equal nKnowns = %zu and nUnknowns = %zu",
+            f, nseed, nsens, nk, nu);
+        return 0;
+    }
+    const char* why = NULL;
+    for (size_t k = 0; k < nk && why == NULL; ++k)
+        if (!isfinite(seed[k])) why = "every seed must be finite";
+    if (why == NULL && i->state == S_INITIALIZATION) why = "the derivatives are offered once initialization has ended";
+    if (why != NULL) fmi_refuse(i, f, why);
+    return why == NULL;
+}
+
+/* Co-Simulation: the outputs are held between steps, so their derivatives with respect to the inputs
+ * are 0 (the FMI 2.0 face explains); unknowns must be outputs, knowns inputs. */
+static fmi3Status cosimulation_derivatives(FmiInstance* i, const char* f, const unsigned u[], size_t nu,
+                                           const unsigned kn[], size_t nk, fmi3Float64 sensitivity[]) {
+    GimbalVariableInfo info;
+    for (size_t k = 0; k < nu; ++k)
+        if (!gimbal_variable_info(GIMBAL_REAL, u[k], &info) || info.causality != GIMBAL_OUTPUT)
+            return refuse(i, f, "in Co-Simulation the unknowns are outputs");
+    for (size_t k = 0; k < nk; ++k)
+        if (!gimbal_variable_info(GIMBAL_REAL, kn[k], &info) || info.causality != GIMBAL_INPUT)
+            return refuse(i, f, "in Co-Simulation the knowns are inputs");
+    for (size_t k = 0; k < nu; ++k) sensitivity[k] = 0.0;
+    return fmi3OK;
+}
+
+static fmi3Status directional_derivative(FmiInstance* i, const fmi3ValueReference unknowns[], size_t nu,
                                          const fmi3ValueReference knowns[], size_t nk, const fmi3Float64 seed[],
                                          size_t nseed, fmi3Float64 sensitivity[], size_t nsens) {
     const char* f = "fmi3GetDirectionalDerivative";
-    if (!allowed(i, f, i->model_exchange ? (S_INITIALIZATION | S_EVALUATE) : (S_INITIALIZATION | S_RUNNING | S_TERMINATED)))
+    if (!fmi_allowed(i, f, i->model_exchange ? (S_INITIALIZATION | S_EVALUATE) : (S_INITIALIZATION | S_RUNNING | S_TERMINATED)) ||
+        !directional_arguments_valid(i, f, unknowns, nu, knowns, nk, seed, nseed, sensitivity, nsens))
         return fmi3Error;
-    if ((nu > 0 && (!not_null(i, f, unknowns, "unknowns") || !not_null(i, f, sensitivity, "sensitivity"))) ||
-        (nk > 0 && (!not_null(i, f, knowns, "knowns") || !not_null(i, f, seed, "seed"))))
-        return fmi3Error;
-    if (nseed != nk || nsens != nu) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: nSeed = %zu and nSensitivity = %zu must equal nKnowns = %zu and nUnknowns = %zu",
-            f, nseed, nsens, nk, nu);
-        return fmi3Error;
-    }
-    for (size_t k = 0; k < nk; ++k)
-        if (!isfinite(seed[k])) return refuse(i, f, "every seed must be finite");
-    if (i->state == S_INITIALIZATION) return refuse(i, f, "the derivatives are offered once initialization has ended");
     unsigned* u = (unsigned*)malloc((nu + 1) * sizeof *u);
     unsigned* kn = (unsigned*)malloc((nk + 1) * sizeof *kn);
     if (u == NULL || kn == NULL) {
@@ -609,23 +406,12 @@ static fmi3Status directional_derivative(GimbalFmi3Instance* i, const fmi3ValueR
     for (size_t k = 0; k < nu && ok; ++k) ok = unknowns[k] < FMI3_INTEGER_BASE, u[k] = unknowns[k];
     for (size_t k = 0; k < nk && ok; ++k) ok = knowns[k] < FMI3_INTEGER_BASE, kn[k] = knowns[k];
     fmi3Status status;
-    if (!ok) {
+    if (!ok)
         status = refuse(i, f, "unknowns and knowns are Float64 variables");
-    } else if (i->model_exchange) {
-        status = from_core(gimbal_core_directional_derivative(i->core, u, nu, kn, nk, seed, sensitivity));
-    } else {
-        /* Co-Simulation: the outputs are held between steps, so their derivatives with respect to the
-         * inputs are 0 (the FMI 2.0 wrapper explains); unknowns must be outputs, knowns inputs. */
-        status = fmi3OK;
-        GimbalVariableInfo info;
-        for (size_t k = 0; k < nu && status == fmi3OK; ++k)
-            if (!gimbal_variable_info(GIMBAL_REAL, u[k], &info) || info.causality != GIMBAL_OUTPUT)
-                status = refuse(i, f, "in Co-Simulation the unknowns are outputs");
-        for (size_t k = 0; k < nk && status == fmi3OK; ++k)
-            if (!gimbal_variable_info(GIMBAL_REAL, kn[k], &info) || info.causality != GIMBAL_INPUT)
-                status = refuse(i, f, "in Co-Simulation the knowns are inputs");
-        for (size_t k = 0; k < nu && status == fmi3OK; ++k) sensitivity[k] = 0.0;
-    }
+    else if (i->model_exchange)
+        status = from_core(gimbal_core_directional_derivative(gimbal_core_of(i), u, nu, kn, nk, seed, sensitivity));
+    else
+        status = cosimulation_derivatives(i, f, u, nu, kn, nk, sensitivity);
     free(u);
     free(kn);
     return status;
@@ -633,35 +419,35 @@ static fmi3Status directional_derivative(GimbalFmi3Instance* i, const fmi3ValueR
 
 /* ---------------------------------------------------------------- Model Exchange */
 
-static int me_vector(GimbalFmi3Instance* i, const char* f, int states, const void* values, size_t given, size_t expected,
+static int me_vector(FmiInstance* i, const char* f, int states, const void* values, size_t given, size_t expected,
                      const char* argument) {
-    if (!allowed(i, f, states)) return 0;
+    if (!fmi_allowed(i, f, states)) return 0;
     if (!i->model_exchange) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation",
+        fmi_log_error(i, "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation",
             f, i->name);
         return 0;
     }
     if (given != expected) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: the count is %zu, but the model has %zu", f, given, expected);
+        fmi_log_error(i, "%s: the count is %zu, but the model has %zu", f, given, expected);
         return 0;
     }
-    return not_null(i, f, values, argument);
+    return fmi_not_null(i, f, values, argument);
 }
 
-static fmi3Status update_discrete_states(GimbalFmi3Instance* i, fmi3Boolean* need, fmi3Boolean* terminate, fmi3Boolean* nominals,
+static fmi3Status update_discrete_states(FmiInstance* i, fmi3Boolean* need, fmi3Boolean* terminate, fmi3Boolean* nominals,
                                          fmi3Boolean* values, fmi3Boolean* next_defined, fmi3Float64* next) {
     const char* f = "fmi3UpdateDiscreteStates";
-    if (!allowed(i, f, S_EVENT)) return fmi3Error;
-    if (!not_null(i, f, need, "discreteStatesNeedUpdate") || !not_null(i, f, terminate, "terminateSimulation") ||
-        !not_null(i, f, nominals, "nominalsOfContinuousStatesChanged") ||
-        !not_null(i, f, values, "valuesOfContinuousStatesChanged") || !not_null(i, f, next_defined, "nextEventTimeDefined") ||
-        !not_null(i, f, next, "nextEventTime"))
+    if (!fmi_allowed(i, f, S_EVENT)) return fmi3Error;
+    if (!fmi_not_null(i, f, need, "discreteStatesNeedUpdate") || !fmi_not_null(i, f, terminate, "terminateSimulation") ||
+        !fmi_not_null(i, f, nominals, "nominalsOfContinuousStatesChanged") ||
+        !fmi_not_null(i, f, values, "valuesOfContinuousStatesChanged") || !fmi_not_null(i, f, next_defined, "nextEventTimeDefined") ||
+        !fmi_not_null(i, f, next, "nextEventTime"))
         return fmi3Error;
     *need = *terminate = *nominals = *values = *next_defined = fmi3False;
     *next = 0.0;
     if (!i->model_exchange) return fmi3OK; /* Co-Simulation has handled its mode changes in fmi3DoStep */
     GimbalDiscreteUpdate update;
-    const fmi3Status status = from_core(gimbal_core_update_discrete_states(i->core, &update));
+    const fmi3Status status = from_core(gimbal_core_update_discrete_states(gimbal_core_of(i), &update));
     if (status > fmi3Warning) return status;
     *values = update.states_changed != 0;
     *next_defined = update.next_time_defined != 0;
@@ -671,36 +457,23 @@ static fmi3Status update_discrete_states(GimbalFmi3Instance* i, fmi3Boolean* nee
 
 /* ---------------------------------------------------------------- Co-Simulation */
 
-static fmi3Status do_step(GimbalFmi3Instance* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean* event, fmi3Boolean* terminate,
+static fmi3Status do_step(FmiInstance* i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean* event, fmi3Boolean* terminate,
                           fmi3Boolean* early, fmi3Float64* last) {
     const char* f = "fmi3DoStep";
-    if (!allowed(i, f, S_STEP)) return fmi3Error;
-    if (!not_null(i, f, event, "eventHandlingNeeded") || !not_null(i, f, terminate, "terminateSimulation") ||
-        !not_null(i, f, early, "earlyReturn") || !not_null(i, f, last, "lastSuccessfulTime"))
+    if (!fmi_allowed(i, f, S_STEP)) return fmi3Error;
+    if (!fmi_not_null(i, f, event, "eventHandlingNeeded") || !fmi_not_null(i, f, terminate, "terminateSimulation") ||
+        !fmi_not_null(i, f, early, "earlyReturn") || !fmi_not_null(i, f, last, "lastSuccessfulTime"))
         return fmi3Error;
     *event = *terminate = *early = fmi3False;
     *last = i->time;
-    if (!(h > 0.0) || !isfinite(h)) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: communicationStepSize = %g must be finite and > 0", f, h);
-        return fmi3Error;
-    }
-    /* The master's point becomes the FMU's time (common/communication_point.h). */
-    if (!communication_point_matches(i->time, t, h)) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", f, t,
-            i->time);
-        return fmi3Error;
-    }
+    if (!fmi_step_valid(i, f, t, h)) return fmi3Error;
     const double end = t + h;
-    if (i->stop_time_defined && communication_step_passes_stop_time(end, i->stop_time, h)) {
-        log_to_host(i, fmi3Error, "logStatusError", "%s: step to t = %.17g passes the stopTime %.17g", f, end, i->stop_time);
-        return fmi3Error;
-    }
     /* With early return allowed, the step ends right after the first mode change inside it: the
      * importer sees the event where it happens (and handles it in Event Mode if it uses that). */
     double elapsed = h; /* how far the step went: all of it, or to the first mode change */
     const fmi3Status status = from_core(i->early_return_allowed
-                                            ? gimbal_core_do_step_until_mode_change(i->core, t, h, &elapsed)
-                                            : gimbal_core_do_step(i->core, t, h));
+                                            ? gimbal_core_do_step_until_mode_change(gimbal_core_of(i), t, h, &elapsed)
+                                            : gimbal_core_do_step(gimbal_core_of(i), t, h));
     if (status > fmi3Warning) {
         i->state = status == fmi3Discard ? S_STEP_DISCARDED : S_ERROR;
         return status;
@@ -717,7 +490,7 @@ static fmi3Status do_step(GimbalFmi3Instance* i, fmi3Float64 t, fmi3Float64 h, f
 
 /* Every entry runs in the FMU's own floating-point environment and restores the host's on the way out
  * (IN_FMU_FP_ENVIRONMENT, host_fp_environment.h); OWN_INSTANCE is the host's opaque handle as ours. */
-#define OWN_INSTANCE ((GimbalFmi3Instance*)instance)
+#define OWN_INSTANCE ((FmiInstance*)instance)
 
 const char* fmi3GetVersion(void) { return fmi3Version; }
 
@@ -761,7 +534,7 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
 void fmi3FreeInstance(fmi3Instance instance) {
     HostFpEnvironment host_environment;
     enter_fmu_fp(&host_environment);
-    free_instance(OWN_INSTANCE);
+    fmi_free_instance(OWN_INSTANCE);
     leave_fmu_fp(&host_environment);
 }
 
@@ -772,8 +545,8 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, exit_initialization(OWN_INSTANCE)); }
 
-static fmi3Status enter_event_mode(GimbalFmi3Instance* i) {
-    if (!allowed(i, "fmi3EnterEventMode", i->model_exchange ? S_CONTINUOUS_TIME : S_STEP)) return fmi3Error;
+static fmi3Status enter_event_mode(FmiInstance* i) {
+    if (!fmi_allowed(i, "fmi3EnterEventMode", i->model_exchange ? S_CONTINUOUS_TIME : S_STEP)) return fmi3Error;
     if (!i->model_exchange && !i->event_mode_used)
         return refuse(i, "fmi3EnterEventMode", "the instance was made with eventModeUsed = false");
     i->state = S_EVENT;
@@ -781,24 +554,16 @@ static fmi3Status enter_event_mode(GimbalFmi3Instance* i) {
 }
 fmi3Status fmi3EnterEventMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, enter_event_mode(OWN_INSTANCE)); }
 
-static fmi3Status terminate(GimbalFmi3Instance* i) {
-    if (!allowed(i, "fmi3Terminate", S_RUNNING)) return fmi3Error;
+static fmi3Status terminate(FmiInstance* i) {
+    if (!fmi_allowed(i, "fmi3Terminate", S_RUNNING)) return fmi3Error;
     i->state = S_TERMINATED;
     return fmi3OK;
 }
 fmi3Status fmi3Terminate(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, terminate(OWN_INSTANCE)); }
 
-static fmi3Status reset(GimbalFmi3Instance* i) {
-    if (!allowed(i, "fmi3Reset", S_ANY)) return fmi3Error;
-    const fmi3Status status = from_core(gimbal_core_reset(i->core));
-    if (status > fmi3Warning) {
-        i->state = S_ERROR;
-        return status;
-    }
-    i->time = 0.0;
-    i->stop_time_defined = 0;
-    i->state = S_INSTANTIATED;
-    return fmi3OK;
+static fmi3Status reset(FmiInstance* i) {
+    if (!fmi_allowed(i, "fmi3Reset", S_ANY)) return fmi3Error;
+    return (fmi3Status)fmi_reset(i);
 }
 fmi3Status fmi3Reset(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, reset(OWN_INSTANCE)); }
 
@@ -971,17 +736,17 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discrete
                                             nextEventTimeDefined, nextEventTime));
 }
 
-static fmi3Status enter_continuous_time_mode(GimbalFmi3Instance* i) {
+static fmi3Status enter_continuous_time_mode(FmiInstance* i) {
     if (!me_vector(i, "fmi3EnterContinuousTimeMode", S_EVENT, i, 0, 0, "instance")) return fmi3Error;
     i->state = S_CONTINUOUS_TIME;
     return fmi3OK;
 }
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { IN_FMU_FP_ENVIRONMENT(fmi3Status, enter_continuous_time_mode(OWN_INSTANCE)); }
 
-static fmi3Status completed_integrator_step(GimbalFmi3Instance* i, fmi3Boolean* enter, fmi3Boolean* terminate) {
+static fmi3Status completed_integrator_step(FmiInstance* i, fmi3Boolean* enter, fmi3Boolean* terminate) {
     const char* f = "fmi3CompletedIntegratorStep";
-    if (!me_vector(i, f, S_CONTINUOUS_TIME, i, 0, 0, "instance") || !not_null(i, f, enter, "enterEventMode") ||
-        !not_null(i, f, terminate, "terminateSimulation"))
+    if (!me_vector(i, f, S_CONTINUOUS_TIME, i, 0, 0, "instance") || !fmi_not_null(i, f, enter, "enterEventMode") ||
+        !fmi_not_null(i, f, terminate, "terminateSimulation"))
         return fmi3Error;
     *enter = *terminate = fmi3False; /* every mode change shows in an event indicator */
     return fmi3OK;
@@ -992,64 +757,64 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetF
     IN_FMU_FP_ENVIRONMENT(fmi3Status, completed_integrator_step(OWN_INSTANCE, enterEventMode, terminateSimulation));
 }
 
-static fmi3Status set_time(GimbalFmi3Instance* i, fmi3Float64 t) {
+static fmi3Status set_time(FmiInstance* i, fmi3Float64 t) {
     if (!me_vector(i, "fmi3SetTime", S_EVENT | S_CONTINUOUS_TIME, i, 0, 0, "instance")) return fmi3Error;
-    const fmi3Status status = from_core(gimbal_core_set_time(i->core, t));
+    const fmi3Status status = from_core(gimbal_core_set_time(gimbal_core_of(i), t));
     if (status <= fmi3Warning) i->time = t;
     return status;
 }
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) { IN_FMU_FP_ENVIRONMENT(fmi3Status, set_time(OWN_INSTANCE, time)); }
 
-static fmi3Status set_continuous_states(GimbalFmi3Instance* i, const fmi3Float64 x[], size_t n) {
+static fmi3Status set_continuous_states(FmiInstance* i, const fmi3Float64 x[], size_t n) {
     if (!me_vector(i, "fmi3SetContinuousStates", S_CONTINUOUS_TIME, x, n, GIMBAL_CONTINUOUS_STATES, "continuousStates"))
         return fmi3Error;
-    return from_core(gimbal_core_set_continuous_states(i->core, x));
+    return from_core(gimbal_core_set_continuous_states(gimbal_core_of(i), x));
 }
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[], size_t n) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, set_continuous_states(OWN_INSTANCE, continuousStates, n));
 }
 
-static fmi3Status get_derivatives(GimbalFmi3Instance* i, fmi3Float64 dx[], size_t n) {
+static fmi3Status get_derivatives(FmiInstance* i, fmi3Float64 dx[], size_t n) {
     if (!me_vector(i, "fmi3GetContinuousStateDerivatives", S_EVALUATE, dx, n, GIMBAL_CONTINUOUS_STATES, "derivatives"))
         return fmi3Error;
-    return from_core(gimbal_core_get_derivatives(i->core, dx));
+    return from_core(gimbal_core_get_derivatives(gimbal_core_of(i), dx));
 }
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t n) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, get_derivatives(OWN_INSTANCE, derivatives, n));
 }
 
-static fmi3Status get_event_indicators(GimbalFmi3Instance* i, fmi3Float64 z[], size_t n) {
+static fmi3Status get_event_indicators(FmiInstance* i, fmi3Float64 z[], size_t n) {
     if (!me_vector(i, "fmi3GetEventIndicators", S_INITIALIZATION | S_EVALUATE, z, n, GIMBAL_EVENT_INDICATORS,
                    "eventIndicators"))
         return fmi3Error;
-    return from_core(gimbal_core_get_event_indicators(i->core, z));
+    return from_core(gimbal_core_get_event_indicators(gimbal_core_of(i), z));
 }
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t n) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, get_event_indicators(OWN_INSTANCE, eventIndicators, n));
 }
 
-static fmi3Status get_continuous_states(GimbalFmi3Instance* i, fmi3Float64 x[], size_t n) {
+static fmi3Status get_continuous_states(FmiInstance* i, fmi3Float64 x[], size_t n) {
     if (!me_vector(i, "fmi3GetContinuousStates", S_INITIALIZATION | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
                    "continuousStates"))
         return fmi3Error;
-    return from_core(gimbal_core_get_continuous_states(i->core, x));
+    return from_core(gimbal_core_get_continuous_states(gimbal_core_of(i), x));
 }
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t n) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, get_continuous_states(OWN_INSTANCE, continuousStates, n));
 }
 
-static fmi3Status get_nominals(GimbalFmi3Instance* i, fmi3Float64 x[], size_t n) {
+static fmi3Status get_nominals(FmiInstance* i, fmi3Float64 x[], size_t n) {
     if (!me_vector(i, "fmi3GetNominalsOfContinuousStates", S_INSTANTIATED | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
                    "nominals"))
         return fmi3Error;
-    return from_core(gimbal_core_get_nominal_states(i->core, x));
+    return from_core(gimbal_core_get_nominal_states(gimbal_core_of(i), x));
 }
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t n) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, get_nominals(OWN_INSTANCE, nominals, n));
 }
 
-static fmi3Status count(GimbalFmi3Instance* i, const char* f, size_t* n, size_t value) {
-    if (!allowed(i, f, S_ANY) || !not_null(i, f, n, "count")) return fmi3Error;
+static fmi3Status count(FmiInstance* i, const char* f, size_t* n, size_t value) {
+    if (!fmi_allowed(i, f, S_ANY) || !fmi_not_null(i, f, n, "count")) return fmi3Error;
     *n = value;
     return fmi3OK;
 }
@@ -1060,8 +825,8 @@ fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* n) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, count(OWN_INSTANCE, "fmi3GetNumberOfContinuousStates", n, GIMBAL_CONTINUOUS_STATES));
 }
 
-static fmi3Status enter_step_mode(GimbalFmi3Instance* i) {
-    if (!allowed(i, "fmi3EnterStepMode", S_EVENT)) return fmi3Error;
+static fmi3Status enter_step_mode(FmiInstance* i) {
+    if (!fmi_allowed(i, "fmi3EnterStepMode", S_EVENT)) return fmi3Error;
     if (i->model_exchange) return refuse(i, "fmi3EnterStepMode", "a Model Exchange instance has no step mode");
     i->state = S_STEP;
     return fmi3OK;
