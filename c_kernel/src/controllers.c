@@ -20,7 +20,8 @@ int gimbal_controller_kind(const char* name) {
 }
 
 /* The axis' voltage, clamped to +-u_limit; the value before the clamp goes to *asked. */
-static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double ref_rate, double* asked) {
+static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double ref_rate,
+                       const double* ref_acceleration, double* asked) {
     if (p->has_prev) {
         const double raw = (e - p->e_prev) / h;
         p->derivative += (h / (p->d_filter_s + h)) * (raw - p->derivative);
@@ -30,7 +31,8 @@ static double axis_pid(GimbalAxisPid* p, double e, double rate, double h, double
         p->integral += e * h;
         if (fabs(p->ki * p->integral) > p->i_limit) p->integral = copysign(p->i_limit / fabs(p->ki), p->integral);
     }
-    const double u = p->kp * e + p->ki * p->integral + p->kd * p->derivative - p->k_gyro * rate + p->k_ff * ref_rate;
+    double u = p->kp * e + p->ki * p->integral + p->kd * p->derivative - p->k_gyro * rate + p->k_ff * ref_rate;
+    if (ref_acceleration != NULL) u = u + p->k_acc * *ref_acceleration; /* a moving target's set points only */
     p->saturated = u > p->u_limit ? 1 : (u < -p->u_limit ? -1 : 0);
     *asked = u;
     return py_min(py_max(u, -p->u_limit), p->u_limit);
@@ -77,20 +79,27 @@ void gimbal_controller_step(GimbalController* c, long k, double h, const double 
     }
     const double alpha = measured[0], beta = measured[1];
     double r[2], r_dot[2];
+    const double* r_ddot = NULL;     /* the set points' accelerations, with a moving target */
+    const double* on_track = NULL;   /* the gyro's rates on track (x2, z2), with a moving target */
     if (set_point != NULL) {
         r[0] = set_point[0], r[1] = set_point[1], r_dot[0] = set_point[2], r_dot[1] = set_point[3];
     } else {
         r[0] = prepared_set_point(&c->set_points, k, 0, alpha), r[1] = prepared_set_point(&c->set_points, k, 1, beta);
         r_dot[0] = c->set_points.rates[2 * k], r_dot[1] = c->set_points.rates[2 * k + 1];
+        if (c->set_points.accelerations != NULL) r_ddot = c->set_points.accelerations + 2 * k;
+        if (c->set_points.gyro_rates != NULL) on_track = c->set_points.gyro_rates + 2 * k;
     }
     reference[0] = r[0], reference[1] = r[1];
     /* The payload gyro gives the inertial rate about the elevation axis (gyro[0]) and the
        cross-elevation rate (gyro[2]); divided by cos(beta), the azimuth rate that moves the line of
        sight (secant correction, bounded near the zenith). */
-    const double w_az = measured[4] / py_max(cos(beta), 0.2), w_el = measured[2];
+    double w_az = measured[4] / py_max(cos(beta), 0.2), w_el = measured[2];
+    if (on_track != NULL) { /* tracking: the departure from the line of sight's rate on track */
+        w_az = (measured[4] - on_track[1]) / py_max(cos(beta), 0.2), w_el = measured[2] - on_track[0];
+    }
     if (c->kind == kPid) {
-        u[0] = axis_pid(&c->axis[0], r[0] - alpha, w_az, h, r_dot[0], &c->asked[0]);
-        u[1] = axis_pid(&c->axis[1], r[1] - beta, w_el, h, r_dot[1], &c->asked[1]);
+        u[0] = axis_pid(&c->axis[0], r[0] - alpha, w_az, h, r_dot[0], r_ddot, &c->asked[0]);
+        u[1] = axis_pid(&c->axis[1], r[1] - beta, w_el, h, r_dot[1], r_ddot == NULL ? NULL : r_ddot + 1, &c->asked[1]);
         return;
     }
     state_feedback(c, h, alpha, beta, w_az, w_el, r, u);

@@ -73,6 +73,8 @@ class CompiledLoop:
         m.sensors.gyro.error = source.gyro.error
         m.controller.set_points.values = plan.controller.state.set_points.values
         m.controller.set_points.rates = plan.controller.state.set_points.rates
+        m.controller.set_points.accelerations = plan.controller.state.set_points.accelerations
+        m.controller.set_points.gyro_rates = plan.controller.state.set_points.gyro_rates
 
     def run(self, first: int, last: int) -> None:
         failed = self.library.gimbal_master_loop(ctypes.addressof(self.loop), first, last)

@@ -24,7 +24,7 @@ from ..fmu import FMU
 from ..scene.controllers import AXES, ControllerError
 from ..progress import Progress
 from .results import RunResult
-from ..scene.scene import Scene, check_against_fmu, parameter_value, start_values
+from ..scene.scene import Scene, check_against_fmu, check_run_length, parameter_value, start_values
 
 # How a run ended before its stop time (Stop.kind), in the words of the summary line.
 STOP_KINDS = {"failed": "failed", "interrupted": "interrupted (SIGINT)", "terminated": "terminated (SIGTERM)"}
@@ -92,6 +92,7 @@ class Plan:
         self.scene, self.h = scene, scene.step_size
         self.t_end = scene.stop_time if stop_time is None else stop_time
         self.n = int(round(self.t_end / self.h))
+        check_run_length(scene, self.t_end)
         self.motion = scene.base_motion()
         check_memory(scene, fmu, self)
         self.times = np.arange(self.n + 1) * self.h
@@ -103,7 +104,8 @@ class Plan:
         # What the IMU measures (the sensors' noise of the whole run drawn here), and from it the
         # built-in controllers' set points of the whole run.
         self.measured_attitude = self.sensors.prepare(self.base, self.h)
-        self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6])
+        self.controller.prepare(self.times, self.h, self.measured_attitude, self.base[:, 3:6],
+                                **moving_target_accelerations(scene, self.base))
 
         choose_records(self, fmu)
 
@@ -116,6 +118,13 @@ class Plan:
         self.u_cmd, self.refs, self.u_asked = [], [], []
         self.k = 0                      # the step reached (for the message of a failure)
         self.rows = 0                   # communication points recorded whole (rows 0 .. rows - 1)
+
+
+def moving_target_accelerations(scene: Scene, base) -> dict:
+    """The base's angular accelerations for a controller's prepare(), as a keyword, with a moving
+    target only (the command's accelerations); controllers that wrap another (an injection) take
+    the fixed target's four arguments."""
+    return {"accelerations": base[:, 6:9]} if scene.moving_target is not None else {}
 
 
 def memory_needed(fmu: FMU, points: int) -> int:

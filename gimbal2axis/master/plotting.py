@@ -237,3 +237,99 @@ def plot_spectrum(result, path: pathlib.Path) -> bool:
         return False
     fig.savefig(path, dpi=100)
     return True
+
+
+# The signals the tracking figure draws (a run with a moving target: results.tracking_signals).
+TRACKING_PLOT_SIGNALS = ("time", "los_error", "target_elevation", "beta_cmd", "alpha_cmd_dot", "beta_cmd_dot",
+                         "alpha_dot", "beta_dot", "i_R1", "i_R2")
+TRACKING_PLOT_POINTS = 20000   # samples drawn at most (evenly strided): the figure's pixels hold fewer
+
+
+def tracking_figure(scene, columns: dict, title_prefix: str = ""):
+    """The tracking figure of a run with a moving target: the pointing error against time (the time
+    near the keyhole shaded) and against the target's elevation, the azimuth and elevation rates the
+    pointing command asked and those achieved, and the motors' currents. `columns`: the
+    TRACKING_PLOT_SIGNALS (whole or strided record)."""
+    from matplotlib.figure import Figure
+
+    t = columns["time"]
+    error = columns["los_error"] * 1e3
+    spec = scene.target_spec
+    half_beam = spec["beam_width_mrad"] / 2.0
+    near = np.abs(columns["beta_cmd"]) > math.radians(90.0 - spec["keyhole_deg"])
+    fig = Figure(figsize=(12, 10))
+    axes = fig.subplots(4, 1, squeeze=False)[:, 0]
+    ax = axes[0]
+    positive = np.where(error > ROUND_OFF_MRAD, error, np.nan)
+    ax.semilogy(t, positive, lw=0.8, label="line-of-sight error")
+    ax.axhline(half_beam, color="C3", lw=0.8, ls="--", label=f"half beam ({half_beam:g} mrad)")
+    if near.any():
+        edges = np.flatnonzero(np.diff(np.r_[0, near.astype(int), 0]))
+        for start, stop in zip(edges[::2], edges[1::2]):
+            ax.axvspan(t[start], t[stop - 1], color="C1", alpha=0.15, lw=0)
+        ax.axvspan(np.nan, np.nan, color="C1", alpha=0.15, label=f"near the keyhole (within {spec['keyhole_deg']:g} deg)")
+    ax.set_ylabel("pointing error\n[mrad]", fontsize="small")
+    ax.set_xlabel("time [s]", fontsize="small")
+    ax = axes[1]
+    ax.semilogy(np.degrees(columns["target_elevation"]), positive, ".", ms=1.0, alpha=0.5)
+    ax.axhline(half_beam, color="C3", lw=0.8, ls="--")
+    ax.set_xlabel("target elevation in G [deg]", fontsize="small")
+    ax.set_ylabel("pointing error\n[mrad]", fontsize="small")
+    ax = axes[2]
+    # what was achieved under what was asked, which is drawn dashed on top
+    for name, label, style, color in (("alpha_dot", "azimuth rate achieved", "-", "C0"),
+                                      ("beta_dot", "elevation rate achieved", "-", "C1"),
+                                      ("alpha_cmd_dot", "azimuth rate asked", "--", "navy"),
+                                      ("beta_cmd_dot", "elevation rate asked", "--", "saddlebrown")):
+        ax.plot(t, np.degrees(columns[name]), style, color=color, lw=0.9, label=label)
+    ax.set_ylabel("joint rates\n[deg/s]", fontsize="small")
+    ax.set_xlabel("time [s]", fontsize="small")
+    ax = axes[3]
+    for name in ("i_R1", "i_R2"):
+        if name in columns:
+            ax.plot(t, columns[name], lw=0.9, label=f"{name} (motor {name[-1]})")
+    ax.set_ylabel("currents\n[A]", fontsize="small")
+    ax.set_xlabel("time [s]", fontsize="small")
+    for ax in axes:
+        ax.grid(True, alpha=0.3, which="both")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0, fontsize="x-small")
+    for ax in (axes[0], axes[2], axes[3]):
+        if t[-1] > t[0]:
+            ax.set_xlim(t[0], t[-1])
+    kinds = {"earth_point": "a point on the Earth", "flyby": "an aircraft's flyby", "track": "a recorded track"}
+    title = f"{title_prefix}{scene.title}: tracking {kinds[spec['type']]}"
+    fig.suptitle("\n".join(textwrap.wrap(title, 130)), fontsize="medium")
+    fig.tight_layout()
+    return fig
+
+
+def plot_tracking(result, path: pathlib.Path, parquet_path: pathlib.Path | None = None) -> bool:
+    """Writes <scene>_tracking.png (tracking_figure) of a run with a moving target, from the record
+    in memory or, for a streamed run, the Parquet file's columns; False (nothing written) without a
+    moving target."""
+    scene = result.scene
+    if scene.moving_target is None:
+        return False
+    if parquet_path is not None:
+        import pyarrow.parquet as pq
+
+        available = set(pq.ParquetFile(parquet_path).schema_arrow.names)
+        table = pq.read_table(parquet_path, columns=[n for n in TRACKING_PLOT_SIGNALS if n in available])
+        columns = {name: table.column(name).to_numpy() for name in table.column_names}
+    else:
+        columns = {name: np.asarray(result.signal(name), dtype=float) for name in TRACKING_PLOT_SIGNALS
+                   if name in result.signals or name in result.derived}
+    stride = max(1, len(columns["time"]) // TRACKING_PLOT_POINTS)
+    if stride > 1:
+        # the largest errors stay in: every sample whose error is its stride's maximum is kept too
+        keep = np.zeros(len(columns["time"]), dtype=bool)
+        keep[::stride] = True
+        error = columns["los_error"]
+        blocks = np.arange(0, len(error), stride)
+        keep[blocks + np.array([np.argmax(error[i:i + stride]) for i in blocks])] = True
+        columns = {name: values[keep] for name, values in columns.items()}
+    stopped = getattr(result, "stopped", None)
+    prefix = f"PARTIAL: {stopped.kind} at t = {stopped.time:g} s. " if stopped is not None else ""
+    tracking_figure(scene, columns, prefix).savefig(path, dpi=100)
+    return True

@@ -20,6 +20,23 @@ CARRIER_RATES = [f"base.omega2[{i}]" for i in (1, 2, 3)]
 ISOLATION_AXES = {1: "elevation", 3: "cross_elevation"}
 
 
+def tracking_signals(moving, s: dict) -> dict:
+    """The tracking signals (scene.TRACKING_SIGNALS) of a record `s` toward the moving target: its
+    azimuth, elevation (as target_direction's) and range in G, and the pointing command for the
+    carrier's exact attitude, rates and accelerations (the base inputs), its azimuth in the 2 pi
+    branch nearest the recorded alpha; "_direction": the unit vectors (3, n)."""
+    from ..target import PointingCommand
+
+    u, u_dot, u_ddot, distance, _ = moving.kinematics(s["time"])
+    base = [np.array([s[f"base.{n}{suffix}"] for n in ("delta", "psi", "gamma")]) for suffix in ("", "_dot", "_ddot")]
+    command = PointingCommand(u, u_dot, u_ddot, *base)
+    alpha_cmd = command.alpha + 2.0 * np.pi * np.round((s["alpha"] - command.alpha) / (2.0 * np.pi))
+    return {"target_azimuth": np.arctan2(-u[0], u[1]), "target_elevation": np.arctan2(u[2], np.hypot(u[0], u[1])),
+            "target_range": distance, "alpha_cmd": alpha_cmd, "beta_cmd": command.beta,
+            "alpha_cmd_dot": command.alpha_dot, "beta_cmd_dot": command.beta_dot,
+            "alpha_cmd_ddot": command.alpha_ddot, "beta_cmd_ddot": command.beta_ddot, "_direction": u}
+
+
 class RunResult:
     """`stop_time`: the end of the record (the last communication point recorded). `stopped`: None
     for a whole run, else a master.Stop (kind, time, reason) of a run that ended early, whose record
@@ -35,7 +52,14 @@ class RunResult:
         s["beta_error"] = s["beta_ref"] - s["beta"]
         az, el = geometry.los_azimuth_elevation(s["alpha"], s["beta"], *attitude)
         s["los_azimuth"], s["los_elevation"] = az, el
-        if scene.target_spec is not None:
+        moving = scene.moving_target
+        if moving is not None:
+            # a moving target: the error to where it is at each sample, the pointing command toward it
+            tracking = tracking_signals(moving, s)
+            direction = tracking.pop("_direction")
+            s["los_error"] = geometry.angle_between(geometry.los_direction(s["alpha"], s["beta"], *attitude),
+                                                    direction)
+        elif scene.target_spec is not None:
             s["los_error"] = geometry.los_error(s["alpha"], s["beta"], *attitude,
                                                 math.radians(scene.target_spec["azimuth_deg"]),
                                                 math.radians(scene.target_spec["elevation_deg"]))
@@ -44,7 +68,11 @@ class RunResult:
         # Signals derived for the spectra. Kept apart from `signals` (whose set is the record the golden
         # digests hold fixed), written to the CSV with them and readable by name through signal().
         self.derived = {}
-        if self.has_target:
+        if moving is not None:
+            self.derived.update(zip(AXIS_ERRORS, geometry.los_axis_errors(
+                s["alpha"], s["beta"], *attitude, tracking["target_azimuth"], tracking["target_elevation"])))
+            self.derived.update(tracking)
+        elif self.has_target:
             self.derived.update(zip(AXIS_ERRORS, geometry.los_axis_errors(
                 s["alpha"], s["beta"], *attitude, math.radians(scene.target_spec["azimuth_deg"]),
                 math.radians(scene.target_spec["elevation_deg"]))))
@@ -182,6 +210,20 @@ class RunResult:
                    comments="", fmt="%.10g")
         return True
 
+    def tracking_metrics(self):
+        """The target.metrics.TrackingMetrics of a run with a moving target (else None), over the
+        metrics window."""
+        if self.scene.moving_target is None:
+            return None
+        from ..target.metrics import NEEDED, TrackingMetrics
+
+        spec = self.scene.target_spec
+        metrics = TrackingMetrics(spec["beam_width_mrad"], spec["keyhole_deg"], self.scene.step_size,
+                                  self.window_start())
+        metrics.add({name: np.asarray(self.signal(name)) for name in NEEDED
+                     if name in self.signals or name in self.derived})
+        return metrics
+
     def requirement_failures(self) -> list[str]:
         """The scene's [requirements] this run does not meet (empty: all met, or none stated). A
         window that starts after the end of a shortened run cannot be judged and is skipped."""
@@ -229,6 +271,9 @@ class RunResult:
         else:
             parts.append(f"final alpha {math.degrees(self.final('alpha')):.4f} deg, "
                          f"beta {math.degrees(self.final('beta')):.4f} deg")
+        tracking = self.tracking_metrics()
+        if tracking is not None:
+            parts.append(tracking.summary())
         bands = self.scene.analysis.bands
         if self.has_target and bands:
             spectrum = next(iter(self.los_spectra().values()), None)

@@ -52,7 +52,8 @@ def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_t
                    keep_partial: bool = False, stop=None, stream: bool = False):
     """Runs one scene file and writes <out>/<scene file's name>.csv and .png; with a target also
     <name>_psd.csv and <name>_spectrum.png (the line-of-sight error's spectrum), on a moving base
-    <name>_isolation.csv (the isolation estimated from the run); and <name>_run.json (run_status).
+    <name>_isolation.csv (the isolation estimated from the run); with a moving target
+    <name>_tracking.png (plotting.tracking_figure); and <name>_run.json (run_status).
     Returns (result, csv, png). `keep_partial`, `stop`: as master.run; a partial result is written
     the same way, over the time it covers. A derived file the run cannot make (a spectrum of fewer
     than 2 samples) is removed, not left from an earlier run.
@@ -69,7 +70,7 @@ def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_t
 
 
 def _run_and_write(scene, fmu_path, out: pathlib.Path, progress, stop_time, keep_partial, stop, stream):
-    from .plotting import plot, plot_spectrum
+    from .plotting import plot, plot_spectrum, plot_tracking
     from .streaming import run_streamed
 
     csv_path, png_path = out / f"{scene.name}.csv", out / f"{scene.name}.png"
@@ -93,7 +94,9 @@ def _run_and_write(scene, fmu_path, out: pathlib.Path, progress, stop_time, keep
     written.append(png_path)
     for path, write in ((out / f"{scene.name}_psd.csv", result.write_psd_csv),
                         (out / f"{scene.name}_isolation.csv", result.write_isolation_csv),
-                        (out / f"{scene.name}_spectrum.png", lambda p: plot_spectrum(result, p))):
+                        (out / f"{scene.name}_spectrum.png", lambda p: plot_spectrum(result, p)),
+        (out / f"{scene.name}_tracking.png",
+         lambda p: plot_tracking(result, p, out / f"{scene.name}.parquet" if stream else None))):
         if write(path):
             written.append(path)
         else:

@@ -36,11 +36,11 @@ from ..errors import SceneError
 from ..fmu import FMU
 from ..progress import Progress
 from ..scene.base_motion import INPUTS as BASE_INPUTS
-from ..scene.scene import Scene, check_against_fmu, parameter_value
+from ..scene.scene import TRACKING_SIGNALS, Scene, check_against_fmu, check_run_length, parameter_value
 from . import compiled_loop, spectra, units
 from ..scene.controllers import ControllerError
 from .master import (ClampCount, FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records,
-                     failure_error, failure_message, initialize)
+                     failure_error, failure_message, initialize, moving_target_accelerations)
 from .results import AXIS_ERRORS, CARRIER_RATES, ISOLATION_AXES, RunResult
 
 # Communication points per chunk: 2^14 rows of ~60 doubles are 7.9 MB of record, some 50 MB with
@@ -66,6 +66,7 @@ class StreamPlan:
         self.scene, self.h = scene, scene.step_size
         self.t_end = scene.stop_time if stop_time is None else stop_time
         self.n = int(round(self.t_end / self.h))
+        check_run_length(scene, self.t_end)
         self.motion = scene.base_motion()
         u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
         self.controller = controller or scene.controller(u_limit)
@@ -95,12 +96,16 @@ class StreamPlan:
         if not self.motion.fixed:
             self.inputs[:count, 2:] = self.base
         self.measured_attitude = self.sensor_stream.rows(first, self.base)
-        self.controller.prepare(self.times, h, self.measured_attitude, self.base[:, 3:6])
+        self.controller.prepare(self.times, h, self.measured_attitude, self.base[:, 3:6],
+                                **moving_target_accelerations(self.scene, self.base))
         state = getattr(self.controller, "state", None)   # a user controller has no kernel state
         points = state.set_points if state is not None else None
         if points is not None and points.values:   # the set points' tables of this chunk, addressed by the run's step
             points.values -= first * 2 * 8
             points.rates -= first * 2 * 8
+            for name in ("accelerations", "gyro_rates"):   # a moving target's
+                if getattr(points, name):
+                    setattr(points, name, getattr(points, name) - first * 2 * 8)
 
     def chunk_signals(self, count: int) -> dict:
         """master.recorded_signals of the chunk's first `count` rows."""
@@ -196,8 +201,9 @@ class Metrics:
     chunk (results.RunResult.los_metrics over the whole record, with sums in chunk order), and the
     means over the metrics window the spectra remove."""
 
-    def __init__(self, window_start: float, spectral: list[str]):
+    def __init__(self, window_start: float, spectral: list[str], tracking=None):
         self.window_start = window_start
+        self.tracking = tracking   # a target.metrics.TrackingMetrics with a moving target, else None
         self.sum_squares = {"window": 0.0, "all": 0.0}
         self.count = {"window": 0, "all": 0}
         self.maximum = {"window": -math.inf, "all": -math.inf}
@@ -224,6 +230,8 @@ class Metrics:
             self.base_moves = self.base_moves or any(np.any(columns[f"base.{n}_dot"] != 0)
                                                      for n in ("delta", "psi", "gamma"))
         self.last = {name: float(values[-1]) for name, values in columns.items()}
+        if self.tracking is not None:
+            self.tracking.add(columns)
 
     def part(self) -> str:
         """"window" when the window holds samples (RunResult: else the whole run)."""
@@ -318,6 +326,9 @@ class StreamedResult(RunResult):
     def window_bounds(self) -> tuple[float, float]:
         return self.window_times
 
+    def tracking_metrics(self):
+        return self.metrics.tracking
+
 
 def record_needs(plan: StreamPlan, columns: int) -> tuple[int, int]:
     """(bytes on disk at most, bytes in memory) of a streamed run of `plan` with `columns` signals:
@@ -355,6 +366,7 @@ def column_count(plan: StreamPlan, scene: Scene) -> int:
     inputs and heave,
     and the derived line-of-sight signals (RunResult)."""
     derived = 5 + (len(AXIS_ERRORS) if scene.target_spec is not None else 0) + \
+        (len(TRACKING_SIGNALS) if scene.moving_target is not None else 0) + \
         (len(CARRIER_RATES) if not plan.motion.fixed else 0)
     return 1 + len(plan.real_names) + len(plan.mode_names) + 8 + len(BASE_INPUTS) + 1 + derived
 
@@ -505,7 +517,12 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     spectral = (list(AXIS_ERRORS) if has_target else []) + \
         ([] if plan.motion.fixed else [CARRIER_RATES[i - 1] for i in ISOLATION_AXES] +
          [f"los.omega[{i}]" for i in ISOLATION_AXES])
-    metrics = Metrics(float(scene.requirements.get("from_s", 0.0)), spectral)
+    tracking = None
+    if scene.moving_target is not None:
+        from ..target.metrics import TrackingMetrics
+        tracking = TrackingMetrics(scene.target_spec["beam_width_mrad"], scene.target_spec["keyhole_deg"],
+                                   scene.step_size, float(scene.requirements.get("from_s", 0.0)))
+    metrics = Metrics(float(scene.requirements.get("from_s", 0.0)), spectral, tracking)
     log: list = []
     slave = fmu.instantiate(scene.name, log)
     bar = Progress(plan.t_end, enabled=progress)

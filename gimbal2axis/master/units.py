@@ -47,6 +47,11 @@ _RUNNER_UNITS = {
     **{name: "rad" for name in ("alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_azimuth",
                                 "los_elevation", "los_error", "los_error_xel", "los_error_el")},
     "heave": "m",
+    # a moving target (results.tracking_signals)
+    **{name: "rad" for name in ("target_azimuth", "target_elevation", "alpha_cmd", "beta_cmd")},
+    "target_range": "m",
+    **{name: "rad/s" for name in ("alpha_cmd_dot", "beta_cmd_dot")},
+    **{name: "rad/s2" for name in ("alpha_cmd_ddot", "beta_cmd_ddot")},
     **{f"base.omega2[{i}]": "rad/s" for i in (1, 2, 3)},
 }
 

@@ -34,9 +34,10 @@ from .. import native
 from ..errors import SceneError, check_keys, did_you_mean, number, shown
 from .references import Reference
 from .setpoints import plan_set_points
+from ..target import MovingTarget, pointing
 
 AXES = ("azimuth", "elevation")
-PID_KEYS = {"kp", "ki", "kd", "k_gyro", "k_ff", "d_filter_s", "i_limit_V", "reference"}
+PID_KEYS = {"kp", "ki", "kd", "k_gyro", "k_ff", "k_acc", "d_filter_s", "i_limit_V", "reference"}
 
 
 def gyro_axis_rates(gyro, beta: float):
@@ -87,9 +88,10 @@ class Controller:
     def start(self, step_size: float, scene_name: str) -> None:
         """Called by the master before every run (the built-in controllers need nothing)."""
 
-    def prepare(self, times, h: float, attitude, rates) -> None:
+    def prepare(self, times, h: float, attitude, rates, accelerations=None) -> None:
         """Called by the master before the loop with the measured base attitude and rates of the
-        whole run ((n + 1) x 3 arrays): the built-in controllers compute their set points here."""
+        whole run ((n + 1) x 3 arrays), and the base's angular accelerations (for a moving target's
+        set points; None: zero): the built-in controllers compute their set points here."""
 
     def __call__(self, t: float, h: float, alpha: float, beta: float, gyro, base_attitude, base_rates,
                  step: int | None = None) -> tuple:
@@ -103,11 +105,14 @@ class Controller:
 class _ReferenceMixin:
     set_points = None   # SetPoints of the run, once prepared
 
-    def prepare(self, times, h, attitude, rates) -> None:
-        points = self.set_points = plan_set_points(self.refs, self.target, times, h, attitude, rates)
+    def prepare(self, times, h, attitude, rates, accelerations=None) -> None:
+        points = self.set_points = plan_set_points(self.refs, self.target, times, h, attitude, rates, accelerations)
         kernel_points = self.state.set_points
         kernel_points.values, kernel_points.rates = points.values.ctypes.data, points.rates.ctypes.data
         kernel_points.unwrap[:] = points.unwrap
+        # a moving target's (None: NULL, the kernel's fixed-target arithmetic)
+        kernel_points.accelerations, kernel_points.gyro_rates = (None if a is None else a.ctypes.data
+                                                                 for a in (points.accelerations, points.gyro_rates))
 
     def _step_with_references(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step) -> tuple:
         """The kernel's step with the prepared set points of `step`, or, called outside a run (no
@@ -119,6 +124,11 @@ class _ReferenceMixin:
             u = self._step(step, h, alpha, beta, gyro)
         self.reference = (self._buffer[11], self._buffer[12])
         return u
+
+    @staticmethod
+    def state_nearest_turn(principal: float, measured: float) -> float:
+        """The kernel's choice of the azimuth's 2 pi branch (gimbal_angle_nearest_turn)."""
+        return native.kernel().gimbal_angle_nearest_turn(principal, measured)
 
     def _setup_references(self, spec: dict, target):
         self.target = target
@@ -139,13 +149,18 @@ class _ReferenceMixin:
         """Set points (r1, r2) and, with base_rates and h, their rates: for 'target' the exact
         derivative of the inverse kinematics along the measured base rates, else a difference
         quotient of the reference over one step."""
-        if "target" in self.refs:
+        if "target" in self.refs and isinstance(self.target, MovingTarget):
+            command = pointing(self.target, [t], [base_attitude], [base_rates if base_rates is not None else (0, 0, 0)])
+            a_t = self.state_nearest_turn(float(command.alpha[0]), alpha)
+            b_t = float(command.beta[0])
+            target_rates = (float(command.alpha_dot[0]), float(command.beta_dot[0]))
+        elif "target" in self.refs:
             a_t, b_t = geometry.gimbal_angles_for(self.target, *base_attitude, alpha_near=alpha)
         r1 = a_t if self.refs[0] == "target" else self.refs[0].at(t)
         r2 = b_t if self.refs[1] == "target" else self.refs[1].at(t)
         if h is None:
             return r1, r2
-        if "target" in self.refs:
+        if "target" in self.refs and not isinstance(self.target, MovingTarget):
             eps = 1e-6
             ahead = [q + eps * w for q, w in zip(base_attitude, base_rates)]
             a_e, b_e = geometry.gimbal_angles_for(self.target, *ahead, alpha_near=a_t)
@@ -160,13 +175,16 @@ class AxisPID:
     u = kp e + ki int(e) + kd de/dt - k_gyro w + k_ff r_dot, e = reference - encoder angle, de/dt a
     backward difference through a first-order filter (time constant d_filter_s), w the gyro rate
     about the axis, r_dot the rate of the reference relative to the base (feed-forward: k_ff = N k_emf
-    cancels the motor's back-emf). Anti-windup: the integral stops while the output is saturated in the direction of e,
+    cancels the motor's back-emf). Toward a moving target (gimbal2axis/target) w is the gyro rate's
+    departure from the line of sight's rate on track, and + k_acc r_ddot feeds the reference's
+    acceleration forward [V s2/rad]: R J / (N k_torque) gives the torque of the reflected inertia J.
+    Anti-windup: the integral stops while the output is saturated in the direction of e,
     and ki*int(e) is kept within +-i_limit_V."""
 
     def __init__(self, where: str, spec: dict, u_limit: float):
         check_keys(where, spec, PID_KEYS)
-        self.kp, self.ki, self.kd, self.k_gyro, self.k_ff = (number(f"{where}.{k}", spec.get(k, 0.0))
-                                                             for k in ("kp", "ki", "kd", "k_gyro", "k_ff"))
+        self.kp, self.ki, self.kd, self.k_gyro, self.k_ff, self.k_acc = (
+            number(f"{where}.{k}", spec.get(k, 0.0)) for k in ("kp", "ki", "kd", "k_gyro", "k_ff", "k_acc"))
         self.tau = number(f"{where}.d_filter_s", spec.get("d_filter_s", 0.0))
         self.i_limit = number(f"{where}.i_limit_V", spec["i_limit_V"]) if "i_limit_V" in spec else u_limit
         self.u_limit = u_limit
@@ -175,6 +193,7 @@ class AxisPID:
         """Writes the gains into the kernel's GimbalAxisPid `axis` (its state starts at rest)."""
         axis.kp, axis.ki, axis.kd, axis.k_gyro, axis.k_ff = self.kp, self.ki, self.kd, self.k_gyro, self.k_ff
         axis.d_filter_s, axis.i_limit, axis.u_limit = self.tau, self.i_limit, self.u_limit
+        axis.k_acc = self.k_acc
 
 
 class PID(_ReferenceMixin, Controller):
@@ -556,7 +575,8 @@ CONTROLLER_KEYS = {"type", "delay_steps", "reference", "voltage_V", "K", "ki", "
 
 
 def make_controller(spec: dict | None, target, u_limit, base_dir: pathlib.Path | None = None) -> Controller:
-    """Builds the controller of a scene's [controller] table; `target` a unit vector in G or None,
+    """Builds the controller of a scene's [controller] table; `target` a unit vector in G, a moving
+    target (gimbal2axis.target.MovingTarget: the built-in controllers' set points follow it) or None,
     `u_limit` the motors' voltage limits (the controller output saturates there, like a DAC),
     `base_dir` where a user controller's module file is looked for first (the scene's folder)."""
     spec = dict(spec or {"type": "none"})
@@ -578,6 +598,8 @@ def make_controller(spec: dict | None, target, u_limit, base_dir: pathlib.Path |
         return StateFeedback(spec, target, u_limit)
     if kind == "python":
         check_keys("controller", spec, {"type", "delay_steps", "file", "module", "class", "options"})
-        return UserController(spec, target, u_limit, base_dir)
+        # a user controller's context.target is a fixed direction or None (docs/targets.md: a moving target
+        # is not passed to user controllers yet; the record still measures the error to it)
+        return UserController(spec, None if isinstance(target, MovingTarget) else target, u_limit, base_dir)
     raise SceneError(f"[controller] type must be 'none', 'pid', 'state_feedback' or 'python', got {shown(kind)}"
                      f"{did_you_mean(kind, ('none', 'pid', 'state_feedback', 'python'))}")

@@ -16,7 +16,9 @@ file's name), description, stop_time [s], step_size [s] (communication step), ou
                   turn; a rotor angle/rate not given follows its load through the gear (alpha_m = N1 alpha)
   [base_motion]   type = "fixed" | "sinusoids" | "sea_state" | "recorded" (base_motion.py)
   [target]        azimuth_deg, elevation_deg: the fixed inertial direction the line of sight should
-                  hold (geometry.py); start_on_target = true starts the gimbal pointing at it
+                  hold (geometry.py); start_on_target = true starts the gimbal pointing at it; or
+                  type = "earth_point" | "flyby" | "track", a moving target (gimbal2axis/target/spec.py,
+                  docs/targets.md)
   [controller]    type = "none" | "pid" | "state_feedback" | "python", delay_steps (default 1)
                   (controllers.py)
   [sensors]       encoders, a datasheet gyro, direct or indirect stabilization, IMU noise (sensors.py)
@@ -51,6 +53,8 @@ import numpy as np
 from . import analysis, geometry
 from .base_motion import Recorded, make_base_motion
 from .controllers import make_controller
+from .. import target as moving_targets
+from ..target import spec as target_spec_table
 from ..errors import (SceneError, SceneWarning, boolean, check_keys, did_you_mean, excerpt, is_number_text, number,
                       positive, read_toml, shown)
 from ..fmu import FIDELITY, FMU, enumeration_items
@@ -103,11 +107,24 @@ class Scene:
     @property
     def target(self):
         """Unit vector of the target in G, or None: the kernel's (setpoints.target_direction), whose
-        bits the controller FMU computes from the same angles."""
-        if self.target_spec is None:
+        bits the controller FMU computes from the same angles. None for a moving target too
+        (moving_target)."""
+        if self.target_spec is None or "type" in self.target_spec:
             return None
         return target_direction(math.radians(self.target_spec["azimuth_deg"]),
                                 math.radians(self.target_spec["elevation_deg"]))
+
+    @property
+    def moving_target(self):
+        """The target.motion.MovingTarget of a [target] with a type (earth_point, flyby, track), else None."""
+        if self.target_spec is None or "type" not in self.target_spec:
+            return None
+        cache = self.__dict__.setdefault("_moving_target", {})
+        key = repr(sorted(self.target_spec.items(), key=str))
+        if key not in cache:
+            cache.clear()
+            cache[key] = target_spec_table.build(self.target_spec, self.path.parent)
+        return cache[key]
 
     @property
     def delay_steps(self) -> int:
@@ -122,7 +139,8 @@ class Scene:
         return make_base_motion(self.base_motion_spec, self.path.parent)
 
     def controller(self, u_limit=(math.inf, math.inf)):
-        return make_controller(self.controller_spec, self.target, u_limit, base_dir=self.path.parent)
+        target = self.target if self.moving_target is None else self.moving_target
+        return make_controller(self.controller_spec, target, u_limit, base_dir=self.path.parent)
 
     def sensors(self):
         return Sensors(self.sensors_spec)
@@ -231,8 +249,10 @@ def load_scene(path: pathlib.Path | str) -> Scene:
             raise SceneError(f"'description' must be a string, got {shown(description)}")
         step = positive("step_size", raw["step_size"])
         target = raw.get("target")
-        if target is not None:
-            target = _table(raw, "target")
+        if target is not None and target_spec_table.kind_of(_table(raw, "target")) != "direction":
+            target = target_spec_table.parse(target)
+        elif target is not None:
+            target = {key: value for key, value in _table(raw, "target").items() if key != "type"}
             check_keys("target", target, {"azimuth_deg", "elevation_deg", "start_on_target"})
             target = {"azimuth_deg": number("target.azimuth_deg", target.get("azimuth_deg", 0.0)),
                       "elevation_deg": number("target.elevation_deg", target.get("elevation_deg", 0.0)),
@@ -287,7 +307,9 @@ def _validate(scene: Scene) -> None:
         # start_values would let [parameters] win without a word
         raise SceneError(f"{', '.join(repr(n) for n in overlap)} set in both [fidelity] and [parameters]: "
                          "set each FMU variable in one table only")
-    if scene.target_spec is not None:
+    if scene.moving_target is not None:
+        target_spec_table.check_run(scene.moving_target, scene.stop_time)
+    elif scene.target_spec is not None:
         elevation = number("target.elevation_deg", scene.target_spec["elevation_deg"])
         if not -90.0 <= elevation <= 90.0:
             raise SceneError(f"target.elevation_deg = {elevation:g} is outside [-90, 90] deg (0 = horizon, "
@@ -339,6 +361,7 @@ WHY_NOT_NEGATIVE = {
     "kd": "a negative gain feeds the error's rate back with the wrong sign",
     "k_gyro": "negative rate feedback undamps the axis",
     "k_ff": "the feed-forward cancels the motor's back-emf (k_ff = N k_emf); a negative one adds to it",
+    "k_acc": "the feed-forward gives the torque of the set point's acceleration; a negative one opposes it",
     "d_filter_s": "it is the time constant of the derivative filter",
     "i_limit_V": "it bounds |ki * integral|",
 }
@@ -422,12 +445,26 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
         raise SceneError(f"{scene.path}: {exc}") from None
 
 
+# What a run with a moving target adds (master/results.py): the target's direction and range in G, the
+# pointing command on the carrier (inverse kinematics) with its rates and accelerations.
+TRACKING_SIGNALS = ("target_azimuth", "target_elevation", "target_range", "alpha_cmd", "beta_cmd", "alpha_cmd_dot",
+                    "beta_cmd_dot", "alpha_cmd_ddot", "beta_cmd_ddot")
 DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "u_R1_asked", "u_R2_asked",
                    "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
                    "los_azimuth", "los_elevation", "heave", "los_error_xel", "los_error_el",
-                   "base.omega2[1]", "base.omega2[2]", "base.omega2[3]"} | {f"base.{n}" for n in (
+                   "base.omega2[1]", "base.omega2[2]", "base.omega2[3]"} | set(TRACKING_SIGNALS) | {f"base.{n}" for n in (
                        "delta", "psi", "gamma", "delta_dot", "psi_dot", "gamma_dot",
                        "delta_ddot", "psi_ddot", "gamma_ddot")}
+
+
+def check_run_length(scene: Scene, t_end: float) -> None:
+    """Refuses a run to t_end (a --stop-time beyond the scene's) that a recorded target or carrier
+    track does not cover; the scene's own stop_time is checked when it loads."""
+    if scene.moving_target is not None:
+        try:
+            target_spec_table.check_run(scene.moving_target, t_end)
+        except SceneError as exc:
+            raise SceneError(f"{scene.path}: {exc}") from None
 
 
 def parameter_value(scene: Scene, fmu: FMU, name: str):
@@ -445,7 +482,12 @@ def start_values(scene: Scene, fmu: FMU, base_row0: np.ndarray, base_row_eps: np
     their loads when not given; start_on_target points the gimbal at the target for the base
     attitude at t = 0 (and gives it the rates that keep it there, from base_row_eps at t = eps)."""
     initial = dict(scene.initial)
-    if scene.target_spec is not None and scene.target_spec["start_on_target"]:
+    if scene.moving_target is not None and scene.target_spec["start_on_target"]:
+        rows = np.asarray(base_row0, dtype=float).reshape(1, -1)
+        command = moving_targets.pointing(scene.moving_target, [0.0], rows[:, 0:3], rows[:, 3:6], rows[:, 6:9])
+        for name in ("alpha", "beta", "alpha_dot", "beta_dot"):
+            initial.setdefault(name, float(getattr(command, name)[0]))
+    elif scene.target_spec is not None and scene.target_spec["start_on_target"]:
         a0, b0 = geometry.gimbal_angles_for(scene.target, *base_row0[:3])
         initial.setdefault("alpha", a0)
         initial.setdefault("beta", b0)

@@ -21,6 +21,7 @@ import ctypes
 import numpy as np
 
 from .. import native
+from ..target import MovingTarget, pointing
 
 RATE_STEP_S = 1e-6   # the attitude difference for the target's rate (set_points.h GIMBAL_SET_POINT_RATE_STEP_S)
 
@@ -63,21 +64,34 @@ def target_direction(azimuth: float, elevation: float) -> tuple:
 
 class SetPoints:
     """values[k, axis] and rates[k, axis], (n + 1) x 2 arrays; unwrap[axis]: the value is a
-    principal angle to be taken in the branch nearest the measured one."""
+    principal angle to be taken in the branch nearest the measured one. A moving target adds
+    accelerations[k, axis] and gyro_rates[k, (x2, z2)], the payload's inertial rate on track (the
+    kernel's GimbalSetPoints); None otherwise."""
 
-    def __init__(self, values: np.ndarray, rates: np.ndarray, unwrap: tuple):
+    def __init__(self, values: np.ndarray, rates: np.ndarray, unwrap: tuple, accelerations=None, gyro_rates=None):
         self.values = np.ascontiguousarray(values, dtype=float)
         self.rates = np.ascontiguousarray(rates, dtype=float)
         self.unwrap = tuple(bool(u) for u in unwrap)
+        self.accelerations, self.gyro_rates = (None if a is None else np.ascontiguousarray(a, dtype=float)
+                                               for a in (accelerations, gyro_rates))
 
 
 def plan_set_points(references: list, target, times: np.ndarray, h: float, attitude: np.ndarray,
-                    rates: np.ndarray) -> SetPoints:
-    """`references` per axis: "target" or a Reference; `attitude` and `rates` the measured base
+                    rates: np.ndarray, accelerations: np.ndarray | None = None) -> SetPoints:
+    """`references` per axis: "target" or a Reference; `target` a unit vector in G or a moving target
+    (gimbal2axis.target.MovingTarget); `accelerations` the base's angular accelerations (the command's
+    accelerations toward a moving target; None: zero); `attitude` and `rates` the measured base
     attitude (delta, psi, gamma) and its rates at every time, (n + 1) x 3."""
     count = len(times)
     values, value_rates = np.zeros((count, 2)), np.zeros((count, 2))
-    if "target" in references:
+    if "target" in references and isinstance(target, MovingTarget):
+        # a moving target: the inverse kinematics' exact rates along the target's and the measured
+        # carrier's motion (gimbal2axis/target), computed here in numpy for the whole run or chunk
+        command = pointing(target, times, attitude, rates, accelerations)
+        target_values = np.array([command.alpha, command.beta])
+        target_rates = np.array([command.alpha_dot, command.beta_dot])
+        target_accelerations = np.array([command.alpha_ddot, command.beta_ddot])
+    elif "target" in references:
         target_values, target_rates = target_set_points(target, attitude, rates)
     for axis, reference in enumerate(references):
         if reference == "target":
@@ -86,5 +100,12 @@ def plan_set_points(references: list, target, times: np.ndarray, h: float, attit
             now = [reference.at(float(t)) for t in times]
             values[:, axis] = now
             value_rates[:, axis] = [(reference.at(float(t) + h) - r) / h for t, r in zip(times, now)]
-    return SetPoints(values, value_rates, tuple(reference == "target" and axis == 0
-                                               for axis, reference in enumerate(references)))
+    unwrap = tuple(reference == "target" and axis == 0 for axis, reference in enumerate(references))
+    if "target" in references and isinstance(target, MovingTarget):
+        # per axis the target's acceleration, or the other reference's (zero: its rate is a difference)
+        value_accelerations = np.zeros((count, 2))
+        for axis, reference in enumerate(references):
+            if reference == "target":
+                value_accelerations[:, axis] = target_accelerations[axis]
+        return SetPoints(values, value_rates, unwrap, value_accelerations, command.los_rate[[0, 2]].T)
+    return SetPoints(values, value_rates, unwrap)

@@ -16,20 +16,27 @@
 
 /* One axis of the PID: u = kp e + ki int(e) + kd de/dt - k_gyro w + k_ff r_dot, de/dt a backward
  * difference through a first-order filter (time constant d_filter_s); anti-windup: the integral
- * stops while the output is saturated in the direction of e, and ki int(e) stays within +-i_limit. */
+ * stops while the output is saturated in the direction of e, and ki int(e) stays within +-i_limit.
+ * With set points that carry accelerations (a moving target), + k_acc r_ddot after the other terms. */
 #define GIMBAL_AXIS_PID_FIELDS(FIELD, ARRAY)                                                       \
     FIELD(double, kp, double) FIELD(double, ki, double) FIELD(double, kd, double)                  \
     FIELD(double, k_gyro, double) FIELD(double, k_ff, double) FIELD(double, d_filter_s, double)    \
-    FIELD(double, i_limit, double) FIELD(double, u_limit, double)                                  \
+    FIELD(double, i_limit, double) FIELD(double, u_limit, double) FIELD(double, k_acc, double)     \
     FIELD(double, integral, double) FIELD(double, e_prev, double) FIELD(double, derivative, double) \
     FIELD(int, has_prev, int) FIELD(int, saturated, int)
 GIMBAL_STRUCT(GimbalAxisPid, GIMBAL_AXIS_PID_FIELDS)
 
 /* The set points of a whole run, computed before it (gimbal2axis/scene/setpoints.py): row k of values and
  * rates, (n + 1) x 2. An axis with unwrap takes the 2 pi branch of its value nearest the measured
- * angle (the azimuth to a target: a gimbal that turned a full circle keeps tracking). */
-#define GIMBAL_SET_POINTS_FIELDS(FIELD, ARRAY) \
-    FIELD(const double*, values, pointer) FIELD(const double*, rates, pointer) ARRAY(int, unwrap, int, 2)
+ * angle (the azimuth to a target: a gimbal that turned a full circle keeps tracking).
+ * A moving target (gimbal2axis/target) adds, (n + 1) x 2 each, NULL otherwise: accelerations, the
+ * set points' second derivatives (fed forward by the PID's k_acc), and gyro_rates, the payload's
+ * inertial rate on track about the elevation axis x2 and the cross-elevation axis z2 (what
+ * los.omega[1] and los.omega[3] read when the line of sight follows the target): the gyro terms
+ * then act on the rate's departure from it, not on the rate itself. */
+#define GIMBAL_SET_POINTS_FIELDS(FIELD, ARRAY)                                                        \
+    FIELD(const double*, values, pointer) FIELD(const double*, rates, pointer) ARRAY(int, unwrap, int, 2) \
+    FIELD(const double*, accelerations, pointer) FIELD(const double*, gyro_rates, pointer)
 GIMBAL_STRUCT(GimbalSetPoints, GIMBAL_SET_POINTS_FIELDS)
 
 /* kind: gimbal_controller_kind(name). State feedback: u = -K x + ki int(reference - angle),

@@ -1,0 +1,271 @@
+"""Where a moving target is, seen from the gimbal on a carrier that sails: the position p(t) of the
+target relative to the gimbal in G [m] with its first two time derivatives, for the scene's
+[target] kinds earth_point, flyby and track (spec.py reads them).
+
+G is the carrier's local level frame: z_G up, y_G horizontal along the carrier's mean course (true
+course, clockwise from north), x_G to starboard of it, as the recorded ship motions are fed
+(docs/physics.md, section 7.1): with course 0, x_G is east and y_G north. The carrier's attitude
+(the scene's base motion) is relative to this frame.
+
+Geodesy is pymap3d's (WGS 84): the carrier sails a rhumb line (constant course,
+pymap3d.lox.loxodrome_direct) or follows a recorded track; the target's position in the carrier's
+local east-north-up frame at each instant is pymap3d.geodetic2enu, so the Earth's curvature (a point
+10 km away lies 7.8 m below the carrier's horizon plane) and the turning of the local vertical along
+the carrier's way are in it. Its derivatives are central differences over DIFFERENCE_STEP_S of
+that position: the relative motion of a ship and a coastal point is smooth on that scale (the
+error of the rate is (step^2 / 6) p''' and the rounding of the acceleration about 1e-9 m / step^2).
+
+The flyby is flat: an aircraft on a straight line in the carrier's local level frame at its start,
+exact derivatives (closed form).
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+
+import numpy as np
+
+from ..errors import SceneError, excerpt
+from .kinematics import unit_and_derivatives
+
+DIFFERENCE_STEP_S = 0.05
+
+
+def enu_to_g(east, north, up, course):
+    """G components of an east-north-up vector, G's y axis along the true course [rad]."""
+    c, s = math.cos(course), math.sin(course)
+    return np.array([c * east - s * north, s * east + c * north, up])
+
+
+def g_to_enu(x, y, z, course):
+    c, s = math.cos(course), math.sin(course)
+    return np.array([c * x + s * y, -s * x + c * y, z])
+
+
+class Track:
+    """A recorded track: a comma-separated file with a header row (`#` starts a comment line), a
+    `time` column [s] and either latitude_deg, longitude_deg, altitude_m (geodetic, WGS 84) or
+    north_m, east_m, down_m (from `origin`, the carrier's start: pymap3d.ned2geodetic). Each
+    coordinate is a C2 cubic spline through the samples (scipy's CubicSpline, not-a-knot ends, as
+    the recorded ship motions). Checked like them: a header with a time column, numbers in every
+    cell, at least 4 rows, time strictly increasing; refusals name the file, line and column."""
+
+    GEODETIC = ("latitude_deg", "longitude_deg", "altitude_m")
+    LOCAL = ("north_m", "east_m", "down_m")
+
+    def __init__(self, where: str, path: pathlib.Path, origin=None):
+        self.path = path
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SceneError(f"{where}: recorded track {path}: cannot read it: {getattr(exc, 'strerror', exc)}") \
+                from None
+        lines = [(number, line.strip()) for number, line in enumerate(text.splitlines(), start=1)
+                 if line.strip() and not line.lstrip().startswith("#")]
+        if lines and ";" in lines[0][1] and "time" in lines[0][1]:
+            raise SceneError(f"{where}: {path}: line {lines[0][0]} (the header) is separated by semicolons; the "
+                             "file must be comma-separated with '.' as the decimal point")
+        if not lines or "time" not in [c.strip() for c in lines[0][1].split(",")]:
+            raise SceneError(f"{where}: {path} is not a recorded track: its header (the first line that is not a "
+                             "comment) has no 'time' column (expected a header such as 'time,latitude_deg,"
+                             "longitude_deg,altitude_m', then rows of numbers)")
+        header_line, header = lines[0]
+        names = [c.strip() for c in header.split(",")]
+        for kind in (self.GEODETIC, self.LOCAL):
+            if set(kind) <= set(names):
+                self.columns = kind
+                break
+        else:
+            raise SceneError(f"{where}: {path}: the header has columns {excerpt(', '.join(names))}; a track needs "
+                             f"time and either {', '.join(self.GEODETIC)} or {', '.join(self.LOCAL)}")
+        extra = sorted(set(names) - {"time", *self.columns})
+        if extra:
+            raise SceneError(f"{where}: {path}: unknown column(s) {excerpt(', '.join(extra))} (a track has time and "
+                             f"{', '.join(self.columns)})")
+        rows = []
+        for row_number, (line_number, line) in enumerate(lines[1:], start=1):
+            cells = [c.strip() for c in line.split(",")]
+            if len(cells) != len(names):
+                raise SceneError(f"{where}: {path}: line {line_number} (data row {row_number}) has {len(cells)} "
+                                 f"cells, the header {len(names)}")
+            values = []
+            for name, cell in zip(names, cells):
+                try:
+                    value = float(cell)
+                except ValueError:
+                    what = "is empty" if not cell else f"is not a number: '{excerpt(cell)}'"
+                    raise SceneError(f"{where}: {path}: line {line_number} (data row {row_number}), column "
+                                     f"'{name}' {what}") from None
+                if not math.isfinite(value):
+                    raise SceneError(f"{where}: {path}: line {line_number} (data row {row_number}), column "
+                                     f"'{name}' is '{excerpt(cell)}', not a finite number")
+                values.append(value)
+            rows.append(values)
+        if len(rows) < 4:
+            raise SceneError(f"{where}: {path}: {len(rows)} data row(s); a track needs at least 4 (a cubic spline)")
+        table = np.array(rows)
+        t = table[:, names.index("time")]
+        steps = np.flatnonzero(np.diff(t) <= 0)
+        if steps.size:
+            row = int(steps[0]) + 2
+            raise SceneError(f"{where}: {path}: line {lines[row][0]} (data row {row}): time {t[row - 1]:g} s does "
+                             f"not increase (the row before: {t[row - 2]:g} s)")
+        self.time = t
+        self.t_start, self.t_end = float(t[0]), float(t[-1])
+        coordinates = [table[:, names.index(c)] for c in self.columns]
+        if self.columns == self.GEODETIC:
+            if np.any(np.abs(coordinates[0]) > 90.0):
+                row = int(np.flatnonzero(np.abs(coordinates[0]) > 90.0)[0]) + 1
+                raise SceneError(f"{where}: {path}: line {lines[row][0]} (data row {row}): latitude_deg "
+                                 f"{coordinates[0][row - 1]:g} is outside [-90, 90]")
+            # a track across the antimeridian stays continuous for the spline
+            coordinates[1] = np.degrees(np.unwrap(np.radians(coordinates[1])))
+        elif origin is not None:
+            import pymap3d
+            coordinates = list(pymap3d.ned2geodetic(*coordinates, *origin))
+        else:
+            raise SceneError(f"{where}: {path}: a track in north_m, east_m, down_m is relative to the carrier's "
+                             "start, which needs a geodetic [target.carrier] position")
+        from scipy.interpolate import CubicSpline   # here: a scene without a track imports no scipy
+
+        self.splines = [CubicSpline(t, c, bc_type="not-a-knot") for c in coordinates]
+
+    def check_covers(self, where: str, stop_time: float) -> None:
+        # the differences reach DIFFERENCE_STEP_S beyond the run's ends
+        if self.t_start > -DIFFERENCE_STEP_S or self.t_end < stop_time + DIFFERENCE_STEP_S:
+            raise SceneError(f"{where}: the track {self.path} covers [{self.t_start:g}, {self.t_end:g}] s, not "
+                             f"[{-DIFFERENCE_STEP_S:g}, {stop_time + DIFFERENCE_STEP_S:g}] s (the run and "
+                             f"{DIFFERENCE_STEP_S:g} s either side for the rates)")
+
+    def geodetic(self, t):
+        return tuple(spline(t) for spline in self.splines)
+
+
+class Carrier:
+    """The carrier's gimbal on the Earth: sailing a rhumb line at speed_m_s along course from a
+    start position, or a recorded Track; G's y axis along `course` [rad] (the mean course, the
+    frame the base motion's yaw is relative to)."""
+
+    def __init__(self, latitude_deg, longitude_deg, altitude_m, course, speed_m_s, track: Track | None = None):
+        self.latitude_deg, self.longitude_deg, self.altitude_m = latitude_deg, longitude_deg, altitude_m
+        self.course, self.speed, self.track = course, speed_m_s, track
+
+    def geodetic(self, t):
+        t = np.asarray(t, dtype=float)
+        if self.track is not None:
+            return self.track.geodetic(t)
+        distance = self.speed * t
+        if self.speed == 0.0:
+            lat, lon = np.full(t.shape, self.latitude_deg), np.full(t.shape, self.longitude_deg)
+        else:
+            from pymap3d.lox import loxodrome_direct
+            # loxodrome_direct takes a non-negative range: a time before the start sails the reciprocal course
+            lat, lon = loxodrome_direct(self.latitude_deg, self.longitude_deg, np.abs(distance),
+                                        np.where(distance >= 0, math.degrees(self.course),
+                                                 math.degrees(self.course) + 180.0))
+            # (it returns a 0-d array for a single time)
+            lat, lon = (np.broadcast_to(np.asarray(x, dtype=float), t.shape).copy() for x in (lat, lon))
+        return lat, lon, np.full(t.shape, float(self.altitude_m))
+
+    def flat_position(self, t):
+        """Position in G relative to the start, on a flat Earth (for the flyby): course along y_G."""
+        t = np.asarray(t, dtype=float)
+        return np.array([np.zeros_like(t), self.speed * t, np.zeros_like(t)])
+
+
+class MovingTarget:
+    """Base of the moving targets: `relative(t)` -> p, p', p'' ((3, n) in G, metres) of the target
+    from the gimbal; `direction(t)` the unit vector; `kinematics(t)` u, u', u'', range, range rate."""
+    kind = "?"
+
+    def __init__(self, carrier: Carrier):
+        self.carrier = carrier
+
+    def relative(self, t):
+        raise NotImplementedError
+
+    def kinematics(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return unit_and_derivatives(*self.relative(t))
+
+    def direction(self, t):
+        return self.kinematics(t)[0]
+
+
+class GeodeticTarget(MovingTarget):
+    """A target whose geodetic position is known at any time (`position(t)` -> lat, lon, alt): the
+    relative position is pymap3d.geodetic2enu from the carrier's position at that instant, turned
+    into G; its rates by central differences."""
+
+    def position(self, t):
+        raise NotImplementedError
+
+    def _offset(self, t):
+        import pymap3d   # here: pymap3d is imported by the scenes with a geodetic target only
+
+        lat, lon, alt = self.position(t)
+        lat0, lon0, alt0 = self.carrier.geodetic(t)
+        east, north, up = pymap3d.geodetic2enu(lat, lon, alt, lat0, lon0, alt0)
+        return enu_to_g(np.asarray(east), np.asarray(north), np.asarray(up), self.carrier.course)
+
+    def relative(self, t):
+        step = DIFFERENCE_STEP_S
+        p, ahead, behind = (self._offset(t + shift) for shift in (0.0, step, -step))
+        return p, (ahead - behind) / (2.0 * step), (ahead - 2.0 * p + behind) / (step * step)
+
+
+class EarthPoint(GeodeticTarget):
+    """A point fixed on the Earth (a coastal landmark, a buoy): latitude, longitude [deg], altitude [m]."""
+    kind = "earth_point"
+
+    def __init__(self, carrier: Carrier, latitude_deg, longitude_deg, altitude_m):
+        super().__init__(carrier)
+        self.point = (latitude_deg, longitude_deg, altitude_m)
+
+    def position(self, t):
+        shape = np.shape(t)
+        return tuple(np.full(shape, float(value)) for value in self.point)
+
+
+class RecordedTarget(GeodeticTarget):
+    """A target on a recorded Track (a boat's AIS track, a recorded flight)."""
+    kind = "track"
+
+    def __init__(self, carrier: Carrier, track: Track):
+        super().__init__(carrier)
+        self.track = track
+
+    def position(self, t):
+        return self.track.geodetic(t)
+
+
+class Flyby(MovingTarget):
+    """An aircraft on a straight line at constant speed and altitude: heading (true, clockwise from
+    north), speed, height above the gimbal, and its closest approach: at time t_ca it passes
+    `closest_approach` metres (horizontally) from where the carrier then is; > 0: its track lies to
+    the right of the carrier, seen along its heading. On a carrier that stands still the ground
+    range is smallest there, the slant range hypot(closest_approach, height) and the line of sight's
+    rate v / hypot(...), so the azimuth rate is v / (slant range cos(elevation)) = v /
+    closest_approach. Flat Earth: the few kilometres of a pass bend the horizon by a few metres at
+    most (docs/targets.md)."""
+    kind = "flyby"
+
+    def __init__(self, carrier: Carrier, height_m, speed_m_s, heading, closest_approach_m, closest_approach_s):
+        super().__init__(carrier)
+        self.height, self.speed, self.heading = height_m, speed_m_s, heading
+        self.closest_approach, self.t_ca = closest_approach_m, closest_approach_s
+        # in G: the heading relative to the carrier's course, clockwise from y_G; right of the track is
+        # the heading turned 90 degrees clockwise
+        relative_heading = heading - carrier.course
+        self.velocity = np.array([math.sin(relative_heading), math.cos(relative_heading), 0.0]) * speed_m_s
+        right = np.array([math.cos(relative_heading), -math.sin(relative_heading), 0.0])
+        self.closest_point = carrier.flat_position(closest_approach_s) + right * closest_approach_m
+        self.closest_point[2] = height_m
+
+    def relative(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        aircraft = self.closest_point[:, None] + self.velocity[:, None] * (t - self.t_ca)
+        p = aircraft - self.carrier.flat_position(t)
+        carrier_velocity = np.array([0.0, self.carrier.speed, 0.0])
+        p_dot = np.broadcast_to((self.velocity - carrier_velocity)[:, None], p.shape).copy()
+        return p, p_dot, np.zeros_like(p)

@@ -1,0 +1,148 @@
+"""The scene's [target] table of a moving target (docs/targets.md):
+
+    [target]
+    type = "earth_point"            # or "flyby", "track"; "direction" (the default): a fixed inertial direction
+    latitude_deg = 59.91            # earth_point: geodetic (WGS 84) ...
+    longitude_deg = 10.60
+    altitude_m = 40.0
+    # north_m, east_m, down_m       # ... or from the carrier's start, in its local north-east-down frame
+    beam_width_mrad = 2.0           # on target: the error within half of it
+    keyhole_deg = 10.0              # near the keyhole: the target within this of the azimuth axis
+    start_on_target = true
+
+    [target.carrier]                # the carrier's gimbal on the Earth
+    latitude_deg = 59.85
+    longitude_deg = 10.55
+    altitude_m = 15.0               # the gimbal's height above the ellipsoid
+    course_deg = 20.0               # true course: G's y axis, the base motion's yaw is relative to it
+    speed_m_s = 8.0                 # sailing a rhumb line; or track = "own_ship.csv", a recorded track
+
+flyby: altitude_m (above the ellipsoid; the flat pass's height is altitude_m minus the carrier's),
+speed_m_s, heading_deg (true), closest_approach_m (horizontal, > 0 to the right of the aircraft's
+track), closest_approach_s (when). track: file = "boat.csv" (motion.Track), relative to the scene file.
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+
+from ..errors import SceneError, boolean, check_keys, choice, did_you_mean, non_negative, number, positive, shown
+from .motion import Carrier, EarthPoint, Flyby, RecordedTarget, Track
+
+MOVING_KINDS = ("earth_point", "flyby", "track")
+KINDS = ("direction",) + MOVING_KINDS
+COMMON_KEYS = {"type", "start_on_target", "beam_width_mrad", "keyhole_deg", "carrier"}
+KIND_KEYS = {
+    "earth_point": {"latitude_deg", "longitude_deg", "altitude_m", "north_m", "east_m", "down_m"},
+    "flyby": {"altitude_m", "speed_m_s", "heading_deg", "closest_approach_m", "closest_approach_s"},
+    "track": {"file"},
+}
+CARRIER_KEYS = {"latitude_deg", "longitude_deg", "altitude_m", "course_deg", "speed_m_s", "track"}
+DEFAULT_BEAM_WIDTH_MRAD = 1.0
+DEFAULT_KEYHOLE_DEG = 10.0
+
+
+def kind_of(table: dict) -> str:
+    kind = table.get("type", "direction")
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise SceneError(f"target.type must be one of {list(KINDS)}, got {shown(kind)}{did_you_mean(kind, KINDS)}")
+    return kind
+
+
+def parse(table: dict) -> dict:
+    """The validated [target] table of a moving target (numbers checked by key), as Scene.target_spec."""
+    kind = kind_of(table)
+    check_keys("target", table, COMMON_KEYS | KIND_KEYS[kind])
+    spec = {"type": kind, "start_on_target": boolean("target.start_on_target", table.get("start_on_target", False)),
+            "beam_width_mrad": positive("target.beam_width_mrad", table.get("beam_width_mrad",
+                                                                              DEFAULT_BEAM_WIDTH_MRAD)),
+            "keyhole_deg": positive("target.keyhole_deg", table.get("keyhole_deg", DEFAULT_KEYHOLE_DEG))}
+    if spec["keyhole_deg"] >= 90.0:
+        raise SceneError(f"target.keyhole_deg = {spec['keyhole_deg']:g} must be below 90 (degrees from the azimuth "
+                         "axis)")
+    carrier = table.get("carrier", {})
+    if not isinstance(carrier, dict):
+        raise SceneError(f"target.carrier must be a table ([target.carrier]), got {shown(carrier)}")
+    check_keys("target.carrier", carrier, CARRIER_KEYS)
+    spec["carrier"] = {key: number(f"target.carrier.{key}", value) for key, value in carrier.items() if key != "track"}
+    if "track" in carrier:
+        if not isinstance(carrier["track"], str):
+            raise SceneError(f"target.carrier.track must be a file name, got {shown(carrier['track'])}")
+        spec["carrier"]["track"] = carrier["track"]
+    if "speed_m_s" in carrier:
+        non_negative("target.carrier.speed_m_s", carrier["speed_m_s"])
+        if "track" in carrier:
+            raise SceneError("target.carrier has both speed_m_s and track: the carrier sails at a speed or follows "
+                             "its recorded track, not both")
+    if abs(spec["carrier"].get("latitude_deg", 0.0)) > 90.0:
+        raise SceneError(f"target.carrier.latitude_deg = {spec['carrier']['latitude_deg']:g} is outside [-90, 90]")
+    for key in KIND_KEYS[kind] - {"file"}:
+        if key in table:
+            spec[key] = number(f"target.{key}", table[key])
+    if kind == "earth_point":
+        geodetic = {"latitude_deg", "longitude_deg"} & set(table)
+        local = {"north_m", "east_m", "down_m"} & set(table)
+        if geodetic and local:
+            raise SceneError("target: give the point by latitude_deg, longitude_deg (and altitude_m) or by north_m, "
+                             "east_m, down_m from the carrier's start, not both")
+        if len(geodetic) == 1:
+            missing = ({"latitude_deg", "longitude_deg"} - geodetic).pop()
+            raise SceneError(f"target: {geodetic.pop()} without {missing}")
+        if not geodetic and not local:
+            raise SceneError("target type 'earth_point' needs latitude_deg, longitude_deg (and altitude_m), or "
+                             "north_m, east_m, down_m from the carrier's start")
+        if local and "altitude_m" in table:
+            raise SceneError("target: altitude_m is for a geodetic point; a local one gives down_m")
+        if geodetic and abs(spec["latitude_deg"]) > 90.0:
+            raise SceneError(f"target.latitude_deg = {spec['latitude_deg']:g} is outside [-90, 90]")
+        if geodetic and not {"latitude_deg", "longitude_deg"} <= set(carrier) and "track" not in carrier:
+            raise SceneError("target: a geodetic point needs the carrier's position: [target.carrier] latitude_deg "
+                             "and longitude_deg (or track)")
+    elif kind == "flyby":
+        for key in ("altitude_m", "speed_m_s", "heading_deg", "closest_approach_m", "closest_approach_s"):
+            if key not in table:
+                raise SceneError(f"target type 'flyby' needs {key}")
+        positive("target.speed_m_s", spec["speed_m_s"])
+        if "track" in carrier:
+            raise SceneError("target type 'flyby' is flat, on a carrier sailing at speed_m_s; a recorded carrier "
+                             "track goes with earth_point or track targets")
+        if spec["altitude_m"] - spec["carrier"].get("altitude_m", 0.0) == 0.0 and spec["closest_approach_m"] == 0.0:
+            raise SceneError("target: a flyby at the gimbal's own altitude with closest_approach_m = 0 passes "
+                             "through the gimbal")
+    else:
+        if not isinstance(table.get("file"), str):
+            raise SceneError(f"target type 'track' needs file = \"<track>.csv\" (relative to the scene file), got "
+                             f"{shown(table.get('file'))}")
+        spec["file"] = table["file"]
+    return spec
+
+
+def build(spec: dict, base_dir: pathlib.Path):
+    """The motion.MovingTarget of a parsed spec; files relative to base_dir (the scene's folder)."""
+    c = spec["carrier"]
+    origin = (c.get("latitude_deg", 0.0), c.get("longitude_deg", 0.0), c.get("altitude_m", 0.0))
+    carrier_track = None
+    if "track" in c:
+        carrier_track = Track("target.carrier.track", base_dir / c["track"], origin if "latitude_deg" in c else None)
+    carrier = Carrier(*origin, math.radians(c.get("course_deg", 0.0)), c.get("speed_m_s", 0.0), carrier_track)
+    kind = spec["type"]
+    if kind == "earth_point":
+        if "latitude_deg" in spec:
+            point = (spec["latitude_deg"], spec["longitude_deg"], spec.get("altitude_m", 0.0))
+        else:
+            import pymap3d
+            point = pymap3d.ned2geodetic(spec.get("north_m", 0.0), spec.get("east_m", 0.0), spec.get("down_m", 0.0),
+                                         *origin)
+        return EarthPoint(carrier, *(float(v) for v in point))
+    if kind == "flyby":
+        return Flyby(carrier, spec["altitude_m"] - origin[2], spec["speed_m_s"], math.radians(spec["heading_deg"]),
+                     spec["closest_approach_m"], spec["closest_approach_s"])
+    return RecordedTarget(carrier, Track("target.file", base_dir / spec["file"], origin))
+
+
+def check_run(target, stop_time: float) -> None:
+    """Refuses recorded tracks that do not cover the run (with the margin the rates need)."""
+    if getattr(target, "track", None) is not None:
+        target.track.check_covers("target.file", stop_time)
+    if target.carrier.track is not None:
+        target.carrier.track.check_covers("target.carrier.track", stop_time)
