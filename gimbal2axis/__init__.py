@@ -1,5 +1,5 @@
 """gimbal2axis: scenes, a co-simulation master, analyses and sweeps for the Gimbal2Axis FMU, and the
-`gimbal2axis` command (subcommands run, sweep, linearize, freqresp, report, system, bench; `python -m
+`gimbal2axis` command (subcommands run, sweep, tune, linearize, freqresp, report, system, bench; `python -m
 gimbal2axis`).
 
     from gimbal2axis import FMU, load_scene, run
@@ -9,9 +9,11 @@ gimbal2axis`).
 Layout, and the one direction imports go (tests/test_package_layout.py refuses any other):
 
     cli                      the command and its subcommands, one module each
+     -> tune                 tuning gains with Optuna over the sweep engine
      -> sweep | analysis     sweeps on Dask | linearization, frequency responses, isolation prediction
      -> master               the co-simulation loop (Python, compiled, lockstep), results, plots
      -> scene                scene files, base motion, references, controllers, sensors, geometry
+     -> target               moving targets: geodesy (pymap3d), target and inverse kinematics, tracking metrics
      -> fmu                  the FMU wrapper, an FMU kept per worker
      -> errors, version, progress, native, locations    leaves: error types, the version, progress bars, the C kernels
                                                (the extension gimbal2axis.native._native, compiled from

@@ -14,7 +14,7 @@ from gimbal2axis.cli import main as cli_main
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 COMMAND = [sys.executable, "-m", "gimbal2axis"]
-SUBCOMMANDS = ["run", "sweep", "linearize", "freqresp", "system", "report", "bench"]
+SUBCOMMANDS = ["run", "sweep", "linearize", "freqresp", "system", "report", "bench", "tune"]
 
 # Per subcommand, a refusal that only the subcommand's own checks make (argparse accepts the values),
 # and what its one line must name.
@@ -26,9 +26,10 @@ BAD_VALUES = {
     "system": (["no_such_scene.toml"], ["no_such_scene.toml"]),
     "report": (["no_such_comparison.toml"], ["no_such_comparison.toml"]),
     "bench": (["--repeat", "0"], ["--repeat 0"]),
+    "tune": (["a.toml", "b.toml", "--workers", "0"], ["--workers"]),
 }
 # The statuses each --help must list beyond 0, 2 and 130, which all list.
-MORE_STATUSES = {"run": [1, 3, 143], "sweep": [1, 143], "bench": [1]}
+MORE_STATUSES = {"run": [1, 3, 143], "sweep": [1, 143], "bench": [1], "tune": [1, 143]}
 
 
 def command(*args, timeout=120):
@@ -46,7 +47,7 @@ def assert_one_line_refusal(done, subcommand: str, *named: str) -> None:
 
 
 # The positional arguments a subcommand requires (else their absence is what is refused).
-REQUIRED = {"sweep": ["a.toml", "b.toml"], "freqresp": ["open-loop"], "system": ["a.toml"]}
+REQUIRED = {"sweep": ["a.toml", "b.toml"], "freqresp": ["open-loop"], "system": ["a.toml"], "tune": ["a.toml", "b.toml"]}
 
 
 @pytest.mark.parametrize("subcommand", SUBCOMMANDS)
@@ -116,6 +117,7 @@ INTERRUPTED_AT = {
     "system": ("gimbal2axis.cli.system", "_write", ["system", "a.toml"]),
     "report": ("gimbal2axis.cli.report", "_report", ["report"]),
     "bench": ("gimbal2axis.cli.bench", "scene_file", ["bench"]),
+    "tune": ("gimbal2axis.cli.tune", "fmu_path", ["tune", "a.toml", "b.toml"]),
 }
 
 

@@ -3,11 +3,11 @@ master's benchmark on the Gimbal2Axis FMU. `gimbal2axis COMMAND --help` says mor
 
 Every subcommand ends with one of these exit statuses (its --help lists those it uses):
   0    done
-  1    ran, but a requirement (run --check), a case (sweep) or a check (bench) failed
+  1    ran, but a requirement (run --check), a case (sweep), a check (bench) or the constraints (tune) failed
   2    refused: a bad argument, an input file, an output that cannot be written; nothing done
   3    run: failed part-way, the results up to the last good step kept, marked partial
   130  interrupted (SIGINT, Ctrl-C)
-  143  run, sweep: terminated (SIGTERM), what was finished kept"""
+  143  run, sweep, tune: terminated (SIGTERM), what was finished kept"""
 from __future__ import annotations
 
 import argparse
@@ -16,12 +16,12 @@ import sys
 from ..version import __version__
 # The subcommands' modules import only the standard library at their top (their work's imports are
 # inside their functions), so that --help and a refused argument answer at once.
-from . import bench, freqresp, linearize, report, run, sweep, system
+from . import bench, freqresp, linearize, report, run, sweep, system, tune
 from .failures import DEFAULT_EXIT_STATUSES, EXIT_ERROR, EXIT_INTERRUPTED, exit_status_help
 
 PROG = "gimbal2axis"
 SUBCOMMANDS = {"run": run, "sweep": sweep, "linearize": linearize, "freqresp": freqresp, "report": report,
-               "system": system, "bench": bench}
+               "system": system, "bench": bench, "tune": tune}
 EXIT_USAGE = EXIT_ERROR
 
 

@@ -1,0 +1,149 @@
+"""Tune a controller: an optimizer (Optuna's CMA-ES by default) over the sweep engine.
+
+TUNE.toml names the parameters to tune (the paths a sweep takes: controller.azimuth.kp, gear1.k_s,
+...) with bounds and scale, the objective (line-of-sight RMS over a window, a band RMS from the run's
+PSD, or a weighted sum), the constraints (peak current against the limit, voltage saturation time,
+gain and phase margins of the linearized loop, the scene's requirements) and the robustness set (sea
+states x seeds x parameter draws) on which every candidate runs, the same for all of them. The
+candidates run in batches on Dask (a local cluster or a scheduler's workers, one FMU instance per
+worker), or serially.
+
+Writes <out>/<tuning>__<scene>.parquet and .csv (every evaluation: candidate x scenario, as it
+finishes), <out>/<tuning>__<scene>_trials.parquet and .csv (one row per candidate: objective,
+constraints, margins), and unless --no-report <out>/<tuning>__<scene>_report.html with its figures
+(convergence, the best candidates, time and PSD plots of the best against the scene's own gains, S and
+T with the margins, the pointing error budget, the held-out check). The same command again continues
+an interrupted tuning: evaluations in the table are not run again, and the seeded study ends where an
+uninterrupted one would.
+"""
+import signal
+import sys
+
+from ..errors import SceneError
+from ..locations import fmu_path
+
+SUMMARY = "tune controller gains (or any parameters) with an optimizer over the sweep engine"
+PROG = "gimbal2axis tune"
+EXIT_STATUSES = {
+    0: "done: the best candidate meets every constraint",
+    1: "ran, but no candidate met the constraints (the least violating one is reported)",
+    2: "refused: the scene, the tuning file (a misspelt key or parameter name, bad bounds, ...) or an option; "
+       "nothing ran",
+    130: "interrupted by Ctrl-C (SIGINT): the evaluations finished so far are kept; the same command continues",
+    143: "terminated (SIGTERM): likewise",
+}
+
+EPILOG = """\
+tuning file: [parameters] (name = { bounds = [low, high], scale = "linear" | "log" }),
+  [objective], [constraints], [robustness], [holdout], [optimizer]; the format in full:
+  docs/tuning.md in the repository, and gimbal2axis/tune/spec.py.
+
+example:
+  gimbal2axis tune scenes/ship_stabilization.toml tunings/ship_pid.toml --workers 2
+"""
+
+
+def _terminated(signum, frame):
+    from ..sweep.runner import Stopped
+
+    raise Stopped("terminated (SIGTERM)")
+
+
+def add_arguments(parser) -> None:
+    parser.epilog = EPILOG
+    parser.add_argument("scene", metavar="SCENE.toml", help="scene file (scenes/*.toml)")
+    parser.add_argument("tuning", metavar="TUNE.toml", help="tuning file (tunings/*.toml)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="run on the workers of this Dask scheduler instead of a local cluster")
+    parser.add_argument("--workers", type=int, default=2, metavar="N",
+                        help="worker processes of the local cluster (default 2)")
+    parser.add_argument("--out", default="results/tuning", metavar="DIR",
+                        help="directory of the tables and the report (default results/tuning)")
+    parser.add_argument("--fmu", default=None,
+                        help="the FMU to run (default $GIMBAL2AXIS_FMU, else the build the package was configured with)")
+    parser.add_argument("--quiet", action="store_true",
+                        help="print nothing but errors and warnings (no progress, no summary)")
+    parser.add_argument("--serial", action="store_true", help="no Dask: run the evaluations in this process")
+    parser.add_argument("--threads", action="store_true",
+                        help="local cluster of threads in this process instead of worker processes")
+    parser.add_argument("--trials", type=int, default=None, metavar="N",
+                        help="candidates in all (default: the file's [optimizer] trials)")
+    parser.add_argument("--save-every", type=float, default=20.0, metavar="SECONDS",
+                        help="while evaluations finish, save them at least this often (default 20; and after "
+                             "every batch)")
+    parser.add_argument("--no-report", action="store_true",
+                        help="no report page (nor its runs of the best and the scene's gains, nor the held-out check)")
+
+
+def execute(args) -> int:
+    if args.workers < 1:
+        args.command_parser.error("--workers must be >= 1")
+    if args.trials is not None and args.trials < 1:
+        args.command_parser.error("--trials must be >= 1")
+    if not args.save_every >= 0:
+        args.command_parser.error("--save-every must be >= 0 seconds")
+    from ..sweep import SweepError
+    from ..sweep.runner import Stopped
+    from ..tune.engine import TuneOptions, describe_candidate, plan, run_tuning
+
+    signal.signal(signal.SIGTERM, _terminated)
+    options = TuneOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
+                          serial=args.serial, progress=not args.quiet, checkpoint_s=args.save_every,
+                          trials=args.trials)
+    problem = None
+    try:
+        problem = plan(args.scene, args.tuning, fmu_path(args.fmu), args.out)
+        if not args.quiet:
+            t = problem.tuning
+            print(f"tune {t.name} on scene {problem.scene.name}: {len(t.parameters)} parameters, "
+                  f"{options.trials or t.trials} candidates in batches of {min(t.batch, options.trials or t.trials)}, "
+                  f"each on {len(problem.scenarios)} runs ({t.sampler}, seed {t.seed}); "
+                  f"{'serially' if options.serial else options.scheduler or f'{options.workers} local workers'}",
+                  file=sys.stderr)
+        from ..tune.engine import Evaluator
+        evaluator = Evaluator(problem, options)
+        interrupted = False
+        try:
+            result = run_tuning(problem, options, evaluator)
+            report_path = None
+            if not args.no_report:
+                from ..tune.report import write_report
+                evaluator.progress = None
+                report_path = write_report(result, evaluator)
+        except KeyboardInterrupt:
+            interrupted = True
+            raise
+        finally:
+            evaluator.close(interrupted)
+    except (SceneError, SweepError) as exc:
+        print(f"{PROG}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        print(f"\ntune: {str(exc) or 'interrupted'}; the evaluations finished so far are kept in "
+              f"{problem.evaluations.parquet if problem else args.out}; the same command again continues",
+              file=sys.stderr)
+        return 128 + (signal.SIGTERM if isinstance(exc, Stopped) else signal.SIGINT)
+    finally:
+        if problem is not None:
+            problem.fmu.close()
+    best = result.best or result.least_violating
+    if not args.quiet:
+        print(f"{len(result.trials)} candidates, {result.evaluations_run} evaluations run, "
+              f"{result.evaluations_reused} taken from the table; {result.wall_time:.1f} s")
+        if best is not None:
+            names = problem.tuning.parameter_names
+            print(f"{'best' if result.best else 'least violating (no candidate met the constraints)'}: trial "
+                  f"{best['trial']}: {describe_candidate({n: best[n] for n in names})}; objective "
+                  f"{best['objective_mrad']:.5g} mrad; peak current {best['worst_i_frac_peak']:.3g} of the limit"
+                  + (f"; margins az {best['gm_az_db']:.3g} dB / {best['pm_az_deg']:.3g} deg, el {best['gm_el_db']:.3g}"
+                     f" dB / {best['pm_el_deg']:.3g} deg" if "gm_az_db" in best else ""))
+        if result.holdout:
+            h = result.holdout
+            print(f"held out ({h['runs']} runs): best {h['best_mrad']:.5g} mrad, scene's own {h['own_mrad']:.5g} mrad")
+        print(f"wrote {problem.evaluations.parquet}, {problem.trials_files.parquet} (and .csv)"
+              + (f", {report_path}" if report_path else ""))
+    if result.best is None:
+        print(f"{PROG}: no candidate met the constraints; see {problem.trials_files.csv} (violation_* columns)",
+              file=sys.stderr)
+        return 1
+    return 0

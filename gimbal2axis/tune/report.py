@@ -1,0 +1,269 @@
+"""The evidence of a tuning: <out>/<tuning>__<scene>_report.html with its figures (PNG files beside it)
+and <out>/<tuning>__<scene>_summary.json.
+
+  - convergence: the objective of every candidate against its trial (feasible, violating, failed) and
+    the best feasible so far;
+  - the best candidates (up to 5 feasible ones): their values, objective, margins and peak currents;
+  - the best against the scene's own values of the tuned parameters (and any `compare` candidates) on
+    the scene's own sea (its nominal run, the tuning's stop_time): the LOS error per axis in time and its
+    PSD, and the pointing error budget per axis (budget.py: bias, drift, jitter in the sea, loop and high
+    bands);
+  - the loops: |S| and |T| per axis for the best and the scene's own gains, with the margins
+    (margins.py, python-control);
+  - the held-out check: the best and the others on the tuning file's [holdout] set, which the tuning never
+    ran, objective per member and aggregated as the tuning aggregates.
+"""
+from __future__ import annotations
+
+import html
+import json
+import math
+import pathlib
+
+import numpy as np
+
+from ..sweep import store
+from . import budget as budgets
+from .engine import TuneResult, describe_candidate, evaluate, scene_gains
+
+TOP_CANDIDATES = 5
+
+
+def _nominal_run(problem, candidate: dict):
+    from ..master.master import run
+
+    return run(problem.apply(candidate), problem.fmu)
+
+
+def _from_s(problem, result) -> float:
+    from_s = problem.tuning.metrics_from_s
+    if from_s is None:
+        start = result.window_start()
+        from_s = start if start < result.stop_time else 0.0
+    return from_s
+
+
+def compared_candidates(result: TuneResult, compare: dict | None) -> dict:
+    """{label: candidate}: the best (or least violating), the scene's own values, and `compare`'s."""
+    problem = result.problem
+    names = problem.tuning.parameter_names
+    chosen = result.best or result.least_violating
+    out = {}
+    if chosen is not None:
+        out["tuned"] = {n: chosen[n] for n in names}
+    own = scene_gains(problem)
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in own.values()):
+        out["scene's own"] = {n: float(v) for n, v in own.items()}
+    for label, candidate in (compare or {}).items():
+        out[label] = dict(candidate)
+    return out
+
+
+def holdout_check(result: TuneResult, evaluator, candidates: dict) -> dict:
+    """{label: judged row on the holdout set} (empty without [holdout])."""
+    problem = result.problem
+    if not problem.holdout:
+        return {}
+    return {label: evaluate(problem, evaluator, candidate, problem.holdout, "holdout")
+            for label, candidate in candidates.items()}
+
+
+def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> pathlib.Path:
+    """Writes the report page, its figures and the summary JSON; returns the page's path. Sets
+    result.holdout (best and scene's own objective on the holdout set)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    problem = result.problem
+    tuning = problem.tuning
+    folder = problem.trials_files.folder
+    stem = problem.evaluations.parquet.stem
+    candidates = compared_candidates(result, compare)
+    if problem.loops is None:   # no margin constraint: the report shows S, T and the margins of a PID scene still
+        from ..analysis.isolation_prediction import pid_gains
+        from ..errors import SceneError
+        from .margins import LoopModels
+        try:
+            pid_gains(problem.scene, problem.fmu)
+            problem.loops = LoopModels(problem.scene, problem.fmu, problem.apply)
+        except SceneError:
+            pass
+    held = holdout_check(result, evaluator, candidates)
+    if held and "tuned" in held and "scene's own" in held:
+        result.holdout = {"runs": len(problem.holdout), "best_mrad": held["tuned"]["objective_mrad"],
+                          "own_mrad": held["scene's own"]["objective_mrad"]}
+    runs = {label: _nominal_run(problem, c) for label, c in candidates.items()}
+    loops = {}
+    if problem.loops is not None:
+        from .margins import frequency_response
+        for label, c in candidates.items():
+            try:
+                loop = problem.loops.loop(c)
+                loops[label] = {axis: frequency_response(loop, motor) for motor, axis in (("1", "az"), ("2", "el"))}
+            except Exception as exc:   # no linear loop for this candidate: said on the page
+                loops[label] = str(exc)
+    figures = {}
+
+    # convergence
+    fig, ax = plt.subplots(figsize=(8, 4))
+    trials = result.trials
+    for status, style in (("ok", dict(marker="o", color="C0", label="feasible")),
+                          ("infeasible", dict(marker="x", color="C3", label="violates a constraint")),
+                          ("failed", dict(marker="v", color="k", label="a run failed"))):
+        pts = [(r["trial"], r["objective_mrad"]) for r in trials if r["status"] == status
+               and r["objective_mrad"] is not None and math.isfinite(r["objective_mrad"])]
+        if pts:
+            ax.plot(*zip(*pts), linestyle="none", ms=4, **style)
+    best_so_far, line = math.inf, []
+    for r in trials:
+        if r["feasible"]:
+            best_so_far = min(best_so_far, r["objective_mrad"])
+        line.append(best_so_far if math.isfinite(best_so_far) else np.nan)
+    ax.plot([r["trial"] for r in trials], line, color="C2", label="best feasible so far")
+    ax.set_yscale("log")
+    ax.set_xlabel("trial")
+    ax.set_ylabel("objective [mrad]")
+    ax.set_title(f"{tuning.name} on {problem.scene.name}: {tuning.objective.describe()}", fontsize=8)
+    ax.legend(fontsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+    figures["convergence"] = _save(fig, folder / f"{stem}_convergence.png")
+
+    # time and PSD of the nominal run
+    fig, axes = plt.subplots(2, 2, figsize=(11, 6))
+    budget_rows = {}
+    for k, (label, run) in enumerate(runs.items()):
+        from_s = _from_s(problem, run)
+        t = run.signals["time"]
+        for col, (axis, name) in enumerate(budgets.AXES.items()):
+            axes[0, col].plot(t, run.derived[name] * 1e3, lw=0.7, label=label, color=f"C{k}")
+            f, p = budgets.spectra_of(run, from_s)[axis]
+            axes[1, col].loglog(f[1:], p[1:], lw=0.8, label=label, color=f"C{k}")
+        budget_rows[label] = budgets.budget(run, from_s)
+    for col, axis in enumerate(budgets.AXES):
+        axes[0, col].set_title(f"LOS error, {axis} [mrad] (nominal sea)", fontsize=9)
+        axes[0, col].set_xlabel("time [s]")
+        axes[1, col].set_title(f"PSD of the LOS error, {axis} [mrad^2/Hz]", fontsize=9)
+        axes[1, col].set_xlabel("frequency [Hz]")
+        for row in axes[:, col]:
+            row.grid(True, which="both", alpha=0.3)
+            row.legend(fontsize=7)
+        for edge in (budgets.SEA_HZ, budgets.HIGH_HZ):
+            axes[1, col].axvline(edge, color="grey", lw=0.5, ls="--")
+    fig.tight_layout()
+    figures["time_psd"] = _save(fig, folder / f"{stem}_time_psd.png")
+
+    # S and T
+    if loops:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+        for k, (label, by_axis) in enumerate(loops.items()):
+            if isinstance(by_axis, str):
+                continue
+            for col, axis in enumerate(("az", "el")):
+                r = by_axis[axis]
+                margins = f"GM {r['gm_db']:.3g} dB, PM {r['pm_deg']:.3g} deg, Ms {r['ms']:.3g}"
+                axes[col].loglog(r["f_hz"], np.abs(r["S"]), color=f"C{k}", label=f"{label} |S| ({margins})")
+                axes[col].loglog(r["f_hz"], np.abs(r["T"]), color=f"C{k}", ls="--", label=f"{label} |T|")
+        for col, axis in enumerate(("azimuth (motor 1)", "elevation (motor 2)")):
+            axes[col].set_title(f"loop broken at {axis}: S and T", fontsize=9)
+            axes[col].set_xlabel("frequency [Hz]")
+            axes[col].grid(True, which="both", alpha=0.3)
+            axes[col].legend(fontsize=6)
+        fig.tight_layout()
+        figures["loops"] = _save(fig, folder / f"{stem}_loops.png")
+
+    names = tuning.parameter_names
+    top = sorted([r for r in trials if r["feasible"]], key=lambda r: (r["objective_mrad"], r["trial"]))[:TOP_CANDIDATES]
+    summary = {
+        "tuning": tuning.name, "scene": problem.scene.name, "sampler": tuning.sampler, "seed": tuning.seed,
+        "objective": tuning.objective.describe(), "trials": len(trials), "runs_per_candidate": len(problem.scenarios),
+        "evaluations_run": result.evaluations_run, "evaluations_reused": result.evaluations_reused,
+        "wall_time_s": result.wall_time, "feasible": bool(result.best),
+        "best": _clean(result.best or result.least_violating),
+        "top": [_clean(r) for r in top],
+        "candidates": candidates,
+        "nominal_los_rms_mrad": {label: float(np.sqrt(np.mean(run.signals["los_error"][run.metrics_window(
+            _from_s(problem, run))] ** 2))) * 1e3 for label, run in runs.items()},
+        "budget_mrad": budget_rows,
+        "margins": {label: ({axis: {k: r[k] for k in ("gm_db", "pm_deg", "crossover_hz", "ms")}
+                             for axis, r in by_axis.items()} if not isinstance(by_axis, str) else by_axis)
+                    for label, by_axis in loops.items()},
+        "holdout": {label: {"objective_mrad": row["objective_mrad"], "per_run_mrad": row["per_scenario"],
+                            "feasible": row["feasible"], "worst_i_frac_peak": row["worst_i_frac_peak"]}
+                    for label, row in held.items()},
+        "holdout_scenarios": problem.holdout,
+    }
+    summary_path = folder / f"{stem}_summary.json"
+    store.publish(summary_path, lambda p: pathlib.Path(p).write_text(json.dumps(summary, indent=1, default=_json)))
+
+    page = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(stem)}</title>",
+            "<style>body{font-family:sans-serif;max-width:1100px}td,th{padding:2px 8px;text-align:right}"
+            "table{border-collapse:collapse}tr:nth-child(even){background:#f4f4f4}</style></head><body>",
+            f"<h1>Tuning {html.escape(tuning.name)} on {html.escape(problem.scene.name)}</h1>",
+            f"<p>{html.escape(tuning.description)}</p>",
+            f"<p>Objective: {html.escape(tuning.objective.describe())}; {len(problem.scenarios)} runs per candidate "
+            f"(robustness set), sampler {tuning.sampler}, seed {tuning.seed}; {len(trials)} candidates, "
+            f"{result.evaluations_run} evaluations run now, {result.evaluations_reused} from the table.</p>",
+            "<h2>Convergence</h2>", f"<img src='{figures['convergence'].name}' width='800'>",
+            "<h2>Best candidates</h2>",
+            _table(["trial"] + names + ["objective_mrad", "worst_i_frac_peak", "worst_i_peak_A", "worst_u_sat_s",
+                                        "gm_az_db", "pm_az_deg", "gm_el_db", "pm_el_deg"], top)]
+    if not result.best:
+        page.append("<p><b>No candidate met the constraints</b>; the least violating: "
+                    f"{html.escape(describe_candidate({n: (result.least_violating or {}).get(n, math.nan) for n in names}))}</p>")
+    page += ["<h2>Compared on the scene's own sea</h2>",
+             "<p>" + "<br>".join(f"{html.escape(label)}: {html.escape(describe_candidate(c))}"
+                                 for label, c in candidates.items()) + "</p>",
+             f"<img src='{figures['time_psd'].name}' width='1000'>",
+             "<h3>Pointing error budget per axis [mrad] (slope in mrad/s)</h3>",
+             _table(["candidate", "axis", "bias", "drift_slope_per_s", "drift_rms", "sea", "loop", "high", "total", "rms"],
+                    [dict(candidate=label, axis=axis, **values) for label, by_axis in budget_rows.items()
+                     for axis, values in by_axis.items()]),
+             f"<p>Bands: sea [0, {budgets.SEA_HZ:g}) Hz, loop [{budgets.SEA_HZ:g}, {budgets.HIGH_HZ:g}) Hz, high "
+             f"[{budgets.HIGH_HZ:g} Hz, Nyquist]; total = root-sum-square of the bias and the bands.</p>"]
+    if "loops" in figures:
+        page += ["<h2>Sensitivity and complementary sensitivity</h2>", f"<img src='{figures['loops'].name}' width='1000'>"]
+    if held:
+        page += [f"<h2>Held out: {len(problem.holdout)} runs the tuning did not see</h2>",
+                 _table(["candidate", "objective_mrad", "feasible", "worst_i_frac_peak"],
+                        [dict(candidate=label, **{k: row[k] for k in ("objective_mrad", "feasible",
+                                                                      "worst_i_frac_peak")})
+                         for label, row in held.items()])]
+    page.append("</body></html>")
+    path = folder / f"{stem}_report.html"
+    store.publish(path, lambda p: pathlib.Path(p).write_text("".join(page), encoding="utf-8"))
+    return path
+
+
+def _save(fig, path: pathlib.Path) -> pathlib.Path:
+    import matplotlib.pyplot as plt
+
+    store.publish(path, lambda p: fig.savefig(p, dpi=100, format="png"))
+    plt.close(fig)
+    return path
+
+
+def _table(columns: list, rows: list) -> str:
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+    body = "".join("<tr>" + "".join(f"<td>{_cell(row.get(c))}</td>" for c in columns) + "</tr>" for row in rows)
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return html.escape("" if value is None else str(value))
+
+
+def _clean(row):
+    if row is None:
+        return None
+    return {k: v for k, v in row.items() if k not in ("per_scenario",)}
+
+
+def _json(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return str(value)
