@@ -4,11 +4,12 @@ file(READ ${FRAGMENTS}/types.xml GIMBAL_TYPE_DEFINITIONS)
 file(READ ${FRAGMENTS}/variables.xml GIMBAL_MODEL_VARIABLES)
 file(READ ${FRAGMENTS}/structure.xml GIMBAL_MODEL_STRUCTURE)
 file(READ ${FRAGMENTS}/default_tolerance.txt GIMBAL_DEFAULT_TOLERANCE)
-# numberOfEventIndicators: the core's count (gimbal_c_api.h), the one place it is written.
-file(STRINGS ${SOURCE_DIR}/model_core/include/gimbal/gimbal_c_api.h _indicators REGEX "^#define GIMBAL_EVENT_INDICATORS ")
-string(REGEX REPLACE "^#define GIMBAL_EVENT_INDICATORS ([0-9]+).*" "\\1" GIMBAL_EVENT_INDICATORS "${_indicators}")
+# numberOfEventIndicators and the mode outputs: the generator's, from the switching elements' one
+# declaration (model_core/include/gimbal/switching_elements.def).
+file(READ ${FRAGMENTS}/event_indicators.txt GIMBAL_EVENT_INDICATORS)
+file(READ ${FRAGMENTS}/vendor_annotations.xml GIMBAL_VENDOR_ANNOTATIONS)
 if(NOT GIMBAL_EVENT_INDICATORS MATCHES "^[0-9]+$")
-  message(FATAL_ERROR "GIMBAL_EVENT_INDICATORS not found in gimbal_c_api.h")
+  message(FATAL_ERROR "event_indicators.txt holds no count: '${GIMBAL_EVENT_INDICATORS}'")
 endif()
 
 # generationDateAndTime: the rule of every model description of the project.

@@ -11,7 +11,8 @@ add_test(NAME fmu_states
 set_tests_properties(fmu_states PROPERTIES TIMEOUT 600)
 
 add_executable(test_host_environment test_host_environment.cpp)
-target_include_directories(test_host_environment PRIVATE ${FMI2_INCLUDE_DIR})
+# GIMBAL_EVENT_INDICATORS: the count of the switching elements' declaration (gimbal/switching_elements.def).
+target_include_directories(test_host_environment PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_SOURCE_DIR}/model_core/include)
 target_link_libraries(test_host_environment PRIVATE ${CMAKE_DL_LIBS})
 add_dependencies(test_host_environment fmu)
 add_test(NAME host_environment

@@ -29,13 +29,14 @@
 #include <string>
 #include <vector>
 
+#include "gimbal/gimbal_c_api.h"  // GIMBAL_EVENT_INDICATORS
 #include "fmi3FunctionTypes.h"
 
 namespace {
 
 // Value references, read from the FMI 3.0 model description by name.
 fmi3ValueReference kBeta, kUR1, kBaseGammaDot, kIR1, kGearModel, kSolverSteps, kDryFriction, kIndicators, kTime, kDerAlphaDot;
-constexpr size_t kStates = 17, kEventIndicators = 36;
+constexpr size_t kStates = 17, kEventIndicators = GIMBAL_EVENT_INDICATORS;
 
 struct Api {
     fmi3InstantiateModelExchangeTYPE* instantiateModelExchange;

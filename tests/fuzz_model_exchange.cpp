@@ -33,11 +33,12 @@
 #include <string>
 #include <vector>
 
+#include "gimbal/gimbal_c_api.h"  // GIMBAL_EVENT_INDICATORS
 #include "fmi2Functions.h"
 
 namespace {
 
-constexpr size_t kStates = 17, kIndicators = 36;
+constexpr size_t kStates = 17, kIndicators = GIMBAL_EVENT_INDICATORS;
 
 struct Api {
     fmi2InstantiateTYPE* instantiate;

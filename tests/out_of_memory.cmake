@@ -12,7 +12,7 @@ target_compile_options(oom_shim PRIVATE -Wall -Wextra)
 set_target_properties(oom_shim PROPERTIES C_VISIBILITY_PRESET hidden)
 
 add_executable(test_out_of_memory test_out_of_memory.cpp)
-target_include_directories(test_out_of_memory PRIVATE ${FMI2_INCLUDE_DIR})
+target_include_directories(test_out_of_memory PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_SOURCE_DIR}/model_core/include)
 target_compile_options(test_out_of_memory PRIVATE -Wall -Wextra)
 target_link_libraries(test_out_of_memory PRIVATE ${CMAKE_DL_LIBS})
 add_dependencies(test_out_of_memory fmu fmu3 oom_shim)

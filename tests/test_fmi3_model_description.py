@@ -1,8 +1,11 @@
 """The FMI 3.0 model description (build/fmi3/modelDescription.xml, from the same variable tables as
 FMI 2.0's): valid against the FMI 3.0 schema and fmpy's checks, and the same variables under the
 value-reference rule of docs/fmi_interfaces.md (Real as in FMI 2.0, Integer 1000 +, Boolean 2000 +;
-time at 3001; the 36 event indicators scalar Float64 locals from 3002 on), and no array variable."""
+time at 3001; the event indicators, every switching element's guards as declared once in
+model_core/include/gimbal/switching_elements.def, scalar Float64 locals from 3002 on), and no array variable."""
 from __future__ import annotations
+
+import re
 
 import pathlib
 import shutil
@@ -11,6 +14,8 @@ import subprocess
 import fmpy
 import pytest
 from fmpy import read_model_description
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
 
 BASE = {"Real": 0, "Integer": 1000, "Enumeration": 1000, "Boolean": 2000}
 FMI3_TYPE = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Enumeration", "Boolean": "Boolean"}
@@ -50,7 +55,8 @@ def test_the_same_variables_under_the_value_reference_rule(descriptions):
         if v.type == "Enumeration":
             assert w.declaredType.name == v.declaredType.name
             assert [(i.name, i.value) for i in w.declaredType.items] == [(i.name, i.value) for i in v.declaredType.items]
-    assert len(fmi3.modelVariables) == len(fmi2.modelVariables) + 1 + 36  # time and the event indicators
+    # time and the event indicators
+    assert len(fmi3.modelVariables) == len(fmi2.modelVariables) + 1 + fmi2.numberOfEventIndicators
 
 
 def test_no_variable_is_an_array(descriptions):
@@ -66,9 +72,11 @@ def test_states_indicators_and_dependencies_are_fmi_2s(descriptions):
     assert [d.variable.name for d in fmi3.derivatives] == [d.variable.name for d in fmi2.derivatives]
     assert [d.variable.derivative.name for d in fmi3.derivatives] == [d.variable.derivative.name for d in fmi2.derivatives]
     assert fmi3.numberOfContinuousStates == fmi2.numberOfContinuousStates == 17
-    assert fmi3.numberOfEventIndicators == fmi2.numberOfEventIndicators == 36
-    assert [e.variable.name for e in fmi3.eventIndicators] == [f"event_indicators[{k}]" for k in range(1, 37)]
-    assert [e.variable.valueReference for e in fmi3.eventIndicators] == list(range(3002, 3038))
+    declared = (REPO / "model_core" / "include" / "gimbal" / "switching_elements.def").read_text()
+    count = sum(int(n) * int(g) for n, g in re.findall(r"^ELEMENT\(\w+, (\d+), (\d+),", declared, re.MULTILINE))
+    assert fmi3.numberOfEventIndicators == fmi2.numberOfEventIndicators == count >= 36
+    assert [e.variable.name for e in fmi3.eventIndicators] == [f"event_indicators[{k}]" for k in range(1, count + 1)]
+    assert [e.variable.valueReference for e in fmi3.eventIndicators] == list(range(3002, 3002 + count))
     assert {(e.variable.causality, e.variable.variability) for e in fmi3.eventIndicators} == {("local", "continuous")}
     for mine, theirs in ((fmi3.outputs, fmi2.outputs), (fmi3.derivatives, fmi2.derivatives)):
         assert [u.variable.name for u in mine] == [u.variable.name for u in theirs]

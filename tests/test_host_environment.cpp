@@ -21,6 +21,7 @@
 
 #include "check.hpp"
 #include "fmu_loader.hpp"
+#include "gimbal/gimbal_c_api.h"
 
 namespace {
 
@@ -146,11 +147,11 @@ std::vector<double> run_model_exchange(long& calls_changing_environment) {
     fmi2EventInfo info{};
     CHECK(checked([&] { return api.newDiscreteStates(c, &info); }) == fmi2OK);
     CHECK(checked([&] { return api.enterContinuousTimeMode(c); }) == fmi2OK);
-    double x[17], dx[17], z[36], z_before[36];
+    double x[17], dx[17], z[GIMBAL_EVENT_INDICATORS], z_before[GIMBAL_EVENT_INDICATORS];
     std::vector<double> trajectory;
     long events = 0;
     for (int k = 1; k <= 4000; ++k) {
-        CHECK(checked([&] { return api.getEventIndicators(c, z_before, 36); }) == fmi2OK);
+        CHECK(checked([&] { return api.getEventIndicators(c, z_before, GIMBAL_EVENT_INDICATORS); }) == fmi2OK);
         CHECK(checked([&] { return api.getContinuousStates(c, x, 17); }) == fmi2OK);
         CHECK(checked([&] { return api.getDerivatives(c, dx, 17); }) == fmi2OK);
         // The first derivatives come before any arithmetic of the host's: the same bits in any host.
@@ -158,9 +159,9 @@ std::vector<double> run_model_exchange(long& calls_changing_environment) {
         for (int i = 0; i < 17; ++i) x[i] += 2.5e-5 * dx[i];
         CHECK(checked([&] { return api.setTime(c, k * 2.5e-5); }) == fmi2OK);
         CHECK(checked([&] { return api.setContinuousStates(c, x, 17); }) == fmi2OK);
-        CHECK(checked([&] { return api.getEventIndicators(c, z, 36); }) == fmi2OK);
+        CHECK(checked([&] { return api.getEventIndicators(c, z, GIMBAL_EVENT_INDICATORS); }) == fmi2OK);
         bool crossed = false;
-        for (int i = 0; i < 36; ++i) crossed = crossed || ((z[i] > 0.0) != (z_before[i] > 0.0));
+        for (int i = 0; i < GIMBAL_EVENT_INDICATORS; ++i) crossed = crossed || ((z[i] > 0.0) != (z_before[i] > 0.0));
         if (crossed) {
             ++events;
             CHECK(checked([&] { return api.enterEventMode(c); }) == fmi2OK);

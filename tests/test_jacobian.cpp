@@ -114,6 +114,9 @@ int main() {
                     values.integers[vi_motor2_model] = 1 - motor_model;
                     values.flags[vb_dry_friction] = friction != 0;
                     values.flags[vb_base_fixed] = fixed_base != 0;
+                    // The elevation end stop: present in every case, the payload resting on it in one
+                    // repeat of three (on the stop of the contact's side), free in the others.
+                    values.flags[vb_elevation_stop] = true;
                     // Products of inertia and centres of mass off the axes: every rigid-body term present.
                     values.reals[vr_body2_I_xy] = 0.002, values.reals[vr_body2_I_xz] = -0.003, values.reals[vr_body2_I_yz] = 0.001;
                     values.reals[vr_body2_d_bd_1] = 0.01, values.reals[vr_body2_d_bd_2] = 0.02, values.reals[vr_body2_d_bd_3] = -0.03;
@@ -152,12 +155,14 @@ int main() {
                                 for (int body = 0; body < 4; ++body)
                                     if (params.coordinate_friction[body].present())
                                         modes.friction[body] = kFrictionModes[(repeat + body + contact + 1) % 5];
+                                modes.elevation_stop = repeat == 1 ? contact : 0;
                                 const std::string label = "gear model " + std::to_string(gear_model) + ", motor model " +
                                                           std::to_string(motor_model) + ", friction " +
                                                           std::to_string(friction) + ", fixed base " +
                                                           std::to_string(fixed_base) + ", disturbances " +
                                                           std::to_string(disturbed) + ", contact " + std::to_string(contact) +
-                                                          ", limited " + std::to_string(limited);
+                                                          ", limited " + std::to_string(limited) + ", elevation stop " +
+                                                          std::to_string(modes.elevation_stop);
                                 check_case(params, modes, random, label);
                             }
                         }

@@ -107,8 +107,8 @@ def test_every_angle_rate_and_acceleration_has_its_display_unit(md):
             checked += 1
         else:
             assert v.displayUnit is None, v.name
-    assert checked == 42  # 32 angles, rates and accelerations (4 of them the cables' angle_0 and the cogging
-    # phases), and 10 derivatives of angles and rates
+    assert checked == 45  # 35 angles, rates and accelerations (4 of them the cables' angle_0 and the cogging
+    # phases, 3 the elevation stops and their rest rate), and 10 derivatives of angles and rates
     for name in ("body1.w_min", "rotor2.w_min", "gear1.eta", "base.delta_ddot", "base.gamma_ddot"):
         assert next(v for v in md.modelVariables if v.name == name).displayUnit is not None, name
 

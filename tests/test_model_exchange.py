@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import ctypes
+import re
 import math
 import pathlib
 import tomllib
@@ -292,7 +293,7 @@ def test_refusals_name_the_function_and_the_culprit(gimbal_fmu):
         refused(lambda: model.getDerivatives(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
                 "fmi2GetDerivatives", "nx = 3", "17")
         refused(lambda: model.getEventIndicators(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
-                "fmi2GetEventIndicators", "ni = 3", "36")
+                "fmi2GetEventIndicators", "ni = 3", str(gimbal_fmu.model_description.numberOfEventIndicators))
         refused(lambda: model.getDerivatives(None, 17), "fmi2GetDerivatives", "derivatives", "null")
         bad = states(instance)
         bad[9] = float("nan")
@@ -325,9 +326,13 @@ def test_the_model_description_declares_model_exchange(gimbal_fmu):
     md = gimbal_fmu.model_description
     assert md.modelExchange is not None and md.coSimulation is not None
     assert md.modelExchange.modelIdentifier == md.coSimulation.modelIdentifier
-    assert md.numberOfContinuousStates == 17 and md.numberOfEventIndicators == 36
+    # The indicators: every switching element's guards, as declared once (switching_elements.def), whose
+    # sum gimbal_c_api.h's GIMBAL_EVENT_INDICATORS is.
+    declared = (REPO / "model_core" / "include" / "gimbal" / "switching_elements.def").read_text()
+    guards = sum(int(n) * int(g) for n, g in re.findall(r"^ELEMENT\(\w+, (\d+), (\d+),", declared, re.MULTILINE))
+    assert md.numberOfContinuousStates == 17 and md.numberOfEventIndicators == guards >= 36
     header = (REPO / "model_core" / "include" / "gimbal" / "gimbal_c_api.h").read_text()
-    assert "#define GIMBAL_EVENT_INDICATORS 36" in header and "#define GIMBAL_CONTINUOUS_STATES 17" in header
+    assert '#include "gimbal/switching_elements.def"' in header and "#define GIMBAL_CONTINUOUS_STATES 17" in header
     states = [d.variable.derivative.name for d in md.derivatives]
     assert states == ANGLES + ["alpha_dot", "alpha_m_dot", "beta_dot", "beta_m_dot", "i_R1", "i_R2", "theta_b1",
                                "theta_b2", "energy.electrical_in", "energy.resistive", "energy.viscous",
@@ -436,14 +441,15 @@ def test_states_and_indicators_in_initialization_mode_are_those_of_the_start(gim
         gimbal_fmu.set_values(model, {"gear1.model": 0, "alpha": 0.2, "alpha_m": 5.0, "beta": 0.3, "i_R2": 0.5})
         model.enterInitializationMode()
         gimbal_fmu.set_values(model, {"u_R1": 30.0})
-        x0, z0 = np.zeros(17), np.zeros(36)
+        indicators = md.numberOfEventIndicators
+        x0, z0 = np.zeros(17), np.zeros(indicators)
         pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))  # noqa: E731
         model.getContinuousStates(pointer(x0), 17)
-        model.getEventIndicators(pointer(z0), 36)
+        model.getEventIndicators(pointer(z0), indicators)
         model.exitInitializationMode()
-        x1, z1 = np.zeros(17), np.zeros(36)
+        x1, z1 = np.zeros(17), np.zeros(indicators)
         model.getContinuousStates(pointer(x1), 17)
-        model.getEventIndicators(pointer(z1), 36)
+        model.getEventIndicators(pointer(z1), indicators)
         assert np.array_equal(x0, x1) and np.array_equal(z0, z1)
         assert x0[0] == 0.2 and x0[1] == 0.2 * gimbal_fmu.start("gear1.N") and x0[9] == 0.5
         assert z0[0] == 1.0 and z0[1] == 1.0  # gear 1 is rigid: no backlash guards

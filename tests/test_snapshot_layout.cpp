@@ -1,4 +1,5 @@
-// The FMU state's bytes (snapshot format 9: format 7's layout over the present variable tables) field by
+// The FMU state's bytes (snapshot format 10: format 7's layout over the present variable tables, with the
+// elevation stop's mode in what was Modes' tail padding) field by
 // field: the table of gimbal/simulation/snapshot.hpp must lay every field where format 7 put it. Format 7 was a C++ struct copied as bytes; that struct is kept
 // here as the reference (Format7), and every row's offset and size is compared with its member's.
 // Then: content survives encode/decode bit for bit, and single faults are refused naming the field.
@@ -66,7 +67,7 @@ const Place kFormat7[] = {
     PLACE(reals), PLACE(integers), PLACE(booleans), PLACE(initialized), PLACE(integrator_running), PLACE(at_rest),
     PLACE(rtol_set), PLACE(master_tolerance_defined), PLACE(master_tolerance), PLACE(time), PLACE(clock), PLACE(state),
     PLACE_IN(modes, gear_contact), PLACE_IN(modes, motor_limited), PLACE_IN(modes, voltage_clamped),
-    PLACE_IN(modes, friction), PLACE_IN(counters, total), PLACE_IN(counters, backlash),
+    PLACE_IN(modes, friction), PLACE_IN(modes, elevation_stop), PLACE_IN(counters, total), PLACE_IN(counters, backlash),
     PLACE_IN(counters, current_limit), PLACE_IN(counters, stick_slip), PLACE_IN(counters, last_event_time),
     PLACE_IN(statistics, steps), PLACE_IN(statistics, rhs_evaluations), PLACE_IN(statistics, jacobian_evaluations),
     PLACE_IN(statistics, events), PLACE_IN(statistics, zeno_holds), PLACE_IN(statistics, method_switches),
@@ -95,7 +96,7 @@ const Place kFormat7[] = {
 };
 
 void test_layout_is_format_7() {
-    CHECK(kSnapshotFormat == 9);
+    CHECK(kSnapshotFormat == 10);
     CHECK(snapshot_bytes() == sizeof(Format7));
     CHECK(GimbalInstance::snapshot_size() == sizeof(Format7));
     const std::size_t rows = sizeof kFormat7 / sizeof kFormat7[0];
@@ -192,7 +193,7 @@ void test_single_faults_name_the_field() {
         CHECK(reason.compare(0, fault.reason.size(), fault.reason) == 0);
     }
     CHECK(check_snapshot_content(good, false, false) ==
-          "it was not saved by this version of Gimbal2Axis (snapshot format 9)");
+          "it was not saved by this version of Gimbal2Axis (snapshot format 10)");
     // An uninitialized instance's snapshot has no run: its modes are not looked at.
     GimbalInstance fresh([](GimbalStatus, const char*, const std::string&) {}, [](const char*) { return false; });
     fresh.save(bytes.data());

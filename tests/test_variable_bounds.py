@@ -31,6 +31,8 @@ EXPECTED_REAL_BOUNDS = {
     **{f"cable{j}.{p}": (0.0, None) for j in (1, 2) for p in ("k", "c")},
     **{f"motor{j}.T_cogging": (0.0, None) for j in (1, 2)},
     "solver.rtol": (ABOVE_ZERO, math.nextafter(1.0, 0.0)),
+    "elevation_stop.e": (0.0, 1.0),
+    "elevation_stop.w_rest": (ABOVE_ZERO, None),
     "solver.atol": (ABOVE_ZERO, None),
 }
 

@@ -175,6 +175,11 @@ std::vector<RealParameter> real_parameters() {
         list.push_back(
             {motor + "cogging_phase", d.cogging_phase, [j](const ModelParameters& m) { return m.disturbances.cogging[j].phase; }});
     }
+    // The elevation end stop (switching_elements/elevation_stop.hpp).
+    list.push_back({"elevation_stop.beta_min", -1.21, [](const ModelParameters& m) { return m.elevation_stop.lower; }});
+    list.push_back({"elevation_stop.beta_max", 1.31, [](const ModelParameters& m) { return m.elevation_stop.upper; }});
+    list.push_back({"elevation_stop.e", 0.61, [](const ModelParameters& m) { return m.elevation_stop.restitution; }});
+    list.push_back({"elevation_stop.w_rest", 0.0017, [](const ModelParameters& m) { return m.elevation_stop.rest_rate; }});
     list.push_back({"solver.rtol", 1.1e-6, [](const ModelParameters& m) { return m.relative_tolerance; }});
     list.push_back({"solver.atol", 1.2e-8, [](const ModelParameters& m) { return m.absolute_tolerance; }});
     return list;
@@ -204,6 +209,7 @@ const std::map<std::string, BooleanField>& boolean_parameter_fields() {
         {"energy_accounting", [](const ModelParameters& m) { return m.energy_accounting; }},
         {"dry_friction", [](const ModelParameters& m) { return m.fidelity.dry_friction; }},
         {"base.fixed", [](const ModelParameters& m) { return m.fidelity.fixed_base; }},
+        {"elevation_stop", [](const ModelParameters& m) { return m.elevation_stop.present; }},
     };
     return fields;
 }

@@ -8,12 +8,17 @@
 
 extern const FmiModel kGimbalModel;
 
-/* The FMI 3.0 value references (docs/fmi_interfaces.md), as the model description generator
- * (model_core/tools/model_description_generator.cpp) numbers them: a Float64 is the core's Real of
- * the same reference, an Int32 or Enumeration the core's Integer at FMI3_INTEGER_BASE + its
- * reference, a Boolean the core's Boolean at FMI3_BOOLEAN_BASE + its reference, then the independent
- * variable and the GIMBAL_EVENT_INDICATORS scalar event indicators. */
-enum { FMI3_INTEGER_BASE = 1000, FMI3_BOOLEAN_BASE = 2000, FMI3_TIME = 3001, FMI3_FIRST_EVENT_INDICATOR = 3002 };
+/* The FMI 3.0 value references (docs/fmi_interfaces.md), defined once in gimbal_c_api.h (GIMBAL_FMI3_*),
+ * which the model description generator (model_core/tools/model_description_generator.cpp) numbers by
+ * too: a Float64 is the core's Real of the same reference, an Int32 or Enumeration the core's Integer at
+ * FMI3_INTEGER_BASE + its reference, a Boolean the core's Boolean at FMI3_BOOLEAN_BASE + its reference,
+ * then the independent variable and the GIMBAL_EVENT_INDICATORS scalar event indicators. */
+enum {
+    FMI3_INTEGER_BASE = GIMBAL_FMI3_INTEGER_BASE,
+    FMI3_BOOLEAN_BASE = GIMBAL_FMI3_BOOLEAN_BASE,
+    FMI3_TIME = GIMBAL_FMI3_TIME,
+    FMI3_FIRST_EVENT_INDICATOR = GIMBAL_FMI3_FIRST_EVENT_INDICATOR
+};
 
 static inline GimbalCore* gimbal_core_of(const FmiInstance* instance) { return (GimbalCore*)instance->model_data; }
 

@@ -66,6 +66,7 @@ def _linear_model_struct(lib):
                     ("motor_limited", ctypes.c_int * 2),
                     ("voltage_clamped", ctypes.c_int * 2),
                     ("friction", ctypes.c_int * 4),
+                    ("elevation_stop", ctypes.c_int),
                     ("time", ctypes.c_double)]
 
     if ctypes.sizeof(LinearModelStruct) != size.value:
@@ -146,6 +147,7 @@ class Probe:
             modes[f"motor{axis + 1}.voltage_clamped"] = int(model.voltage_clamped[axis])
         for body, name in enumerate(["body1", "rotor1", "body2", "rotor2"]):
             modes[f"{name}.friction"] = FRICTION_MODES[model.friction[body]]
+        modes["elevation_stop.contact"] = int(model.elevation_stop)
         return LinearModel(A=A, B=B, C=C, D=D,
                            states=[self.real_names[model.state_vr[k]] for k in range(n)],
                            inputs=[self.real_names[model.input_vr[k]] for k in range(input_count)],
@@ -268,6 +270,9 @@ class LinearModel:
                     how = (f"--set dry_friction=false, or a start rate that makes it slip, e.g. --set {rate}=0.1"
                            if rate in self.states else "--set dry_friction=false")
                     held.append((f"{body}.friction", "stuck", how))
+            if axis == 2 and self.modes.get("elevation_stop.contact", 0) != 0:
+                held.append(("elevation_stop.contact", self.modes["elevation_stop.contact"],
+                             "a start inside the elevation stops, e.g. --set beta=0, or --set elevation_stop=false"))
             # contact 0 means "in the gap" only where there is a gap: the backlash position is then a state
             if self.modes.get(f"gear{axis}.contact", 0) == 0 and f"theta_b{axis}" in self.states:
                 held.append((f"gear{axis}.contact", 0, f"a gear without backlash, --set gear{axis}.model=1 "

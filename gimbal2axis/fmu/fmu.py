@@ -54,12 +54,34 @@ class LogEntry(NamedTuple):
         return f"[{self.category}] {self.text}"
 
 
+class ModeOutput(NamedTuple):
+    """An Integer output that shows a switching element's mode, and the Boolean parameter that switches
+    the element on (None: always on)."""
+    name: str
+    element: str
+    switch: str | None
+
+
+def mode_outputs(path: pathlib.Path) -> list[ModeOutput]:
+    """The mode outputs the FMU declares, in the order a run records them: its model description's
+    <VendorAnnotations><Tool name="gimbal2axis"><ModeOutputs>, written by the generator from the switching
+    elements' one declaration (model_core/include/gimbal/switching_elements.def). None for an FMU without it."""
+    import xml.etree.ElementTree as ElementTree
+    import zipfile
+
+    with zipfile.ZipFile(path) as archive:
+        root = ElementTree.fromstring(archive.read("modelDescription.xml"))
+    return [ModeOutput(node.get("name"), node.get("element"), node.get("switch"))
+            for node in root.iterfind("VendorAnnotations/Tool[@name='gimbal2axis']/ModeOutputs/ModeOutput")]
+
+
 class FMU:
     """An extracted FMU, reusable for many instances; a context manager that removes the extracted
     files on exit (or call close()).
 
     variables      {name: fmpy ModelVariable} of the model description (`model_description`)
     states         the names of the states (outputs with initial="exact" or "approx"), in the description's order
+    mode_outputs   the switching elements' mode outputs (ModeOutput), from the model description
     vr(name)       the value reference; variable(name) the ModelVariable; has(name), start(name)
     check(...)     validates scene values (names, causalities, types) before a run
     set_values(slave, {name: value})   Real, Integer (and Enumeration) and Boolean, each with the setter of its type
@@ -78,6 +100,7 @@ class FMU:
         self.model_description = read_model_description(str(self.path))
         self.variables = {v.name: v for v in self.model_description.modelVariables}
         self.states = state_names(self.model_description)
+        self.mode_outputs = mode_outputs(self.path)
         # what an instance loads (binaries/, resources/, the model description), not the FMU's sources
         # and documentation: 300 files whose writing was a fifth of a 60-s run's time
         self.unzipdir = extract(str(self.path), unzipdir=tempfile.mkdtemp(prefix="gimbal_fmu_", dir=workdir),

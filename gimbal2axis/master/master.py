@@ -77,8 +77,18 @@ OTHER_REAL_OUTPUTS = ["T_E1", "T_E2", "los.omega[1]", "los.omega[2]", "los.omega
 def real_outputs(fmu: FMU) -> list[str]:
     """The Real outputs a run records: the FMU's states, then the gear torques and the payload gyro."""
     return fmu.states + [name for name in OTHER_REAL_OUTPUTS if fmu.has(name)]
-MODE_OUTPUTS = ["gear1.contact", "gear2.contact", "motor1.limited", "motor2.limited", "body1.stick_slip",
-                "rotor1.stick_slip", "body2.stick_slip", "rotor2.stick_slip", "events.total"]
+# Recorded after the modes: the number of mode changes.
+EVENT_OUTPUTS = ["events.total"]
+
+
+def mode_outputs(fmu: FMU, scene: Scene | None = None) -> list[str]:
+    """The Integer outputs a run records besides the counters: the switching elements' modes, as the FMU
+    declares them (FMU.mode_outputs, from model_core/include/gimbal/switching_elements.def), then
+    EVENT_OUTPUTS. An element switched on by a parameter is recorded only in a scene that switches it on
+    (without a scene: all), so that a scene without it records what it did before the element existed."""
+    def switched_on(switch):
+        return switch is None or scene is None or bool(parameter_value(scene, fmu, switch))
+    return [mode.name for mode in fmu.mode_outputs if switched_on(mode.switch)] + EVENT_OUTPUTS
 
 
 class Plan:
@@ -132,7 +142,7 @@ def memory_needed(fmu: FMU, points: int) -> int:
     outputs, the modes), the inputs and base motion, the times, the measured attitude, the set points,
     the commands, and the RunResult's columns (recorded and derived) made from them."""
     real = len(real_outputs(fmu))
-    modes = sum(1 for name in MODE_OUTPUTS if fmu.has(name))
+    modes = sum(1 for name in mode_outputs(fmu) if fmu.has(name))
     plan = real + modes / 2 + (2 + len(BASE_INPUTS)) + len(BASE_INPUTS) + 1 + 3 + 4 + 4
     result = 1 + real + modes + 6 + len(BASE_INPUTS) + 1 + 10
     return int(points * (plan + result) * 8)
@@ -155,7 +165,7 @@ def choose_records(plan, fmu: FMU) -> None:
     """What a run records and sets, on `plan` (a Plan or a streaming.StreamPlan): the outputs' names
     and value references, the columns the sensors read, the inputs' value references."""
     plan.real_names = real_outputs(fmu)
-    plan.mode_names = [name for name in MODE_OUTPUTS
+    plan.mode_names = [name for name in mode_outputs(fmu, plan.scene)
                        if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
     for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]", "alpha_dot", "beta_dot"):
         if needed not in plan.real_names:

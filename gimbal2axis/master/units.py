@@ -33,7 +33,7 @@ _FMU_UNITS = {
     "events.last_time": "s",
     **{name: "1" for name in ("gear1.contact", "gear2.contact", "motor1.limited", "motor2.limited",
                               "body1.stick_slip", "rotor1.stick_slip", "body2.stick_slip", "rotor2.stick_slip",
-                              "events.total", "events.backlash1", "events.backlash2", "events.current_limit1",
+                              "elevation_stop.contact", "events.total", "events.backlash1", "events.backlash2", "events.current_limit1",
                               "events.current_limit2", "events.stick_slip", "events.zeno_guard", "solver.states",
                               "solver.steps", "solver.rhs_evaluations", "solver.jacobian_evaluations",
                               "solver.method_switches")},

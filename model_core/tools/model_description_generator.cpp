@@ -5,7 +5,9 @@
 // Usage: gimbal_model_description_generator [--fmi3] <units.xml> <variables.xml> <structure.xml> <types.xml>
 //                                           <default_tolerance.txt>
 // (--fmi3: the parts of the FMI 3.0 model description, modelDescription3.xml.in)
-// The last is the DefaultExperiment's tolerance: the start value of solver.rtol.
+// The last is the DefaultExperiment's tolerance: the start value of solver.rtol. Next to it (FMI 2.0) it
+// also writes event_indicators.txt (numberOfEventIndicators) and vendor_annotations.xml (the mode outputs
+// of the switching elements), both from their one declaration, gimbal/switching_elements.def.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -99,6 +101,70 @@ std::string xml_escape(const char* text) {
         }
     }
     return out;
+}
+
+// The switching elements' declarations (gimbal/switching_elements.def), for the texts that name them.
+struct ElementText {
+    const char* identifier;
+    int instances, guards;
+    const char* element_switch;
+};
+constexpr ElementText kElements[] = {
+#define ELEMENT(identifier, instances, guards, element_switch) {#identifier, instances, guards, element_switch},
+#define MODE_OUTPUT(element, output, lowest, highest)
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+};
+struct ModeOutputText {
+    const char* element;
+    gimbal::IntegerVariable output;
+};
+constexpr ModeOutputText kModeOutputs[] = {
+#define ELEMENT(identifier, instances, guards, element_switch)
+#define MODE_OUTPUT(element, output, lowest, highest) {#element, gimbal::vi_##output},
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+};
+
+// Event indicator k (from 0) in words: its element, instance and guard.
+std::string indicator_text(unsigned k) {
+    for (const ElementText& element : kElements) {
+        const unsigned size = static_cast<unsigned>(element.instances * element.guards);
+        if (k < size)
+            return std::string(element.identifier) + " " + std::to_string(k / element.guards + 1) + ", its guard " +
+                   std::to_string(k % element.guards + 1);
+        k -= size;
+    }
+    return "none";
+}
+
+// The Integer outputs that show the elements' modes, with the Boolean parameter that switches each one's
+// element on (none: always on), as a tool's annotation: FMI 2.0's <VendorAnnotations><Tool>, FMI 3.0's
+// <Annotations><Annotation type>. gimbal2axis records them (FMU.mode_outputs).
+std::string vendor_annotations(bool fmi3) {
+    std::ostringstream s;
+    s << (fmi3 ? "  <Annotations>\n    <Annotation type=\"gimbal2axis\">\n"
+               : "  <VendorAnnotations>\n    <Tool name=\"gimbal2axis\">\n")
+      << "      <ModeOutputs>\n";
+    for (const ModeOutputText& mode : kModeOutputs) {
+        s << "        <ModeOutput name=\"" << gimbal::kIntegerVariables[mode.output].name << "\" element=\""
+          << mode.element << "\"";
+        for (const ElementText& element : kElements)
+            if (std::string(element.identifier) == mode.element && element.element_switch[0] != '\0')
+                s << " switch=\"" << element.element_switch << "\"";
+        s << "/>\n";
+    }
+    s << "      </ModeOutputs>\n" << (fmi3 ? "    </Annotation>\n  </Annotations>\n" : "    </Tool>\n  </VendorAnnotations>\n");
+    return s.str();
+}
+
+// A file in the same folder as `path`.
+std::string beside(const char* path, const char* name) {
+    const std::string p(path);
+    const std::size_t slash = p.find_last_of('/');
+    return (slash == std::string::npos ? std::string() : p.substr(0, slash + 1)) + name;
 }
 
 bool write(const char* path, const std::string& text) {
@@ -213,12 +279,14 @@ std::string bound(double value, Type type) {
 // The same tables as FMI 3.0 model-description parts. FMI 3 has one value-reference space for all
 // types: a Real keeps its value reference, an Integer (Int32 or Enumeration) gets kFmi3IntegerBase +
 // its own, a Boolean kFmi3BooleanBase + its own (docs/fmi_interfaces.md). The independent variable,
-// which FMI 3.0 requires, is `time` (3001). The 36 event indicators are 36 scalar Float64 locals,
-// `event_indicators[1]` .. `event_indicators[36]` at kFmi3FirstEventIndicator + 0 .. 35, each an
+// which FMI 3.0 requires, is `time` (GIMBAL_FMI3_TIME). The GIMBAL_EVENT_INDICATORS event indicators are
+// as many scalar Float64 locals, `event_indicators[1]` .. at GIMBAL_FMI3_FIRST_EVENT_INDICATOR + 0 .., each an
 // <EventIndicator> of <ModelStructure>: not one array, because a host without array support reads
 // every Float64 as one value (ecos records all variables, locals too, and an array among them made
 // each of its reads fail).
-constexpr unsigned kFmi3IntegerBase = 1000, kFmi3BooleanBase = 2000, kFmi3Time = 3001, kFmi3FirstEventIndicator = 3002;
+// The offsets are gimbal_c_api.h's, which the FMI 3.0 layer adds too.
+constexpr unsigned kFmi3IntegerBase = GIMBAL_FMI3_INTEGER_BASE, kFmi3BooleanBase = GIMBAL_FMI3_BOOLEAN_BASE,
+                   kFmi3Time = GIMBAL_FMI3_TIME, kFmi3FirstEventIndicator = GIMBAL_FMI3_FIRST_EVENT_INDICATOR;
 
 std::string vr_list(const std::vector<unsigned>& references) {
     std::string list;
@@ -287,10 +355,8 @@ int write_fmi3(char** paths) {
         const unsigned vr = kFmi3FirstEventIndicator + k;
         variables << "    <Float64 name=\"event_indicators[" << k + 1 << "]\" valueReference=\"" << vr
                   << "\" causality=\"local\" variability=\"continuous\" initial=\"calculated\"\n"
-                  << "      description=\"guard " << k + 1 << " of the switching elements, in the order of docs/model_exchange.md: "
-                     "gear 1 and 2 backlash (2 each), motor 1 and 2 voltage clamp, current limiter (2 each), dry friction of "
-                     "body1, rotor1, body2, rotor2 (6 each); constant 1 where the fidelity has no such element, and in "
-                     "Co-Simulation\"/>\n";
+                  << "      description=\"guard " << k + 1 << " of the switching elements (docs/model_exchange.md): "
+                  << indicator_text(k) << "; constant 1 where the fidelity has no such element, and in Co-Simulation\"/>\n";
         event_indicators << "    <EventIndicator valueReference=\"" << vr << "\"/>\n";
     }
     for (int k = 0; k < kContinuousStateCount; ++k) {
@@ -324,7 +390,9 @@ int write_fmi3(char** paths) {
     structure << outputs.str() << derivatives.str() << initial_unknowns.str() << event_indicators.str();
     const std::string tolerance = number(kRealVariables[vr_solver_rtol].start);
     return write(paths[0], units.str()) && write(paths[1], variables.str()) && write(paths[2], structure.str()) &&
-                   write(paths[3], types.str()) && write(paths[4], tolerance)
+                   write(paths[3], types.str()) && write(paths[4], tolerance) &&
+                   write(beside(paths[4], "event_indicators.txt").c_str(), std::to_string(GIMBAL_EVENT_INDICATORS)) &&
+                   write(beside(paths[4], "vendor_annotations.xml").c_str(), vendor_annotations(true))
                ? 0
                : 1;
 }
@@ -434,7 +502,9 @@ int main(int argc, char** argv) {
               << "    <InitialUnknowns>\n" << initial_unknowns.str() << "    </InitialUnknowns>\n";
     const std::string tolerance = number(gimbal::kRealVariables[gimbal::vr_solver_rtol].start);
     return write(argv[1], units.str()) && write(argv[2], variables.str()) && write(argv[3], structure.str()) &&
-                   write(argv[4], types.str()) && write(argv[5], tolerance)
+                   write(argv[4], types.str()) && write(argv[5], tolerance) &&
+                   write(beside(argv[5], "event_indicators.txt").c_str(), std::to_string(GIMBAL_EVENT_INDICATORS)) &&
+                   write(beside(argv[5], "vendor_annotations.xml").c_str(), vendor_annotations(false))
                ? 0
                : 1;
 }

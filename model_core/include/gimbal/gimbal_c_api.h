@@ -41,6 +41,18 @@ typedef struct GimbalVariableInfo {
 
 typedef enum { GIMBAL_REAL = 0, GIMBAL_INTEGER = 1, GIMBAL_BOOLEAN = 2 } GimbalType;
 
+/* FMI 3.0 value references: FMI 3.0 has one value-reference space for all types, and the core has one per
+ * type (the .def tables). The FMI 3.0 layer and its model description add these offsets: Float64 at their
+ * Real value reference, Int32 and Enumeration at GIMBAL_FMI3_INTEGER_BASE + theirs, Boolean at
+ * GIMBAL_FMI3_BOOLEAN_BASE + theirs; time at GIMBAL_FMI3_TIME and the event indicators (FMI 3.0 makes them
+ * variables) at GIMBAL_FMI3_FIRST_EVENT_INDICATOR + 0 .. GIMBAL_EVENT_INDICATORS - 1. */
+enum {
+    GIMBAL_FMI3_INTEGER_BASE = 1000,
+    GIMBAL_FMI3_BOOLEAN_BASE = 2000,
+    GIMBAL_FMI3_TIME = 3001,
+    GIMBAL_FMI3_FIRST_EVENT_INDICATOR = 3002
+};
+
 /* Returns 0 when vr is not a variable of that type. */
 int gimbal_variable_info(GimbalType type, unsigned vr, GimbalVariableInfo* info);
 /* The index of the first of vr[0..count) that is not a variable of that type or cannot be set, or
@@ -96,7 +108,15 @@ GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
  * GIMBAL_EVENT_INDICATORS guards in a fixed order (an element the fidelity lacks gives constants).
  */
 #define GIMBAL_CONTINUOUS_STATES 17
-#define GIMBAL_EVENT_INDICATORS 36
+/* Each switching element's guards, summed from their one declaration (gimbal/switching_elements.def). */
+enum {
+    GIMBAL_EVENT_INDICATORS = 0
+#define ELEMENT(identifier, instances, guards, element_switch) + (instances) * (guards)
+#define MODE_OUTPUT(element, output, lowest, highest)
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+};
 GimbalStatus gimbal_core_use_continuous_time(GimbalCore* core);
 /* The Real value references of state k and of its derivative; k in [0, GIMBAL_CONTINUOUS_STATES). */
 unsigned gimbal_continuous_state_vr(int k);
@@ -143,11 +163,13 @@ typedef struct GimbalLinearModel {
     double D[GIMBAL_LINEAR_OUTPUTS][GIMBAL_LINEAR_INPUTS];
     /* The modes the model holds in: gear contact -1/0/+1, current limiter -1/0/+1, voltage clamp
      * -1/0/+1, friction per body q-order: 0 none, 1 slipping +, 2 slipping -, 3 stuck (held),
-     * 4 at the break-away torque +, 5 at the break-away torque -. */
+     * 4 at the break-away torque +, 5 at the break-away torque -; the elevation end stop -1/0/+1
+     * (resting on beta_min, free, resting on beta_max: at rest the model holds beta there). */
     int gear_contact[2];
     int motor_limited[2];
     int voltage_clamped[2];
     int friction[4];
+    int elevation_stop;
     double time;
 } GimbalLinearModel;
 

@@ -1,7 +1,7 @@
 // d(dx/dt)/dx (gimbal_model.hpp, evaluate_jacobian), from the same passes as the dynamics: the
 // drive train's elements (gear_backlash, current_limiter), the disturbance elements (cable, cogging),
-// the multibody terms, the dry friction element's hold torques, and the state rows of the elements
-// with states of their own.
+// the multibody terms, the dry friction element's hold torques, the elevation end stop's reaction while
+// the payload rests on it, and the state rows of the elements with states of their own.
 #include "gimbal/model/gimbal_model.hpp"
 
 #include <algorithm>
@@ -138,7 +138,8 @@ void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const 
     const Mat4x12 friction = hold_friction_derivatives(params, modes, d, applied, padded_inertia_derivative);
     Mat4x12 acceleration_rhs = applied + friction;
     for (int k = 0; k < 4; ++k) acceleration_rhs.col(k) -= padded_inertia_derivative[k] * d.acceleration;
-    const Mat4x12 acceleration = solve_mass_matrix<12>(d.reduced_mass, acceleration_rhs);
+    Mat4x12 acceleration = solve_mass_matrix<12>(d.reduced_mass, acceleration_rhs);
+    hold_at_elevation_stop_derivatives(modes, d.reduced_mass, acceleration);
 
     write_state_rows(params, modes, T, acceleration, column_major);
 }

@@ -233,6 +233,7 @@ GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
             model->voltage_clamped[axis] = linear.modes.voltage_clamped[axis];
         }
         for (int body = 0; body < 4; ++body) model->friction[body] = static_cast<int>(linear.modes.friction[body]);
+        model->elevation_stop = linear.modes.elevation_stop;
         model->time = core->instance.time();
         return GIMBAL_OK;
     });

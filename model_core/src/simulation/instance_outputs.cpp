@@ -76,6 +76,7 @@ void publish_outputs(const OutputPoint& point, double (&reals)[kRealVariableCoun
     integers[vi_gear2_contact] = modes.gear_contact[1];
     integers[vi_motor1_limited] = modes.motor_limited[0];
     integers[vi_motor2_limited] = modes.motor_limited[1];
+    integers[vi_elevation_stop_contact] = modes.elevation_stop;
     for (int body = 0; body < 4; ++body)
         integers[kBodyStickSlip[body]] = friction_mode_indicator(modes.friction[body], out.full.rate[body]);
     publish_counters(point, reals, integers);

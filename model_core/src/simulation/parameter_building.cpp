@@ -273,6 +273,19 @@ void read_disturbances(const double (&values)[kRealVariableCount], const int (&i
     }
 }
 
+// The elevation end stop (switching_elements/elevation_stop.hpp). e in [0, 1] and w_rest > 0 are the
+// variables' own bounds; the order of the stops is checked whether or not the stop is on, so that a value
+// set for it is refused when it is set, not when the stop is switched on later.
+bool read_elevation_stop(Checker& check, const bool (&flags)[kBooleanVariableCount], ElevationStopParameters& stop) {
+    stop.present = flags[vb_elevation_stop];
+    stop.lower = check.get(vr_elevation_stop_beta_min);
+    stop.upper = check.get(vr_elevation_stop_beta_max);
+    stop.restitution = check.get(vr_elevation_stop_e);
+    stop.rest_rate = check.get(vr_elevation_stop_w_rest);
+    return check.require(vr_elevation_stop_beta_min, stop.lower < stop.upper,
+                         "it must be below elevation_stop.beta_max");
+}
+
 // solver.*: the method (its range checked from the table; here: one this binary has), its step limit and
 // substeps.
 bool read_solver(const int (&integers)[kIntegerVariableCount], ModelParameters& params, std::string& error) {
@@ -314,6 +327,7 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     params.energy_accounting = flags[vb_energy_accounting];
     if (!read_drive_train(check, params) || !read_solver(integers, params, error)) return false;
     read_disturbances(values, integers, params.disturbances);
+    if (!read_elevation_stop(check, flags, params.elevation_stop)) return false;
     read_fidelity(integers, flags, params);
     // Checked against its Enumeration items with the other single-variable rules.
     params.gear_start[0] = static_cast<GearStart>(integers[vi_gear1_start]);
@@ -340,6 +354,11 @@ bool validate_start_state(const double (&values)[kRealVariableCount], const Mode
                            "a start backlash state must lie within +-eta"))
             return false;
     }
+    const ElevationStopParameters& stop = params.elevation_stop;
+    if (stop.present && !check.require(vr_beta, values[vr_beta] >= stop.lower && values[vr_beta] <= stop.upper,
+                                       "the start value must lie within the elevation stops, "
+                                       "[elevation_stop.beta_min, elevation_stop.beta_max]"))
+        return false;
     return true;
 }
 

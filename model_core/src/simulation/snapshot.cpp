@@ -165,18 +165,25 @@ bool listed(const IntegerVariable (&list)[N], std::size_t k) {
     return false;
 }
 
-// The Integer outputs a run can produce: modes in -1..1, stick-slip indicators in -2..2, counters.
-// Parameters are validated with the model (snapshot_parameters).
+// The Integer outputs a run can produce: the elements' mode outputs in their declared ranges
+// (gimbal/switching_elements.def), counters. Parameters are validated with the model (snapshot_parameters).
 ElementRule integer_variable_rule(std::size_t k) {
-    static constexpr IntegerVariable kModeOutputs[] = {vi_gear1_contact, vi_gear2_contact, vi_motor1_limited,
-                                                       vi_motor2_limited};
-    static constexpr IntegerVariable kFrictionOutputs[] = {vi_body1_stick_slip, vi_rotor1_stick_slip,
-                                                           vi_body2_stick_slip, vi_rotor2_stick_slip};
+    struct ModeOutputRange {
+        IntegerVariable output;
+        std::int64_t lowest, highest;
+    };
+    static constexpr ModeOutputRange kModeOutputs[] = {
+#define ELEMENT(identifier, instances, guards, element_switch)
+#define MODE_OUTPUT(element, output, lowest, highest) {vi_##output, lowest, highest},
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+    };
     static constexpr IntegerVariable kSolverOutputs[] = {vi_solver_states, vi_solver_steps, vi_solver_rhs_evaluations,
                                                          vi_solver_jacobian_evaluations, vi_solver_method_switches};
     const char* name = kIntegerVariables[k].name;
-    if (listed(kModeOutputs, k)) return {name, Rule::range, -1, 1};
-    if (listed(kFrictionOutputs, k)) return {name, Rule::range, -2, 2};
+    for (const ModeOutputRange& mode : kModeOutputs)
+        if (static_cast<std::size_t>(mode.output) == k) return {name, Rule::range, mode.lowest, mode.highest};
     if (listed(kEventCounters, k) || listed(kSolverOutputs, k)) return {name, Rule::count, 0, 0};
     return {name, Rule::none, 0, 0};
 }
@@ -209,6 +216,8 @@ constexpr Field kFields[] = {
     field<&C::modes, &Modes::friction>("modes.friction", "friction mode", kInit,
                                        range(static_cast<long>(FrictionMode::none),
                                              static_cast<long>(FrictionMode::at_max_negative))),
+    // In what was the tail padding of Modes in format 9: no later field moves.
+    field<&C::modes, &Modes::elevation_stop>("modes.elevation_stop", "elevation stop mode", kInit, range(-1, 1)),
     field<&C::counters, &EventCounters::total>("counters.total", "event counter", kInit, count()),
     field<&C::counters, &EventCounters::backlash>("counters.backlash", "event counter", kInit, count()),
     field<&C::counters, &EventCounters::current_limit>("counters.current_limit", "event counter", kInit, count()),
@@ -398,6 +407,8 @@ void check_against_model(const SnapshotContent& content, SnapshotCheck& check) {
         if (params.fidelity.gear[axis] != GearModel::backlash && content.modes.gear_contact[axis] != 0)
             check.fail("gear " + std::to_string(axis + 1) + " has no backlash but a contact mode");
     }
+    if (check.ok() && !params.elevation_stop.present && content.modes.elevation_stop != 0)
+        check.fail("an elevation stop mode is set but the elevation stop is off");
     for (int body = 0; body < 4 && check.ok(); ++body) {
         if (!params.fidelity.dry_friction && content.modes.friction[body] != FrictionMode::none)
             check.fail("a friction mode is set but dry friction is off");

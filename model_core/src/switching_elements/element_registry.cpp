@@ -4,21 +4,26 @@
 
 namespace gimbal {
 
-template <class Element>
-void SwitchingElementSet::add(std::vector<Element>& kind, int index, int first_indicator) {
+template <ElementKind Kind, class Element>
+void SwitchingElementSet::add(std::vector<Element>& kind, int index) {
+    constexpr ElementDeclaration declared = kElementDeclarations[static_cast<int>(Kind)];
+    static_assert(Element::kGuards == declared.guards, "an element's guards are as many as switching_elements.def declares");
+    const int first_indicator = first_indicator_of(Kind) + declared.guards * index;
     kind.emplace_back(index, guard_count_);
-    for (int k = 0; k < kind.back().guard_count(); ++k) guard_indicator_.push_back(first_indicator + k);
-    guard_count_ += kind.back().guard_count();
+    for (int k = 0; k < Element::kGuards; ++k) guard_indicator_.push_back(first_indicator + k);
+    guard_count_ += Element::kGuards;
 }
 
 SwitchingElementSet::SwitchingElementSet(const ModelParameters& params) : state_size_(params.layout.size) {
-    // Each kind in decision order, with the first indicator of its first instance.
+    // Each kind in decision order.
+    if (params.elevation_stop.present) add<ElementKind::elevation_stop>(stops_, 0);
     for (int axis = 0; axis < 2; ++axis)
-        if (params.layout.backlash_slot[axis] >= 0) add(backlash_, axis, 2 * axis);
-    for (int axis = 0; axis < 2; ++axis) add(clamps_, axis, 4 + 2 * axis);
-    for (int axis = 0; axis < 2; ++axis) add(limiters_, axis, 8 + 2 * axis);
+        if (params.layout.backlash_slot[axis] >= 0) add<ElementKind::gear_backlash>(backlash_, axis);
+    for (int axis = 0; axis < 2; ++axis) add<ElementKind::voltage_clamp>(clamps_, axis);
+    for (int axis = 0; axis < 2; ++axis) add<ElementKind::current_limiter>(limiters_, axis);
     for (int body = 0; body < 4; ++body)
-        if (params.coordinate_friction[body].present()) add(friction_, body, 12 + 6 * body);
+        if (params.coordinate_friction[body].present()) add<ElementKind::dry_friction>(friction_, body);
+    for (const auto& e : stops_) elements_.push_back(&e);
     for (const auto& e : backlash_) elements_.push_back(&e);
     for (const auto& e : clamps_) elements_.push_back(&e);
     for (const auto& e : limiters_) elements_.push_back(&e);
@@ -38,6 +43,12 @@ void SwitchingElementSet::decide(const SwitchingContext& context, const Modes& p
                                  const int* crossings, FunctionRef<void()> refresh) const {
     double state_before[kMaxStateSize];
     std::copy(state, state + state_size_, state_before);
+    for (const ElevationStopElement& element : stops_) {
+        element.decide(context, previous, modes, state, crossings);
+        // An impact moved the rates: the gears' and the rest's decisions read the dynamics after it.
+        if (!std::equal(state, state + state_size_, state_before)) refresh();
+        element.decide_rest(context, previous, modes, state);
+    }
     for (const BacklashElement& element : backlash_) element.decide(context, previous, modes, state, crossings);
     bool clamp_changed = false;
     for (const VoltageClampElement& element : clamps_) {

@@ -43,6 +43,19 @@ struct Fidelity {
 // Rotor coordinate of axis j in q order (alpha_m, beta_m) and its load coordinate (alpha, beta).
 constexpr int rotor_index(int axis) { return axis == 0 ? 1 : 3; }
 constexpr int load_index(int axis) { return axis == 0 ? 0 : 2; }
+// The payload's elevation angle beta, the coordinate the elevation end stop limits.
+constexpr int kElevation = load_index(1);
+
+// The elevation end stop (switching_elements/elevation_stop.hpp): hard stops at beta = lower and upper,
+// Newton's impact law with the coefficient of restitution, rest on a stop below the rebound rate
+// rest_rate. Off by default: no guard, no mode, no term in any sum.
+struct ElevationStopParameters {
+    bool present = false;
+    double lower = -1.5707963267948966;  // rad
+    double upper = 1.5707963267948966;   // rad
+    double restitution = 0.5;            // 1
+    double rest_rate = 1e-3;             // rad/s
+};
 
 // Where each quantity lives in the integrated state vector; -1 when the fidelity removed it.
 // Coordinates are "padded": a rigid axis's rotor keeps its index 0..3 in the equations of motion
@@ -67,6 +80,7 @@ struct ModelParameters {
     double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
     DryFrictionParameters dry_friction[4];      // per body, as given
     DisturbanceParameters disturbances;         // cable restraints and cogging; `active` set by finalize()
+    ElevationStopParameters elevation_stop;
     Fidelity fidelity;
     // Where the compliant gears' rotors start (gear<j>.start): used only by the start state.
     GearStart gear_start[2] = {GearStart::in_mesh_unless_given, GearStart::in_mesh_unless_given};
@@ -107,6 +121,7 @@ struct Modes {
     int motor_limited[2] = {0, 0};   // -1 held at -i_L, 0 free, +1 held at +i_L
     int voltage_clamped[2] = {0, 0}; // a ramped voltage held at -U_L / +U_L (0: follows the ramp)
     FrictionMode friction[4] = {FrictionMode::none, FrictionMode::none, FrictionMode::none, FrictionMode::none};
+    int elevation_stop = 0;          // -1 resting on the lower stop, 0 free (or no stop), +1 resting on the upper
 };
 
 // Inputs over one communication step: voltages held (or, when the master gives their derivatives,
@@ -142,6 +157,7 @@ struct Dynamics {
     Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
     double voltage[2];              // applied
     Mat4 reduced_mass;              // padded coordinates
+    double stop_torque;             // the elevation end stop's reaction on the payload while it rests there
 };
 
 // Derivatives of the full generalized forces (or accelerations) with respect to the full state:

@@ -58,7 +58,9 @@ constexpr std::uint32_t kSnapshotMagic = 0x47324158;
 // Format 8: format 7's fields with the longer variable tables of the disturbance elements (cables,
 // cogging): the variable arrays grew, so a format-7 state is refused by its number, not misread.
 // Format 9: format 8's fields with the Integer table grown by gear1.start and gear2.start.
-constexpr std::uint32_t kSnapshotFormat = 9;
+// Format 10: format 9's fields with the elevation end stop: its variables (4 Real, 1 Integer, 1 Boolean)
+// and its 2 event indicators lengthen the tables, and its mode sits in Modes' former tail padding.
+constexpr std::uint32_t kSnapshotFormat = 10;
 
 std::size_t snapshot_bytes();
 // The bytes of a content (every gap zero).

@@ -58,7 +58,8 @@ bool current_state_row(const ModelParameters& params, const Modes& modes, int ax
 class CurrentLimiterElement final : public SwitchingElement {
 public:
     CurrentLimiterElement(int axis, int first_guard);
-    int guard_count() const override { return 2; }
+    static constexpr int kGuards = 2;
+    int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                 const int* crossings) const override;

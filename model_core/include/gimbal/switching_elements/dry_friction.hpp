@@ -58,7 +58,8 @@ int friction_mode_indicator(FrictionMode mode, double rate);
 class DryFrictionElement final : public SwitchingElement {
 public:
     DryFrictionElement(int body, int first_guard);
-    int guard_count() const override { return 6; }
+    static constexpr int kGuards = 6;
+    int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
     // The speed regime; decide_torque completes the decision with the dynamics of the new regimes.
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,

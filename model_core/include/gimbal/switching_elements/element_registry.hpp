@@ -10,16 +10,46 @@
 #include "gimbal/function_ref.hpp"
 #include "gimbal/switching_elements/current_limiter.hpp"
 #include "gimbal/switching_elements/dry_friction.hpp"
+#include "gimbal/switching_elements/elevation_stop.hpp"
 #include "gimbal/switching_elements/gear_backlash.hpp"
 #include "gimbal/switching_elements/voltage_clamp.hpp"
 
 namespace gimbal {
 
-// The guards of every switching element the model can have, in one fixed order whatever the fidelity
-// (Model Exchange's event indicators, GIMBAL_EVENT_INDICATORS of gimbal_c_api.h): gear 1 and 2
-// backlash (2 each), motor 1 and 2 voltage clamp (2 each), current limiter (2 each), then dry friction
-// of body1, rotor1, body2, rotor2 (6 each). An element this fidelity lacks contributes constants 1.
-constexpr int kEventIndicatorCount = 36;
+// The kinds of switching element, as declared once in gimbal/switching_elements.def.
+enum class ElementKind : int {
+#define ELEMENT(identifier, instances, guards, element_switch) identifier,
+#define MODE_OUTPUT(element, output, lowest, highest)
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+};
+
+struct ElementDeclaration {
+    int instances;
+    int guards;  // per instance
+};
+
+inline constexpr ElementDeclaration kElementDeclarations[] = {
+#define ELEMENT(identifier, instances, guards, element_switch) {instances, guards},
+#define MODE_OUTPUT(element, output, lowest, highest)
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+};
+
+// Where a kind's first instance's guards sit among the event indicators: after every kind declared before.
+constexpr int first_indicator_of(ElementKind kind) {
+    int first = 0;
+    for (int k = 0; k < static_cast<int>(kind); ++k) first += kElementDeclarations[k].instances * kElementDeclarations[k].guards;
+    return first;
+}
+
+// The guards of every switching element the model can have, in the fixed order of the declaration whatever
+// the fidelity (Model Exchange's event indicators, GIMBAL_EVENT_INDICATORS of gimbal_c_api.h, summed from
+// the same table). An element this fidelity lacks contributes constants 1.
+constexpr int kEventIndicatorCount =
+    first_indicator_of(static_cast<ElementKind>(sizeof(kElementDeclarations) / sizeof(kElementDeclarations[0])));
 
 class SwitchingElementSet {
 public:
@@ -35,7 +65,8 @@ public:
     // Every element's guards under `modes`, each in its slice of `values` (guard_count() of them).
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const;
 
-    // Re-selects every element's mode, in dependency order: the contacts first, then the voltage
+    // Re-selects every element's mode, in dependency order: the contacts first (the end stop, whose
+    // impulse moves the rates every other element reads, before the gears), then the voltage
     // clamps, the limiters (whose steady current depends on the clamped voltage), then friction
     // (whose torques depend on everything before). `refresh` re-evaluates context.dynamics at
     // (time, state) under the modes chosen so far, where a later decision depends on them.
@@ -51,10 +82,12 @@ public:
     std::string describe(const Modes& before, const Modes& after) const;
 
 private:
-    template <class Element>
-    void add(std::vector<Element>& kind, int index, int first_indicator);
+    // Instance `index` of a kind; its guards' indicators follow from the declaration.
+    template <ElementKind Kind, class Element>
+    void add(std::vector<Element>& kind, int index);
     bool any_changed(const Modes& before, const Modes& after) const;
 
+    std::vector<ElevationStopElement> stops_;
     std::vector<BacklashElement> backlash_;
     std::vector<VoltageClampElement> clamps_;
     std::vector<CurrentLimiterElement> limiters_;

@@ -91,7 +91,8 @@ bool backlash_state_row(const ModelParameters& params, const Modes& modes, int a
 class BacklashElement final : public SwitchingElement {
 public:
     BacklashElement(int axis, int first_guard);
-    int guard_count() const override { return 2; }
+    static constexpr int kGuards = 2;
+    int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                 const int* crossings) const override;

@@ -37,7 +37,8 @@ inline int held_clamp_side(const MotorParameters& motor, double commanded_voltag
 class VoltageClampElement final : public SwitchingElement {
 public:
     VoltageClampElement(int axis, int first_guard);
-    int guard_count() const override { return 2; }
+    static constexpr int kGuards = 2;
+    int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                 const int* crossings) const override;
