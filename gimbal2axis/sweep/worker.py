@@ -49,10 +49,12 @@ def band_columns(result, from_s: float) -> dict:
     return {f"los_band_{name}_rms_mrad": value * 1e3 for name, value in result.band_rms(from_s).items()}
 
 
-def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float | None = None) -> dict:
+def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float | None = None,
+             extra_metrics=None) -> dict:
     """Runs one case (the scene with its values already put in) on this worker's FMU instance and
     returns its row: metrics and status 'ok', or status 'failed' with the error and the FMU's log.
-    Never raises for a failing case: failures are results too."""
+    Never raises for a failing case: failures are results too. `extra_metrics(result, fmu)`, when
+    given, adds its columns to the row of a run that went through (the tuner's objectives)."""
     from ..errors import SceneError
     from ..master.master import run
 
@@ -70,6 +72,8 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
             loaded.discard_instance()
             result = run(scene, loaded.fmu, slave=loaded.instance(), log=loaded.log)
         row.update(metrics(result, from_s))
+        if extra_metrics is not None:
+            row.update(extra_metrics(result, loaded.fmu))
         row["status"] = "ok"
         row["wall_time_s"] = time.perf_counter() - wall0   # the whole case: set-up, run, metrics
         if loaded.log:   # warnings of a run that went through

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import pathlib
 
-from ..errors import SceneError, boolean, check_keys, choice, did_you_mean, non_negative, number, positive, shown
+from ..errors import SceneError, boolean, check_keys, did_you_mean, non_negative, number, positive, shown
 from .motion import Carrier, EarthPoint, Flyby, RecordedTarget, Track
 
 MOVING_KINDS = ("earth_point", "flyby", "track")

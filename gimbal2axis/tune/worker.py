@@ -11,11 +11,10 @@ objective and constraints need besides a sweep's:
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 
-from ..sweep.worker import _worker_name, metrics
+from ..sweep.worker import run_case
 
 SATURATION_TOLERANCE = 1e-9   # relative: an asked voltage this close to U_L counts as saturated
 
@@ -57,41 +56,12 @@ def extra_metrics(result, fmu, from_s: float | None, bands: dict) -> dict:
 
 
 def run_tune_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float | None, bands: dict) -> dict:
-    """One evaluation on this worker's FMU instance: its row (metrics, status 'ok'), or status 'failed'
-    with the error and the FMU's log (a diverging candidate is a result too). Never raises for a case."""
-    from ..errors import SceneError
-    from ..fmu.worker_cache import loaded_fmu
-    from ..master.master import run
-
-    row = {"case_id": case_id, "status": "failed", "message": "", "fmu_log": "", "wall_time_s": math.nan,
-           "worker": _worker_name()}
-    wall0, cpu0 = time.perf_counter(), time.thread_time()
-    loaded = None
-    try:
-        loaded = loaded_fmu(fmu_bytes, digest)
-        try:
-            result = run(scene, loaded.fmu, slave=loaded.instance(), log=loaded.log)
-        except SceneError:
-            raise
-        except Exception:   # the reused instance would not reset: once more on a fresh one
-            loaded.discard_instance()
-            result = run(scene, loaded.fmu, slave=loaded.instance(), log=loaded.log)
-        row.update(metrics(result, from_s))
-        row.update(extra_metrics(result, loaded.fmu, from_s, bands))
-        row["status"] = "ok"
-    except SceneError as exc:
-        row["message"] = str(exc)
-    except Exception as exc:   # anything else: report it, and do not trust the instance any more
-        row["message"] = f"{type(exc).__name__}: {exc}"
-        if loaded is not None:
-            loaded.discard_instance()
-    if loaded is not None and loaded.log:
-        row["fmu_log"] = "\n".join(map(str, loaded.log))[-4000:]
-    row["wall_time_s"] = time.perf_counter() - wall0
-    row["cpu_time_s"] = time.thread_time() - cpu0
-    if loaded is not None:
-        loaded.cases += 1
-        row["instance_use"] = loaded.cases
+    """One evaluation on this worker's FMU instance: the sweep's case (its row, its failure handling
+    and instance reuse) with the tuner's objective columns added; the FMU's log cut to its last 4000
+    characters (a tuning stores thousands of rows)."""
+    row = run_case(scene, case_id, fmu_bytes, digest, from_s,
+                   extra_metrics=lambda result, fmu: extra_metrics(result, fmu, from_s, bands))
+    row["fmu_log"] = row["fmu_log"][-4000:]
     return row
 
 
