@@ -4,10 +4,10 @@
 # build too, and its packaging waits for that build (fmu_src/win64.cmake).
 
 # add_small_cosimulation_fmu_binary(<model identifier>
-#     SOURCES <the FMI wrapper's sources>... LIBRARIES <the model's libraries>...
+#     SOURCES <the model file defining kSmallFmi2Model>... LIBRARIES <the model's libraries>...
 #     VARIABLE_TABLE <file> GUID_HEADER <name>_guid.h.in GUID_VARIABLE <variable>)
-# The shared library <model identifier> (no "lib" prefix): the wrapper over the FMI instance layer
-# (fmu_src/fmi_layer/) and its FMI 2.0 face, linked
+# The shared library <model identifier> (no "lib" prefix): the model file behind the small FMUs' FMI
+# 2.0 Co-Simulation face (fmu_src/fmi_layer/small_fmi2_cosim.c) on the FMI instance layer, linked
 # as the gimbal's binary (fmu_src/CMakeLists.txt says why each option): only fmi2* exported, libgcc
 # inside, on Linux the C runtime's libm and libc its only shared libraries. Sets <variable> here and
 # in the caller's scope to the FMU's GUID, a name-based UUID of the identifier, the version and the
@@ -25,8 +25,8 @@ function(add_small_cosimulation_fmu_binary identifier)
 
   set(_common ${PROJECT_SOURCE_DIR}/fmu_src/common)
   set(_fmu_src ${PROJECT_SOURCE_DIR}/fmu_src)
-  add_library(${identifier} SHARED ${ARG_SOURCES} ${_fmu_src}/fmi_layer/fmi_instance.c ${_fmu_src}/fmi_layer/fmi2_face.c
-              ${_fmu_src}/fmu_state.c)
+  add_library(${identifier} SHARED ${ARG_SOURCES} ${_fmu_src}/fmi_layer/small_fmi2_cosim.c
+              ${_fmu_src}/fmi_layer/fmi_instance.c ${_fmu_src}/fmi_layer/fmi2_face.c ${_fmu_src}/fmu_state.c)
   target_include_directories(${identifier} PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_BINARY_DIR}/generated
                              ${PROJECT_SOURCE_DIR}/fmu_src ${_common})
   # No contraction into fused multiply-adds: the outputs are the bits the scene runner computes.
