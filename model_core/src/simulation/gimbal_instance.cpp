@@ -23,29 +23,29 @@ GimbalInstance::GimbalInstance(Logger logger, LogFilter filter)
 }
 
 void GimbalInstance::reset() {
-    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) reals_[vr] = kRealVariables[vr].start;
-    for (unsigned vr = 0; vr < kIntegerVariableCount; ++vr) integers_[vr] = static_cast<int>(kIntegerVariables[vr].start);
-    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) booleans_[vr] = kBooleanVariables[vr].start != 0.0;
-    integrator_.reset();
-    system_.reset();
-    integrator_running_ = false;
-    preview_current_ = false;
-    at_rest_ = false;
-    voltage_rate_[0] = voltage_rate_[1] = 0.0;
-    std::fill(state_, state_ + kMaxStateSize, 0.0);
-    time_ = 0.0;
-    epoch_ = 0.0;
-    clock_ = 0.0;
-    master_tolerance_defined_ = false;
-    master_tolerance_ = 0.0;
-    rtol_set_ = false;
-    step_work_.reset();
-    inputs_stale_ = outputs_stale_ = true;
-    decided_here_ = false;
-    std::fill(reference_guards_, reference_guards_ + kIndicatorCount, 0.0);
-    std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
-    chattering_ = ChatteringMemory{};
-    zeno_holds_ = 0;
+    for (unsigned vr = 0; vr < kRealVariableCount; ++vr) run_.reals[vr] = kRealVariables[vr].start;
+    for (unsigned vr = 0; vr < kIntegerVariableCount; ++vr) run_.integers[vr] = static_cast<int>(kIntegerVariables[vr].start);
+    for (unsigned vr = 0; vr < kBooleanVariableCount; ++vr) run_.booleans[vr] = kBooleanVariables[vr].start != 0.0;
+    run_.integrator.reset();
+    run_.system.reset();
+    run_.integrator_running = false;
+    run_.preview_current = false;
+    run_.at_rest = false;
+    run_.voltage_rate[0] = run_.voltage_rate[1] = 0.0;
+    std::fill(run_.state, run_.state + kMaxStateSize, 0.0);
+    run_.time = 0.0;
+    run_.epoch = 0.0;
+    run_.clock = 0.0;
+    run_.master_tolerance_defined = false;
+    run_.master_tolerance = 0.0;
+    run_.rtol_set = false;
+    run_.step_work.reset();
+    run_.inputs_stale = run_.outputs_stale = true;
+    run_.decided_here = false;
+    std::fill(run_.reference_guards, run_.reference_guards + kIndicatorCount, 0.0);
+    std::fill(run_.decided_side, run_.decided_side + kIndicatorCount, static_cast<std::int8_t>(0));
+    run_.chattering = ChatteringMemory{};
+    run_.zeno_holds = 0;
 }
 
 GimbalStatus GimbalInstance::refuse(GimbalStatus status, const std::string& message) const {
@@ -69,17 +69,17 @@ GimbalStatus GimbalInstance::set_reals(const unsigned* vr, std::size_t count, co
     bool input_set = false;
     for (std::size_t k = 0; k < count; ++k) {
         const unsigned variable = vr[k];
-        reals_[variable] = values[k];
+        run_.reals[variable] = values[k];
         input_set |= kRealVariables[variable].causality == Causality::input;
-        if (variable == vr_solver_rtol) rtol_set_ = true;
+        if (variable == vr_solver_rtol) run_.rtol_set = true;
         // A new voltage starts a new ramp: its derivative must be given again.
-        if (variable == vr_u_R1) voltage_rate_[0] = 0.0;
-        if (variable == vr_u_R2) voltage_rate_[1] = 0.0;
+        if (variable == vr_u_R1) run_.voltage_rate[0] = 0.0;
+        if (variable == vr_u_R2) run_.voltage_rate[1] = 0.0;
     }
-    preview_current_ = false;
+    run_.preview_current = false;
     if (input_set) {
-        inputs_stale_ = outputs_stale_ = true;
-        decided_here_ = false;
+        run_.inputs_stale = run_.outputs_stale = true;
+        run_.decided_here = false;
     }
     return GIMBAL_OK;
 }
@@ -100,7 +100,7 @@ GimbalStatus GimbalInstance::set_input_derivative(unsigned vr, int order, double
         return refuse(GIMBAL_ERROR, std::string("the derivative of ") +
                                         kRealVariables[vr].name + " must be finite");
     }
-    voltage_rate_[axis] = value;
+    run_.voltage_rate[axis] = value;
     return GIMBAL_OK;
 }
 
@@ -108,24 +108,24 @@ GimbalStatus GimbalInstance::get_real(unsigned vr, double& value) {
     if (vr >= kRealVariableCount) {
         return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Real variable");
     }
-    if (!system_ && kRealVariables[vr].initial == Initial::calculated) {
+    if (!run_.system && kRealVariables[vr].initial == Initial::calculated) {
         const GimbalStatus status = preview_outputs(kRealVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
-    if (!system_ && kRealVariables[vr].initial == Initial::approx) {
+    if (!run_.system && kRealVariables[vr].initial == Initial::approx) {
         // Before initialization a rotor reads where it will start (in mesh, or as given); its start
         // value stays what the host set.
         const GimbalStatus status = preview_outputs(kRealVariables[vr].name);
         if (status != GIMBAL_OK) return status;
         for (int k = 0; k < 4; ++k)
-            if (kRotorStart[k] == vr) value = preview_rotor_start_[k];
+            if (kRotorStart[k] == vr) value = run_.preview_rotor_start[k];
         return GIMBAL_OK;
     }
-    if (system_ && continuous_time_ && outputs_stale_) {
+    if (run_.system && run_.continuous_time && run_.outputs_stale) {
         const GimbalStatus status = publish_continuous_time_outputs();
         if (status != GIMBAL_OK) return status;
     }
-    value = reals_[vr];
+    value = run_.reals[vr];
     return GIMBAL_OK;
 }
 
@@ -133,8 +133,8 @@ GimbalStatus GimbalInstance::set_integer(unsigned vr, int value) {
     if (vr >= kIntegerVariableCount) {
         return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not an Integer variable");
     }
-    integers_[vr] = value;
-    preview_current_ = false;
+    run_.integers[vr] = value;
+    run_.preview_current = false;
     return GIMBAL_OK;
 }
 
@@ -142,15 +142,15 @@ GimbalStatus GimbalInstance::get_integer(unsigned vr, int& value) {
     if (vr >= kIntegerVariableCount) {
         return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not an Integer variable");
     }
-    if (!system_ && kIntegerVariables[vr].initial == Initial::calculated) {
+    if (!run_.system && kIntegerVariables[vr].initial == Initial::calculated) {
         const GimbalStatus status = preview_outputs(kIntegerVariables[vr].name);
         if (status != GIMBAL_OK) return status;
     }
-    if (system_ && continuous_time_ && outputs_stale_) {
+    if (run_.system && run_.continuous_time && run_.outputs_stale) {
         const GimbalStatus status = publish_continuous_time_outputs();
         if (status != GIMBAL_OK) return status;
     }
-    value = integers_[vr];
+    value = run_.integers[vr];
     return GIMBAL_OK;
 }
 
@@ -158,8 +158,8 @@ GimbalStatus GimbalInstance::set_boolean(unsigned vr, bool value) {
     if (vr >= kBooleanVariableCount) {
         return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Boolean variable");
     }
-    booleans_[vr] = value;
-    preview_current_ = false;
+    run_.booleans[vr] = value;
+    run_.preview_current = false;
     return GIMBAL_OK;
 }
 
@@ -167,73 +167,76 @@ GimbalStatus GimbalInstance::get_boolean(unsigned vr, bool& value) const {
     if (vr >= kBooleanVariableCount) {
         return refuse(GIMBAL_ERROR, "value reference " + std::to_string(vr) + " is not a Boolean variable");
     }
-    value = booleans_[vr];
+    value = run_.booleans[vr];
     return GIMBAL_OK;
 }
 
 StepInputs GimbalInstance::read_step_inputs(double step_start) const {
-    return gimbal::read_step_inputs(params_, reals_, voltage_rate_, step_start);
+    return gimbal::read_step_inputs(model_.params, run_.reals, run_.voltage_rate, step_start);
 }
 
 // gear<j>.start (docs/physics.md section 3.3). By default a rotor angle or rate left at its start value 0
 // follows its load: an FMI host that sets only alpha and beta gets relaxed gears, whether or not it
 // also sets the rotors' untouched start values (importers differ in that, the values decide alike).
-GearStart GimbalInstance::gear_start(int axis) const { return params_.gear_start[axis]; }
+namespace {
 
-bool GimbalInstance::rotor_start_given(int axis, double value) const {
-    const GearStart rule = gear_start(axis);
+// Whether a rotor's start value is used as given, under the model's gear<j>.start.
+bool rotor_start_given(const InstanceModel& model, int axis, double value) {
+    const GearStart rule = model.params.gear_start[axis];
     return rule == GearStart::as_given || (rule == GearStart::in_mesh_unless_given && value != 0.0);
 }
+
+}  // namespace
 
 // In mesh, the shaft is neither twisted (theta_d = theta_b, the backlash state as given: centred by
 // default) nor twisting (theta_d' = 0): T_E = 0 (section 4.2). A gear without backlash has theta_b = 0.
 void GimbalInstance::rotor_in_mesh(int axis, double& angle, double& rate) const {
     const RealVariable backlash = axis == 0 ? vr_theta_b1 : vr_theta_b2;
-    const double theta_b = params_.fidelity.gear[axis] == GearModel::backlash ? reals_[backlash] : 0.0;
+    const double theta_b = model_.params.fidelity.gear[axis] == GearModel::backlash ? run_.reals[backlash] : 0.0;
     const int load = load_index(axis);
-    const double ratio = params_.gear[axis].ratio;
-    angle = ratio * (reals_[kBodyAngle[load]] + theta_b);
-    rate = ratio * reals_[kBodyRate[load]];
+    const double ratio = model_.params.gear[axis].ratio;
+    angle = ratio * (run_.reals[kBodyAngle[load]] + theta_b);
+    rate = ratio * run_.reals[kBodyRate[load]];
 }
 
 void GimbalInstance::load_start_state() {
-    const StateLayout& layout = params_.layout;
-    std::fill(state_, state_ + kMaxStateSize, 0.0);
+    const StateLayout& layout = model_.params.layout;
+    std::fill(run_.state, run_.state + kMaxStateSize, 0.0);
     for (int body = 0; body < 4; ++body) {
         if (!layout.independent(body)) continue;
-        state_[layout.angle_slot[body]] = reals_[kBodyAngle[body]];
-        state_[layout.rate_slot[body]] = reals_[kBodyRate[body]];
+        run_.state[layout.angle_slot[body]] = run_.reals[kBodyAngle[body]];
+        run_.state[layout.rate_slot[body]] = run_.reals[kBodyRate[body]];
     }
     const RealVariable currents[2] = {vr_i_R1, vr_i_R2}, backlash[2] = {vr_theta_b1, vr_theta_b2};
     for (int axis = 0; axis < 2; ++axis) {
-        if (layout.current_slot[axis] >= 0) state_[layout.current_slot[axis]] = reals_[currents[axis]];
-        if (layout.backlash_slot[axis] >= 0) state_[layout.backlash_slot[axis]] = reals_[backlash[axis]];
+        if (layout.current_slot[axis] >= 0) run_.state[layout.current_slot[axis]] = run_.reals[currents[axis]];
+        if (layout.backlash_slot[axis] >= 0) run_.state[layout.backlash_slot[axis]] = run_.reals[backlash[axis]];
         const int rotor = rotor_index(axis);
         if (!layout.independent(rotor)) continue;  // a rigid gear: the rotor is N times its load anyway
         double mesh_angle = 0.0, mesh_rate = 0.0;
         rotor_in_mesh(axis, mesh_angle, mesh_rate);
-        if (!rotor_start_given(axis, reals_[kBodyAngle[rotor]])) state_[layout.angle_slot[rotor]] = mesh_angle;
-        if (!rotor_start_given(axis, reals_[kBodyRate[rotor]])) state_[layout.rate_slot[rotor]] = mesh_rate;
+        if (!rotor_start_given(model_, axis, run_.reals[kBodyAngle[rotor]])) run_.state[layout.angle_slot[rotor]] = mesh_angle;
+        if (!rotor_start_given(model_, axis, run_.reals[kBodyRate[rotor]])) run_.state[layout.rate_slot[rotor]] = mesh_rate;
     }
 }
 
 // Said once, at initialization (not at the previews before it): a start value of a rotor that is not
 // used, and a gear that starts twisted because its rotor's start values were given so.
 void GimbalInstance::report_gear_starts() const {
-    const StateLayout& layout = params_.layout;
+    const StateLayout& layout = model_.params.layout;
     for (int axis = 0; axis < 2; ++axis) {
         const int rotor = rotor_index(axis), load = load_index(axis);
         const std::string gear = "gear" + std::to_string(axis + 1);
         const char* angle_name = kRealVariables[kBodyAngle[rotor]].name;
         const char* rate_name = kRealVariables[kBodyRate[rotor]].name;
-        const double given_angle = reals_[kBodyAngle[rotor]], given_rate = reals_[kBodyRate[rotor]];
+        const double given_angle = run_.reals[kBodyAngle[rotor]], given_rate = run_.reals[kBodyRate[rotor]];
         std::ostringstream s;
         s.precision(6);
         if (!layout.independent(rotor)) {
-            const double ratio = params_.gear[axis].ratio;
-            const double angle = ratio * reals_[kBodyAngle[load]], rate = ratio * reals_[kBodyRate[load]];
-            if ((rotor_start_given(axis, given_angle) && given_angle != angle) ||
-                (rotor_start_given(axis, given_rate) && given_rate != rate)) {
+            const double ratio = model_.params.gear[axis].ratio;
+            const double angle = ratio * run_.reals[kBodyAngle[load]], rate = ratio * run_.reals[kBodyRate[load]];
+            if ((rotor_start_given(model_, axis, given_angle) && given_angle != angle) ||
+                (rotor_start_given(model_, axis, given_rate) && given_rate != rate)) {
                 s << "rigid gear " << axis + 1 << ": the start values " << angle_name << " = " << given_angle << ", "
                   << rate_name << " = " << given_rate << " are not used: a rigid gear's rotor is " << gear
                   << ".N times its load, " << angle << " rad, " << rate << " rad/s";
@@ -243,7 +246,7 @@ void GimbalInstance::report_gear_starts() const {
         }
         double mesh_angle = 0.0, mesh_rate = 0.0;
         rotor_in_mesh(axis, mesh_angle, mesh_rate);
-        if (gear_start(axis) == GearStart::in_mesh) {
+        if (model_.params.gear_start[axis] == GearStart::in_mesh) {
             const bool angle_dropped = given_angle != 0.0 && given_angle != mesh_angle;
             const bool rate_dropped = given_rate != 0.0 && given_rate != mesh_rate;
             if (angle_dropped || rate_dropped) {
@@ -259,12 +262,12 @@ void GimbalInstance::report_gear_starts() const {
         }
         // The twist the shaft carries from the start: the deflection beyond the backlash play (the
         // shaft's end reaches the stop within c_s/k_s), and the rate of deflection.
-        const double ratio = params_.gear[axis].ratio;
-        const double rotor_angle = state_[layout.angle_slot[rotor]], rotor_rate = state_[layout.rate_slot[rotor]];
-        const double load_angle = reals_[kBodyAngle[load]];
+        const double ratio = model_.params.gear[axis].ratio;
+        const double rotor_angle = run_.state[layout.angle_slot[rotor]], rotor_rate = run_.state[layout.rate_slot[rotor]];
+        const double load_angle = run_.reals[kBodyAngle[load]];
         const double deflection = rotor_angle / ratio - load_angle;
-        const double deflection_rate = rotor_rate / ratio - reals_[kBodyRate[load]];
-        const double play = params_.fidelity.gear[axis] == GearModel::backlash ? params_.gear[axis].half_backlash : 0.0;
+        const double deflection_rate = rotor_rate / ratio - run_.reals[kBodyRate[load]];
+        const double play = model_.params.fidelity.gear[axis] == GearModel::backlash ? model_.params.gear[axis].half_backlash : 0.0;
         const double twist = deflection - std::clamp(deflection, -play, play);
         // Rounding of N (q_l + theta_b) / N - q_l is not a twist.
         const double resolution = 1e-12 * (1.0 + std::fabs(load_angle) + std::fabs(rotor_angle / ratio));
@@ -274,18 +277,18 @@ void GimbalInstance::report_gear_starts() const {
         s << gear << " starts twisted: " << angle_name << " = " << rotor_angle << " rad";
         if (twisting) s << ", " << rate_name << " = " << rotor_rate << " rad/s";
         s << " against " << kRealVariables[kBodyAngle[load]].name << " = " << load_angle << " rad";
-        if (twisting) s << ", " << kRealVariables[kBodyRate[load]].name << " = " << reals_[kBodyRate[load]] << " rad/s";
+        if (twisting) s << ", " << kRealVariables[kBodyRate[load]].name << " = " << run_.reals[kBodyRate[load]] << " rad/s";
         if (twisted) {
             s << ": the shaft is twisted by " << twist << " rad";
             if (play > 0.0) s << " beyond the backlash (" << gear << ".eta = " << play << " rad)";
-            s << ", a torque of " << params_.gear[axis].stiffness * twist << " N.m (" << gear << ".k_s times the twist)";
+            s << ", a torque of " << model_.params.gear[axis].stiffness * twist << " N.m (" << gear << ".k_s times the twist)";
         }
         if (twisting) {
             s << (twisted ? "; " : ": ") << "the shaft twists at " << deflection_rate << " rad/s, a damping torque of "
-              << params_.gear[axis].damping * deflection_rate << " N.m (" << gear << ".c_s times the rate)";
+              << model_.params.gear[axis].damping * deflection_rate << " N.m (" << gear << ".c_s times the rate)";
             if (!twisted && play > 0.0) s << " once the backlash closes";
         }
-        if (gear_start(axis) == GearStart::as_given)
+        if (model_.params.gear_start[axis] == GearStart::as_given)
             s << "; " << gear << ".start = as_given keeps the rotor's start values";
         else
             s << "; the rotor's start values were given (left at 0, they follow the load: " << mesh_angle << " rad, "
@@ -295,11 +298,11 @@ void GimbalInstance::report_gear_starts() const {
 }
 
 GimbalStatus GimbalInstance::check_fixed_base() const {
-    if (!params_.fidelity.fixed_base) return GIMBAL_OK;
+    if (!model_.params.fidelity.fixed_base) return GIMBAL_OK;
     for (RealVariable vr : kBaseInputs) {
-        if (reals_[vr] != 0.0) {
+        if (run_.reals[vr] != 0.0) {
             std::ostringstream s;
-            s << kRealVariables[vr].name << " = " << reals_[vr]
+            s << kRealVariables[vr].name << " = " << run_.reals[vr]
               << " refused: base.fixed = true, so every base input must be 0";
             return refuse(GIMBAL_ERROR, s.str());
         }
@@ -308,8 +311,8 @@ GimbalStatus GimbalInstance::check_fixed_base() const {
 }
 
 bool GimbalInstance::build_parameters(ModelParameters& params, std::string& error) const {
-    return build_model_parameters(reals_, integers_, booleans_, params, error) &&
-           validate_start_state(reals_, params, error);
+    return build_model_parameters(run_.reals, run_.integers, run_.booleans, params, error) &&
+           validate_start_state(run_.reals, params, error);
 }
 
 std::unique_ptr<HybridIntegrator> GimbalInstance::make_integrator(GimbalHybridSystem& system,
@@ -328,49 +331,49 @@ std::unique_ptr<HybridIntegrator> GimbalInstance::make_integrator(GimbalHybridSy
     return HybridIntegrator::create(
         system, settings,
         [this](const std::string& message) {
-            last_integrator_error_ = message;
+            run_.last_integrator_error = message;
             logger_(GIMBAL_WARNING, "logSolver", message);
         },
         [this](const std::string& message) { logger_(GIMBAL_OK, "logEvents", message); });
 }
 
 void GimbalInstance::create_integrator() {
-    integrator_ = make_integrator(*system_, params_);
-    integrator_running_ = false;
+    run_.integrator = make_integrator(*run_.system, model_.params);
+    run_.integrator_running = false;
 }
 
 void GimbalInstance::set_master_tolerance(bool defined, double tolerance) {
-    master_tolerance_defined_ = defined;
-    master_tolerance_ = defined ? tolerance : 0.0;
+    run_.master_tolerance_defined = defined;
+    run_.master_tolerance = defined ? tolerance : 0.0;
 }
 
 // The FMI standard gives the master's tolerance to the FMU's integrator; solver.rtol, when the user
 // set it, says more precisely what this FMU should do.
 void GimbalInstance::apply_master_tolerance() {
-    if (!master_tolerance_defined_) return;
+    if (!run_.master_tolerance_defined) return;
     std::ostringstream s;
     s.precision(17);
-    if (rtol_set_) {
-        if (master_tolerance_ != reals_[vr_solver_rtol]) {
-            s << "the master's tolerance = " << master_tolerance_ << " is not used: solver.rtol = "
-              << reals_[vr_solver_rtol] << " was set explicitly";
+    if (run_.rtol_set) {
+        if (run_.master_tolerance != run_.reals[vr_solver_rtol]) {
+            s << "the master's tolerance = " << run_.master_tolerance << " is not used: solver.rtol = "
+              << run_.reals[vr_solver_rtol] << " was set explicitly";
             logger_(GIMBAL_OK, "logSolver", s.str());
         }
         return;
     }
-    if (!(master_tolerance_ > 0.0 && master_tolerance_ < 1.0)) {
-        s << "the master's tolerance = " << master_tolerance_ << " is ignored (a relative tolerance lies in "
-          << "(0, 1)); solver.rtol keeps " << reals_[vr_solver_rtol];
+    if (!(run_.master_tolerance > 0.0 && run_.master_tolerance < 1.0)) {
+        s << "the master's tolerance = " << run_.master_tolerance << " is ignored (a relative tolerance lies in "
+          << "(0, 1)); solver.rtol keeps " << run_.reals[vr_solver_rtol];
         logger_(GIMBAL_WARNING, "logStatusWarning", s.str());
         return;
     }
-    reals_[vr_solver_rtol] = master_tolerance_;
-    s << "solver.rtol = " << master_tolerance_ << ", the tolerance the master gave (set solver.rtol to override)";
+    run_.reals[vr_solver_rtol] = run_.master_tolerance;
+    s << "solver.rtol = " << run_.master_tolerance << ", the tolerance the master gave (set solver.rtol to override)";
     logger_(GIMBAL_OK, "logSolver", s.str());
 }
 
 GimbalStatus GimbalInstance::preview_outputs(const char* name) {
-    if (preview_current_) return GIMBAL_OK;
+    if (run_.preview_current) return GIMBAL_OK;
     std::string error;
     ModelParameters params;
     if (!build_parameters(params, error)) {
@@ -378,87 +381,85 @@ GimbalStatus GimbalInstance::preview_outputs(const char* name) {
                                         " cannot be computed from the current values: " + error);
     }
     // Built aside and committed only at the end: a failure (out of memory) leaves nothing half-made.
-    ParameterSwap swap(params_, params);
-    auto system = std::make_unique<GimbalHybridSystem>(params_);
-    auto integrator = make_integrator(*system, params_);
+    ModelSwap swap(model_, make_instance_model(params));
+    auto system = std::make_unique<GimbalHybridSystem>(model_.params);
+    auto integrator = make_integrator(*system, model_.params);
     swap.commit();
-    map_integrated_states();
     load_start_state();
-    epoch_ = time_;
-    clock_ = 0.0;
-    system->hold_inputs_at_any_time(continuous_time_);
+    run_.epoch = run_.time;
+    run_.clock = 0.0;
+    system->hold_inputs_at_any_time(run_.continuous_time);
     system->set_inputs(read_step_inputs(0.0));
-    system->update_modes(0.0, state_, nullptr);
-    system_ = std::move(system);
-    integrator_ = std::move(integrator);
+    system->update_modes(0.0, run_.state, nullptr);
+    run_.system = std::move(system);
+    run_.integrator = std::move(integrator);
     // Publishing writes the rotors' start into their variables: keep the host's start values there
     // (gear<j>.start reads them again), and the start the preview computed aside.
     double rotor_start_values[4];
-    for (int k = 0; k < 4; ++k) rotor_start_values[k] = reals_[kRotorStart[k]];
+    for (int k = 0; k < 4; ++k) rotor_start_values[k] = run_.reals[kRotorStart[k]];
     publish_outputs();
     for (int k = 0; k < 4; ++k) {
-        preview_rotor_start_[k] = reals_[kRotorStart[k]];
-        reals_[kRotorStart[k]] = rotor_start_values[k];
+        run_.preview_rotor_start[k] = run_.reals[kRotorStart[k]];
+        run_.reals[kRotorStart[k]] = rotor_start_values[k];
     }
     // The continuous-time interface may ask for the states and indicators during initialization.
-    full_state_vector(params_, system_->dynamics_at(0.0, state_), state_, preview_states_);
-    system_->event_indicators(0.0, state_, preview_indicators_);
+    full_state_vector(model_.params, run_.system->dynamics_at(0.0, run_.state), run_.state, run_.preview_states);
+    run_.system->event_indicators(0.0, run_.state, run_.preview_indicators);
     // The preview must not count as initialization: forget the integrator again.
-    integrator_.reset();
-    system_.reset();
-    preview_current_ = true;
+    run_.integrator.reset();
+    run_.system.reset();
+    run_.preview_current = true;
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::initialize(double start_time) {
-    const double rtol_before = reals_[vr_solver_rtol];
+    const double rtol_before = run_.reals[vr_solver_rtol];
     apply_master_tolerance();
     std::string error;
     ModelParameters params;
     if (!build_parameters(params, error)) {
-        reals_[vr_solver_rtol] = rtol_before;
+        run_.reals[vr_solver_rtol] = rtol_before;
         return refuse(GIMBAL_ERROR, error);
     }
     std::unique_ptr<GimbalHybridSystem> system;
     std::unique_ptr<HybridIntegrator> integrator;
-    ParameterSwap swap(params_, params);
+    ModelSwap swap(model_, make_instance_model(params));
     try {
-        system = std::make_unique<GimbalHybridSystem>(params_);
-        integrator = make_integrator(*system, params_);
+        system = std::make_unique<GimbalHybridSystem>(model_.params);
+        integrator = make_integrator(*system, model_.params);
     } catch (...) {
-        reals_[vr_solver_rtol] = rtol_before;
+        run_.reals[vr_solver_rtol] = rtol_before;
         throw;
     }
     const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) {
-        reals_[vr_solver_rtol] = rtol_before;
+        run_.reals[vr_solver_rtol] = rtol_before;
         return base_status;
     }
     swap.commit();
-    map_integrated_states();
     load_start_state();
-    time_ = start_time;
-    epoch_ = start_time;
-    clock_ = 0.0;
-    system->hold_inputs_at_any_time(continuous_time_);
+    run_.time = start_time;
+    run_.epoch = start_time;
+    run_.clock = 0.0;
+    system->hold_inputs_at_any_time(run_.continuous_time);
     system->set_inputs(read_step_inputs(0.0));
-    system->update_modes(0.0, state_, nullptr);
+    system->update_modes(0.0, run_.state, nullptr);
     EventCounters none;
     none.last_event_time = 0.0;
     system->restore(system->modes(), none);  // the initial choice of modes is not an event
-    system_ = std::move(system);
-    integrator_ = std::move(integrator);
-    integrator_running_ = false;
-    step_work_.reset();
+    run_.system = std::move(system);
+    run_.integrator = std::move(integrator);
+    run_.integrator_running = false;
+    run_.step_work.reset();
     // The continuous-time interface measures the first crossings against the guards of the start.
-    system_->event_functions(0.0, state_, reference_guards_);
-    std::fill(decided_side_, decided_side_ + kIndicatorCount, static_cast<std::int8_t>(0));
-    inputs_stale_ = decided_here_ = false;
-    chattering_ = ChatteringMemory{};
-    zeno_holds_ = 0;
+    run_.system->event_functions(0.0, run_.state, run_.reference_guards);
+    std::fill(run_.decided_side, run_.decided_side + kIndicatorCount, static_cast<std::int8_t>(0));
+    run_.inputs_stale = run_.decided_here = false;
+    run_.chattering = ChatteringMemory{};
+    run_.zeno_holds = 0;
     report_gear_starts();  // reads the rotors' start values: before publishing replaces them
     publish_outputs();
-    outputs_stale_ = false;
+    run_.outputs_stale = false;
     return check_initial_outputs();
 }
 
@@ -466,10 +467,10 @@ GimbalStatus GimbalInstance::initialize(double start_time) {
 // represent (a carrier rate of 1e300 makes the kinetic energy overflow) are refused, not published.
 GimbalStatus GimbalInstance::check_initial_outputs() {
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
-        if (kRealVariables[vr].causality != Causality::output || std::isfinite(reals_[vr])) continue;
+        if (kRealVariables[vr].causality != Causality::output || std::isfinite(run_.reals[vr])) continue;
         std::ostringstream s;
         s.precision(17);
-        s << kRealVariables[vr].name << " = " << reals_[vr] << " at the start time " << time_
+        s << kRealVariables[vr].name << " = " << run_.reals[vr] << " at the start time " << run_.time
           << ": an input or parameter lies beyond what the model can represent";
         return refuse(GIMBAL_ERROR, s.str());
     }
@@ -477,18 +478,18 @@ GimbalStatus GimbalInstance::check_initial_outputs() {
 }
 
 GimbalStatus GimbalInstance::linearize(LinearModel& model) {
-    if (!system_) return refuse(GIMBAL_ERROR, "linearize: the instance is not initialized (no operating point yet)");
-    const double now = clock_;
+    if (!run_.system) return refuse(GIMBAL_ERROR, "linearize: the instance is not initialized (no operating point yet)");
+    const double now = run_.clock;
     StepInputs inputs = read_step_inputs(now);
     inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;
     // The modes the next step would start in: inputs set since the last step may have switched some.
-    GimbalHybridSystem selector(params_);
+    GimbalHybridSystem selector(model_.params);
     selector.set_inputs(inputs);
-    selector.restore(system_->modes(), system_->counters());
+    selector.restore(run_.system->modes(), run_.system->counters());
     double state[kMaxStateSize];
-    std::copy(state_, state_ + kMaxStateSize, state);
+    std::copy(run_.state, run_.state + kMaxStateSize, state);
     selector.update_modes(now, state, nullptr);
-    gimbal::linearize(params_, inputs, selector.modes(), now, state, model);
+    gimbal::linearize(model_.params, inputs, selector.modes(), now, state, model);
     return GIMBAL_OK;
 }
 

@@ -31,9 +31,8 @@ constexpr double kDepartureLookahead = 1e-12;
 
 }  // namespace
 
-void GimbalInstance::map_integrated_states() {
-    const StateLayout& layout = params_.layout;
-    int slot_of[kStateCount];
+IntegratedStates integrated_states_of(const StateLayout& layout) {
+    int slot_of[kContinuousStateCount];
     for (int body = 0; body < 4; ++body) {
         slot_of[body] = layout.angle_slot[body];
         slot_of[kRates + body] = layout.rate_slot[body];
@@ -43,35 +42,43 @@ void GimbalInstance::map_integrated_states() {
         slot_of[kBacklash + axis] = layout.backlash_slot[axis];
     }
     for (int k = 0; k < kEnergyFlowCount; ++k) slot_of[kStateSize + k] = layout.energy_slot >= 0 ? layout.energy_slot + k : -1;
-    integrated_count_ = 0;
-    for (int k = 0; k < kStateCount; ++k) {
+    IntegratedStates integrated;
+    for (int k = 0; k < kContinuousStateCount; ++k) {
         if (slot_of[k] < 0) continue;
-        integrated_state_[integrated_count_] = k;
-        integrated_slot_[integrated_count_++] = slot_of[k];
+        integrated.state[integrated.count] = k;
+        integrated.slot[integrated.count++] = slot_of[k];
     }
+    return integrated;
+}
+
+InstanceModel make_instance_model(const ModelParameters& params) {
+    InstanceModel model;
+    model.params = params;
+    model.integrated = integrated_states_of(params.layout);
+    return model;
 }
 
 void GimbalInstance::refresh_held_inputs() {
-    if (!inputs_stale_) return;
-    StepInputs inputs = read_step_inputs(clock_);
+    if (!run_.inputs_stale) return;
+    StepInputs inputs = read_step_inputs(run_.clock);
     inputs.voltage_rate[0] = inputs.voltage_rate[1] = 0.0;  // no input derivatives in this interface
-    system_->set_inputs(inputs);
-    inputs_stale_ = false;
+    run_.system->set_inputs(inputs);
+    run_.inputs_stale = false;
 }
 
 GimbalStatus GimbalInstance::set_time(double time) {
     if (!std::isfinite(time)) return refuse(GIMBAL_ERROR, "the time must be finite");
-    if (time < epoch_) {
+    if (time < run_.epoch) {
         std::ostringstream s;
         s.precision(17);
-        s << "time = " << time << " lies before the start time " << epoch_;
+        s << "time = " << time << " lies before the start time " << run_.epoch;
         return refuse(GIMBAL_ERROR, s.str());
     }
-    if (time != time_) {
-        time_ = time;
-        clock_ = time - epoch_;
-        outputs_stale_ = true;
-        decided_here_ = false;
+    if (time != run_.time) {
+        run_.time = time;
+        run_.clock = time - run_.epoch;
+        run_.outputs_stale = true;
+        run_.decided_here = false;
     }
     return GIMBAL_OK;
 }
@@ -90,15 +97,16 @@ GimbalStatus GimbalInstance::set_continuous_states(const double* states) {
         }
     }
     // The states this fidelity integrates take the host's values; the others follow from them.
-    for (int k = 0; k < integrated_count_; ++k) state_[integrated_slot_[k]] = states[integrated_state_[k]];
-    outputs_stale_ = true;
-    decided_here_ = false;
+    const IntegratedStates& integrated = model_.integrated;
+    for (int k = 0; k < integrated.count; ++k) run_.state[integrated.slot[k]] = states[integrated.state[k]];
+    run_.outputs_stale = true;
+    run_.decided_here = false;
     return GIMBAL_OK;
 }
 
 void GimbalInstance::get_continuous_states(double* states) {
     refresh_held_inputs();
-    full_state_vector(params_, system_->dynamics_at(clock_, state_), state_, states);
+    full_state_vector(model_.params, run_.system->dynamics_at(run_.clock, run_.state), run_.state, states);
 }
 
 void GimbalInstance::get_nominal_states(double* nominals) const {
@@ -110,62 +118,62 @@ void GimbalInstance::get_nominal_states(double* nominals) const {
     const RealVariable half_backlash_values[2] = {vr_gear1_eta, vr_gear2_eta};
     for (int axis = 0; axis < 2; ++axis) {
         const double half_backlash =
-            initialized() ? params_.gear[axis].half_backlash : reals_[half_backlash_values[axis]];
+            initialized() ? model_.params.gear[axis].half_backlash : run_.reals[half_backlash_values[axis]];
         if (half_backlash > 0.0) nominals[kBacklash + axis] = half_backlash;
     }
 }
 
 GimbalStatus GimbalInstance::preview_continuous(double* states, double* indicators) {
-    if (system_) return refuse(GIMBAL_ERROR, "the instance is initialized: ask for the current point instead");
+    if (run_.system) return refuse(GIMBAL_ERROR, "the instance is initialized: ask for the current point instead");
     const GimbalStatus status = preview_outputs(states != nullptr ? "the continuous states" : "the event indicators");
     if (status != GIMBAL_OK) return status;
-    if (states != nullptr) std::copy(preview_states_, preview_states_ + kStateCount, states);
-    if (indicators != nullptr) std::copy(preview_indicators_, preview_indicators_ + kIndicatorCount, indicators);
+    if (states != nullptr) std::copy(run_.preview_states, run_.preview_states + kStateCount, states);
+    if (indicators != nullptr) std::copy(run_.preview_indicators, run_.preview_indicators + kIndicatorCount, indicators);
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::get_derivatives(double* derivatives) {
     refresh_held_inputs();
-    const double now = clock_;
-    const Dynamics& dynamics = system_->dynamics_at(now, state_);
+    const double now = run_.clock;
+    const Dynamics& dynamics = run_.system->dynamics_at(now, run_.state);
     double integrated[kMaxStateSize];
-    if (!state_derivative(params_, dynamics, integrated)) {
+    if (!state_derivative(model_.params, dynamics, integrated)) {
         std::ostringstream s;
         s.precision(17);
-        s << "the derivatives are not finite at t = " << time_
+        s << "the derivatives are not finite at t = " << run_.time
           << ": the states or inputs set lie beyond what the model can represent";
         return refuse(GIMBAL_ERROR, s.str());
     }
-    full_state_derivative(params_, system_->modes(), dynamics, integrated, derivatives);
+    full_state_derivative(model_.params, run_.system->modes(), dynamics, integrated, derivatives);
     return GIMBAL_OK;
 }
 
 GimbalStatus GimbalInstance::get_event_indicators(double* indicators) {
     refresh_held_inputs();
-    const double now = clock_;
-    if (now < chattering_.dwell_until) {
+    const double now = run_.clock;
+    if (now < run_.chattering.dwell_until) {
         // The chattering guard holds the modes: the indicators keep the values of its start, so that
         // the host sees no crossing before the time event that ends the hold.
         std::fill(indicators, indicators + kIndicatorCount, 1.0);
-        for (int k = 0; k < system_->event_count(); ++k)
-            indicators[system_->indicator_of_guard(k)] = reference_guards_[k];
+        for (int k = 0; k < run_.system->event_count(); ++k)
+            indicators[run_.system->indicator_of_guard(k)] = run_.reference_guards[k];
         return GIMBAL_OK;
     }
     double guards[kIndicatorCount];
-    system_->event_functions(now, state_, guards);
+    run_.system->event_functions(now, run_.state, guards);
     std::fill(indicators, indicators + kIndicatorCount, 1.0);
-    for (int k = 0; k < system_->event_count(); ++k) {
+    for (int k = 0; k < run_.system->event_count(); ++k) {
         double value = guards[k];
         if (!std::isfinite(value)) {
             std::ostringstream s;
             s.precision(17);
-            s << "event indicator " << system_->indicator_of_guard(k) << " is not finite at t = " << time_
+            s << "event indicator " << run_.system->indicator_of_guard(k) << " is not finite at t = " << run_.time
               << ": the states or inputs set lie beyond what the model can represent";
             return refuse(GIMBAL_ERROR, s.str());
         }
         // A guard exactly on zero where the modes were decided has the side it was decided for.
-        if (value == 0.0 && decided_side_[k] != 0) value = decided_side_[k] * std::numeric_limits<double>::min();
-        indicators[system_->indicator_of_guard(k)] = value;
+        if (value == 0.0 && run_.decided_side[k] != 0) value = run_.decided_side[k] * std::numeric_limits<double>::min();
+        indicators[run_.system->indicator_of_guard(k)] = value;
     }
     return GIMBAL_OK;
 }
@@ -177,19 +185,21 @@ int GimbalInstance::settle_guards(double now, int n, const int* directions, cons
     double raw[kIndicatorCount];
     int settled_changes = 0;
     const double lookahead = kDepartureLookahead * std::max(1.0, std::fabs(now));
-    const bool evaluated = guard_settling_.settle(
-        now, state_, params_.layout.size, n, lookahead, directions, derivative, reference_guards_, settled_changes,
-        [this](double t, const double* x, double* dx) { return system_->derivative(t, x, dx); },
+    const bool evaluated = run_.guard_settling.settle(
+        now, run_.state, model_.params.layout.size, n, lookahead, directions, derivative, run_.reference_guards, settled_changes,
+        [this](double t, const double* x, double* dx) { return run_.system->derivative(t, x, dx); },
         [this, n, &raw](double t, const double* x, double* g) {
-            system_->event_functions(t, x, g);
-            if (g == reference_guards_) std::copy(g, g + n, raw);
+            run_.system->event_functions(t, x, g);
+            if (g == run_.reference_guards) std::copy(g, g + n, raw);
             return true;
         },
         [this, now, &sink](const int* settle_directions) {
-            return switch_modes(*system_, now, state_, settle_directions, event_settings_, sink, time_);
+            return switch_modes(*run_.system, now, run_.state, settle_directions, event_settings_, sink, run_.time);
         });
-    for (int k = 0; k < n; ++k)
-        decided_side_[k] = static_cast<std::int8_t>(evaluated && raw[k] == 0.0 ? (reference_guards_[k] > 0.0) - (reference_guards_[k] < 0.0) : 0);
+    for (int k = 0; k < n; ++k) {
+        const double reference = run_.reference_guards[k];
+        run_.decided_side[k] = static_cast<std::int8_t>(evaluated && raw[k] == 0.0 ? (reference > 0.0) - (reference < 0.0) : 0);
+    }
     // A failed evaluation (non-finite derivatives) is reported by the next fmi2GetDerivatives.
     return settled_changes;
 }
@@ -197,41 +207,41 @@ int GimbalInstance::settle_guards(double now, int n, const int* directions, cons
 GimbalStatus GimbalInstance::update_discrete_states(DiscreteUpdate& update) {
     update = DiscreteUpdate{};
     refresh_held_inputs();
-    const double now = clock_;
-    const bool holding = chattering_.holding();
-    if (holding && now < chattering_.dwell_until) {
+    const double now = run_.clock;
+    const bool holding = run_.chattering.holding();
+    if (holding && now < run_.chattering.dwell_until) {
         update.next_time_defined = true;
-        update.next_time = epoch_ + chattering_.dwell_until;
+        update.next_time = run_.epoch + run_.chattering.dwell_until;
         return GIMBAL_OK;
     }
     // A repeated call at the point just decided (a host that iterates once more) changes nothing: a
     // second decision without the crossing directions could undo what they decided.
-    if (decided_here_ && !holding) return GIMBAL_OK;
+    if (run_.decided_here && !holding) return GIMBAL_OK;
 
-    const int n = system_->event_count();
+    const int n = run_.system->event_count();
     double guards[kIndicatorCount];
-    system_->event_functions(now, state_, guards);
+    run_.system->event_functions(now, run_.state, guards);
     int directions[kIndicatorCount] = {};
     if (holding) {
         // The hold ends here: the modes are chosen again from the signs, as after an input change.
-        chattering_.dwell_until = -1e300;
+        run_.chattering.dwell_until = -1e300;
     } else {
         for (int k = 0; k < n; ++k)
-            if (crossed(reference_guards_[k], guards[k])) directions[k] = guards[k] > reference_guards_[k] ? 1 : -1;
+            if (crossed(run_.reference_guards[k], guards[k])) directions[k] = guards[k] > run_.reference_guards[k] ? 1 : -1;
     }
     double before[kMaxStateSize];
-    std::copy(state_, state_ + kMaxStateSize, before);
+    std::copy(run_.state, run_.state + kMaxStateSize, before);
     const HybridIntegrator::MessageSink sink = [this](const std::string& message) { log_event(message); };
-    int changes = switch_modes(*system_, now, state_, directions, event_settings_, sink, time_);
+    int changes = switch_modes(*run_.system, now, run_.state, directions, event_settings_, sink, run_.time);
     changes += settle_guards(now, n, directions, sink);
 
-    if (changes > 0 && record_mode_change(chattering_, event_settings_, now, 0.0, sink, epoch_)) ++zeno_holds_;
+    if (changes > 0 && record_mode_change(run_.chattering, event_settings_, now, 0.0, sink, run_.epoch)) ++run_.zeno_holds;
     update.mode_changes = changes;
-    update.states_changed = !std::equal(state_, state_ + params_.layout.size, before);
-    update.next_time_defined = chattering_.holding();
-    update.next_time = epoch_ + chattering_.dwell_until;
-    decided_here_ = true;
-    outputs_stale_ = true;
+    update.states_changed = !std::equal(run_.state, run_.state + model_.params.layout.size, before);
+    update.next_time_defined = run_.chattering.holding();
+    update.next_time = run_.epoch + run_.chattering.dwell_until;
+    run_.decided_here = true;
+    run_.outputs_stale = true;
     return GIMBAL_OK;
 }
 
@@ -270,8 +280,8 @@ GimbalStatus GimbalInstance::jacobian_rows(const unsigned* unknowns, std::size_t
                                             " is neither a state derivative nor an output");
         if (derivative != kStateDerivatives + kStateCount) {
             const int state = static_cast<int>(derivative - kStateDerivatives);
-            for (int k = 0; k < integrated_count_; ++k)
-                if (integrated_state_[k] == state && state < kStateSize) jacobian_row[i] = integrated_slot_[k];
+            for (int k = 0; k < model_.integrated.count; ++k)
+                if (model_.integrated.state[k] == state && state < kStateSize) jacobian_row[i] = model_.integrated.slot[k];
         }
         all_rows_analytic &= jacobian_row[i] >= 0;
     }
@@ -282,17 +292,17 @@ GimbalStatus GimbalInstance::jacobian_rows(const unsigned* unknowns, std::size_t
 // where the model is stiff), into result; `used` says whether there was any.
 GimbalStatus GimbalInstance::jacobian_part(const std::vector<int>& jacobian_row, const double* state_seed,
                                            double* result, bool& used) {
-    const int n = params_.layout.size;
+    const int n = model_.params.layout.size;
     double jacobian[kMaxStateSize * kMaxStateSize];
     double slot_seed[kMaxStateSize] = {};
     bool any_state_seed = false;
-    for (int k = 0; k < integrated_count_; ++k) {
-        slot_seed[integrated_slot_[k]] = state_seed[integrated_state_[k]];
-        any_state_seed |= state_seed[integrated_state_[k]] != 0.0;
+    for (int k = 0; k < model_.integrated.count; ++k) {
+        slot_seed[model_.integrated.slot[k]] = state_seed[model_.integrated.state[k]];
+        any_state_seed |= state_seed[model_.integrated.state[k]] != 0.0;
     }
     used = any_state_seed && std::any_of(jacobian_row.begin(), jacobian_row.end(), [](int r) { return r >= 0; });
     if (!used) return GIMBAL_OK;
-    system_->jacobian(clock_, state_, jacobian);
+    run_.system->jacobian(run_.clock, run_.state, jacobian);
     for (std::size_t i = 0; i < jacobian_row.size(); ++i) {
         if (jacobian_row[i] < 0) continue;
         double sum = 0.0;
@@ -300,7 +310,7 @@ GimbalStatus GimbalInstance::jacobian_part(const std::vector<int>& jacobian_row,
         if (!std::isfinite(sum)) {
             std::ostringstream s;
             s.precision(17);
-            s << "the Jacobian is not finite at t = " << time_
+            s << "the Jacobian is not finite at t = " << run_.time
               << ": the states or inputs set lie beyond what the model can represent";
             return refuse(GIMBAL_ERROR, s.str());
         }
@@ -358,7 +368,7 @@ bool GimbalInstance::difference_step(const double* state_seed,
     for (int k = 0; k < kStateCount; ++k)
         if (state_seed[k] != 0.0) size = std::max(size, std::fabs(state_seed[k])), scale = std::max(scale, std::fabs(states[k]));
     for (const auto& [vr, value] : input_seed)
-        if (value != 0.0) size = std::max(size, std::fabs(value)), scale = std::max(scale, std::fabs(reals_[vr]));
+        if (value != 0.0) size = std::max(size, std::fabs(value)), scale = std::max(scale, std::fabs(run_.reals[vr]));
     if (size == 0.0) return false;
     step = 6e-6 * scale / size;
     return true;
@@ -374,34 +384,34 @@ GimbalStatus GimbalInstance::central_difference(const unsigned* unknowns, std::s
     if (!difference_step(state_seed, input_seed, step)) return GIMBAL_OK;
 
     double saved_state[kMaxStateSize];
-    std::copy(state_, state_ + kMaxStateSize, saved_state);
-    std::vector<double> saved_reals(reals_, reals_ + kRealVariableCount);
-    std::vector<int> saved_integers(integers_, integers_ + kIntegerVariableCount);
-    const bool saved_outputs_stale = outputs_stale_, saved_decided = decided_here_;
+    std::copy(run_.state, run_.state + kMaxStateSize, saved_state);
+    std::vector<double> saved_reals(run_.reals, run_.reals + kRealVariableCount);
+    std::vector<int> saved_integers(run_.integers, run_.integers + kIntegerVariableCount);
+    const bool saved_outputs_stale = run_.outputs_stale, saved_decided = run_.decided_here;
     std::vector<double> values[2] = {std::vector<double>(unknown_count), std::vector<double>(unknown_count)};
     GimbalStatus status = GIMBAL_OK;
     for (int side = 0; side < 2 && status == GIMBAL_OK; ++side) {
         const double h = side == 0 ? step : -step;
-        std::copy(saved_state, saved_state + kMaxStateSize, state_);
-        for (int k = 0; k < integrated_count_; ++k)
-            state_[integrated_slot_[k]] += h * state_seed[integrated_state_[k]];
-        std::copy(saved_reals.begin(), saved_reals.end(), reals_);
-        for (const auto& [vr, value] : input_seed) reals_[vr] += h * value;
-        inputs_stale_ = true;
+        std::copy(saved_state, saved_state + kMaxStateSize, run_.state);
+        for (int k = 0; k < model_.integrated.count; ++k)
+            run_.state[model_.integrated.slot[k]] += h * state_seed[model_.integrated.state[k]];
+        std::copy(saved_reals.begin(), saved_reals.end(), run_.reals);
+        for (const auto& [vr, value] : input_seed) run_.reals[vr] += h * value;
+        run_.inputs_stale = true;
         double derivatives[kStateCount];
         status = get_derivatives(derivatives);
         if (status == GIMBAL_OK) status = publish_continuous_time_outputs();
         for (std::size_t i = 0; i < unknown_count; ++i) {
             const auto d = std::find(kStateDerivatives, kStateDerivatives + kStateCount, unknowns[i]);
-            values[side][i] = d != kStateDerivatives + kStateCount ? derivatives[d - kStateDerivatives] : reals_[unknowns[i]];
+            values[side][i] = d != kStateDerivatives + kStateCount ? derivatives[d - kStateDerivatives] : run_.reals[unknowns[i]];
         }
     }
-    std::copy(saved_state, saved_state + kMaxStateSize, state_);
-    std::copy(saved_reals.begin(), saved_reals.end(), reals_);
-    std::copy(saved_integers.begin(), saved_integers.end(), integers_);
-    inputs_stale_ = true;
-    outputs_stale_ = saved_outputs_stale;
-    decided_here_ = saved_decided;
+    std::copy(saved_state, saved_state + kMaxStateSize, run_.state);
+    std::copy(saved_reals.begin(), saved_reals.end(), run_.reals);
+    std::copy(saved_integers.begin(), saved_integers.end(), run_.integers);
+    run_.inputs_stale = true;
+    run_.outputs_stale = saved_outputs_stale;
+    run_.decided_here = saved_decided;
     if (status != GIMBAL_OK) return status;
     for (std::size_t i = 0; i < unknown_count; ++i) result[i] = (values[0][i] - values[1][i]) / (2.0 * step);
     return GIMBAL_OK;
@@ -411,21 +421,21 @@ GimbalStatus GimbalInstance::publish_continuous_time_outputs() {
     refresh_held_inputs();
     double reals[kRealVariableCount];
     int integers[kIntegerVariableCount];
-    std::copy(reals_, reals_ + kRealVariableCount, reals);
-    std::copy(integers_, integers_ + kIntegerVariableCount, integers);
+    std::copy(run_.reals, run_.reals + kRealVariableCount, reals);
+    std::copy(run_.integers, run_.integers + kIntegerVariableCount, integers);
     publish_outputs();
-    clamp_published_to_bounds(params_, reals_);
+    clamp_published_to_bounds(model_.params, run_.reals);
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
-        if (std::isfinite(reals_[vr])) continue;
+        if (std::isfinite(run_.reals[vr])) continue;
         std::ostringstream s;
         s.precision(17);
-        s << kRealVariables[vr].name << " is not finite at t = " << time_
+        s << kRealVariables[vr].name << " is not finite at t = " << run_.time
           << ": the states or inputs set lie beyond what the model can represent";
-        std::copy(reals, reals + kRealVariableCount, reals_);
-        std::copy(integers, integers + kIntegerVariableCount, integers_);
+        std::copy(reals, reals + kRealVariableCount, run_.reals);
+        std::copy(integers, integers + kIntegerVariableCount, run_.integers);
         return refuse(GIMBAL_ERROR, s.str());
     }
-    outputs_stale_ = false;
+    run_.outputs_stale = false;
     return GIMBAL_OK;
 }
 

@@ -23,15 +23,15 @@ GimbalStatus GimbalInstance::do_step_until_mode_change(double current_time, doub
 }
 
 GimbalStatus GimbalInstance::advance_step(double current_time, double step_size, double* early, double& reached) {
-    if (!integrator_) return refuse(GIMBAL_ERROR, "the instance is not initialized");
-    if (continuous_time_) return refuse(GIMBAL_ERROR, "the instance serves the continuous-time interface");
+    if (!run_.integrator) return refuse(GIMBAL_ERROR, "the instance is not initialized");
+    if (run_.continuous_time) return refuse(GIMBAL_ERROR, "the instance serves the continuous-time interface");
     StepStart start;
-    std::copy(state_, state_ + kMaxStateSize, start.state);
-    start.modes = system_->modes();
-    start.counters = system_->counters();
-    start.work = integrator_->statistics();
-    start.time = time_;
-    start.clock = clock_;
+    std::copy(run_.state, run_.state + kMaxStateSize, start.state);
+    start.modes = run_.system->modes();
+    start.counters = run_.system->counters();
+    start.work = run_.integrator->statistics();
+    start.time = run_.time;
+    start.clock = run_.clock;
     GimbalStatus status;
     try {
         status = integrate_step(current_time, step_size, start, early);
@@ -40,32 +40,32 @@ GimbalStatus GimbalInstance::advance_step(double current_time, double step_size,
         roll_back(start);
         throw;
     }
-    reached = time_;
+    reached = run_.time;
     if (status != GIMBAL_OK) return status;
     return report_step_work(step_size, start.work, start.counters);
 }
 
 void GimbalInstance::roll_back(const StepStart& start) {
-    std::copy(start.state, start.state + kMaxStateSize, state_);
-    system_->restore(start.modes, start.counters);
+    std::copy(start.state, start.state + kMaxStateSize, run_.state);
+    run_.system->restore(start.modes, start.counters);
     if (start.outputs_saved) {
-        std::copy(start.reals, start.reals + kRealVariableCount, reals_);
-        std::copy(start.integers, start.integers + kIntegerVariableCount, integers_);
+        std::copy(start.reals, start.reals + kRealVariableCount, run_.reals);
+        std::copy(start.integers, start.integers + kIntegerVariableCount, run_.integers);
     }
-    time_ = start.time;
-    clock_ = start.clock;
-    integrator_running_ = false;
-    at_rest_ = false;
+    run_.time = start.time;
+    run_.clock = start.clock;
+    run_.integrator_running = false;
+    run_.at_rest = false;
 }
 
 // A step that costs far more than the model usually needs is reported once in a while (StepWorkMonitor).
 GimbalStatus GimbalInstance::report_step_work(double step_size, const IntegratorStatistics& before,
                                               const EventCounters& events_before) {
-    const IntegratorStatistics after = integrator_->statistics();
+    const IntegratorStatistics after = run_.integrator->statistics();
     if (after.rhs_evaluations - before.rhs_evaluations <= kStepWorkBudget) return GIMBAL_OK;  // every doStep
-    const StepWork work{time_, step_size, before, after, system_->counters().total - events_before.total};
+    const StepWork work{run_.time, step_size, before, after, run_.system->counters().total - events_before.total};
     std::string report;
-    if (!step_work_.over_budget(work, params_, report)) return GIMBAL_OK;
+    if (!run_.step_work.over_budget(work, model_.params, report)) return GIMBAL_OK;
     if (!report.empty()) logger_(GIMBAL_WARNING, "logStatusWarning", report);
     return GIMBAL_WARNING;
 }
@@ -75,14 +75,15 @@ GimbalStatus GimbalInstance::report_step_work(double step_size, const Integrator
 GIMBAL_HOT_PART GimbalStatus GimbalInstance::check_step(double step_size) {
     const GimbalStatus base_status = check_fixed_base();
     if (base_status != GIMBAL_OK) return base_status;
-    if (params_.method != static_cast<int>(IntegrationMethod::real_time)) return GIMBAL_OK;
+    if (model_.params.method != static_cast<int>(IntegrationMethod::real_time)) return GIMBAL_OK;
     return check_real_time_resolution(step_size);
 }
 
 // Out of line: its message buffer stays out of integrate_step's frame.
 GimbalStatus GimbalInstance::check_real_time_resolution(double step_size) {
     std::string why;
-    if (real_time_resolution_ok(params_, system_->dynamics_at(clock_, state_), step_size, why)) return GIMBAL_OK;
+    if (real_time_resolution_ok(model_.params, run_.system->dynamics_at(run_.clock, run_.state), step_size, why))
+        return GIMBAL_OK;
     return refuse(GIMBAL_ERROR, why);
 }
 
@@ -92,24 +93,25 @@ GimbalStatus GimbalInstance::check_real_time_resolution(double step_size) {
 // `resting`: an exact equilibrium continues under the same inputs, and the step needs no integration.
 GIMBAL_HOT_PART GimbalStatus GimbalInstance::take_step_inputs(double step_start, bool& resting) {
     StepInputs inputs = read_step_inputs(step_start);
-    const StepInputs& running = system_->inputs();
-    const bool continuous = integrator_running_ && continues_running_inputs(running, inputs, step_start);
-    resting = continuous && at_rest_ && inputs.voltage_rate[0] == 0.0 && inputs.voltage_rate[1] == 0.0;
+    const StepInputs& running = run_.system->inputs();
+    const bool continuous = run_.integrator_running && continues_running_inputs(running, inputs, step_start);
+    resting = continuous && run_.at_rest && inputs.voltage_rate[0] == 0.0 && inputs.voltage_rate[1] == 0.0;
     if (resting) return GIMBAL_OK;
-    at_rest_ = false;
+    run_.at_rest = false;
     if (!continuous) {
-        system_->set_inputs(inputs);
+        run_.system->set_inputs(inputs);
         // New inputs may cross a switching surface at once (e.g. the voltage reverses while limited).
-        system_->update_modes(step_start, state_, nullptr);
-        if (!integrator_->restart(step_start, state_)) return refuse(GIMBAL_ERROR, "the integrator could not be restarted");
+        run_.system->update_modes(step_start, run_.state, nullptr);
+        if (!run_.integrator->restart(step_start, run_.state))
+            return refuse(GIMBAL_ERROR, "the integrator could not be restarted");
         return GIMBAL_OK;
     }
     if (!voltages_changed(running, inputs)) return GIMBAL_OK;
     // The right-hand side does not jump: keep the integrator's history, follow the new ramps.
     inputs.base = running.base.advanced(step_start - running.step_start_time);
-    system_->set_inputs(inputs);
-    if (!integrator_->inputs_changed(step_start, state_))
-        return refuse(GIMBAL_ERROR, "the integrator could not take the new inputs (" + last_integrator_error_ + ")");
+    run_.system->set_inputs(inputs);
+    if (!run_.integrator->inputs_changed(step_start, run_.state))
+        return refuse(GIMBAL_ERROR, "the integrator could not take the new inputs (" + run_.last_integrator_error + ")");
     return GIMBAL_OK;
 }
 
@@ -117,15 +119,15 @@ GIMBAL_HOT_PART GimbalStatus GimbalInstance::take_step_inputs(double step_start,
 // change: the inputs are then left as the step carried them there).
 GIMBAL_HOT_PART void GimbalInstance::end_step_at(double step_end, double reached_model_time, bool ended_early) {
     if (ended_early) {
-        carry_inputs_to(system_->inputs(), reached_model_time, params_.fidelity.fixed_base, reals_);
-        clock_ = reached_model_time;
-        time_ = epoch_ + clock_;
-        at_rest_ = false;
+        carry_inputs_to(run_.system->inputs(), reached_model_time, model_.params.fidelity.fixed_base, run_.reals);
+        run_.clock = reached_model_time;
+        run_.time = run_.epoch + run_.clock;
+        run_.at_rest = false;
     } else {
-        voltage_rate_[0] = voltage_rate_[1] = 0.0;  // input derivatives hold for one step
-        at_rest_ = system_->at_rest(step_end, state_);
-        clock_ = step_end;
-        time_ = epoch_ + clock_;
+        run_.voltage_rate[0] = run_.voltage_rate[1] = 0.0;  // input derivatives hold for one step
+        run_.at_rest = run_.system->at_rest(step_end, run_.state);
+        run_.clock = step_end;
+        run_.time = run_.epoch + run_.clock;
     }
 }
 
@@ -133,10 +135,10 @@ GIMBAL_HOT_PART void GimbalInstance::end_step_at(double step_end, double reached
 // makes the kinetic energy overflow): refuse rather than hand out garbage.
 GIMBAL_HOT_PART GimbalStatus GimbalInstance::check_published_outputs(double current_time, const StepStart& start) {
     for (unsigned vr = 0; vr < kRealVariableCount; ++vr) {
-        if (kRealVariables[vr].causality != Causality::output || std::isfinite(reals_[vr])) continue;
+        if (kRealVariables[vr].causality != Causality::output || std::isfinite(run_.reals[vr])) continue;
         std::ostringstream s;
         s.precision(17);
-        s << kRealVariables[vr].name << " = " << reals_[vr] << " at t = " << time_
+        s << kRealVariables[vr].name << " = " << run_.reals[vr] << " at t = " << run_.time
           << ": an input or parameter lies beyond what the model can represent; state rolled back to t = "
           << current_time;
         roll_back(start);
@@ -150,32 +152,32 @@ GimbalStatus GimbalInstance::integrate_step(double current_time, double step_siz
     if (ready != GIMBAL_OK) return ready;
     // From the instance's own clock (the host's current_time was checked against its time by the
     // interface): any start time gives the same model times, bit for bit.
-    const double step_start = clock_;
-    const double step_end = clock_ + step_size;
+    const double step_start = run_.clock;
+    const double step_end = run_.clock + step_size;
     bool resting = false;
     const GimbalStatus taken = take_step_inputs(step_start, resting);
     if (taken != GIMBAL_OK) return taken;
     if (resting) {
-        clock_ = step_end;
-        time_ = epoch_ + clock_;  // outputs cannot change either
+        run_.clock = step_end;
+        run_.time = run_.epoch + run_.clock;  // outputs cannot change either
         return GIMBAL_OK;
     }
-    last_integrator_error_.clear();
+    run_.last_integrator_error.clear();
     double reached_model_time = step_end;
-    const bool advanced = early != nullptr ? integrator_->advance_until_mode_change(step_end, state_, reached_model_time)
-                                           : integrator_->advance(step_end, state_);
+    const bool advanced = early != nullptr ? run_.integrator->advance_until_mode_change(step_end, run_.state, reached_model_time)
+                                           : run_.integrator->advance(step_end, run_.state);
     if (!advanced) {
         roll_back(start);
         std::ostringstream s;
         s.precision(17);
         s << "integration from t = " << current_time << " over h = " << step_size << " failed ("
-          << last_integrator_error_ << "); state rolled back to t = " << current_time;
+          << run_.last_integrator_error << "); state rolled back to t = " << current_time;
         return refuse(GIMBAL_DISCARD, s.str());
     }
-    integrator_running_ = true;
+    run_.integrator_running = true;
     // Only now is there anything to undo in the published values (a step at rest publishes nothing).
-    std::copy(reals_, reals_ + kRealVariableCount, start.reals);
-    std::copy(integers_, integers_ + kIntegerVariableCount, start.integers);
+    std::copy(run_.reals, run_.reals + kRealVariableCount, start.reals);
+    std::copy(run_.integers, run_.integers + kIntegerVariableCount, start.integers);
     start.outputs_saved = true;
     end_step_at(step_end, reached_model_time, early != nullptr && reached_model_time < step_end);
     publish_outputs();

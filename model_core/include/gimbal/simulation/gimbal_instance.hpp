@@ -1,7 +1,7 @@
-// One simulation instance: the variable values, the constant model built from them (params_, rebuilt
-// only at initialization and restore), the state, the hybrid system and its integrator, and the
-// continuous-time interface's event memory. One class holds them all: the constant model and the
-// per-run data are not (yet) separate objects.
+// One simulation instance, split as Pinocchio splits a robot: an InstanceModel, constant through a
+// run (the built parameters and what follows from them alone), and a RunData, everything a run
+// changes (the variable values, the state, the hybrid system and its integrator, the clocks, the
+// continuous-time interface's event memory). The instance holds one of each, and the host's logger.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +24,73 @@
 namespace gimbal {
 
 struct SnapshotContent;  // gimbal/simulation/snapshot.hpp
+
+// Which of the 17 continuous states (kContinuousStateCount, the FMU's order) a fidelity integrates,
+// and where each lives in the state vector.
+struct IntegratedStates {
+    int count = 0;
+    int state[kContinuousStateCount] = {};  // index among the 17 states
+    int slot[kContinuousStateCount] = {};   // its slot in RunData::state
+};
+IntegratedStates integrated_states_of(const StateLayout& layout);
+
+// What is fixed once the parameters are built: constant during a run. Built whole from the variable
+// values at initialization (and a preview before it), or from a snapshot at a restore, and put in
+// place whole (ModelSwap, parameter_swap.hpp). The fidelity and the state layout are
+// params.fidelity and params.layout.
+struct InstanceModel {
+    ModelParameters params;
+    IntegratedStates integrated;
+};
+InstanceModel make_instance_model(const ModelParameters& params);
+
+// Everything a run changes, from the host's set values to the integrator's memory.
+struct RunData {
+    static constexpr int kIndicatorCount = GimbalHybridSystem::kIndicatorCount;
+
+    // The variable values: set by the host (parameters, inputs, start values), published by the
+    // model (outputs).
+    double reals[kRealVariableCount];
+    int integers[kIntegerVariableCount];
+    bool booleans[kBooleanVariableCount];
+    double state[kMaxStateSize];
+    // Made at initialization (and restore) with a reference to InstanceModel::params: the current
+    // modes, inputs, event counters and dynamics cache, and the integrator working on them.
+    std::unique_ptr<GimbalHybridSystem> system;
+    std::unique_ptr<HybridIntegrator> integrator;
+    bool integrator_running = false;  // false: the next step must restart the integrator
+    bool preview_current = false;
+    bool at_rest = false;             // exact equilibrium under the running inputs: steps need no integration
+    std::string last_integrator_error;
+    double voltage_rate[2] = {0.0, 0.0};  // for the next step only
+    double time = 0.0;  // the host's time of the current point: epoch + clock
+    // The model runs on its own clock, the time since initialization: results do not depend on where
+    // the host's clock starts, and event times keep their resolution at large start times. A step
+    // advances it by communicationStepSize (never by differences of the host's times, which lose the
+    // step's low bits at a large start time); in the continuous-time interface the host owns time and
+    // clock is its time less the start.
+    double epoch = 0.0;
+    double clock = 0.0;
+    bool master_tolerance_defined = false;
+    double master_tolerance = 0.0;
+    bool rtol_set = false;            // solver.rtol set by the user: the master's tolerance does not apply
+    StepWorkMonitor step_work;
+
+    // Continuous-time interface state (saved with an FMU state).
+    bool continuous_time = false;  // chosen once, before initialization; reset() keeps it
+    bool inputs_stale = true;      // an input was set since the hybrid system last took them
+    bool outputs_stale = true;     // time, state or inputs changed since outputs were published
+    bool decided_here = false;     // update_discrete_states ran at this very point: a repeat changes nothing
+    double reference_guards[kIndicatorCount] = {};  // guards as decided at the last update (crossings are
+                                                    // measured against them)
+    std::int8_t decided_side[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
+    ChatteringMemory chattering;      // model times
+    GuardSettling guard_settling;
+    double preview_states[kContinuousStateCount] = {};      // at the start values, before initialization
+    double preview_rotor_start[4] = {};                      // where the rotors start (kRotorStart order)
+    double preview_indicators[kIndicatorCount] = {};
+    std::int64_t zeno_holds = 0;
+};
 
 class GimbalInstance {
 public:
@@ -67,9 +134,9 @@ public:
     // Work of one fmi2DoStep, in right-hand-side evaluations, beyond which the step is reported
     // (simulation/step_checks.hpp).
     static constexpr long kStepWorkBudget = gimbal::kStepWorkBudget;
-    double time() const { return time_; }
-    double model_clock() const { return clock_; }  // the time since initialization
-    bool initialized() const { return system_ != nullptr && integrator_ != nullptr; }
+    double time() const { return run_.time; }
+    double model_clock() const { return run_.clock; }  // the time since initialization
+    bool initialized() const { return run_.system != nullptr && run_.integrator != nullptr; }
     // The continuous model linearized at the current time and state, with the inputs as last set.
     GimbalStatus linearize(LinearModel& model);
 
@@ -77,8 +144,8 @@ public:
     // The host integrates: it sets the time, the states and the inputs, reads derivatives and event
     // indicators, and calls update_discrete_states() where an indicator crossed zero (or an input
     // jumped, or the time event it was given came). Chosen once, before initialization.
-    void use_continuous_time_interface() { continuous_time_ = true; }
-    bool continuous_time_interface() const { return continuous_time_; }
+    void use_continuous_time_interface() { run_.continuous_time = true; }
+    bool continuous_time_interface() const { return run_.continuous_time; }
     static constexpr int kStateCount = kContinuousStateCount;
     static constexpr int kIndicatorCount = GimbalHybridSystem::kIndicatorCount;
     struct DiscreteUpdate {
@@ -114,8 +181,6 @@ private:
     StepInputs read_step_inputs(double step_start) const;
     bool build_parameters(ModelParameters& params, std::string& error) const;
     void load_start_state();
-    GearStart gear_start(int axis) const;
-    bool rotor_start_given(int axis, double value) const;
     void rotor_in_mesh(int axis, double& angle, double& rate) const;
     void report_gear_starts() const;
     GimbalStatus check_fixed_base() const;
@@ -149,12 +214,11 @@ private:
     // Before initialization ends, calculated outputs follow from the start values on request.
     GimbalStatus preview_outputs(const char* name);
     void publish_outputs() {
-        gimbal::publish_outputs(OutputPoint{params_, *system_, *integrator_, state_, clock_, epoch_, zeno_holds_},
-                                reals_, integers_);
+        gimbal::publish_outputs(OutputPoint{model_.params, *run_.system, *run_.integrator, run_.state, run_.clock,
+                                            run_.epoch, run_.zeno_holds},
+                                run_.reals, run_.integers);
     }
     GimbalStatus refuse(GimbalStatus status, const std::string& message) const;
-    // Which of the 17 states this fidelity integrates, and where (set with the parameters).
-    void map_integrated_states();
     // Pushes inputs set since the last evaluation into the hybrid system.
     void refresh_held_inputs();
     void log_event(const std::string& message) const { logger_(GIMBAL_OK, "logEvents", message); }
@@ -177,51 +241,13 @@ private:
     GimbalStatus central_difference(const unsigned* unknowns, std::size_t unknown_count, const double* state_seed,
                                     const std::vector<std::pair<unsigned, double>>& input_seed, double* result);
 
+    // The host's connection, fixed for the instance's life: where messages go, which are wanted, and
+    // the chattering guard's limits with the filter of event messages.
     Logger logger_;
     LogFilter log_filter_;
-    double reals_[kRealVariableCount];
-    int integers_[kIntegerVariableCount];
-    bool booleans_[kBooleanVariableCount];
-    ModelParameters params_;
-    double state_[kMaxStateSize];
-    std::unique_ptr<GimbalHybridSystem> system_;
-    std::unique_ptr<HybridIntegrator> integrator_;
-    bool integrator_running_ = false;  // false: the next step must restart the integrator
-    bool preview_current_ = false;
-    bool at_rest_ = false;             // exact equilibrium under the running inputs: steps need no integration
-    std::string last_integrator_error_;
-    double voltage_rate_[2] = {0.0, 0.0};  // for the next step only
-    double time_ = 0.0;  // the host's time of the current point: epoch_ + clock_
-    // The model runs on its own clock, the time since initialization: results do not depend on where
-    // the host's clock starts, and event times keep their resolution at large start times. A step
-    // advances it by communicationStepSize (never by differences of the host's times, which lose the
-    // step's low bits at a large start time); in the continuous-time interface the host owns time and
-    // clock_ is its time less the start.
-    double epoch_ = 0.0;
-    double clock_ = 0.0;
-    bool master_tolerance_defined_ = false;
-    double master_tolerance_ = 0.0;
-    bool rtol_set_ = false;            // solver.rtol set by the user: the master's tolerance does not apply
-    StepWorkMonitor step_work_;
-
-    // Continuous-time interface state (saved with an FMU state).
-    bool continuous_time_ = false;
-    bool inputs_stale_ = true;     // an input was set since the hybrid system last took them
-    bool outputs_stale_ = true;    // time, state or inputs changed since outputs were published
-    bool decided_here_ = false;    // update_discrete_states ran at this very point: a repeat changes nothing
-    double reference_guards_[kIndicatorCount] = {};  // guards as decided at the last update (crossings are
-                                                     // measured against them)
-    std::int8_t decided_side_[kIndicatorCount] = {}; // side a guard exactly on zero was decided for
-    ChatteringMemory chattering_;      // model times
-    GuardSettling guard_settling_;
-    double preview_states_[kContinuousStateCount] = {};      // at the start values, before initialization
-    double preview_rotor_start_[4] = {};                      // where the rotors start (kRotorStart order)
-    double preview_indicators_[GimbalHybridSystem::kIndicatorCount] = {};
-    int integrated_count_ = 0;
-    int integrated_state_[kContinuousStateCount] = {};  // index among the 17 states
-    int integrated_slot_[kContinuousStateCount] = {};   // its slot in state_
-    EventHandlingSettings event_settings_;  // the chattering guard's limits, and whether events are logged
-    std::int64_t zeno_holds_ = 0;
+    EventHandlingSettings event_settings_;
+    InstanceModel model_;
+    RunData run_;
 };
 
 }  // namespace gimbal

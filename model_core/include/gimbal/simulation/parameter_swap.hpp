@@ -1,25 +1,25 @@
-// Parameters put in place for a run being built (GimbalInstance): the hybrid system keeps a reference
-// to the instance's parameters, so new ones go in place before it is built.
+// The model put in place for a run being built (GimbalInstance): the hybrid system keeps a reference
+// to the instance model's parameters, so a new model goes in place, whole, before it is built.
 #pragma once
 
-#include "gimbal/model/gimbal_model.hpp"
+#include "gimbal/simulation/gimbal_instance.hpp"
 
 namespace gimbal {
 
-// Puts the previous parameters back unless the new run is committed.
-class ParameterSwap {
+// Puts the previous model back unless the new run is committed.
+class ModelSwap {
 public:
-    ParameterSwap(ModelParameters& current, const ModelParameters& next) : current_(current), previous_(current) {
+    ModelSwap(InstanceModel& current, const InstanceModel& next) : current_(current), previous_(current) {
         current_ = next;
     }
-    ~ParameterSwap() {
+    ~ModelSwap() {
         if (!committed_) current_ = previous_;
     }
     void commit() { committed_ = true; }
 
 private:
-    ModelParameters& current_;
-    ModelParameters previous_;
+    InstanceModel& current_;
+    InstanceModel previous_;
     bool committed_ = false;
 };
 
