@@ -109,6 +109,18 @@ def test_recorded_motion_refusals_in_the_library(tmp_path):
     np.testing.assert_allclose(scene.base_motion().sample(np.array([0.005]))[0, 2], 0.001)
 
 
+def test_many_long_unknown_columns_are_quoted_in_part(tmp_path):
+    # A header is any text: the message names the first five columns, each cut, and counts the rest.
+    names = [f"column_{k:02d}_" + "x" * 200 for k in range(20)]
+    rows = "".join(f"{t},0," + ",".join("0" for _ in names) + "\n" for t in (0, 0.005, 0.01, 0.015))
+    (tmp_path / "motion.csv").write_text("time,gamma," + ",".join(names) + "\n" + rows)
+    with pytest.raises(SceneError) as refused:
+        load_scene(scene_file(tmp_path, RECORDED))
+    message = str(refused.value)
+    assert "column_00_" in message and "column_04_" in message and "column_05_" not in message, message
+    assert "and 15 more" in message and "x" * 41 not in message and len(message) < 600, message
+
+
 # --- options -----------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("value", ["-1", "0", "nan"])

@@ -172,7 +172,7 @@ BAD_FILES = [
     ("[optimiser]\nsampler = 'tpe'\n", ["unknown key 'optimiser'", "did you mean 'optimizer'"]),
     ("[optimizer]\nsampler = 'cma'\n", ["sampler", "did you mean 'cmaes'"]),
     ("[objective]\nmetric = 'los_rsm'\n", ["metric", "did you mean 'los_rms'"]),
-    ("[objective]\nmetric = 'tracking_rms'\n", ["tracking_rms", "moving target"]),
+    ("[constraints]\non_target_min_fraction = 1.5\n", ["on_target_min_fraction", "at most 1"]),
     ("[constraints]\npeak_current_fractoin = 0.5\n", ["peak_current_fractoin", "did you mean 'peak_current_fraction'"]),
     ("[objective]\nmetric = 'band_rms'\n", ["band = [f_lo, f_hi]"]),
 ]
@@ -216,6 +216,74 @@ def test_the_command_refuses_a_bad_tuning_file_with_status_2(tmp_path, text, nam
     line = refused(tmp_path, text)
     for fragment in named:
         assert fragment in line, (fragment, line)
+
+
+@pytest.mark.parametrize("text, named", [
+    ("[objective]\nmetric = 'tracking_rms'\n", ["tracking_rms", "needs a moving target", "fixed direction"]),
+    ("[constraints]\non_target_min_fraction = 0.9\n", ["on_target_min_fraction", "needs a moving target"]),
+])
+def test_tracking_figures_are_refused_for_a_fixed_direction(tmp_path, text, named):
+    line = refused(tmp_path, GOOD_PARAMETER + text)
+    for fragment in named:
+        assert fragment in line, (fragment, line)
+
+
+def test_a_tracking_tuning_minimizes_the_error_to_the_moving_target_under_a_time_on_target_floor(tmp_path, fmu_path):
+    """The flyby scene with its aircraft 200 m to the side at 0.5 s (an azimuth rate near 30 deg/s), its
+    azimuth feed-forward tuned: without it (k_ff = 0) the gimbal lags the aircraft, near the motor's
+    back-EMF constant times the gear ratio it follows. The objective is the error to where the aircraft
+    is; the floor on the time on target is judged on the worst run; the evaluations carry the sweep's
+    tracking columns."""
+    text = (ROOT / "scenes" / "track_flyby_keyhole.toml").read_text()
+    for old, new in (('name = "track_flyby_keyhole"', 'name = "scene"'),
+                     ("closest_approach_m = 10.0", "closest_approach_m = 200.0"),
+                     ("closest_approach_s = 15.0", "closest_approach_s = 0.5")):
+        assert old in text
+        text = text.replace(old, new)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text)
+    tuning = write(tmp_path / "track.toml", """\
+        seed = 5
+        stop_time = 0.8
+        metrics_from_s = 0.2
+        [parameters]
+        "controller.azimuth.k_ff" = { bounds = [0.0, 8.0] }
+        [objective]
+        metric = "tracking_rms"
+        [constraints]
+        on_target_min_fraction = 0.5
+        [optimizer]
+        sampler = "cmaes"
+        trials = 12
+        batch = 4
+        """)
+    options = engine.TuneOptions(serial=True, progress=False)
+    problem = engine.plan(scene, tuning, fmu_path, tmp_path / "out")
+    try:
+        evaluator = engine.Evaluator(problem, options)
+        try:
+            outcome = engine.run_tuning(problem, options, evaluator)
+        finally:
+            evaluator.close()
+    finally:
+        problem.fmu.close()
+    from gimbal2axis.sweep.table import read_rows
+    evaluations = read_rows(tmp_path / "out" / "track__scene.parquet")
+    assert len(evaluations) == 12
+    assert all(0.0 <= r["on_target_fraction"] <= 1.0 and r["time_lost_s"] >= 0.0 for r in evaluations)
+    trials = outcome.trials
+    for trial in trials:   # the floor, judged on the worst run of the set
+        assert trial["feasible"] == (trial["worst_on_target_fraction"] >= 0.5 and trial["failed_runs"] == 0)
+    # the objective is the run's error to where the aircraft is: the best's gain run directly agrees
+    best = outcome.best
+    gain = best["controller.azimuth.k_ff"]
+    scene.write_text(text.replace("k_ff = 4.8", f"k_ff = {gain!r}", 1))
+    from gimbal2axis import FMU, load_scene, run
+    with FMU(fmu_path) as loaded:
+        direct = run(load_scene(scene), loaded, stop_time=0.8)
+    assert direct.scene.moving_target is not None
+    assert best["objective_mrad"] == pytest.approx(direct.los_metrics(from_s=0.2)["rms"] * 1e3, rel=1e-12)
+    assert best["objective_mrad"] == min(t["objective_mrad"] for t in trials if t["feasible"])
 
 
 def test_the_command_line_imports_nothing_heavy_for_tune_help():

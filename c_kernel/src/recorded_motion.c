@@ -75,9 +75,17 @@ static int check_columns(const GimbalCsvTable* table, char* message, size_t size
         return 0;
     }
     qsort(unknown, (size_t)count, sizeof(char*), compare_names);
+    /* What the user wrote is quoted in part (a header is any text: a message stays a line): the first
+     * kQuotedColumns names, each cut at kQuotedNameLength characters, then how many more. */
+    enum { kQuotedColumns = 5, kQuotedNameLength = 40 };
     int written = snprintf(message, size, "unknown columns [");
-    for (int k = 0; k < count && written >= 0 && (size_t)written < size; ++k)
-        written += snprintf(message + written, size - (size_t)written, "%s'%s'", k > 0 ? ", " : "", unknown[k]);
+    for (int k = 0; k < count && k < kQuotedColumns && written >= 0 && (size_t)written < size; ++k) {
+        const int cut = strlen(unknown[k]) > kQuotedNameLength;
+        written += snprintf(message + written, size - (size_t)written, "%s'%.*s%s'", k > 0 ? ", " : "",
+                            (int)kQuotedNameLength, unknown[k], cut ? "..." : "");
+    }
+    if (count > kQuotedColumns && written >= 0 && (size_t)written < size)
+        written += snprintf(message + written, size - (size_t)written, " and %d more", count - kQuotedColumns);
     if (written >= 0 && (size_t)written < size) snprintf(message + written, size - (size_t)written, "] (allowed: %s)", kAllowed);
     free(unknown);
     return GIMBAL_RECORDED_MOTION_BAD_COLUMNS;

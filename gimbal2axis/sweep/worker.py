@@ -40,7 +40,29 @@ def metrics(result, from_s: float | None) -> dict:
            "events": int(s["events.total"][-1]) if "events.total" in s else -1,
            "requirements_met": (not failures) if judged else None}
     row.update(band_columns(result, from_s))
+    row.update(tracking_columns(result, from_s))
     return row
+
+
+# The tracking figures a sweep's row carries for a moving target (target.metrics.TrackingMetrics, over the
+# window of the LOS metrics): what a user compares cases by besides the pointing error's RMS and peak.
+TRACKING_COLUMNS = ("on_target_fraction", "time_lost_s", "time_near_keyhole_s", "time_lost_near_keyhole_s",
+                    "asked_azimuth_rate_max")
+
+
+def tracking_columns(result, from_s: float) -> dict:
+    """on_target_fraction, time_lost_s, ... (TRACKING_COLUMNS) of a run with a moving target, over
+    [from_s, end]; none for a fixed direction."""
+    if result.scene.moving_target is None:
+        return {}
+    from ..target.metrics import NEEDED, TrackingMetrics
+
+    spec = result.scene.target_spec
+    tracking = TrackingMetrics(spec["beam_width_mrad"], spec["keyhole_deg"], result.scene.step_size, from_s)
+    tracking.add({name: np.asarray(result.signal(name)) for name in NEEDED
+                  if name in result.signals or name in result.derived})
+    figures = tracking.as_dict()
+    return {name: figures[name] for name in TRACKING_COLUMNS}
 
 
 def band_columns(result, from_s: float) -> dict:

@@ -121,6 +121,14 @@ def plan(scene_path, tuning_path, fmu_path, out_dir, tuning: Tuning | None = Non
         if not scene.target_spec:
             raise TuneError(f"{tuning.path}: scene {scene.name} has no [target]: there is no line-of-sight error to "
                             f"minimize")
+        if scene.moving_target is None:
+            fixed = "its target is a fixed direction, whose error is metric = \"los_rms\""
+            if any(term.metric == "tracking_rms" for term in tuning.objective.terms):
+                raise TuneError(f"{tuning.path}: [objective] metric = \"tracking_rms\" needs a moving target "
+                                f"([target] type = \"earth_point\", \"flyby\" or \"track\") in scene {scene.name}: {fixed}")
+            if tuning.constraints.on_target_min_fraction is not None:
+                raise TuneError(f"{tuning.path}: [constraints] on_target_min_fraction needs a moving target in scene "
+                                f"{scene.name}: {fixed}")
         if tuning.constraints.requirements and not scene.requirements:
             raise TuneError(f"{tuning.path}: [constraints] requirements = true, but scene {scene.name} has no "
                             f"[requirements]")

@@ -10,13 +10,14 @@ number the optimizer minimizes.
                    phase margin      (min_deg - min(pm_az, pm_el)) / max(|min_deg|, 1 deg)
                    (a linear closed loop that is unstable violates each margin by 1)
                    requirements      1 when a run misses the scene's requirements
+                   time on target    (min_fraction - min on_target_fraction) / min_fraction (moving targets)
   value          log10(objective) + PENALTY x sum of the positive violations; FAILED_VALUE when a run
                  failed (diverged, refused) or gave no objective. The log makes a decade of LOS RMS one
                  unit whatever its level, which suits CMA-ES's step-size adaptation and TPE's densities.
 
 The best candidate is the feasible one (no violation, no failed run) of least objective; of equal ones the
-earlier trial. A place for tracking error: spec.METRICS reserves "tracking_rms"; its column goes in
-`Term.column` and the worker's row, the rest here is metric-agnostic.
+earlier trial. Toward a moving target the LOS error is the error to where the target is: "tracking_rms"
+reads the same column as "los_rms" (`Term.column`); the rest here is metric-agnostic.
 """
 from __future__ import annotations
 
@@ -86,6 +87,11 @@ def judge(tuning, rows: list, margins: dict) -> Judgement:
         pm = min(margins.get("pm_az_deg", math.nan), margins.get("pm_el_deg", math.nan))
         violations["phase_margin"] = 1.0 if not stable or not math.isfinite(pm) and not pm == math.inf else \
             (limit - pm) / max(abs(limit), 1.0)
+    if constraints.on_target_min_fraction is not None:   # the least on-target share of the set counts
+        limit = constraints.on_target_min_fraction
+        shares = [r["on_target_fraction"] for r in ok if r.get("on_target_fraction") is not None]
+        worst["on_target_fraction"] = min(shares) if shares else math.nan
+        violations["on_target"] = (limit - worst["on_target_fraction"]) / limit
     if constraints.requirements:
         violations["requirements"] = 1.0 if any(r.get("requirements_met") is False for r in ok) else 0.0
     violations = {k: (v if math.isfinite(v) else -1.0 if v == -math.inf else 1.0) for k, v in violations.items()}
@@ -109,6 +115,8 @@ def trial_row(problem, number: int, batch: int, candidate: dict, verdict: Judgem
                 "worst_i_frac_peak": verdict.worst.get("i_frac_peak"),
                 "worst_i_peak_A": verdict.worst.get("i_peak_A"),
                 "worst_u_sat_s": verdict.worst.get("u_sat_s")})
+    if "on_target_fraction" in verdict.worst:
+        row["worst_on_target_fraction"] = verdict.worst["on_target_fraction"]
     for name, value in verdict.violations.items():
         row[f"violation_{name}"] = value
     for name, value in margins.items():
