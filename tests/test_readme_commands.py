@@ -38,7 +38,7 @@ def test_the_readme_has_the_two_commands_and_a_tour():
     commands = shell_commands()
     assert commands[:2] == ["bash scripts/run.sh", "bash scripts/test.sh"], commands[:2]
     tour = [c.split()[1] for c in commands if c.startswith(".venv/bin/gimbal2axis ")]
-    assert sorted(set(tour)) == ["bench", "freqresp", "linearize", "report", "run", "sweep", "system"], tour
+    assert sorted(set(tour)) == ["bench", "freqresp", "linearize", "report", "run", "sweep", "system", "tune"], tour
     words = len(README.read_text(encoding="utf-8").split())
     assert words <= 1800, f"the README has {words} words; a newcomer reads about 1,500 in five minutes"
 
