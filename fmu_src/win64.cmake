@@ -6,7 +6,8 @@
 # sources (BUILD_ALWAYS only hands over to it; with nothing changed it does nothing).
 # Sets GIMBAL_BUILD_WIN64, GIMBAL_WIN64_DLL, GIMBAL_WIN64_FMI3_DLL (the FMI 3.0 binary) and
 # GIMBAL_WIN64_DRIVER (fmu_scene_driver.exe, for the tests), GIMBAL_WIN64_SHIP_DLL and
-# GIMBAL_WIN64_CONTROLLER_DLL (the ship-motion and controller FMUs' binaries).
+# GIMBAL_WIN64_CONTROLLER_DLL (the ship-motion and controller FMUs' binaries), GIMBAL_WIN64_SHIP3_DLL and
+# GIMBAL_WIN64_CONTROLLER3_DLL (their FMI 3.0 binaries).
 set(GIMBAL_BUILD_WIN64 OFF)
 if(GIMBAL_WIN64 STREQUAL "AUTO")
   find_program(GIMBAL_MINGW_CXX x86_64-w64-mingw32-g++)
@@ -33,6 +34,8 @@ set(GIMBAL_WIN64_DRIVER ${_win64_dir}/fmu_scene_driver.exe)
 set(GIMBAL_WIN64_FMI3_DLL ${_win64_dir}/fmi3/binary/${MODEL_IDENTIFIER}.dll)
 set(GIMBAL_WIN64_SHIP_DLL ${_win64_dir}/fmu_src/ship_motion/${SHIP_MODEL_IDENTIFIER}.dll)
 set(GIMBAL_WIN64_CONTROLLER_DLL ${_win64_dir}/fmu_src/controller/${CONTROLLER_MODEL_IDENTIFIER}.dll)
+set(GIMBAL_WIN64_SHIP3_DLL ${_win64_dir}/fmu_src/ship_motion/fmi3/${SHIP_MODEL_IDENTIFIER}.dll)
+set(GIMBAL_WIN64_CONTROLLER3_DLL ${_win64_dir}/fmu_src/controller/fmi3/${CONTROLLER_MODEL_IDENTIFIER}.dll)
 ExternalProject_Add(gimbal_win64
   SOURCE_DIR ${PROJECT_SOURCE_DIR}
   BINARY_DIR ${_win64_dir}
@@ -45,4 +48,4 @@ ExternalProject_Add(gimbal_win64
   INSTALL_COMMAND ""
   BUILD_ALWAYS ON
   BUILD_BYPRODUCTS ${GIMBAL_WIN64_DLL} ${GIMBAL_WIN64_DRIVER} ${GIMBAL_WIN64_FMI3_DLL} ${GIMBAL_WIN64_SHIP_DLL}
-                   ${GIMBAL_WIN64_CONTROLLER_DLL})
+                   ${GIMBAL_WIN64_CONTROLLER_DLL} ${GIMBAL_WIN64_SHIP3_DLL} ${GIMBAL_WIN64_CONTROLLER3_DLL})

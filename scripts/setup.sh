@@ -87,10 +87,11 @@ cmake -S "$repo" -B "$build_dir" -G Ninja -DPython3_EXECUTABLE="$venv/bin/python
 if [ "$setup_for" = test ]; then
   cmake --build "$build_dir"
 else
-  # Every FMU the README names (the gimbal for FMI 2.0 and 3.0; the ship-motion and controller FMUs that
-  # `gimbal2axis system` puts beside it) and the analysis library `gimbal2axis linearize` loads; no
-  # tests, no fuzzer, no benchmarks.
-  cmake --build "$build_dir" --target fmu fmu3 ship_motion_fmu controller_fmu gimbal_probe
+  # Every FMU the README names (the gimbal, the ship-motion and the controller FMUs, each for FMI 2.0 and
+  # 3.0; `gimbal2axis system` puts the latter two beside the gimbal) and the analysis library
+  # `gimbal2axis linearize` loads; no tests, no fuzzer, no benchmarks. One line: tests/test_main_job_builds.py
+  # reads the targets from it.
+  cmake --build "$build_dir" --target fmu fmu3 ship_motion_fmu ship_motion_fmu3 controller_fmu controller_fmu3 gimbal_probe
 fi
 echo "[setup] FMUs ready in $build_dir: Gimbal2Axis.fmu (FMI 2.0, the one the gimbal2axis command of .venv runs)," \
-     "Gimbal2Axis-fmi3.fmu, Gimbal2Axis-ShipMotion.fmu, Gimbal2Axis-Controller.fmu"
+     "Gimbal2Axis-fmi3.fmu, Gimbal2Axis-ShipMotion.fmu, Gimbal2Axis-Controller.fmu and their -fmi3.fmu twins"

@@ -10,7 +10,7 @@
 # the sources are meant to compile on others.
 #
 # Arguments (-D): CXX, C (compilers), SOURCES (comma-separated absolute paths), ROOTS
-# (comma-separated include roots, searched in order), FMI2_INCLUDE_DIR, EIGEN_DIR, OUTPUT (the
+# (comma-separated include roots, searched in order), FMI2_INCLUDE_DIR, EIGEN_DIR (empty: none), OUTPUT (the
 # sources/ directory, recreated), STAMP.
 string(REPLACE "," ";" _sources "${SOURCES}")
 string(REPLACE "," ";" _roots "${ROOTS}")
@@ -65,15 +65,18 @@ foreach(_file IN LISTS _files)
   file(COPY ${_file} DESTINATION ${_directory})
 endforeach()
 
-file(GLOB _arch LIST_DIRECTORIES true ${EIGEN_DIR}/Eigen/src/Core/arch/*)
-foreach(_backend IN LISTS _arch)
-  get_filename_component(_name ${_backend} NAME)
-  if(NOT _name MATCHES "^(CUDA|GPU|HIP|SYCL)$")  # reached only by device compilers
-    file(COPY ${_backend} DESTINATION ${OUTPUT}/Eigen/src/Core/arch)
+# Eigen's back ends and licence, for a sources/ that includes Eigen (not the small FMUs': EIGEN_DIR empty).
+if(EIGEN_DIR)
+  file(GLOB _arch LIST_DIRECTORIES true ${EIGEN_DIR}/Eigen/src/Core/arch/*)
+  foreach(_backend IN LISTS _arch)
+    get_filename_component(_name ${_backend} NAME)
+    if(NOT _name MATCHES "^(CUDA|GPU|HIP|SYCL)$")  # reached only by device compilers
+      file(COPY ${_backend} DESTINATION ${OUTPUT}/Eigen/src/Core/arch)
+    endif()
+  endforeach()
+  # Eigen's licence next to it (each of its headers points to the MPL 2.0).
+  if(EXISTS /usr/share/common-licenses/MPL-2.0)
+    configure_file(/usr/share/common-licenses/MPL-2.0 ${OUTPUT}/Eigen/COPYING.MPL2 COPYONLY)
   endif()
-endforeach()
-# Eigen's licence next to it (each of its headers points to the MPL 2.0).
-if(EXISTS /usr/share/common-licenses/MPL-2.0)
-  configure_file(/usr/share/common-licenses/MPL-2.0 ${OUTPUT}/Eigen/COPYING.MPL2 COPYONLY)
 endif()
 file(TOUCH ${STAMP})

@@ -38,7 +38,7 @@
 
 namespace {
 
-constexpr size_t kStates = 17, kIndicators = GIMBAL_EVENT_INDICATORS;
+constexpr size_t kStates = GIMBAL_CONTINUOUS_STATES, kIndicators = GIMBAL_EVENT_INDICATORS;
 
 struct Api {
     fmi2InstantiateTYPE* instantiate;

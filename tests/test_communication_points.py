@@ -160,6 +160,16 @@ def ship_fmu(build_dir):
         yield fmu
 
 
+@pytest.fixture(scope="module")
+def small_fmus3(build_dir, tmp_path_factory):
+    """The ship-motion and controller FMUs for FMI 3.0: {name: (model description, unzipped folder)}."""
+    opened = {}
+    for name in ("Gimbal2Axis-ShipMotion-fmi3.fmu", "Gimbal2Axis-Controller-fmi3.fmu"):
+        path = build_dir / name
+        opened[name] = read_model_description(str(path)), extract(str(path), str(tmp_path_factory.mktemp("fmi3_small")))
+    return opened
+
+
 # The gimbal driven by a constant voltage on both motors: the rotors accelerate, the gears and the
 # current limiters switch, the outputs depend on every step.
 GIMBAL_START = {"base.fixed": True, "u_R1": 4.0, "u_R2": -3.0}
@@ -216,22 +226,52 @@ def start_ship(ship_fmu: FMU, t0: float) -> FMI2Stepper:
     return FMI2Stepper(ship_fmu, slave, log)
 
 
+def start_small_fmi3(fmu3, t0: float, parameters: dict, inputs: dict) -> FMI3Stepper:
+    """A small FMU's FMI 3.0 twin started as its FMI 2.0 one is above (the same names and values)."""
+    md, unzipdir = fmu3
+    log: list = []
+    slave = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipdir,
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="clock")
+    slave.instantiate(logMessage=lambda environment, status, category, message: log.append(message.decode()),
+                      loggingOn=True)
+    stepper = FMI3Stepper(md, slave, log)
+    types = {v.name: v.type for v in md.modelVariables}
+
+    def set_values(values: dict) -> None:
+        for name, value in values.items():
+            getattr(slave, "set" + types[name])([stepper.vr(name)], [value])
+
+    slave.enterInitializationMode(startTime=t0)
+    set_values(parameters)
+    slave.exitInitializationMode()
+    set_values(inputs)
+    return stepper
+
+
 def output_names(fmu: FMU) -> list:
     return [v.name for v in fmu.model_description.modelVariables if v.causality == "output" and v.type == "Real"]
 
 
-@pytest.fixture(params=["gimbal FMI 2.0", "gimbal FMI 3.0", "controller", "ship motion"])
+@pytest.fixture(params=["gimbal FMI 2.0", "gimbal FMI 3.0", "controller", "controller FMI 3.0", "ship motion",
+                        "ship motion FMI 3.0"])
 def which(request):
     return request.param
 
 
 @pytest.fixture
-def starter(which, gimbal_fmu, fmu3, controller_fmu, ship_fmu):
+def starter(which, gimbal_fmu, fmu3, controller_fmu, ship_fmu, small_fmus3):
     """(start(t0) -> stepper, the output names compared)."""
+    controller_parameters = controller_fmu_parameters(load_scene(SHIP_SCENE), (24.0, 24.0))
+    ship_parameters = ship_motion_fmu_parameters(load_scene(SHIP_SCENE))
     return {"gimbal FMI 2.0": (lambda t0: start_gimbal_fmi2(gimbal_fmu, t0), GIMBAL_OUTPUTS),
             "gimbal FMI 3.0": (lambda t0: start_gimbal_fmi3(fmu3, t0), GIMBAL_OUTPUTS),
             "controller": (lambda t0: start_controller(controller_fmu, t0), output_names(controller_fmu)),
-            "ship motion": (lambda t0: start_ship(ship_fmu, t0), output_names(ship_fmu))}[which]
+            "controller FMI 3.0": (lambda t0: start_small_fmi3(small_fmus3["Gimbal2Axis-Controller-fmi3.fmu"], t0,
+                                                               controller_parameters, {"alpha": 0.01, "beta": -0.02}),
+                                   output_names(controller_fmu)),
+            "ship motion": (lambda t0: start_ship(ship_fmu, t0), output_names(ship_fmu)),
+            "ship motion FMI 3.0": (lambda t0: start_small_fmi3(small_fmus3["Gimbal2Axis-ShipMotion-fmi3.fmu"], t0,
+                                                                ship_parameters, {}), output_names(ship_fmu))}[which]
 
 
 def run_clock(start, clock, t0: float, h: float, n: int, names) -> tuple[list, float, float]:

@@ -41,11 +41,14 @@ def test_the_capability_and_the_model_structure_agree(gimbal_fmu):
     outputs = md.outputs
     assert outputs
     # One <ModelStructure> serves Model Exchange too: a continuous output depends on the states, and
-    # only these few on inputs directly (the quasi-static current, the gyro and the energies that
+    # only these few on inputs directly (the quasi-static current, the applied voltage, the gyro and the energies that
     # see the carrier). In Co-Simulation the outputs are held between steps, so the derivatives with
     # respect to the inputs are 0 (tested below): a declared dependency allows that.
     states = [d.variable.derivative.name for d in md.derivatives]
-    feedthrough = {"i_R1": {"u_R1"}, "i_R2": {"u_R2"}}
+    # The quasi-static current and the applied voltage (amplifier<j>.u) see the voltage, or in current
+    # drive the current command, at once.
+    feedthrough = {"i_R1": {"u_R1", "i_R1_cmd"}, "i_R2": {"u_R2", "i_R2_cmd"},
+                   "amplifier1.u": {"u_R1", "i_R1_cmd"}, "amplifier2.u": {"u_R2", "i_R2_cmd"}}
     carrier = ["base.delta", "base.psi", "base.gamma", "base.delta_dot", "base.psi_dot", "base.gamma_dot"]
     for k in (1, 2, 3):
         feedthrough[f"los.omega[{k}]"] = set(carrier)

@@ -44,11 +44,16 @@ def fmu(fmu_path):
 def test_the_mode_outputs_are_the_declared_ones(fmu):
     declared = (REPO / "model_core" / "include" / "gimbal" / "switching_elements.def").read_text()
     switches = {element: switch for element, switch in
-                re.findall(r'^ELEMENT\((\w+), \d+, \d+, "(\w*)"\)', declared, re.MULTILINE)}
+                re.findall(r'^ELEMENT\((\w+), \d+, \d+, "([\w.<>]*)"\)', declared, re.MULTILINE)}
     rows = re.findall(r"^MODE_OUTPUT\((\w+), (\w+), -?\d+, -?\d+\)", declared, re.MULTILINE)
     names = {v.name.replace(".", "_").replace("[", "_").replace("]", ""): v.name for v in fmu.variables.values()}
-    assert [(m.name, m.element, m.switch or "") for m in fmu.mode_outputs] == \
-        [(names[output], element, switches[element]) for element, output in rows]
+    # "<j>" in a switch is the instance's number: the element's mode outputs are in instance order.
+    expected = []
+    for k, (element, output) in enumerate(rows):
+        instance = sum(1 for e, _ in rows[:k] if e == element) + 1
+        expected.append((names[output], element, switches[element].replace("<j>", str(instance))))
+    assert [(m.name, m.element, m.switch or "") for m in fmu.mode_outputs] == expected
+    assert ("motor2.amplifier_saturated", "amplifier_saturation", "motor2.drive") in fmu.mode_outputs
     assert ("elevation_stop.contact", "elevation_stop", "elevation_stop") in fmu.mode_outputs
     for mode in fmu.mode_outputs:
         assert fmu.variables[mode.name].causality == "output" and fmu.variables[mode.name].type == "Integer"

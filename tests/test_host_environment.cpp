@@ -147,18 +147,18 @@ std::vector<double> run_model_exchange(long& calls_changing_environment) {
     fmi2EventInfo info{};
     CHECK(checked([&] { return api.newDiscreteStates(c, &info); }) == fmi2OK);
     CHECK(checked([&] { return api.enterContinuousTimeMode(c); }) == fmi2OK);
-    double x[17], dx[17], z[GIMBAL_EVENT_INDICATORS], z_before[GIMBAL_EVENT_INDICATORS];
+    double x[GIMBAL_CONTINUOUS_STATES], dx[GIMBAL_CONTINUOUS_STATES], z[GIMBAL_EVENT_INDICATORS], z_before[GIMBAL_EVENT_INDICATORS];
     std::vector<double> trajectory;
     long events = 0;
     for (int k = 1; k <= 4000; ++k) {
         CHECK(checked([&] { return api.getEventIndicators(c, z_before, GIMBAL_EVENT_INDICATORS); }) == fmi2OK);
-        CHECK(checked([&] { return api.getContinuousStates(c, x, 17); }) == fmi2OK);
-        CHECK(checked([&] { return api.getDerivatives(c, dx, 17); }) == fmi2OK);
+        CHECK(checked([&] { return api.getContinuousStates(c, x, GIMBAL_CONTINUOUS_STATES); }) == fmi2OK);
+        CHECK(checked([&] { return api.getDerivatives(c, dx, GIMBAL_CONTINUOUS_STATES); }) == fmi2OK);
         // The first derivatives come before any arithmetic of the host's: the same bits in any host.
-        if (k == 1) trajectory.insert(trajectory.end(), dx, dx + 17);
-        for (int i = 0; i < 17; ++i) x[i] += 2.5e-5 * dx[i];
+        if (k == 1) trajectory.insert(trajectory.end(), dx, dx + GIMBAL_CONTINUOUS_STATES);
+        for (int i = 0; i < GIMBAL_CONTINUOUS_STATES; ++i) x[i] += 2.5e-5 * dx[i];
         CHECK(checked([&] { return api.setTime(c, k * 2.5e-5); }) == fmi2OK);
-        CHECK(checked([&] { return api.setContinuousStates(c, x, 17); }) == fmi2OK);
+        CHECK(checked([&] { return api.setContinuousStates(c, x, GIMBAL_CONTINUOUS_STATES); }) == fmi2OK);
         CHECK(checked([&] { return api.getEventIndicators(c, z, GIMBAL_EVENT_INDICATORS); }) == fmi2OK);
         bool crossed = false;
         for (int i = 0; i < GIMBAL_EVENT_INDICATORS; ++i) crossed = crossed || ((z[i] > 0.0) != (z_before[i] > 0.0));
@@ -168,12 +168,12 @@ std::vector<double> run_model_exchange(long& calls_changing_environment) {
             CHECK(checked([&] { return api.newDiscreteStates(c, &info); }) == fmi2OK);
             CHECK(checked([&] { return api.enterContinuousTimeMode(c); }) == fmi2OK);
         }
-        if (k % 40 == 0) trajectory.insert(trajectory.end(), x, x + 17);
+        if (k % 40 == 0) trajectory.insert(trajectory.end(), x, x + GIMBAL_CONTINUOUS_STATES);
     }
     CHECK(events > 0);
     // A non-finite state is refused, not trapped.
     x[0] = NAN;
-    CHECK(checked([&] { return api.setContinuousStates(c, x, 17); }) == fmi2Error);
+    CHECK(checked([&] { return api.setContinuousStates(c, x, GIMBAL_CONTINUOUS_STATES); }) == fmi2Error);
     const HostEnvironment before_free = host_environment();
     api.freeInstance(c);
     if (!same(host_environment(), before_free)) ++calls_changing_environment;
@@ -214,8 +214,8 @@ void test_host_floating_point_environment_is_held() {
     long differing_me = 0;
     for (size_t k = 0; k < me_reference.size() && k < hostile_me_host.size(); ++k)
         differing_me += std::memcmp(&me_reference[k], &hostile_me_host[k], sizeof(double)) != 0;
-    CHECK(hostile_me_host.size() >= 17 &&
-          std::memcmp(me_reference.data(), hostile_me_host.data(), 17 * sizeof(double)) == 0);
+    CHECK(hostile_me_host.size() >= GIMBAL_CONTINUOUS_STATES &&
+          std::memcmp(me_reference.data(), hostile_me_host.data(), GIMBAL_CONTINUOUS_STATES * sizeof(double)) == 0);
     // The host's own Euler arithmetic runs in its environment here: only the FMU's part is the same.
     std::printf("  Model Exchange host: %zu states recorded, %ld differ (the host's own arithmetic rounds upward); "
                 "calls that changed the host's environment: %ld and %ld\n",

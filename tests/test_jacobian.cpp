@@ -1,6 +1,7 @@
 // The Jacobian the implicit methods use against central differences of the right-hand side, for every
 // fidelity and every mode, at random states with a moving carrier, gravity and products of inertia;
-// each case once without and once with the disturbance elements (cable restraints, cogging) on.
+// each case once without and once with the disturbance elements (cable restraints, cogging) on, and
+// once in voltage drive and once in current drive (the amplifiers' integrators, free or saturated).
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -39,6 +40,10 @@ void check_case(const ModelParameters& params, const Modes& modes, std::mt19937&
     for (int axis = 0; axis < 2; ++axis) {
         inputs.commanded_voltage[axis] = 10.0 * unit(random);
         inputs.voltage[axis] = clamp_voltage(params.motor[axis], inputs.commanded_voltage[axis]);
+        if (params.fidelity.drive[axis] == DriveMode::current) {
+            inputs.commanded_voltage[axis] = inputs.voltage[axis] = 0.0;
+            inputs.commanded_current[axis] = inputs.current_command[axis] = 2.0 * unit(random);
+        }
     }
     if (!params.fidelity.fixed_base) {
         inputs.base.attitude = Vec3(0.2 * unit(random), 0.3 * unit(random), 0.2 * unit(random));
@@ -58,6 +63,7 @@ void check_case(const ModelParameters& params, const Modes& modes, std::mt19937&
     }
     for (int axis = 0; axis < 2; ++axis) {
         if (layout.current_slot[axis] >= 0) state[layout.current_slot[axis]] = 2.0 * unit(random);
+        if (layout.amplifier_slot[axis] >= 0) state[layout.amplifier_slot[axis]] = 10.0 * unit(random);
         if (layout.backlash_slot[axis] >= 0)
             state[layout.backlash_slot[axis]] = modes.gear_contact[axis] != 0
                                                     ? modes.gear_contact[axis] * params.gear[axis].half_backlash
@@ -100,14 +106,20 @@ void check_case(const ModelParameters& params, const Modes& modes, std::mt19937&
 }  // namespace
 
 int main() {
-    std::mt19937 random(20261122);
+    std::mt19937 voltage_random(20261122);
+    // Current drive draws from its own generator: the voltage-drive cases are the ones checked before it existed.
+    std::mt19937 current_random(20261128);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     for (int gear_model = 0; gear_model <= 2; ++gear_model) {
         for (int motor_model = 0; motor_model <= 1; ++motor_model) {
             for (int friction = 0; friction <= 1; ++friction) {
                 for (int fixed_base = 0; fixed_base <= 1; ++fixed_base) {
                   for (int disturbed = 0; disturbed <= 1; ++disturbed) {
+                   for (int drive = 0; drive <= 1; ++drive) {
                     Values values;
+                    // Current drive: both motors, motor 2 without back-emf feed-forward in the cases with friction.
+                    values.integers[vi_motor1_drive] = values.integers[vi_motor2_drive] = drive;
+                    values.flags[vb_amplifier2_back_emf_feedforward] = friction == 0;
                     values.integers[vi_gear1_model] = gear_model;
                     values.integers[vi_gear2_model] = gear_model == 0 ? 2 : gear_model;  // mixed fidelities too
                     values.integers[vi_motor1_model] = motor_model;
@@ -156,17 +168,24 @@ int main() {
                                     if (params.coordinate_friction[body].present())
                                         modes.friction[body] = kFrictionModes[(repeat + body + contact + 1) % 5];
                                 modes.elevation_stop = repeat == 1 ? contact : 0;
+                                if (drive != 0)
+                                    for (int axis = 0; axis < 2; ++axis)
+                                        modes.amplifier_saturated[axis] = axis == 0 ? repeat - 1 : (repeat + contact + 3) % 3 - 1;
                                 const std::string label = "gear model " + std::to_string(gear_model) + ", motor model " +
                                                           std::to_string(motor_model) + ", friction " +
                                                           std::to_string(friction) + ", fixed base " +
                                                           std::to_string(fixed_base) + ", disturbances " +
                                                           std::to_string(disturbed) + ", contact " + std::to_string(contact) +
                                                           ", limited " + std::to_string(limited) + ", elevation stop " +
-                                                          std::to_string(modes.elevation_stop);
-                                check_case(params, modes, random, label);
+                                                          std::to_string(modes.elevation_stop) + ", drive " +
+                                                          std::to_string(drive) + ", amplifiers " +
+                                                          std::to_string(modes.amplifier_saturated[0]) + " " +
+                                                          std::to_string(modes.amplifier_saturated[1]);
+                                check_case(params, modes, drive != 0 ? current_random : voltage_random, label);
                             }
                         }
                     }
+                   }
                   }
                 }
             }

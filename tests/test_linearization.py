@@ -339,7 +339,7 @@ def test_the_linear_model_struct_is_built_from_the_library_and_checked_against_i
 
     library = ctypes.CDLL(str(probe_lib_path))
     struct_type, dimensions = linearization._linear_model_struct(library)
-    assert dimensions == (12, 17, 17)
+    assert dimensions == (14, 17, 17)  # 12 states and the two current amplifiers' integrators
 
     class OtherVersion:
         """The real library, except that it reports one state more."""

@@ -23,6 +23,8 @@ ENUMERATIONS = {  # name: (declared type, value reference, item names by value)
     "motor2.model": ("MotorModel", 23, ["quasi_static", "inductive"]),
     "solver.method": ("IntegrationMethod", 24, ["cvode_bdf", "cvode_bdf_dq", "cvode_adams", "arkode_erk", "automatic",
                                                 "dormand_prince", "rodas4", "real_time"]),
+    "motor1.drive": ("DriveMode", 32, ["voltage", "current"]),
+    "motor2.drive": ("DriveMode", 33, ["voltage", "current"]),
 }
 DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rad/s2": "deg/s2"}
 
@@ -55,7 +57,7 @@ def test_selectors_are_enumerations_with_named_items(md, by_name):
         assert [(item.name, int(item.value)) for item in v.declaredType.items] == list(zip(items, range(len(items))))
         assert all(item.description for item in v.declaredType.items)
         assert int(v.start) in range(len(items))
-    assert len(types) == 4  # and GearStart, of gear1.start and gear2.start: tests/test_relaxed_start.py
+    assert len(types) == 5  # and GearStart, of gear1.start and gear2.start: tests/test_relaxed_start.py
 
 
 def test_other_discrete_variables_keep_their_types(by_name):
@@ -72,9 +74,9 @@ def test_enumerations_are_set_and_read_as_integers(gimbal_fmu):
     try:
         slave.setupExperiment(startTime=0.0)
         vrs = [vr for _, vr, _ in ENUMERATIONS.values()]
-        slave.setInteger(vrs, [0, 1, 0, 1, 6])
+        slave.setInteger(vrs, [0, 1, 0, 1, 6, 0, 0])
         slave.enterInitializationMode()
-        assert slave.getInteger(vrs) == [0, 1, 0, 1, 6]
+        assert slave.getInteger(vrs) == [0, 1, 0, 1, 6, 0, 0]
         slave.exitInitializationMode()
         slave.doStep(0.0, 1e-3)
         assert slave.getInteger([gimbal_fmu.vr("solver.states")]) == [7]   # rigid gear 1, quasi-static motor 1

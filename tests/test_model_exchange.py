@@ -291,10 +291,10 @@ def test_refusals_name_the_function_and_the_culprit(gimbal_fmu):
 
         small = np.zeros(3)
         refused(lambda: model.getDerivatives(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
-                "fmi2GetDerivatives", "nx = 3", "17")
+                "fmi2GetDerivatives", "nx = 3", "19")
         refused(lambda: model.getEventIndicators(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
                 "fmi2GetEventIndicators", "ni = 3", str(gimbal_fmu.model_description.numberOfEventIndicators))
-        refused(lambda: model.getDerivatives(None, 17), "fmi2GetDerivatives", "derivatives", "null")
+        refused(lambda: model.getDerivatives(None, 19), "fmi2GetDerivatives", "derivatives", "null")
         bad = states(instance)
         bad[9] = float("nan")
         refused(lambda: set_states(instance, bad), "fmi2SetContinuousStates", "i_R2", "finite")
@@ -330,13 +330,13 @@ def test_the_model_description_declares_model_exchange(gimbal_fmu):
     # sum gimbal_c_api.h's GIMBAL_EVENT_INDICATORS is.
     declared = (REPO / "model_core" / "include" / "gimbal" / "switching_elements.def").read_text()
     guards = sum(int(n) * int(g) for n, g in re.findall(r"^ELEMENT\(\w+, (\d+), (\d+),", declared, re.MULTILINE))
-    assert md.numberOfContinuousStates == 17 and md.numberOfEventIndicators == guards >= 36
+    assert md.numberOfContinuousStates == 19 and md.numberOfEventIndicators == guards >= 36
     header = (REPO / "model_core" / "include" / "gimbal" / "gimbal_c_api.h").read_text()
-    assert '#include "gimbal/switching_elements.def"' in header and "#define GIMBAL_CONTINUOUS_STATES 17" in header
+    assert '#include "gimbal/switching_elements.def"' in header and "#define GIMBAL_CONTINUOUS_STATES 19" in header
     states = [d.variable.derivative.name for d in md.derivatives]
     assert states == ANGLES + ["alpha_dot", "alpha_m_dot", "beta_dot", "beta_m_dot", "i_R1", "i_R2", "theta_b1",
                                "theta_b2", "energy.electrical_in", "energy.resistive", "energy.viscous",
-                               "energy.shaft_damping", "energy.dry_friction"]
+                               "energy.shaft_damping", "energy.dry_friction", "amplifier1.x_I", "amplifier2.x_I"]
     initial_unknowns = {u.variable.name for u in md.initialUnknowns}
     assert {d.variable.name for d in md.derivatives} <= initial_unknowns
 
@@ -442,13 +442,13 @@ def test_states_and_indicators_in_initialization_mode_are_those_of_the_start(gim
         model.enterInitializationMode()
         gimbal_fmu.set_values(model, {"u_R1": 30.0})
         indicators = md.numberOfEventIndicators
-        x0, z0 = np.zeros(17), np.zeros(indicators)
+        x0, z0 = np.zeros(19), np.zeros(indicators)
         pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))  # noqa: E731
-        model.getContinuousStates(pointer(x0), 17)
+        model.getContinuousStates(pointer(x0), 19)
         model.getEventIndicators(pointer(z0), indicators)
         model.exitInitializationMode()
-        x1, z1 = np.zeros(17), np.zeros(indicators)
-        model.getContinuousStates(pointer(x1), 17)
+        x1, z1 = np.zeros(19), np.zeros(indicators)
+        model.getContinuousStates(pointer(x1), 19)
         model.getEventIndicators(pointer(z1), indicators)
         assert np.array_equal(x0, x1) and np.array_equal(z0, z1)
         assert x0[0] == 0.2 and x0[1] == 0.2 * gimbal_fmu.start("gear1.N") and x0[9] == 0.5
@@ -465,8 +465,8 @@ def test_model_exchange_functions_refuse_a_co_simulation_instance(gimbal_fmu):
     try:
         get_nominals = slave.dll.fmi2GetNominalsOfContinuousStates
         get_nominals.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t]
-        nominals = np.zeros(17)
-        assert get_nominals(slave.component, nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 17) == 3
+        nominals = np.zeros(19)
+        assert get_nominals(slave.component, nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 19) == 3
         assert any("fmi2GetNominalsOfContinuousStates is a Model Exchange function" in e.text for e in log)
     finally:
         slave.freeInstance()

@@ -354,7 +354,7 @@ void model_exchange_lifecycle() {
         api.instantiate("oom", fmi2ModelExchange, model.guid.c_str(), "", &functions, fmi2False, fmi2True);
     end("fmi2Instantiate(ME)", c == nullptr);
     if (c == nullptr) return;
-    constexpr size_t nx = 17, nz = GIMBAL_EVENT_INDICATORS;
+    constexpr size_t nx = GIMBAL_CONTINUOUS_STATES, nz = GIMBAL_EVENT_INDICATORS;
     double x[nx], dx[nx], z[nz], z_before[nz];
     double time = 0.0;
     auto event_iteration = [&] {
@@ -538,13 +538,13 @@ void fmi3_lifecycle() {
             checked3("fmi3SetFloat64(u_R1)", [&] { return api3.setFloat64(c, &wiring.u_R1, 1, &voltage, 1); });
             for (int k = 0; k < count; ++k) {
                 if (model_exchange) {
-                    double x[17], dx[17], z[GIMBAL_EVENT_INDICATORS];
-                    checked3("fmi3GetContinuousStates", [&] { return api3.getContinuousStates(c, x, 17); });
-                    checked3("fmi3GetContinuousStateDerivatives", [&] { return api3.getContinuousStateDerivatives(c, dx, 17); });
-                    for (int i = 0; i < 17; ++i) x[i] += 1e-5 * dx[i];
+                    double x[GIMBAL_CONTINUOUS_STATES], dx[GIMBAL_CONTINUOUS_STATES], z[GIMBAL_EVENT_INDICATORS];
+                    checked3("fmi3GetContinuousStates", [&] { return api3.getContinuousStates(c, x, GIMBAL_CONTINUOUS_STATES); });
+                    checked3("fmi3GetContinuousStateDerivatives", [&] { return api3.getContinuousStateDerivatives(c, dx, GIMBAL_CONTINUOUS_STATES); });
+                    for (int i = 0; i < GIMBAL_CONTINUOUS_STATES; ++i) x[i] += 1e-5 * dx[i];
                     time += 1e-5;
                     checked3("fmi3SetTime", [&] { return api3.setTime(c, time); });
-                    checked3("fmi3SetContinuousStates", [&] { return api3.setContinuousStates(c, x, 17); });
+                    checked3("fmi3SetContinuousStates", [&] { return api3.setContinuousStates(c, x, GIMBAL_CONTINUOUS_STATES); });
                     checked3("fmi3GetEventIndicators", [&] { return api3.getEventIndicators(c, z, GIMBAL_EVENT_INDICATORS); });
                 } else {
                     fmi3Boolean event = false, stop = false, early = false;

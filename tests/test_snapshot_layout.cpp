@@ -1,5 +1,5 @@
-// The FMU state's bytes (snapshot format 10: format 7's layout over the present variable tables, with the
-// elevation stop's mode in what was Modes' tail padding) field by
+// The FMU state's bytes (snapshot format 11: format 7's layout over the present variable tables, with the
+// elevation stop's mode in what was Modes' tail padding, and format 11's current-drive rows appended) field by
 // field: the table of gimbal/simulation/snapshot.hpp must lay every field where format 7 put it. Format 7 was a C++ struct copied as bytes; that struct is kept
 // here as the reference (Format7), and every row's offset and size is compared with its member's.
 // Then: content survives encode/decode bit for bit, and single faults are refused naming the field.
@@ -19,6 +19,15 @@ namespace {
 
 using namespace gimbal;
 
+// Modes as format 7-10 laid them out (the current amplifiers' modes, format 11, are a row at the end).
+struct Modes10 {
+    int gear_contact[2];
+    int motor_limited[2];
+    int voltage_clamped[2];
+    FrictionMode friction[4];
+    int elevation_stop;
+};
+
 struct Format7 {
     std::uint32_t magic;
     std::uint32_t version;
@@ -34,7 +43,7 @@ struct Format7 {
     double time;
     double clock;
     double state[kMaxStateSize];
-    Modes modes;
+    Modes10 modes;
     EventCounters counters;
     IntegratorStatistics statistics;
     double voltage[2];
@@ -53,6 +62,10 @@ struct Format7 {
     double dwell_until;
     std::int32_t rapid_events;
     std::int64_t zeno_holds;
+    // Format 11.
+    std::int32_t amplifier_saturated[2];
+    double current_command[2];
+    double commanded_current[2];
 };
 
 struct Place {
@@ -93,10 +106,12 @@ const Place kFormat7[] = {
     PLACE_IN(integrator_memory, jump_time), PLACE_IN(integrator_memory, jump_step),
     PLACE_IN(integrator_memory, steps_since_jump), PLACE(continuous_time), PLACE(decided_here), PLACE(decided_side),
     PLACE(reference_guards), PLACE(last_event_time), PLACE(dwell_until), PLACE(rapid_events), PLACE(zeno_holds),
+    Place{"modes.amplifier_saturated", offsetof(Format7, amplifier_saturated), sizeof(Format7::amplifier_saturated)},
+    PLACE(current_command), PLACE(commanded_current),
 };
 
 void test_layout_is_format_7() {
-    CHECK(kSnapshotFormat == 10);
+    CHECK(kSnapshotFormat == 11);
     CHECK(snapshot_bytes() == sizeof(Format7));
     CHECK(GimbalInstance::snapshot_size() == sizeof(Format7));
     const std::size_t rows = sizeof kFormat7 / sizeof kFormat7[0];
@@ -132,7 +147,7 @@ void test_bytes_are_format_7() {
     CHECK(legacy.zeno_holds == content.zeno_holds && legacy.at_rest == content.at_rest);
     // Gaps are zero: the bytes of a state do not depend on what memory held before.
     const std::size_t gaps[][2] = {{offsetof(Format7, master_tolerance_defined) + 1, offsetof(Format7, master_tolerance)},
-                                   {offsetof(Format7, modes) + sizeof(Modes), offsetof(Format7, counters)},
+                                   {offsetof(Format7, modes) + sizeof(Modes10), offsetof(Format7, counters)},
                                    {offsetof(Format7, integrator_memory) + offsetof(IntegratorMemory, chattering) +
                                         offsetof(ChatteringMemory, rapid_events) + sizeof(int),
                                     offsetof(Format7, integrator_memory) + offsetof(IntegratorMemory, chattering) +
@@ -193,7 +208,7 @@ void test_single_faults_name_the_field() {
         CHECK(reason.compare(0, fault.reason.size(), fault.reason) == 0);
     }
     CHECK(check_snapshot_content(good, false, false) ==
-          "it was not saved by this version of Gimbal2Axis (snapshot format 10)");
+          "it was not saved by this version of Gimbal2Axis (snapshot format 11)");
     // An uninitialized instance's snapshot has no run: its modes are not looked at.
     GimbalInstance fresh([](GimbalStatus, const char*, const std::string&) {}, [](const char*) { return false; });
     fresh.save(bytes.data());

@@ -33,6 +33,9 @@ EXPECTED_REAL_BOUNDS = {
     "solver.rtol": (ABOVE_ZERO, math.nextafter(1.0, 0.0)),
     "elevation_stop.e": (0.0, 1.0),
     "elevation_stop.w_rest": (ABOVE_ZERO, None),
+    **{f"amplifier{j}.{p}": (0.0, None) for j in (1, 2) for p in ("K_p", "K_i")},
+    "amplifier1.f_c": (ABOVE_ZERO, None),
+    "amplifier2.f_c": (ABOVE_ZERO, None),
     "solver.atol": (ABOVE_ZERO, None),
 }
 

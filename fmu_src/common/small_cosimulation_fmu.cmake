@@ -1,17 +1,65 @@
-# The small FMI 2.0 Co-Simulation FMUs beside the gimbal's (fmu_src/ship_motion/, fmu_src/controller/):
-# one way to build their binaries and one to package them, so that they link, and their archives
-# are laid out, alike. Two functions, not one: the ship-motion binary is built in the win64 cross
-# build too, and its packaging waits for that build (fmu_src/win64.cmake).
+# The small Co-Simulation FMUs beside the gimbal's (fmu_src/ship_motion/, fmu_src/controller/), each
+# as an FMI 2.0 and an FMI 3.0 FMU: one way to build their binaries and one to package them, so that
+# they link, and their archives are laid out, alike. Two functions, not one: the binaries are built
+# in the win64 cross build too, and the packaging waits for that build (fmu_src/win64.cmake).
+
+# The files a small FMU's binary is compiled from, absolute: `target`'s sources and those of the
+# static libraries it links, recursively (for sources/ and its build description).
+function(small_fmu_source_files target out)
+  set(_files "")
+  get_target_property(_type ${target} TYPE)
+  if(NOT _type STREQUAL "INTERFACE_LIBRARY")
+    get_target_property(_sources ${target} SOURCES)
+    get_target_property(_source_dir ${target} SOURCE_DIR)
+    foreach(_source IN LISTS _sources)
+      get_filename_component(_source ${_source} ABSOLUTE BASE_DIR ${_source_dir})
+      if(_source MATCHES "\\.c$")
+        list(APPEND _files ${_source})
+      endif()
+    endforeach()
+  endif()
+  get_target_property(_libraries ${target} LINK_LIBRARIES)
+  foreach(_library IN LISTS _libraries)
+    if(TARGET ${_library})
+      small_fmu_source_files(${_library} _library_files)
+      list(APPEND _files ${_library_files})
+    endif()
+  endforeach()
+  list(REMOVE_DUPLICATES _files)
+  set(${out} ${_files} PARENT_SCOPE)
+endfunction()
+
+# The link of a small FMU's binary, as the gimbal's (fmu_src/CMakeLists.txt says why each option):
+# only the version's functions exported (`exports`: the version script), libgcc inside, on Linux the
+# C runtime's libm and libc its only shared libraries.
+function(link_small_fmu_binary target exports)
+  target_include_directories(${target} PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_BINARY_DIR}/generated
+                             ${PROJECT_SOURCE_DIR}/fmu_src ${PROJECT_SOURCE_DIR}/fmu_src/common)
+  # No contraction into fused multiply-adds: the outputs are the bits the scene runner computes.
+  target_compile_options(${target} PRIVATE -Wall -Wextra -ffp-contract=off)
+  set_target_properties(${target} PROPERTIES PREFIX "" C_VISIBILITY_PRESET hidden)
+  if(WIN32)
+    target_link_options(${target} PRIVATE -static -Wl,--exclude-all-symbols)
+  else()
+    target_link_libraries(${target} PRIVATE m)
+    set_target_properties(${target} PROPERTIES LINK_DEPENDS ${exports})
+    target_link_options(${target} PRIVATE -static-libgcc -Wl,--version-script=${exports} -Wl,--exclude-libs,ALL)
+    if(NOT GIMBAL_SANITIZE)
+      target_link_options(${target} PRIVATE -Wl,--no-undefined)  # the sanitizer runtimes are preloaded instead
+    endif()
+  endif()
+endfunction()
 
 # add_small_cosimulation_fmu_binary(<model identifier>
-#     SOURCES <the model file defining kSmallFmi2Model>... LIBRARIES <the model's libraries>...
+#     SOURCES <the model file defining kSmallCosimModel>... LIBRARIES <the model's libraries>...
 #     VARIABLE_TABLE <file> GUID_HEADER <name>_guid.h.in GUID_VARIABLE <variable>)
-# The shared library <model identifier> (no "lib" prefix): the model file behind the small FMUs' FMI
-# 2.0 Co-Simulation face (fmu_src/fmi_layer/small_fmi2_cosim.c) on the FMI instance layer, linked
-# as the gimbal's binary (fmu_src/CMakeLists.txt says why each option): only fmi2* exported, libgcc
-# inside, on Linux the C runtime's libm and libc its only shared libraries. Sets <variable> here and
-# in the caller's scope to the FMU's GUID, a name-based UUID of the identifier, the version and the
-# variable table (so that it changes with them), and configures GUID_HEADER with it into generated/.
+# Two shared libraries named <model identifier> (no "lib" prefix), the model file over the FMI
+# instance layer: target <model identifier>, the FMI 2.0 one (fmu_src/fmi_layer/small_fmi2_cosim.c,
+# only fmi2* exported), and target <model identifier>_fmi3 in fmi3/, the FMI 3.0 one
+# (small_fmi3_cosim.c, only fmi3* exported). Sets <variable> here and in the caller's scope to the
+# FMU's GUID (the FMI 3.0 instantiation token too), a name-based UUID of the identifier, the version
+# and the variable table (so that it changes with them), and configures GUID_HEADER with it into
+# generated/.
 function(add_small_cosimulation_fmu_binary identifier)
   cmake_parse_arguments(PARSE_ARGV 1 ARG "" "VARIABLE_TABLE;GUID_HEADER;GUID_VARIABLE" "SOURCES;LIBRARIES")
   file(SHA1 ${ARG_VARIABLE_TABLE} _table_hash)
@@ -23,52 +71,126 @@ function(add_small_cosimulation_fmu_binary identifier)
   get_filename_component(_header ${ARG_GUID_HEADER} NAME_WLE)
   configure_file(${ARG_GUID_HEADER} ${PROJECT_BINARY_DIR}/generated/${_header} @ONLY)
 
-  set(_common ${PROJECT_SOURCE_DIR}/fmu_src/common)
-  set(_fmu_src ${PROJECT_SOURCE_DIR}/fmu_src)
-  add_library(${identifier} SHARED ${ARG_SOURCES} ${_fmu_src}/fmi_layer/small_fmi2_cosim.c
-              ${_fmu_src}/fmi_layer/fmi_instance.c ${_fmu_src}/fmi_layer/fmi2_face.c ${_fmu_src}/fmu_state.c)
-  target_include_directories(${identifier} PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_BINARY_DIR}/generated
-                             ${PROJECT_SOURCE_DIR}/fmu_src ${_common})
-  # No contraction into fused multiply-adds: the outputs are the bits the scene runner computes.
-  target_compile_options(${identifier} PRIVATE -Wall -Wextra -ffp-contract=off)
-  target_link_libraries(${identifier} PRIVATE ${ARG_LIBRARIES})
-  set_target_properties(${identifier} PROPERTIES PREFIX "" C_VISIBILITY_PRESET hidden)
-  if(WIN32)
-    target_link_options(${identifier} PRIVATE -static -Wl,--exclude-all-symbols)
-  else()
-    target_link_libraries(${identifier} PRIVATE m)
-    set_target_properties(${identifier} PROPERTIES LINK_DEPENDS ${PROJECT_SOURCE_DIR}/fmu_src/exports.map)
-    target_link_options(${identifier} PRIVATE -static-libgcc
-                        -Wl,--version-script=${PROJECT_SOURCE_DIR}/fmu_src/exports.map -Wl,--exclude-libs,ALL)
-    if(NOT GIMBAL_SANITIZE)
-      target_link_options(${identifier} PRIVATE -Wl,--no-undefined)  # the sanitizer runtimes are preloaded instead
-    endif()
-  endif()
+  set(_layer ${PROJECT_SOURCE_DIR}/fmu_src/fmi_layer)
+  set(_shared ${_layer}/small_cosim.c ${_layer}/fmi_instance.c ${PROJECT_SOURCE_DIR}/fmu_src/fmu_state.c)
+  add_library(${identifier} SHARED ${ARG_SOURCES} ${_layer}/small_fmi2_cosim.c ${_layer}/fmi2_face.c ${_shared})
+  add_library(${identifier}_fmi3 SHARED ${ARG_SOURCES} ${_layer}/small_fmi3_cosim.c ${_layer}/fmi3_face.c
+              ${_layer}/fmi3_not_offered.c ${_shared})
+  link_small_fmu_binary(${identifier} ${PROJECT_SOURCE_DIR}/fmu_src/exports.map)
+  link_small_fmu_binary(${identifier}_fmi3 ${PROJECT_SOURCE_DIR}/fmu_src/exports_fmi3.map)
+  # Its own directory: its file has the FMI 2.0 binary's name.
+  set_target_properties(${identifier}_fmi3 PROPERTIES OUTPUT_NAME ${identifier}
+                        LIBRARY_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/fmi3
+                        RUNTIME_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/fmi3
+                        ARCHIVE_OUTPUT_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/fmi3)
+  foreach(_target ${identifier} ${identifier}_fmi3)
+    target_link_libraries(${_target} PRIVATE ${ARG_LIBRARIES})
+  endforeach()
 endfunction()
 
-# package_small_cosimulation_fmu(<name> FMU <file name> MODEL_IDENTIFIER <identifier> GUID <guid>
-#     TEMPLATE <modelDescription.xml.in> GENERATOR <executable> GENERATOR_SOURCES <files>...
+# package_small_cosimulation_fmu(<name> FMU <file name> FMI_VERSION <2|3> MODEL_IDENTIFIER <identifier>
+#     GUID <guid> TEMPLATE <modelDescription.xml.in> GENERATOR <executable> GENERATOR_SOURCES <files>...
 #     [GENERATOR_LIBRARIES <libraries>...] LICENSE_AS <path in the FMU>
 #     [WIN64_DLL <file> WIN64_DEPENDS <targets>...] [RESOURCES <files>...])
-# build/<file name> (target <name>_fmu), staged in build/<name>_staging: modelDescription.xml (the
-# generator's fragments of the variable table in TEMPLATE, configure_model_description.cmake), the
-# binary of add_small_cosimulation_fmu_binary in binaries/linux64 and, given one, the win64 DLL in
-# binaries/win64, the project's licence at LICENSE_AS, the RESOURCES in resources/.
+# build/<file name> (target <name>_fmu, FMI 3.0: <name>_fmu3), staged in build/<name>_staging (FMI 3.0:
+# build/<name>_fmi3_staging): modelDescription.xml (the
+# generator's fragments of the variable table in TEMPLATE, configure_model_description.cmake; the
+# generator is given --fmi3 for FMI 3.0), the binary of add_small_cosimulation_fmu_binary of the
+# version in binaries/linux64 (FMI 3.0: binaries/x86_64-linux) and, given one, the win64 DLL in
+# binaries/win64 (x86_64-windows), sources/ (the files the binary is compiled from and the headers
+# they include, listed in <SourceFiles>, FMI 3.0: in sources/buildDescription.xml), the project's
+# licence at LICENSE_AS, the RESOURCES in resources/.
 function(package_small_cosimulation_fmu name)
-  cmake_parse_arguments(PARSE_ARGV 1 ARG "" "FMU;MODEL_IDENTIFIER;GUID;TEMPLATE;GENERATOR;LICENSE_AS;WIN64_DLL"
+  cmake_parse_arguments(PARSE_ARGV 1 ARG "" "FMU;FMI_VERSION;MODEL_IDENTIFIER;GUID;TEMPLATE;GENERATOR;LICENSE_AS;WIN64_DLL"
                         "GENERATOR_SOURCES;GENERATOR_LIBRARIES;WIN64_DEPENDS;RESOURCES")
   set(_common ${PROJECT_SOURCE_DIR}/fmu_src/common)
+  set(_fmu ${PROJECT_BINARY_DIR}/${ARG_FMU})
+  if(ARG_FMI_VERSION STREQUAL "3")
+    set(_target ${name}_fmu3)
+    set(name ${name}_fmi3)
+    set(_binary ${ARG_MODEL_IDENTIFIER}_fmi3)
+    set(_generator_version --fmi3)
+    set(_linux_folder binaries/x86_64-linux)
+    set(_windows_folder binaries/x86_64-windows)
+  else()
+    set(_target ${name}_fmu)
+    set(_binary ${ARG_MODEL_IDENTIFIER})
+    set(_generator_version "")
+    set(_linux_folder binaries/linux64)
+    set(_windows_folder binaries/win64)
+  endif()
   set(_staging ${PROJECT_BINARY_DIR}/${name}_staging)
   set(_fragments ${PROJECT_BINARY_DIR}/${name}_fragments)
-  set(_fmu ${PROJECT_BINARY_DIR}/${ARG_FMU})
 
-  add_executable(${ARG_GENERATOR} ${ARG_GENERATOR_SOURCES} ${_common}/model_description_writer.c)
-  target_include_directories(${ARG_GENERATOR} PRIVATE ${_common})
-  target_compile_options(${ARG_GENERATOR} PRIVATE -Wall -Wextra)
-  target_link_libraries(${ARG_GENERATOR} PRIVATE ${ARG_GENERATOR_LIBRARIES})
+  if(NOT TARGET ${ARG_GENERATOR})  # one generator writes both versions' fragments
+    add_executable(${ARG_GENERATOR} ${ARG_GENERATOR_SOURCES} ${_common}/model_description_writer.c)
+    target_include_directories(${ARG_GENERATOR} PRIVATE ${_common})
+    target_compile_options(${ARG_GENERATOR} PRIVATE -Wall -Wextra)
+    target_link_libraries(${ARG_GENERATOR} PRIVATE ${ARG_GENERATOR_LIBRARIES})
+  endif()
+
+  # sources/: the binary's own files as they are listed, with every header they include (without
+  # SUNDIALS or Eigen, which the small FMUs do not use), collected as for the gimbal's FMU
+  # (scripts/stage_fmu_sources.cmake); each file below the first include root that holds it, so that
+  # sources/ itself is the one include directory a builder gives.
+  small_fmu_source_files(${_binary} _source_files)
+  get_target_property(_model_folder ${ARG_MODEL_IDENTIFIER} SOURCE_DIR)
+  set(_roots ${_model_folder} ${PROJECT_SOURCE_DIR}/fmu_src ${PROJECT_BINARY_DIR}/generated
+             ${PROJECT_SOURCE_DIR}/c_kernel/include ${PROJECT_SOURCE_DIR}/c_kernel/src)
+  set(_source_names "")
+  set(_source_entries "")
+  foreach(_file IN LISTS _source_files)
+    foreach(_root IN LISTS _roots)
+      file(RELATIVE_PATH _name ${_root} ${_file})
+      if(NOT _name MATCHES "^\\.\\.")
+        break()
+      endif()
+    endforeach()
+    list(APPEND _source_names ${_name})
+    string(APPEND _source_entries "      <SourceFile name=\"${_name}\"/>\n")
+  endforeach()
+  string(JOIN "," _source_list ${_source_files})
+  string(JOIN "," _root_list ${_roots})
+  set(_sources_stamp ${PROJECT_BINARY_DIR}/${name}_sources.stamp)
+  file(GLOB_RECURSE _source_inputs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/fmu_src/*.c ${PROJECT_SOURCE_DIR}/fmu_src/*.h
+       ${PROJECT_SOURCE_DIR}/c_kernel/src/*.c ${PROJECT_SOURCE_DIR}/c_kernel/include/*.h)
+  add_custom_command(
+    OUTPUT ${_sources_stamp}
+    COMMAND ${CMAKE_COMMAND} -DCXX=${CMAKE_CXX_COMPILER} -DC=${CMAKE_C_COMPILER} -DSOURCES=${_source_list}
+      -DROOTS=${_root_list} -DFMI2_INCLUDE_DIR=${FMI2_INCLUDE_DIR} -DEIGEN_DIR= -DOUTPUT=${_staging}/sources
+      -DSTAMP=${_sources_stamp} -P ${PROJECT_SOURCE_DIR}/scripts/stage_fmu_sources.cmake
+    DEPENDS ${_source_inputs} ${PROJECT_SOURCE_DIR}/scripts/stage_fmu_sources.cmake
+    COMMENT "Collecting the sources/ of ${ARG_FMU}"
+    VERBATIM)
+  set(_source_description ${PROJECT_BINARY_DIR}/${name}_buildDescription.xml)
+  if(ARG_FMI_VERSION STREQUAL "3")
+    file(WRITE ${_source_description}
+"<?xml version=\"1.0\" encoding=\"UTF-8\"?>
+<fmiBuildDescription fmiVersion=\"3.0\">
+  <BuildConfiguration modelIdentifier=\"${ARG_MODEL_IDENTIFIER}\" description=\"the .c files as C99 with -ffp-contract=off (no fused multiply-adds: the outputs keep the shipped binary's bits); the include path is sources/ itself\">
+    <SourceFileSet language=\"C99\" compilerOptions=\"-ffp-contract=off\">
+${_source_entries}      <IncludeDirectory name=\".\"/>
+    </SourceFileSet>
+  </BuildConfiguration>
+</fmiBuildDescription>
+")
+    set(_copy_source_description COMMAND ${CMAKE_COMMAND} -E copy ${_source_description} sources/buildDescription.xml)
+    set(_source_description_depends ${_source_description})
+    set(SOURCE_FILES "")
+  else()
+    set(_copy_source_description "")
+    set(_source_description_depends "")
+    # <SourceFiles> inside <CoSimulation>, through the template's @SOURCE_FILES@.
+    set(SOURCE_FILES "    <SourceFiles>\n")
+    foreach(_name IN LISTS _source_names)
+      string(APPEND SOURCE_FILES "      <File name=\"${_name}\"/>\n")
+    endforeach()
+    string(APPEND SOURCE_FILES "    </SourceFiles>\n")
+  endif()
+
   # The template filled twice: with what is known now (the project's name, version, author,
-  # copyright and licence, the identifier, the GUID), then at build time with the generator's
-  # fragments and the date; their placeholders pass through the first filling as they are.
+  # copyright and licence, the identifier, the GUID, the source files), then at build time with the
+  # generator's fragments and the date; their placeholders pass through the first filling as they are.
   foreach(_build_time_value IN ITEMS UNIT_DEFINITIONS MODEL_VARIABLES MODEL_STRUCTURE GENERATION_DATE)
     set(${_build_time_value} "@${_build_time_value}@")
   endforeach()
@@ -78,7 +200,8 @@ function(package_small_cosimulation_fmu name)
   add_custom_command(
     OUTPUT ${_staging}/modelDescription.xml
     COMMAND ${CMAKE_COMMAND} -E make_directory ${_fragments} ${_staging}
-    COMMAND ${ARG_GENERATOR} ${_fragments}/units.xml ${_fragments}/variables.xml ${_fragments}/structure.xml
+    COMMAND ${ARG_GENERATOR} ${_generator_version} ${_fragments}/units.xml ${_fragments}/variables.xml
+            ${_fragments}/structure.xml
     COMMAND ${CMAKE_COMMAND} -DTEMPLATE=${_fragments}/modelDescription.xml.in -DOUTPUT=${_staging}/modelDescription.xml
             -DFRAGMENTS=${_fragments} -DSOURCE_DIR=${PROJECT_SOURCE_DIR} -DGIT_EXECUTABLE=${GIT_EXECUTABLE}
             -P ${_common}/configure_model_description.cmake
@@ -88,11 +211,11 @@ function(package_small_cosimulation_fmu name)
     VERBATIM)
 
   set(_optional_commands "")
-  set(_folders modelDescription.xml binaries documentation)
+  set(_folders modelDescription.xml binaries documentation sources)
   if(ARG_WIN64_DLL)
     list(APPEND _optional_commands
-      COMMAND ${CMAKE_COMMAND} -E make_directory binaries/win64
-      COMMAND ${CMAKE_COMMAND} -E copy ${ARG_WIN64_DLL} binaries/win64/${ARG_MODEL_IDENTIFIER}.dll)
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${_windows_folder}
+      COMMAND ${CMAKE_COMMAND} -E copy ${ARG_WIN64_DLL} ${_windows_folder}/${ARG_MODEL_IDENTIFIER}.dll)
   endif()
   if(ARG_RESOURCES)
     list(APPEND _optional_commands COMMAND ${CMAKE_COMMAND} -E make_directory resources)
@@ -105,18 +228,20 @@ function(package_small_cosimulation_fmu name)
   get_filename_component(_license_folder ${ARG_LICENSE_AS} DIRECTORY)
   add_custom_command(
     OUTPUT ${_fmu}
-    # Nothing an earlier build staged stays (a win64 binary of a build that had mingw-w64).
+    # Nothing an earlier build staged stays (a win64 binary of a build that had mingw-w64); sources/
+    # is the stamp's.
     COMMAND ${CMAKE_COMMAND} -E rm -rf binaries documentation resources
-    COMMAND ${CMAKE_COMMAND} -E make_directory binaries/linux64 ${_license_folder}
-    COMMAND ${CMAKE_COMMAND} -E copy $<TARGET_FILE:${ARG_MODEL_IDENTIFIER}> binaries/linux64/${ARG_MODEL_IDENTIFIER}.so
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_linux_folder} ${_license_folder}
+    COMMAND ${CMAKE_COMMAND} -E copy $<TARGET_FILE:${_binary}> ${_linux_folder}/${ARG_MODEL_IDENTIFIER}.so
     COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/LICENSE ${ARG_LICENSE_AS}
+    ${_copy_source_description}
     ${_optional_commands}
     COMMAND ${CMAKE_COMMAND} -E rm -f ${_fmu}
     COMMAND ${CMAKE_COMMAND} -E tar cf ${_fmu} --format=zip ${_folders}
     WORKING_DIRECTORY ${_staging}
-    DEPENDS ${ARG_MODEL_IDENTIFIER} ${_staging}/modelDescription.xml ${PROJECT_SOURCE_DIR}/LICENSE ${ARG_RESOURCES}
-            ${ARG_WIN64_DLL} ${ARG_WIN64_DEPENDS}
+    DEPENDS ${_binary} ${_staging}/modelDescription.xml ${PROJECT_SOURCE_DIR}/LICENSE ${ARG_RESOURCES}
+            ${ARG_WIN64_DLL} ${ARG_WIN64_DEPENDS} ${_sources_stamp} ${_source_description_depends}
     COMMENT "Packaging ${ARG_FMU}"
     VERBATIM)
-  add_custom_target(${name}_fmu ALL DEPENDS ${_fmu})
+  add_custom_target(${_target} ALL DEPENDS ${_fmu})
 endfunction()

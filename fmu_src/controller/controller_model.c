@@ -81,6 +81,7 @@ void controller_model_start(ControllerModel* model) {
     c->rate_from_encoder = model->boolean[P_RATE_FROM_ENCODER];
     gimbal_target_direction(model->real[P_TARGET_AZIMUTH], model->real[P_TARGET_ELEVATION], model->target);
     model->step = 0;
+    model->started = 1;
 }
 
 void controller_model_step(ControllerModel* model, double h) {

@@ -18,6 +18,7 @@ typedef struct {
     GimbalController controller;
     double target[3];            /* unit vector in G */
     long step;                   /* the communication point the next step computes */
+    int started;                 /* 1 from controller_model_start on: the model is initialized */
 } ControllerModel;
 
 /* Every variable at its start value, the kernel's state cleared. */

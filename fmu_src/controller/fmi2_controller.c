@@ -1,25 +1,34 @@
-/* The controller FMU's model file: controller_model.c behind the small FMUs' FMI 2.0 Co-Simulation
- * face (fmi_layer/small_fmi2_cosim.h), which checks the states, pointers and value references and
- * exports the fmi2* functions; here are the controller's values, parameter checks and step. */
+/* The controller FMU's model file: controller_model.c behind the small FMUs' FMI 2.0 and FMI 3.0
+ * Co-Simulation faces (fmi_layer/small_cosim_model.h), which check the states, pointers and value
+ * references and export the fmi2* or fmi3* functions; here are the controller's values, parameter
+ * checks and step, and its FMU-state snapshot (offered by the FMI 3.0 FMU). */
 #include <math.h>
-#include <stdlib.h>
+#include <stddef.h>
+#include <string.h>
 
 #include "controller_guid.h"
 #include "controller_model.h"
-#include "fmi_layer/small_fmi2_cosim.h"
+#include "fmi_layer/small_cosim_model.h"
 
-static ControllerModel* model_of(const FmiInstance* instance) { return (ControllerModel*)instance->model_data; }
+/* The model follows the FmiInstance in one allocation (fmi_instantiate's, zeroed): the snapshot calls,
+ * which the layer hands the model, can then log through the instance. */
+typedef struct {
+    FmiInstance common;
+    ControllerModel model;
+} ControllerInstance;
+_Static_assert(offsetof(ControllerInstance, common) == 0, "the FmiInstance must be the instance's first member");
+
+static ControllerModel* model_of(const FmiInstance* instance) { return &((ControllerInstance*)instance->model_data)->model; }
 
 static void* create_model(FmiInstance* instance) {
-    (void)instance;
-    ControllerModel* model = (ControllerModel*)malloc(sizeof(ControllerModel));
-    if (model != NULL) controller_model_reset(model);
-    return model;
+    controller_model_reset(&((ControllerInstance*)instance)->model);
+    return instance;
 }
+static void no_own_allocation(void* model) { (void)model; }
 
 /* Which variables may be set now: inputs always; parameters before initialization ends. */
 static int settable_now(const FmiInstance* instance, int parameter) {
-    return !parameter || (instance->state & (STATE_INSTANTIATED | STATE_INITIALIZATION));
+    return !parameter || (instance->state & instance->face->before_initialized_states);
 }
 
 /* ---------------------------------------------------------------- Real variables */
@@ -77,7 +86,7 @@ static FmiStatus set_integer(FmiInstance* instance, const char* function, unsign
 
 static FmiStatus get_boolean(FmiInstance* instance, const char* function, unsigned vr, void* value) {
     (void)function;
-    *(int*)value = model_of(instance)->boolean[vr] ? fmi2True : fmi2False;
+    *(int*)value = model_of(instance)->boolean[vr] ? 1 : 0;
     return FMI_OK;
 }
 static int boolean_settable(FmiInstance* instance, const char* function, unsigned vr, const void* value) {
@@ -86,7 +95,7 @@ static int boolean_settable(FmiInstance* instance, const char* function, unsigne
 }
 static FmiStatus set_boolean(FmiInstance* instance, const char* function, unsigned vr, const void* value) {
     (void)function;
-    model_of(instance)->boolean[vr] = *(const int*)value != fmi2False;
+    model_of(instance)->boolean[vr] = *(const int*)value != 0;
     return FMI_OK;
 }
 
@@ -115,12 +124,54 @@ static FmiStatus do_step(FmiInstance* instance, const char* function, double poi
      * or gains that overflow leave no usable command: the host gets an error, never a NaN voltage. */
     for (int k = OUT_U_R1; k <= OUT_BETA_REF; ++k) {
         if (isfinite(model->real[k])) continue;
-        fmi_log_error(instance, "%s: %s = %g after the step of %g s: the controller cannot continue (fmi2Reset)",
+        fmi_log_error(instance, "%s: %s = %g after the step of %g s: the controller cannot continue (reset it)",
                       function, kControllerReals[k].name, model->real[k], step);
-        instance->state = STATE_ERROR;
+        instance->state = instance->face->error_state;
         return FMI_ERROR;
     }
     instance->time = point + step;
+    return FMI_OK;
+}
+
+/* ---------------------------------------------------------------- FMU states */
+
+/* The snapshot is the model as it is: its variables and the kernel's sensors and controller. The
+ * kernel's pointers (the noise, carrier-rate, replay and set-point tables of a scene) are NULL in
+ * this FMU, which takes its inputs per step; a snapshot with one set is refused, never followed. */
+static size_t snapshot_size(void) { return sizeof(ControllerModel); }
+
+static FmiStatus save(void* model, unsigned char* bytes) {
+    memcpy(bytes, model_of((FmiInstance*)model), sizeof(ControllerModel));
+    return FMI_OK;
+}
+
+/* What in a snapshot this FMU could not have saved, or NULL. */
+static const char* snapshot_problem(const ControllerModel* m) {
+    if (m->sensors.gyro_noise != NULL || m->sensors.carrier_rate != NULL || m->sensors.gyro.error != NULL ||
+        m->controller.replayed != NULL || m->controller.set_points.values != NULL ||
+        m->controller.set_points.rates != NULL || m->controller.set_points.accelerations != NULL ||
+        m->controller.set_points.gyro_rates != NULL)
+        return "it refers to tables this FMU has none of";
+    if ((m->started & ~1) != 0 || m->step < 0 || (!m->started && m->step != 0)) return "its step count is not one a run reaches";
+    if (m->sensors.gyro.delay < 0 || m->sensors.gyro.delay > GIMBAL_GYRO_MAX_DELAY) return "its gyro delay is out of range";
+    for (int i = 0; i < REAL_COUNT; ++i)
+        if (!isfinite(m->real[i])) return "a Real variable is not finite";
+    for (int i = 0; i < INTEGER_COUNT; ++i)
+        if (m->integer[i] < kControllerIntegers[i].min || m->integer[i] > kControllerIntegers[i].max)
+            return "an Integer parameter lies outside its bounds";
+    for (int i = 0; i < BOOLEAN_COUNT; ++i)
+        if ((m->boolean[i] & ~1) != 0) return "a Boolean parameter is neither 0 nor 1";
+    return NULL;
+}
+
+static FmiStatus check_snapshot(void* model, const unsigned char* bytes, int* initialized) {
+    ControllerModel snapshot;
+    memcpy(&snapshot, bytes, sizeof snapshot);
+    return fmi_snapshot_verdict((FmiInstance*)model, snapshot_problem(&snapshot), snapshot.started, initialized);
+}
+
+static FmiStatus restore(void* model, const unsigned char* bytes) {
+    memcpy(model_of((FmiInstance*)model), bytes, sizeof(ControllerModel));
     return FMI_OK;
 }
 
@@ -128,9 +179,10 @@ static const char* const kLogCategories[] = {"logStatusError", "logAll"};
 
 /* The controller's step never fails but into the error state, so fmi2GetStatus is asked only after
  * successful steps (status_states): it is fmi2OK. */
-const SmallFmi2Model kSmallFmi2Model = {
-    .layer = {CONTROLLER_GUID, sizeof(FmiInstance), kLogCategories,
-              (int)(sizeof kLogCategories / sizeof kLogCategories[0]), create_model, free, NULL, NULL, NULL, NULL, NULL},
+const SmallCosimModel kSmallCosimModel = {
+    .layer = {CONTROLLER_GUID, sizeof(ControllerInstance), kLogCategories,
+              (int)(sizeof kLogCategories / sizeof kLogCategories[0]), create_model, no_own_allocation, NULL,
+              snapshot_size, save, check_snapshot, restore},
     .get_states = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED,
     .set_states = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE,
     .terminate_states = STATE_STEP_COMPLETE,

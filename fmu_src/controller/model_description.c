@@ -1,11 +1,12 @@
 /* Writes the unit, variable and structure parts of the controller FMU's modelDescription.xml
  * (modelDescription.xml.in holds the rest) from its variable table (controller_variables.def), so
- * the description and the binary cannot disagree:
- *     controller_model_description <units.xml> <variables.xml> <structure.xml> */
+ * the description and the binary cannot disagree, for the FMI 2.0 FMU or (--fmi3) the FMI 3.0 one:
+ *     controller_model_description [--fmi3] <units.xml> <variables.xml> <structure.xml> */
 #include <math.h>
 #include <stdio.h>
 
 #include "controller_variables.h"
+#include "fmi3_value_references.h"
 #include "model_description_writer.h"
 
 /* The units of the table, by their SI base units (kg, m, s, A, rad exponents). */
@@ -19,7 +20,9 @@ static const struct {
     {"V.s/rad", 1, 2, -2, -1, -1, NULL}, {"V/(rad.s)", 1, 2, -4, -1, -1, NULL},
 };
 
-static int write_units(FILE* out) {
+/* The same in FMI 2.0 and FMI 3.0. */
+static int write_units(FILE* out, int fmi3) {
+    (void)fmi3;
     for (size_t i = 0; i < sizeof kUnits / sizeof kUnits[0]; ++i) {
         fprintf(out, "    <Unit name=\"%s\">\n      <BaseUnit", kUnits[i].name);
         const char* names[] = {"kg", "m", "s", "A", "rad"};
@@ -34,45 +37,54 @@ static int write_units(FILE* out) {
     return 0;
 }
 
-static void write_real(FILE* out, int vr, const ControllerReal* v) {
+static void write_real(FILE* out, int fmi3, int vr, const ControllerReal* v) {
     static const char* const kCausality[] = {"input", "output", "parameter"};
     static const char* const kVariability[] = {"continuous", "discrete", "fixed"};
-    fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"%s\" variability=\"%s\"%s description=\"",
-            v->name, vr, kCausality[v->causality], kVariability[v->causality], v->causality == INPUT ? "" : " initial=\"exact\"");
-    write_xml_escaped(out, v->description);
-    fprintf(out, "\">\n      <Real unit=\"%s\"", v->unit);
+    write_variable_start(out, fmi3, "Real", "Float64", v->name, (fmi3 ? SMALL_FMI3_FLOAT64_BASE : 0) + vr,
+                         kCausality[v->causality], kVariability[v->causality], v->causality == INPUT ? NULL : "exact",
+                         v->description);
+    fprintf(out, " unit=\"%s\"", v->unit);
     if (v->display_unit[0] != '\0') fprintf(out, " displayUnit=\"%s\"", v->display_unit);
     if (v->min > -HUGE_VAL) fprintf(out, " min=\"%.17g\"", v->min);
     if (v->max < HUGE_VAL) fprintf(out, " max=\"%.17g\"", v->max);
-    fprintf(out, " start=\"%.17g\"/>\n    </ScalarVariable>\n", v->start);
+    fprintf(out, " start=\"%.17g\"", v->start);
+    write_variable_end(out, fmi3);
 }
 
-/* FMI 2.0 indexes variables from 1 in the order written: Reals, Integers, Booleans. */
-static int write_variables(FILE* out) {
-    for (int vr = 0; vr < REAL_COUNT; ++vr) write_real(out, vr, &kControllerReals[vr]);
+/* FMI 2.0 indexes variables from 1 in the order written: Reals, Integers, Booleans. FMI 3.0's value
+ * references: common/fmi3_value_references.h (FMI 2.0's number each type from 0). */
+_Static_assert((int)REAL_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY && (int)INTEGER_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY &&
+                   (int)BOOLEAN_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY,
+               "FMI 3.0's value references leave room for the variables of each type");
+static int write_variables(FILE* out, int fmi3) {
+    write_independent_time(out, fmi3);
+    for (int vr = 0; vr < REAL_COUNT; ++vr) write_real(out, fmi3, vr, &kControllerReals[vr]);
     for (int vr = 0; vr < INTEGER_COUNT; ++vr) {
         const ControllerInteger* v = &kControllerIntegers[vr];
-        fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
-                     "initial=\"exact\" description=\"", v->name, vr);
-        write_xml_escaped(out, v->description);
-        fprintf(out, "\">\n      <Integer min=\"%d\" max=\"%d\" start=\"%d\"/>\n    </ScalarVariable>\n", v->min, v->max,
-                v->start);
+        write_variable_start(out, fmi3, "Integer", "Int32", v->name, (fmi3 ? SMALL_FMI3_INT32_BASE : 0) + vr,
+                             "parameter", "fixed", "exact", v->description);
+        fprintf(out, " min=\"%d\" max=\"%d\" start=\"%d\"", v->min, v->max, v->start);
+        write_variable_end(out, fmi3);
     }
     for (int vr = 0; vr < BOOLEAN_COUNT; ++vr) {
         const ControllerBoolean* v = &kControllerBooleans[vr];
-        fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
-                     "initial=\"exact\" description=\"", v->name, vr);
-        write_xml_escaped(out, v->description);
-        fprintf(out, "\">\n      <Boolean start=\"%s\"/>\n    </ScalarVariable>\n", v->start ? "true" : "false");
+        write_variable_start(out, fmi3, "Boolean", "Boolean", v->name, (fmi3 ? SMALL_FMI3_BOOLEAN_BASE : 0) + vr,
+                             "parameter", "fixed", "exact", v->description);
+        fprintf(out, " start=\"%s\"", v->start ? "true" : "false");
+        write_variable_end(out, fmi3);
     }
     return 0;
 }
 
 static int is_output(int value_reference) { return kControllerReals[value_reference].causality == OUTPUT; }
 
-/* The outputs change only in fmi2DoStep: no direct feedthrough from any input (dependencies=""),
+/* The outputs change only in the step: no direct feedthrough from any input (dependencies=""),
    so a master has no algebraic loop to solve between this FMU and the gimbal. */
-static int write_structure(FILE* out) {
+static int write_structure(FILE* out, int fmi3) {
+    if (fmi3) {
+        write_outputs_fmi3(out, REAL_COUNT, is_output);
+        return 0;
+    }
     fputs("    <Outputs>\n", out);
     write_output_unknowns(out, REAL_COUNT, is_output);
     fputs("    </Outputs>\n", out);

@@ -24,6 +24,7 @@ static void deliver(const FmiInstance* instance, FmiStatus status, const char* c
 const FmiFace kFmi2Face = {
     .deliver = deliver,
     .logger_formats_message = 1,
+    .resource_location_is_uri = 1,
     .instantiated_state = STATE_INSTANTIATED,
     .any_state = ANY_STATE,
     .error_state = STATE_ERROR,

@@ -235,6 +235,17 @@ static int valid_record(FmiInstance* instance, const char* function, const unsig
     return 1;
 }
 
+FmiStatus fmi_snapshot_verdict(FmiInstance* instance, const char* problem, int snapshot_initialized, int* initialized) {
+    if (problem == NULL) {
+        *initialized = snapshot_initialized;
+        return FMI_OK;
+    }
+    char text[256];
+    snprintf(text, sizeof text, "the FMU state is refused: %s", problem);
+    fmi_log_from_model(instance, FMI_ERROR, "logStatusError", text);
+    return FMI_ERROR;
+}
+
 FmiStatus fmi_get_fmu_state(FmiInstance* instance, const char* function, void** state) {
     if (!fmi_not_null(instance, function, state, instance->face->fmu_state_argument)) return FMI_ERROR;
     /* Overwrite the host's previous state when it hands back one of ours, as the standard allows.

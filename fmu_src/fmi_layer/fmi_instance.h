@@ -1,5 +1,5 @@
 /* The FMI instance layer: what every FMI face of every FMU of the project does the same way, written
- * once. An FMI 2.0 or FMI 3.0 face (gimbal_fmi2.c, gimbal_fmi3.c) maps the standard's functions and
+ * once. An FMI 2.0 or FMI 3.0 face (fmi2_face.c, fmi3_face.c) maps the standard's functions and
  * types onto it; the model behind it is reached through a small table of functions (FmiModel).
  *
  * Here: the instance (name, host logger, state, log categories, times, the FMU states handed out),
@@ -43,6 +43,7 @@ typedef struct {
     /* Hands a finished message to the host's callback (whose signature is the version's). */
     void (*deliver)(const FmiInstance* instance, FmiStatus status, const char* category, const char* message);
     int logger_formats_message;     /* FMI 2.0's logger takes its message as a format: '%' is doubled */
+    int resource_location_is_uri;   /* FMI 2.0 names the resources folder with a file: URI, FMI 3.0 with a path */
     int instantiated_state;
     int any_state;                  /* every state bit of the version */
     int error_state;
@@ -167,6 +168,11 @@ static inline int fmi_step_valid(const FmiInstance* instance, const char* functi
         return 1;
     return fmi_log_step_refusal(instance, function, point, step_size);
 }
+
+/* A model's check_snapshot's verdict: `problem` NULL, the snapshot is one the model could have saved
+ * (*initialized = snapshot_initialized, FMI_OK); otherwise the refusal, logged naming the function
+ * running and the problem, FMI_ERROR. */
+FmiStatus fmi_snapshot_verdict(FmiInstance* instance, const char* problem, int snapshot_initialized, int* initialized);
 
 /* The FMU-state calls, after the face's state check. */
 FmiStatus fmi_get_fmu_state(FmiInstance* instance, const char* function, void** state);

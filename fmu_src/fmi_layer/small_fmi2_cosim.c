@@ -1,13 +1,14 @@
-/* The FMI 2.0 Co-Simulation face of the small FMUs (small_fmi2_cosim.h). Every exported function runs
+/* The FMI 2.0 Co-Simulation face of the small FMUs (small_cosim_model.h): every fmi2* function, over
+ * the model's table, the shared part (small_cosim.c) and the layer. Every exported function runs
  * in the default floating-point environment whatever the host's (host_fp_environment.h), so that the
  * outputs are the bits the scene runner's compiled loop computes. */
-#include "fmi_layer/small_fmi2_cosim.h"
+#include "fmi_layer/small_cosim_model.h"
 
 #include <stddef.h>
 
 #include "host_fp_environment.h"
 
-static const SmallFmi2Model* const kModel = &kSmallFmi2Model;
+static const SmallCosimModel* const kModel = &kSmallCosimModel;
 
 enum { kAnyState = STATE_INSTANTIATED | STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR };
 
@@ -17,67 +18,32 @@ static FmiInstance* usable(fmi2Component c, const char* function, int states) {
     return fmi_allowed(instance, function, states) ? instance : NULL;
 }
 
-static int arrays_given(const FmiInstance* instance, const char* function, size_t nvr, const void* vr, const void* value) {
-    return nvr == 0 || (fmi_not_null(instance, function, vr, "vr") && fmi_not_null(instance, function, value, "value"));
-}
-
-static int reference_known(const FmiInstance* instance, const char* function, const SmallFmi2Variables* variables,
-                           const char* type, fmi2ValueReference vr) {
-    if (vr < variables->count) return 1;
-    const int vowel = type[0] == 'I';
-    fmi_log_error(instance, "%s: value reference %u is not a%s %s variable%s", function, (unsigned)vr, vowel ? "n" : "",
-                  type, variables->count == 0 ? " (this FMU has none)" : "");
-    return 0;
-}
+_Static_assert(sizeof(fmi2ValueReference) == sizeof(unsigned), "value references are the layer's unsigned");
 
 /* fmi2Get<type>: `value` is the host's array of elements of `size` bytes. */
-static fmi2Status get_values(fmi2Component c, const char* function, const SmallFmi2Variables* variables, const char* type,
+static fmi2Status get_values(fmi2Component c, const char* function, const SmallCosimVariables* variables, const char* type,
                              const fmi2ValueReference vr[], size_t nvr, void* value, size_t size) {
     FmiInstance* instance = usable(c, function, kModel->get_states);
-    if (instance == NULL || !arrays_given(instance, function, nvr, vr, value)) return fmi2Error;
-    for (size_t i = 0; i < nvr; ++i) {
-        if (!reference_known(instance, function, variables, type, vr[i])) return fmi2Error;
-        const FmiStatus status = variables->get(instance, function, vr[i], (unsigned char*)value + i * size);
-        if (status != FMI_OK) return (fmi2Status)status;
-    }
-    return fmi2OK;
+    if (instance == NULL) return fmi2Error;
+    return (fmi2Status)small_cosim_get(instance, function, variables, type, 0, vr, nvr, value, size,
+                                       SMALL_VALUES_AS_THE_MODELS);
 }
 
 /* fmi2Set<type>: all or nothing, every value checked before any is set. */
-static fmi2Status set_values(fmi2Component c, const char* function, const SmallFmi2Variables* variables, const char* type,
+static fmi2Status set_values(fmi2Component c, const char* function, const SmallCosimVariables* variables, const char* type,
                              const fmi2ValueReference vr[], size_t nvr, const void* value, size_t size) {
     FmiInstance* instance = usable(c, function, kModel->set_states);
-    if (instance == NULL || !arrays_given(instance, function, nvr, vr, value)) return fmi2Error;
-    for (size_t i = 0; i < nvr; ++i)
-        if (!reference_known(instance, function, variables, type, vr[i]) ||
-            !variables->settable(instance, function, vr[i], (const unsigned char*)value + i * size))
-            return fmi2Error;
-    for (size_t i = 0; i < nvr; ++i) {
-        const FmiStatus status = variables->set(instance, function, vr[i], (const unsigned char*)value + i * size);
-        if (status != FMI_OK) return (fmi2Status)status;
-    }
-    if (nvr > 0 && kModel->values_set != NULL) kModel->values_set(instance);
-    return fmi2OK;
+    if (instance == NULL) return fmi2Error;
+    return (fmi2Status)small_cosim_set(instance, function, variables, type, 0, vr, nvr, value, size,
+                                       SMALL_VALUES_AS_THE_MODELS);
 }
 
 /* ---------------------------------------------------------------- lifetime */
 
-static void free_instance(FmiInstance* instance) {
-    if (instance == NULL) return;
-    if (kModel->release != NULL) kModel->release(instance);
-    fmi_free_instance(instance);
-}
-
 static fmi2Component instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resource_location,
                                  const fmi2CallbackFunctions* functions, fmi2Boolean logging_on) {
     FmiInstance* instance = fmi2_instantiate(&kModel->layer, 0, name, type, guid, functions, logging_on);
-    if (instance == NULL || kModel->instantiated == NULL) return instance;
-    if (kModel->instantiated(instance, resource_location) != 0) {
-        fmi_log_error(instance, "fmi2Instantiate: out of memory");
-        free_instance(instance);
-        return NULL;
-    }
-    return instance;
+    return small_cosim_instantiated(instance, "fmi2Instantiate", resource_location);
 }
 
 static fmi2Status set_debug_logging(fmi2Component c, fmi2Boolean on, size_t count, const fmi2String categories[]) {
@@ -90,12 +56,9 @@ static fmi2Status set_debug_logging(fmi2Component c, fmi2Boolean on, size_t coun
 
 static fmi2Status setup_experiment(fmi2Component c, fmi2Real start, fmi2Boolean stop_defined, fmi2Real stop) {
     FmiInstance* instance = usable(c, "fmi2SetupExperiment", STATE_INSTANTIATED);
-    if (instance == NULL ||
-        !fmi_experiment_times_valid(instance, "fmi2SetupExperiment", start, stop_defined != fmi2False, stop))
-        return fmi2Error;
-    instance->time = start, instance->stop_time = stop, instance->stop_time_defined = stop_defined ? 1 : 0;
-    if (kModel->experiment_start != NULL) kModel->experiment_start(instance, start);
-    return fmi2OK;
+    if (instance == NULL) return fmi2Error;
+    return (fmi2Status)small_cosim_start_experiment(instance, "fmi2SetupExperiment", start, stop_defined != fmi2False,
+                                                    stop);
 }
 
 static fmi2Status enter_initialization_mode(fmi2Component c) {
@@ -108,10 +71,7 @@ static fmi2Status enter_initialization_mode(fmi2Component c) {
 static fmi2Status exit_initialization_mode(fmi2Component c) {
     FmiInstance* instance = usable(c, "fmi2ExitInitializationMode", STATE_INITIALIZATION);
     if (instance == NULL) return fmi2Error;
-    const FmiStatus status = kModel->exit_initialization(instance, "fmi2ExitInitializationMode");
-    if (status != FMI_OK) return (fmi2Status)status;
-    instance->state = STATE_STEP_COMPLETE;
-    return fmi2OK;
+    return (fmi2Status)small_cosim_exit_initialization(instance, "fmi2ExitInitializationMode", STATE_STEP_COMPLETE);
 }
 
 static fmi2Status terminate(fmi2Component c) {
@@ -124,12 +84,7 @@ static fmi2Status terminate(fmi2Component c) {
 static fmi2Status reset(fmi2Component c) {
     FmiInstance* instance = usable(c, "fmi2Reset", kAnyState);
     if (instance == NULL) return fmi2Error;
-    const FmiStatus status = kModel->reset(instance, "fmi2Reset");
-    if (status != FMI_OK) return (fmi2Status)status;
-    instance->time = 0.0, instance->stop_time = 0.0, instance->stop_time_defined = 0;
-    instance->last_step_status = FMI_OK;
-    instance->state = STATE_INSTANTIATED;
-    return fmi2OK;
+    return (fmi2Status)small_cosim_reset(instance, "fmi2Reset");
 }
 
 /* ---------------------------------------------------------------- stepping and its status */
@@ -226,7 +181,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
 void fmi2FreeInstance(fmi2Component c) {
     HostFpEnvironment host_environment;
     enter_fmu_fp(&host_environment);
-    free_instance((FmiInstance*)c);
+    small_cosim_free_instance((FmiInstance*)c);
     leave_fmu_fp(&host_environment);
 }
 

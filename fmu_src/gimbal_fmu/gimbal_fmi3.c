@@ -1,5 +1,7 @@
 /* The gimbal's FMI 3.0 face (Model Exchange and Co-Simulation), beside the FMI 2.0 one: FMI 3.0's state
- * machine, types and value references over the FMI instance layer (fmi_layer/fmi_instance.h) and the
+ * machine, types and value references over the FMI instance layer (fmi_layer/fmi_instance.h), its FMI
+ * 3.0 face (fmi_layer/fmi3_face.h: the states, instantiation, and the functions every FMU of the
+ * project has alike, the FMU-state ones and, in fmi3_not_offered.c, those none offers) and the
  * core's C interface (gimbal_c_api.h).
  *
  * Value references: gimbal_model.h (FMI3_INTEGER_BASE ...). The event indicators are scalar Float64
@@ -11,71 +13,13 @@
  * Mode, where there is no discrete state left to update). */
 #include <math.h>
 #include <stdint.h>
-#include <string.h>
+#include <stdlib.h>
 
-#include "fmi3Functions.h"
+#include "fmi_layer/fmi3_face.h"
 #include "gimbal_model.h"
 #include "host_fp_environment.h"
 
 _Static_assert(sizeof(fmi3ValueReference) == sizeof(unsigned), "value references are passed to the core as unsigned");
-_Static_assert((int)fmi3OK == (int)FMI_OK && (int)fmi3Warning == (int)FMI_WARNING &&
-                   (int)fmi3Discard == (int)FMI_DISCARD && (int)fmi3Error == (int)FMI_ERROR &&
-                   (int)fmi3Fatal == (int)FMI_FATAL,
-               "fmi3Status is the layer's status");
-
-/* The bits are those FMU-state records of the FMI 3.0 binary hold. */
-typedef enum {
-    S_INSTANTIATED = 1 << 0,
-    S_INITIALIZATION = 1 << 1,
-    S_EVENT = 1 << 2,
-    S_CONTINUOUS_TIME = 1 << 3, /* Model Exchange */
-    S_STEP = 1 << 4,            /* Co-Simulation */
-    S_STEP_DISCARDED = 1 << 5,  /* Co-Simulation: a step failed; get, roll back, terminate or reset */
-    S_TERMINATED = 1 << 6,
-    S_ERROR = 1 << 7,
-} State3;
-
-#define S_ANY 0xFF
-#define S_RUNNING (S_EVENT | S_CONTINUOUS_TIME | S_STEP | S_STEP_DISCARDED)
-#define S_GET (S_INITIALIZATION | S_RUNNING | S_TERMINATED | S_ERROR)
-#define S_SET (S_INSTANTIATED | S_INITIALIZATION | S_EVENT | S_CONTINUOUS_TIME | S_STEP)
-#define S_FMU_STATE (S_INSTANTIATED | S_INITIALIZATION | S_RUNNING | S_TERMINATED)
-#define S_EVALUATE (S_EVENT | S_CONTINUOUS_TIME | S_TERMINATED | S_ERROR)
-
-static const char* state_name(int s) {
-    switch (s) {
-        case S_INSTANTIATED: return "instantiated";
-        case S_INITIALIZATION: return "initialization mode";
-        case S_EVENT: return "event mode";
-        case S_CONTINUOUS_TIME: return "continuous-time mode";
-        case S_STEP: return "step mode";
-        case S_STEP_DISCARDED: return "step discarded";
-        case S_TERMINATED: return "terminated";
-        default: return "error";
-    }
-}
-
-static void deliver(const FmiInstance* instance, FmiStatus status, const char* category, const char* message) {
-    ((fmi3LogMessageCallback)instance->logger)(instance->environment, (fmi3Status)status, category, message);
-}
-
-/* FMI 3.0's header records no step status; the interface an instance serves shows in its state. */
-static const FmiFace kFmi3Face = {
-    .deliver = deliver,
-    .logger_formats_message = 0,
-    .instantiated_state = S_INSTANTIATED,
-    .any_state = S_ANY,
-    .error_state = S_ERROR,
-    .before_initialized_states = S_INSTANTIATED | S_INITIALIZATION,
-    .state_name = state_name,
-    .state_magic = STATE_MAGIC_FMI3,
-    .state_rules = {S_FMU_STATE, S_RUNNING | S_TERMINATED, -1, 0, S_CONTINUOUS_TIME, S_STEP | S_STEP_DISCARDED,
-                    state_name},
-    .get_fmu_state = "fmi3GetFMUState",
-    .deserialize_fmu_state = "fmi3DeserializeFMUState",
-    .fmu_state_argument = "FMUState",
-};
-
 
 static fmi3Status refuse(FmiInstance* i, const char* function, const char* why) {
     return (fmi3Status)fmi_refuse(i, function, why);
@@ -88,22 +32,8 @@ static fmi3Status from_core(GimbalStatus status) { return (fmi3Status)gimbal_sta
 static fmi3Instance instantiate(fmi3String name, fmi3String token, int model_exchange, int event_mode_used,
                                 int early_return_allowed, fmi3Boolean loggingOn, fmi3InstanceEnvironment environment,
                                 fmi3LogMessageCallback log, const char* function) {
-    FmiInstance probe;
-    memset(&probe, 0, sizeof probe);
-    probe.face = &kFmi3Face;
-    probe.model = &kGimbalModel;
-    probe.logger = (FmiHostLogger)log;
-    probe.environment = environment;
-    probe.name = (char*)name;
-    probe.model_exchange = model_exchange;
-    probe.event_mode_used = event_mode_used;
-    probe.early_return_allowed = early_return_allowed;
-    return fmi_instantiate(&probe, function, NULL, token, "instantiationToken", loggingOn ? 1 : 0);
-}
-
-static fmi3Status set_debug_logging(FmiInstance* i, fmi3Boolean on, size_t n, const fmi3String categories[]) {
-    if (i == NULL) return fmi3Error;
-    return (fmi3Status)fmi_set_debug_logging(i, "fmi3SetDebugLogging", on ? 1 : 0, n, categories);
+    return fmi3_instantiate(&kGimbalModel, function, NULL, name, token, model_exchange, event_mode_used,
+                            early_return_allowed, loggingOn, environment, log);
 }
 
 static fmi3Status enter_initialization(FmiInstance* i, fmi3Boolean tolerance_defined, fmi3Float64 tolerance,
@@ -187,7 +117,7 @@ static int variable_accessible(FmiInstance* i, const char* f, int set, Kind kind
         return 0;
     }
     if (set && !gimbal_variable_settable(i, &info)) {
-        fmi_log_error(i, "%s: %s cannot be set in state '%s'", f, info.name, state_name(i->state));
+        fmi_log_error(i, "%s: %s cannot be set in state '%s'", f, info.name, i->face->state_name(i->state));
         return 0;
     }
     return 1;
@@ -302,53 +232,6 @@ static fmi3Status set_boolean(FmiInstance* i, const fmi3ValueReference vr[], siz
         if (status > fmi3Warning) return status;
     }
     return fmi3OK;
-}
-
-/* Types the model has no variables of: the state is checked, any value reference refused by name. */
-static fmi3Status no_such_type(FmiInstance* i, const char* f, int set, const fmi3ValueReference vr[], size_t nvr) {
-    if (!fmi_allowed(i, f, set ? S_SET : S_GET)) return fmi3Error;
-    if (nvr == 0) return fmi3OK;
-    if (!fmi_not_null(i, f, vr, "valueReferences")) return fmi3Error;
-    fmi_log_error(i, "%s: value reference %u: the model has no variable of this type", f, (unsigned)vr[0]);
-    return fmi3Error;
-}
-
-/* ---------------------------------------------------------------- FMU states */
-
-static fmi3Status get_fmu_state(FmiInstance* i, fmi3FMUState* out) {
-    const char* f = "fmi3GetFMUState";
-    if (!fmi_allowed(i, f, S_FMU_STATE)) return fmi3Error;
-    return (fmi3Status)fmi_get_fmu_state(i, f, out);
-}
-
-static fmi3Status set_fmu_state(FmiInstance* i, fmi3FMUState state) {
-    const char* f = "fmi3SetFMUState";
-    if (!fmi_allowed(i, f, S_FMU_STATE | S_STEP_DISCARDED)) return fmi3Error;
-    return (fmi3Status)fmi_set_fmu_state(i, f, state);
-}
-
-static fmi3Status free_fmu_state(FmiInstance* i, fmi3FMUState* state) {
-    const char* f = "fmi3FreeFMUState";
-    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
-    return (fmi3Status)fmi_free_fmu_state(i, f, state);
-}
-
-static fmi3Status serialized_size(FmiInstance* i, fmi3FMUState state, size_t* size) {
-    const char* f = "fmi3SerializedFMUStateSize";
-    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
-    return (fmi3Status)fmi_serialized_fmu_state_size(i, f, state, size);
-}
-
-static fmi3Status serialize(FmiInstance* i, fmi3FMUState state, fmi3Byte bytes[], size_t size) {
-    const char* f = "fmi3SerializeFMUState";
-    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
-    return (fmi3Status)fmi_serialize_fmu_state(i, f, state, bytes, size);
-}
-
-static fmi3Status deserialize(FmiInstance* i, const fmi3Byte bytes[], size_t size, fmi3FMUState* out) {
-    const char* f = "fmi3DeserializeFMUState";
-    if (!fmi_allowed(i, f, S_ANY)) return fmi3Error;
-    return (fmi3Status)fmi_deserialize_fmu_state(i, f, bytes, size, out);
 }
 
 /* ---------------------------------------------------------------- derivatives */
@@ -492,13 +375,6 @@ static fmi3Status do_step(FmiInstance* i, fmi3Float64 t, fmi3Float64 h, fmi3Bool
  * (IN_FMU_FP_ENVIRONMENT, host_fp_environment.h); OWN_INSTANCE is the host's opaque handle as ours. */
 #define OWN_INSTANCE ((FmiInstance*)instance)
 
-const char* fmi3GetVersion(void) { return fmi3Version; }
-
-fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
-                               const fmi3String categories[]) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, set_debug_logging(OWN_INSTANCE, loggingOn, nCategories, categories));
-}
-
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath,
                                           fmi3Boolean visible, fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
@@ -594,138 +470,18 @@ fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], 
     IN_FMU_FP_ENVIRONMENT(fmi3Status, set_boolean(OWN_INSTANCE, vr, nvr, values, n));
 }
 
-#define NO_SUCH_GET(name, type)                                                                                 \
-    fmi3Status fmi3Get##name(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, type values[],   \
-                             size_t n) {                                                                        \
-        (void)values, (void)n;                                                                                  \
-        IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3Get" #name, 0, vr, nvr));                                         \
-    }
-#define NO_SUCH_SET(name, type)                                                                                 \
-    fmi3Status fmi3Set##name(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const type values[], \
-                             size_t n) {                                                                        \
-        (void)values, (void)n;                                                                                  \
-        IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3Set" #name, 1, vr, nvr));                                         \
-    }
-NO_SUCH_GET(Float32, fmi3Float32)
-NO_SUCH_SET(Float32, fmi3Float32)
-NO_SUCH_GET(Int8, fmi3Int8)
-NO_SUCH_SET(Int8, fmi3Int8)
-NO_SUCH_GET(UInt8, fmi3UInt8)
-NO_SUCH_SET(UInt8, fmi3UInt8)
-NO_SUCH_GET(Int16, fmi3Int16)
-NO_SUCH_SET(Int16, fmi3Int16)
-NO_SUCH_GET(UInt16, fmi3UInt16)
-NO_SUCH_SET(UInt16, fmi3UInt16)
-NO_SUCH_GET(UInt32, fmi3UInt32)
-NO_SUCH_SET(UInt32, fmi3UInt32)
-NO_SUCH_GET(UInt64, fmi3UInt64)
-NO_SUCH_SET(UInt64, fmi3UInt64)
-NO_SUCH_GET(String, fmi3String)
-NO_SUCH_SET(String, fmi3String)
-
-fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
-                         fmi3Binary values[], size_t n) {
-    (void)sizes, (void)values, (void)n;
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3GetBinary", 0, vr, nvr));
-}
-fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const size_t sizes[],
-                         const fmi3Binary values[], size_t n) {
-    (void)sizes, (void)values, (void)n;
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3SetBinary", 1, vr, nvr));
-}
-fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
-    (void)values;
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3GetClock", 0, vr, nvr));
-}
-fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
-    (void)values;
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, no_such_type(OWN_INSTANCE, "fmi3SetClock", 1, vr, nvr));
-}
+/* String: the one type without variables that not every FMU of the project lacks (fmi3_not_offered.c
+ * refuses the others). */
+FMI3_ABSENT_TYPE(String, fmi3String)
 
 /* What this FMU does not offer, as its model description says: refused with the reason. */
-#define NOT_OFFERED(call, why) IN_FMU_FP_ENVIRONMENT(fmi3Status, (OWN_INSTANCE == NULL ? fmi3Error : refuse(OWN_INSTANCE, call, why)))
+#define NOT_OFFERED(call, why) IN_FMU_FP_ENVIRONMENT(fmi3Status, fmi3_refuse_not_offered(OWN_INSTANCE, call, why))
 
-fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t* n) {
-    (void)vr, (void)n;
-    NOT_OFFERED("fmi3GetNumberOfVariableDependencies", "the dependencies are in <ModelStructure> (no per-element dependencies)");
-}
-fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent, size_t a[],
-                                       fmi3ValueReference b[], size_t c[], fmi3DependencyKind d[], size_t n) {
-    (void)dependent, (void)a, (void)b, (void)c, (void)d, (void)n;
-    NOT_OFFERED("fmi3GetVariableDependencies", "the dependencies are in <ModelStructure> (no per-element dependencies)");
-}
-
-fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { IN_FMU_FP_ENVIRONMENT(fmi3Status, get_fmu_state(OWN_INSTANCE, FMUState)); }
-fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) { IN_FMU_FP_ENVIRONMENT(fmi3Status, set_fmu_state(OWN_INSTANCE, FMUState)); }
-fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState) { IN_FMU_FP_ENVIRONMENT(fmi3Status, free_fmu_state(OWN_INSTANCE, FMUState)); }
-fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, serialized_size(OWN_INSTANCE, FMUState, size));
-}
-fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, serialize(OWN_INSTANCE, FMUState, serializedState, size));
-}
-fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
-                                   fmi3FMUState* FMUState) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, deserialize(OWN_INSTANCE, serializedState, size, FMUState));
-}
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
     IN_FMU_FP_ENVIRONMENT(fmi3Status, directional_derivative(OWN_INSTANCE, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed, sensitivity, nSensitivity));
-}
-fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
-                                    const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
-                                    size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed, (void)sensitivity, (void)nSensitivity;
-    NOT_OFFERED("fmi3GetAdjointDerivative", "providesAdjointDerivatives is false");
-}
-
-fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
-    NOT_OFFERED("fmi3EnterConfigurationMode", "the model has no structural parameters to configure after instantiation");
-}
-fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
-    NOT_OFFERED("fmi3ExitConfigurationMode", "the model has no structural parameters to configure after instantiation");
-}
-fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 a[],
-                                  fmi3IntervalQualifier q[]) {
-    (void)vr, (void)n, (void)a, (void)q;
-    NOT_OFFERED("fmi3GetIntervalDecimal", "the model has no clocks");
-}
-fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3UInt64 a[],
-                                   fmi3UInt64 b[], fmi3IntervalQualifier q[]) {
-    (void)vr, (void)n, (void)a, (void)b, (void)q;
-    NOT_OFFERED("fmi3GetIntervalFraction", "the model has no clocks");
-}
-fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 a[]) {
-    (void)vr, (void)n, (void)a;
-    NOT_OFFERED("fmi3GetShiftDecimal", "the model has no clocks");
-}
-fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3UInt64 a[],
-                                fmi3UInt64 b[]) {
-    (void)vr, (void)n, (void)a, (void)b;
-    NOT_OFFERED("fmi3GetShiftFraction", "the model has no clocks");
-}
-fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Float64 a[]) {
-    (void)vr, (void)n, (void)a;
-    NOT_OFFERED("fmi3SetIntervalDecimal", "the model has no clocks");
-}
-fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 a[],
-                                   const fmi3UInt64 b[]) {
-    (void)vr, (void)n, (void)a, (void)b;
-    NOT_OFFERED("fmi3SetIntervalFraction", "the model has no clocks");
-}
-fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Float64 a[]) {
-    (void)vr, (void)n, (void)a;
-    NOT_OFFERED("fmi3SetShiftDecimal", "the model has no clocks");
-}
-fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 a[],
-                                const fmi3UInt64 b[]) {
-    (void)vr, (void)n, (void)a, (void)b;
-    NOT_OFFERED("fmi3SetShiftFraction", "the model has no clocks");
-}
-fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance) {
-    NOT_OFFERED("fmi3EvaluateDiscreteStates", "providesEvaluateDiscreteStates is false");
 }
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discreteStatesNeedUpdate,
                                     fmi3Boolean* terminateSimulation, fmi3Boolean* nominalsOfContinuousStatesChanged,

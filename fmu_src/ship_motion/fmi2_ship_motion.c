@@ -1,6 +1,7 @@
 /* The ship-motion FMU's model file: ship_motion.h and the recorded motion behind the small FMUs' FMI
- * 2.0 Co-Simulation face (fmi_layer/small_fmi2_cosim.h), which checks the states, pointers and value
- * references and exports the fmi2* functions; here are the checks of the values, the clock, the rows.
+ * 2.0 and FMI 3.0 Co-Simulation faces (fmi_layer/small_cosim_model.h), which check the states,
+ * pointers and value references and export the fmi2* or fmi3* functions; here are the checks of the
+ * values, the clock, the rows, and the FMU-state snapshot (offered by the FMI 3.0 FMU).
  *
  * The clock: the outputs after k steps are row k of the grid at t = k h from the motion's start, h
  * the first doStep's step size; the motion is that of the scene runner's grid from t = 0 (the FMU
@@ -15,10 +16,11 @@
 #include <limits.h>
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi_layer/small_fmi2_cosim.h"
+#include "fmi_layer/small_cosim_model.h"
 #include "gimbal_kernel/recorded_motion.h"
 #include "recording_file.h"
 #include "ship_motion.h"
@@ -164,14 +166,15 @@ static int reset_instance(Instance* instance) {
     instance->common.stop_time = 0.0;
     instance->common.last_step_status = FMI_OK;
     for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) instance->outputs[k] = 0.0;
-    instance->common.state = STATE_INSTANTIATED;
+    instance->common.state = instance->common.face->instantiated_state;
     return 0;
 }
 
 static int instantiated(FmiInstance* common, const char* resource_location) {
     Instance* instance = ship(common);
     /* No resources folder is no error here: only a relative recording_file needs one. */
-    instance->resources = recording_resources_folder(resource_location);
+    instance->resources = common->face->resource_location_is_uri ? recording_resources_folder(resource_location)
+                                                                 : recording_resources_folder_of_path(resource_location);
     return reset_instance(instance);
 }
 
@@ -326,7 +329,7 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     if (instance->recording != NULL) return step_recording(instance, function, step, end_time);
     if (instance->step == 0.0) {
         if (ship_motion_set_step(&instance->motion, step) != 0) {
-            instance->common.state = STATE_ERROR;
+            instance->common.state = instance->common.face->error_state;
             instance->common.last_step_status = FMI_ERROR;
             REFUSE(instance, "%s: out of memory for the rotation tables of step %g", function, step);
         }
@@ -335,7 +338,7 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     double row[SHIP_MOTION_OUTPUTS];
     ship_motion_row(&instance->motion, instance->row + 1, row);
     if (!finite_row(instance, row, function, end_time)) {
-        instance->common.state = STATE_ERROR;
+        instance->common.state = instance->common.face->error_state;
         instance->common.last_step_status = FMI_ERROR;
         return FMI_ERROR;
     }
@@ -346,11 +349,132 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     return FMI_OK;
 }
 
+/* ---------------------------------------------------------------- FMU states */
+
+/* The instance's part of an FMU state (the layer's record holds the times and the state): what the
+ * outputs and the next rows follow from. The sea state's components and the recording's splines are
+ * not in it: restoring prepares them again from the parameters (and the file), as initialization
+ * did, so the rows that follow have the same bits. */
+enum { kSnapshotFileCapacity = 1024 };
+typedef struct {
+    int32_t initialized; /* after initialization: what the layer checks against the record's state */
+    int32_t prepared;
+    int32_t stop_time_defined;
+    int32_t reserved;
+    ShipMotionParameters parameters;
+    double start_time, stop_time, step;
+    int64_t row;
+    double outputs[SHIP_MOTION_OUTPUTS];
+    char recording_file[kSnapshotFileCapacity];
+} ShipSnapshot;
+
+static const char* calling(const Instance* instance) {
+    return instance->common.calling != NULL ? instance->common.calling : "fmi3SetFMUState";
+}
+
+static size_t snapshot_size(void) { return sizeof(ShipSnapshot); }
+
+static FmiStatus save(void* model, unsigned char* bytes) {
+    Instance* instance = (Instance*)model;
+    ShipSnapshot snapshot;
+    memset(&snapshot, 0, sizeof snapshot);
+    const size_t length = strlen(instance->recording_file);
+    if (length >= sizeof snapshot.recording_file)
+        REFUSE(instance, "%s: recording_file has %zu characters, an FMU state holds %zu at most", calling(instance),
+               length, sizeof snapshot.recording_file - 1);
+    snapshot.initialized = (instance->common.state & instance->common.face->before_initialized_states) == 0;
+    snapshot.prepared = instance->prepared;
+    snapshot.stop_time_defined = instance->common.stop_time_defined;
+    snapshot.parameters = instance->parameters;
+    snapshot.start_time = instance->start_time;
+    snapshot.stop_time = instance->common.stop_time;
+    snapshot.step = instance->step;
+    snapshot.row = instance->row;
+    memcpy(snapshot.outputs, instance->outputs, sizeof snapshot.outputs);
+    memcpy(snapshot.recording_file, instance->recording_file, length + 1);
+    memcpy(bytes, &snapshot, sizeof snapshot);
+    return FMI_OK;
+}
+
+/* What in a snapshot this FMU could not have saved, or NULL. */
+static const char* snapshot_problem(ShipSnapshot* snapshot) {
+    if ((snapshot->initialized & ~1) != 0 || (snapshot->prepared & ~1) != 0 || (snapshot->stop_time_defined & ~1) != 0)
+        return "a flag is not a boolean";
+    if (snapshot->initialized && !snapshot->prepared) return "it is initialized without a prepared motion";
+    if (memchr(snapshot->recording_file, '\0', sizeof snapshot->recording_file) == NULL)
+        return "its recording_file is not a terminated string";
+    for (unsigned vr = SHIP_REAL_OUTPUTS; vr < SHIP_REAL_COUNT; ++vr) {
+        const double x = *ship_real_parameter(&snapshot->parameters, vr);
+        const ShipRealVariable* variable = &kShipRealVariables[vr];
+        if (!isfinite(x) || (variable->min_exclusive ? !(x > variable->min) : !(x >= variable->min)))
+            return "a Real parameter lies outside its bounds";
+    }
+    for (unsigned vr = 0; vr < SHIP_INTEGER_COUNT; ++vr) {
+        const int x = *ship_integer_parameter(&snapshot->parameters, vr);
+        if (x < kShipIntegerVariables[vr].min || x > kShipIntegerVariables[vr].max)
+            return "an Integer parameter lies outside its bounds";
+    }
+    if (!isfinite(snapshot->start_time) || !isfinite(snapshot->stop_time) || !isfinite(snapshot->step) ||
+        snapshot->step < 0.0)
+        return "its times or its step are not finite";
+    if (snapshot->row < 0 || snapshot->row >= LONG_MAX - 1 || (snapshot->row > 0 && snapshot->step == 0.0))
+        return "its grid row is not one a step reached";
+    for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k)
+        if (!isfinite(snapshot->outputs[k])) return "an output is not finite";
+    return NULL;
+}
+
+static FmiStatus check_snapshot(void* model, const unsigned char* bytes, int* initialized) {
+    ShipSnapshot snapshot;
+    memcpy(&snapshot, bytes, sizeof snapshot);
+    return fmi_snapshot_verdict((FmiInstance*)model, snapshot_problem(&snapshot), snapshot.initialized, initialized);
+}
+
+/* The motion of the snapshot is prepared beside the instance's and committed only when it could be:
+ * a refusal (the recording file gone, memory short) leaves the instance as it was. */
+static FmiStatus restore(void* model, const unsigned char* bytes) {
+    Instance* instance = (Instance*)model;
+    ShipSnapshot snapshot;
+    memcpy(&snapshot, bytes, sizeof snapshot);
+    Instance restored = *instance; /* the instance's identity, for prepare's messages */
+    memset(&restored.motion, 0, sizeof restored.motion);
+    restored.recording = NULL;
+    restored.prepared = 0;
+    restored.parameters = snapshot.parameters;
+    restored.start_time = snapshot.start_time;
+    restored.common.stop_time = snapshot.stop_time;
+    restored.common.stop_time_defined = snapshot.stop_time_defined;
+    restored.recording_file = copy_text(snapshot.recording_file);
+    if (restored.recording_file == NULL) REFUSE(instance, "%s: out of memory for recording_file", calling(instance));
+    if (snapshot.prepared && prepare(&restored, calling(instance)) != FMI_OK) {
+        free(restored.recording_file);
+        return FMI_ERROR;
+    }
+    if (restored.prepared && restored.recording == NULL && snapshot.step != 0.0 &&
+        ship_motion_set_step(&restored.motion, snapshot.step) != 0) {
+        unprepare(&restored);
+        free(restored.recording_file);
+        REFUSE(instance, "%s: out of memory for the rotation tables of step %g", calling(instance), snapshot.step);
+    }
+    unprepare(instance);
+    free(instance->recording_file);
+    instance->recording_file = restored.recording_file;
+    instance->parameters = restored.parameters;
+    instance->motion = restored.motion;
+    instance->recording = restored.recording;
+    instance->prepared = restored.prepared;
+    instance->start_time = snapshot.start_time;
+    instance->step = snapshot.step;
+    instance->row = (long)snapshot.row;
+    memcpy(instance->outputs, snapshot.outputs, sizeof instance->outputs);
+    return FMI_OK;
+}
+
 /* A failed step leaves the error state, in which the values and the step's status can still be read
  * and the instance terminated. */
-const SmallFmi2Model kSmallFmi2Model = {
+const SmallCosimModel kSmallCosimModel = {
     .layer = {SHIP_MOTION_GUID, sizeof(Instance), kLogCategories, (int)(sizeof kLogCategories / sizeof kLogCategories[0]),
-              model_fields, no_own_allocation, NULL, NULL, NULL, NULL, NULL},
+              model_fields, no_own_allocation, NULL, snapshot_size, save, check_snapshot, restore},
     .get_states = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR,
     .set_states = STATE_INSTANTIATED | STATE_INITIALIZATION,
     .terminate_states = STATE_STEP_COMPLETE | STATE_ERROR,

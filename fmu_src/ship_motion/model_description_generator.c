@@ -1,11 +1,13 @@
 /* Writes the variable, unit and structure parts of the ship-motion FMU's modelDescription.xml from
- * its variable table (ship_motion_variables.c), so that the XML and the binary cannot disagree:
- *     ship_motion_model_description_generator <units.xml> <variables.xml> <structure.xml>
+ * its variable table (ship_motion_variables.c), so that the XML and the binary cannot disagree, for
+ * the FMI 2.0 FMU or (--fmi3) the FMI 3.0 one:
+ *     ship_motion_model_description_generator [--fmi3] <units.xml> <variables.xml> <structure.xml>
  * It refuses (exit status 1, a message on stderr) a variable whose unit or display unit is not defined. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "fmi3_value_references.h"
 #include "model_description_writer.h"
 #include "ship_motion_variables.h"
 
@@ -36,7 +38,9 @@ static const Unit* find_unit(const char* name) {
     return NULL;
 }
 
-static int write_units(FILE* out) {
+/* The same in FMI 2.0 and FMI 3.0. */
+static int write_units(FILE* out, int fmi3) {
+    (void)fmi3;
     for (int k = 0; k < UNIT_COUNT; ++k) {
         fprintf(out, "    <Unit name=\"%s\">", kUnits[k].name);
         if (kUnits[k].base_unit[0] != '\0') fprintf(out, "<BaseUnit %s/>", kUnits[k].base_unit);
@@ -47,7 +51,12 @@ static int write_units(FILE* out) {
     return 0;
 }
 
-static int write_variables(FILE* out) {
+/* FMI 3.0's value references: common/fmi3_value_references.h (FMI 2.0's number each type from 0). */
+_Static_assert((int)SHIP_REAL_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY &&
+                   (int)SHIP_INTEGER_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY,
+               "FMI 3.0's value references leave room for the variables of each type");
+static int write_variables(FILE* out, int fmi3) {
+    write_independent_time(out, fmi3);
     for (int vr = 0; vr < SHIP_REAL_COUNT; ++vr) {
         const ShipRealVariable* v = &kShipRealVariables[vr];
         const Unit* unit = find_unit(v->unit);
@@ -56,41 +65,43 @@ static int write_variables(FILE* out) {
             return 1;
         }
         const int output = v->causality == SHIP_OUTPUT;
-        fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"%s\" variability=\"%s\" initial=\"%s\"\n"
-                     "      description=\"",
-                v->name, vr, output ? "output" : "parameter", output ? "continuous" : "fixed", output ? "calculated" : "exact");
-        write_xml_escaped(out, v->description);
-        fprintf(out, "\">\n      <Real unit=\"%s\"", v->unit);
+        write_variable_start(out, fmi3, "Real", "Float64", v->name, (fmi3 ? SMALL_FMI3_FLOAT64_BASE : 0) + vr,
+                             output ? "output" : "parameter", output ? "continuous" : "fixed",
+                             output ? "calculated" : "exact", v->description);
+        fprintf(out, " unit=\"%s\"", v->unit);
         if (v->display_unit[0] != '\0') fprintf(out, " displayUnit=\"%s\"", v->display_unit);
         if (!output) fprintf(out, " start=\"%.17g\"", v->start);
         if (v->min != -HUGE_VAL) fprintf(out, " min=\"%.17g\"", v->min);
-        fputs("/>\n    </ScalarVariable>\n", out);
+        write_variable_end(out, fmi3);
     }
     for (int vr = 0; vr < SHIP_INTEGER_COUNT; ++vr) {
         const ShipIntegerVariable* v = &kShipIntegerVariables[vr];
-        fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
-                     "initial=\"exact\"\n      description=\"", v->name, vr);
-        write_xml_escaped(out, v->description);
-        fprintf(out, "\">\n      <Integer start=\"%d\" min=\"%d\" max=\"%d\"/>\n    </ScalarVariable>\n", v->start, v->min,
-                v->max);
+        write_variable_start(out, fmi3, "Integer", "Int32", v->name, (fmi3 ? SMALL_FMI3_INT32_BASE : 0) + vr,
+                             "parameter", "fixed", "exact", v->description);
+        fprintf(out, " start=\"%d\" min=\"%d\" max=\"%d\"", v->start, v->min, v->max);
+        write_variable_end(out, fmi3);
     }
     for (int vr = 0; vr < SHIP_STRING_COUNT; ++vr) {
         const ShipStringVariable* v = &kShipStringVariables[vr];
-        fprintf(out, "    <ScalarVariable name=\"%s\" valueReference=\"%d\" causality=\"parameter\" variability=\"fixed\" "
-                     "initial=\"exact\"\n      description=\"", v->name, vr);
-        write_xml_escaped(out, v->description);
-        fputs("\">\n      <String start=\"", out);
-        write_xml_escaped(out, v->start);
-        fputs("\"/>\n    </ScalarVariable>\n", out);
+        write_variable_start(out, fmi3, "String", "String", v->name, (fmi3 ? SMALL_FMI3_STRING_BASE : 0) + vr,
+                             "parameter", "fixed", "exact", v->description);
+        write_string_start_and_end(out, fmi3, v->start);
     }
     return 0;
 }
 
 static int is_output(int value_reference) { return kShipRealVariables[value_reference].causality == SHIP_OUTPUT; }
 
-/* The outputs are the first variables (index = value reference + 1). They depend on no input (there
- * are none); at initialization on the parameters (no dependencies attribute: on all of them). */
-static int write_structure(FILE* out) {
+/* The outputs are the first variables (FMI 2.0's index = value reference + 1, FMI 3.0 names the
+ * value reference). They depend on no input (there are none); at initialization on the parameters
+ * (no dependencies attribute: on all of them). */
+static int write_structure(FILE* out, int fmi3) {
+    if (fmi3) {
+        write_outputs_fmi3(out, SHIP_REAL_COUNT, is_output);
+        for (int vr = 0; vr < SHIP_REAL_OUTPUTS; ++vr)
+            fprintf(out, "    <InitialUnknown valueReference=\"%d\"/>\n", SMALL_FMI3_FLOAT64_BASE + vr);
+        return 0;
+    }
     fputs("    <Outputs>\n", out);
     write_output_unknowns(out, SHIP_REAL_COUNT, is_output);
     fputs("    </Outputs>\n    <InitialUnknowns>\n", out);

@@ -45,6 +45,16 @@ char* recording_resources_folder(const char* resource_location) {
     return folder;
 }
 
+char* recording_resources_folder_of_path(const char* resource_path) {
+    if (resource_path == NULL || resource_path[0] == '\0') return NULL;
+    size_t length = strlen(resource_path);
+    char* folder = malloc(length + 1);
+    if (folder == NULL) return NULL;
+    memcpy(folder, resource_path, length + 1);
+    while (length > 1 && (folder[length - 1] == '/' || folder[length - 1] == '\\')) folder[--length] = '\0';
+    return folder;
+}
+
 static int is_absolute(const char* path) {
     return path[0] == '/' || path[0] == '\\' || has_drive_letter(path);
 }

@@ -1,5 +1,6 @@
 /* The ship-motion FMU's recording file: where it is (absolute, or relative to the resources folder
- * that fmi2Instantiate's fmuResourceLocation names as a file: URI) and its bytes. No FMI here. */
+ * that fmi2Instantiate's fmuResourceLocation names as a file: URI, fmi3InstantiateCoSimulation's
+ * resourcePath as a path) and its bytes. No FMI here. */
 #ifndef SHIP_RECORDING_FILE_H
 #define SHIP_RECORDING_FILE_H
 
@@ -9,6 +10,11 @@
  * "file:/x"), percent-decoded, without a trailing '/'; NULL when the location is NULL or not a local
  * file: URI, or when out of memory. Free it. */
 char* recording_resources_folder(const char* resource_location);
+
+/* The resources folder of FMI 3.0's resourcePath (a path, with or without a trailing separator), a
+ * copy without the trailing separator; NULL when the path is NULL or empty, or when out of memory.
+ * Free it. */
+char* recording_resources_folder_of_path(const char* resource_path);
 
 /* The path of `file`: itself when absolute, else resources/file. NULL, with the reason in `message`,
  * for an empty name, a relative one without a resources folder, or out of memory. Free it. */

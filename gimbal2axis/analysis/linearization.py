@@ -67,7 +67,8 @@ def _linear_model_struct(lib):
                     ("voltage_clamped", ctypes.c_int * 2),
                     ("friction", ctypes.c_int * 4),
                     ("elevation_stop", ctypes.c_int),
-                    ("time", ctypes.c_double)]
+                    ("time", ctypes.c_double),
+                    ("amplifier_saturated", ctypes.c_int * 2)]
 
     if ctypes.sizeof(LinearModelStruct) != size.value:
         raise SceneError(f"the probe library's GimbalLinearModel has {size.value} bytes where its fields as read here "

@@ -32,6 +32,11 @@ def _description(fmu_path: pathlib.Path, fmu: FMU) -> pathlib.Path | None:
     return path if path.is_file() else None
 
 
+# The gimbal's current commands act only with motor<j>.drive = current; the controller FMU commands
+# voltages, so a system of these FMUs drives the motors by voltage and leaves them at their start.
+VOLTAGE_DRIVE_UNUSED = {("gimbal", "i_R1_cmd"), ("gimbal", "i_R2_cmd")}
+
+
 def _connections(fmus: dict) -> list[Connection]:
     """Every input of the gimbal and the controller from the output of the same name (the ship's
     first, then the gimbal's, then the controller's); an input nobody gives is refused."""
@@ -40,7 +45,7 @@ def _connections(fmus: dict) -> list[Connection]:
     connections = []
     for target in ("gimbal", "controller"):
         for variable in fmus[target].model_description.modelVariables:
-            if variable.causality != "input":
+            if variable.causality != "input" or (target, variable.name) in VOLTAGE_DRIVE_UNUSED:
                 continue
             source = next((s for s in ("ship", "gimbal", "controller") if s != target and variable.name in outputs[s]),
                           None)

@@ -57,6 +57,10 @@ const UnitDefinition kUnits[] = {
     {"V.s/rad", "kg=\"1\" m=\"2\" s=\"-2\" A=\"-1\" rad=\"-1\"", ""},
     {"N.m/rad", "kg=\"1\" m=\"2\" s=\"-2\" rad=\"-1\"", ""},
     {"N.m.s/rad", "kg=\"1\" m=\"2\" s=\"-1\" rad=\"-1\"", ""},
+    {"Hz", "s=\"-1\"", ""},
+    {"V/A", "kg=\"1\" m=\"2\" s=\"-3\" A=\"-2\"", ""},
+    {"V/(A.s)", "kg=\"1\" m=\"2\" s=\"-4\" A=\"-2\"", ""},
+    {"V/s", "kg=\"1\" m=\"2\" s=\"-4\" A=\"-1\"", ""},
 };
 
 const char* to_string(gimbal::Causality c) {
@@ -148,12 +152,21 @@ std::string vendor_annotations(bool fmi3) {
     s << (fmi3 ? "  <Annotations>\n    <Annotation type=\"gimbal2axis\">\n"
                : "  <VendorAnnotations>\n    <Tool name=\"gimbal2axis\">\n")
       << "      <ModeOutputs>\n";
-    for (const ModeOutputText& mode : kModeOutputs) {
+    for (std::size_t m = 0; m < sizeof kModeOutputs / sizeof kModeOutputs[0]; ++m) {
+        const ModeOutputText& mode = kModeOutputs[m];
         s << "        <ModeOutput name=\"" << gimbal::kIntegerVariables[mode.output].name << "\" element=\""
           << mode.element << "\"";
-        for (const ElementText& element : kElements)
-            if (std::string(element.identifier) == mode.element && element.element_switch[0] != '\0')
-                s << " switch=\"" << element.element_switch << "\"";
+        // The instance of this output: how many outputs of its element come before it.
+        int instance = 1;
+        for (std::size_t k = 0; k < m; ++k)
+            if (std::string(kModeOutputs[k].element) == mode.element) ++instance;
+        for (const ElementText& element : kElements) {
+            if (std::string(element.identifier) != mode.element || element.element_switch[0] == '\0') continue;
+            std::string name = element.element_switch;
+            const std::size_t at = name.find("<j>");
+            if (at != std::string::npos) name.replace(at, 3, std::to_string(instance));
+            s << " switch=\"" << name << "\"";
+        }
         s << "/>\n";
     }
     s << "      </ModeOutputs>\n" << (fmi3 ? "    </Annotation>\n  </Annotations>\n" : "    </Tool>\n  </VendorAnnotations>\n");
@@ -241,8 +254,15 @@ std::vector<unsigned> output_dependencies(gimbal::RealVariable vr) {
         for (RealVariable input : vector) indices.push_back(real_index(input));
     };
     switch (vr) {
-        case vr_i_R1: indices.push_back(real_index(vr_u_R1)); break;  // a quasi-static motor's current
-        case vr_i_R2: indices.push_back(real_index(vr_u_R2)); break;
+        // A quasi-static motor's current (its command's in current drive), and the applied voltage.
+        case vr_i_R1:
+        case vr_amplifier1_u:
+            indices.push_back(real_index(vr_u_R1)), indices.push_back(real_index(vr_i_R1_cmd));
+            break;
+        case vr_i_R2:
+        case vr_amplifier2_u:
+            indices.push_back(real_index(vr_u_R2)), indices.push_back(real_index(vr_i_R2_cmd));
+            break;
         case vr_los_omega_1:
         case vr_los_omega_2:
         case vr_los_omega_3: add(kBaseMotion.attitude), add(kBaseMotion.attitude_rate); break;

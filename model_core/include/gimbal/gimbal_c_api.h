@@ -107,7 +107,7 @@ GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
  * computed from the others, and what the host sets for it is not used); the indicators are
  * GIMBAL_EVENT_INDICATORS guards in a fixed order (an element the fidelity lacks gives constants).
  */
-#define GIMBAL_CONTINUOUS_STATES 17
+#define GIMBAL_CONTINUOUS_STATES 19
 /* Each switching element's guards, summed from their one declaration (gimbal/switching_elements.def). */
 enum {
     GIMBAL_EVENT_INDICATORS = 0
@@ -149,7 +149,7 @@ GimbalStatus gimbal_core_directional_derivative(GimbalCore* core, const unsigned
  * set, within the modes in force there (docs/linearization.md). Not exported by the FMU (it exports
  * only fmi2*): libgimbal_probe.so offers it to analysis tools. Matrices are row-major with the maximal
  * sizes as leading dimensions; only state_count rows / columns of the state dimension are used. */
-#define GIMBAL_LINEAR_MAX_STATES 12
+#define GIMBAL_LINEAR_MAX_STATES 14 /* the 12 of the full model and the two current amplifiers' integrators */
 #define GIMBAL_LINEAR_INPUTS 17
 #define GIMBAL_LINEAR_OUTPUTS 17
 typedef struct GimbalLinearModel {
@@ -171,6 +171,9 @@ typedef struct GimbalLinearModel {
     int friction[4];
     int elevation_stop;
     double time;
+    /* Current drive: the amplifier's output -1 held at -U_L, 0 free, +1 held at +U_L (0 in voltage drive).
+     * A current-driven motor's B and D column is its current command's (input_vr says i_R<j>_cmd). */
+    int amplifier_saturated[2];
 } GimbalLinearModel;
 
 /* Refused (GIMBAL_ERROR) before initialization. */

@@ -22,9 +22,16 @@ StateLayout StateLayout::from(const Fidelity& fidelity, bool energy_accounting) 
         layout.current_slot[axis] = fidelity.motor[axis] == MotorModel::inductive ? slot++ : -1;
     for (int axis = 0; axis < 2; ++axis)
         layout.backlash_slot[axis] = fidelity.gear[axis] == GearModel::backlash ? slot++ : -1;
+    bool amplifiers = false;
+    for (int axis = 0; axis < 2; ++axis) {
+        const bool integrator =
+            fidelity.drive[axis] == DriveMode::current && fidelity.motor[axis] == MotorModel::inductive;
+        layout.amplifier_slot[axis] = integrator ? slot++ : -1;
+        amplifiers = amplifiers || integrator;
+    }
     layout.energy_slot = energy_accounting ? slot : -1;
     layout.size = slot + (energy_accounting ? kEnergyFlowCount : 0);
-    layout.canonical = slot == kStateSize;
+    layout.canonical = slot == kStateSize && !amplifiers;
     return layout;
 }
 
@@ -62,6 +69,7 @@ FullState expand_state(const ModelParameters& params, const Modes& modes, const 
             const int limited = modes.motor_limited[axis];
             full.current[axis] = limited != 0 ? limited * params.motor[axis].current_limit : state[kCurrents + axis];
             full.backlash[axis] = state[kBacklash + axis];
+            full.amplifier_integrator[axis] = 0.0;
         }
         return full;
     }
@@ -77,6 +85,7 @@ FullState expand_state(const ModelParameters& params, const Modes& modes, const 
             full.angle[rotor] = params.gear[axis].ratio * full.angle[load];
             full.rate[rotor] = params.gear[axis].ratio * full.rate[load];
         }
+        full.amplifier_integrator[axis] = layout.amplifier_slot[axis] >= 0 ? state[layout.amplifier_slot[axis]] : 0.0;
         full.current[axis] = armature_current(params, modes, inputs, time, axis, state, full.rate[rotor]);
         full.backlash[axis] = layout.backlash_slot[axis] >= 0 ? state[layout.backlash_slot[axis]] : 0.0;
     }
@@ -210,6 +219,7 @@ bool state_derivative(const ModelParameters& params, const Dynamics& d, double* 
         for (int axis = 0; axis < 2; ++axis) {
             if (layout.current_slot[axis] >= 0) derivative[layout.current_slot[axis]] = d.current_rate[axis];
             if (layout.backlash_slot[axis] >= 0) derivative[layout.backlash_slot[axis]] = d.backlash_rate[axis];
+            if (layout.amplifier_slot[axis] >= 0) derivative[layout.amplifier_slot[axis]] = d.amplifier_rate[axis];
         }
     }
     if (layout.energy_slot >= 0) {

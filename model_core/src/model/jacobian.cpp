@@ -119,6 +119,15 @@ void write_state_rows(const ModelParameters& params, const Modes& modes, const M
         if (current_state_row(params, modes, axis, T, row)) fill_row(layout.current_slot[axis], row);
         if (backlash_state_row(params, modes, axis, T, row)) fill_row(layout.backlash_slot[axis], row);
     }
+    // The current amplifiers' integrators (amplifier_saturation.hpp), while the output is free: x_I drives
+    // the current through 1/L, and integrates K_i (i_cmd - i) unless the limiter holds i.
+    for (int axis = 0; axis < 2; ++axis) {
+        const int slot = layout.amplifier_slot[axis], current = layout.current_slot[axis];
+        if (slot < 0 || modes.amplifier_saturated[axis] != 0) continue;
+        if (modes.motor_limited[axis] != 0) continue;
+        jac(current, slot) = amplifier_slopes(params, modes, axis).integrator / params.motor[axis].inductance;
+        jac(slot, current) = -params.amplifier[axis].integral_gain;
+    }
 }
 
 }  // namespace

@@ -212,7 +212,7 @@ GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer) {
 GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
     return guarded(core, [&] {
         if (model == nullptr) return GIMBAL_ERROR;
-        static_assert(GIMBAL_LINEAR_MAX_STATES == gimbal::kStateSize && GIMBAL_LINEAR_INPUTS == gimbal::kLinearInputCount &&
+        static_assert(GIMBAL_LINEAR_MAX_STATES == gimbal::kLinearMaxStates && GIMBAL_LINEAR_INPUTS == gimbal::kLinearInputCount &&
                           GIMBAL_LINEAR_OUTPUTS == gimbal::kLinearOutputCount,
                       "the C view of the linear model has the core's sizes");
         gimbal::LinearModel linear;
@@ -221,7 +221,7 @@ GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
         *model = GimbalLinearModel{};
         model->state_count = linear.state_count;
         for (int k = 0; k < GIMBAL_LINEAR_MAX_STATES; ++k) model->state_vr[k] = linear.state_variable[k];
-        for (int k = 0; k < GIMBAL_LINEAR_INPUTS; ++k) model->input_vr[k] = gimbal::kLinearFirstInput + k;
+        for (int k = 0; k < GIMBAL_LINEAR_INPUTS; ++k) model->input_vr[k] = linear.input_variable[k];
         for (int k = 0; k < GIMBAL_LINEAR_OUTPUTS; ++k) model->output_vr[k] = gimbal::kLinearFirstOutput + k;
         std::memcpy(model->A, linear.A, sizeof model->A);
         std::memcpy(model->B, linear.B, sizeof model->B);
@@ -234,6 +234,7 @@ GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
         }
         for (int body = 0; body < 4; ++body) model->friction[body] = static_cast<int>(linear.modes.friction[body]);
         model->elevation_stop = linear.modes.elevation_stop;
+        for (int axis = 0; axis < 2; ++axis) model->amplifier_saturated[axis] = linear.modes.amplifier_saturated[axis];
         model->time = core->instance.time();
         return GIMBAL_OK;
     });

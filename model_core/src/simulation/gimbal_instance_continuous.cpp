@@ -42,6 +42,7 @@ IntegratedStates integrated_states_of(const StateLayout& layout) {
         slot_of[kBacklash + axis] = layout.backlash_slot[axis];
     }
     for (int k = 0; k < kEnergyFlowCount; ++k) slot_of[kStateSize + k] = layout.energy_slot >= 0 ? layout.energy_slot + k : -1;
+    for (int axis = 0; axis < 2; ++axis) slot_of[kAmplifierStates + axis] = layout.amplifier_slot[axis];
     IntegratedStates integrated;
     for (int k = 0; k < kContinuousStateCount; ++k) {
         if (slot_of[k] < 0) continue;
@@ -281,7 +282,8 @@ GimbalStatus GimbalInstance::jacobian_rows(const unsigned* unknowns, std::size_t
         if (derivative != kStateDerivatives + kStateCount) {
             const int state = static_cast<int>(derivative - kStateDerivatives);
             for (int k = 0; k < model_.integrated.count; ++k)
-                if (model_.integrated.state[k] == state && state < kStateSize) jacobian_row[i] = model_.integrated.slot[k];
+                if (model_.integrated.state[k] == state && (state < kStateSize || state >= kAmplifierStates))
+                    jacobian_row[i] = model_.integrated.slot[k];
         }
         all_rows_analytic &= jacobian_row[i] >= 0;
     }

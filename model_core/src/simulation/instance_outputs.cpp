@@ -56,6 +56,10 @@ void publish_outputs(const OutputPoint& point, double (&reals)[kRealVariableCoun
     reals[vr_energy_magnetic] = out.magnetic_energy;
     reals[vr_energy_cable] = out.cable_energy;
     reals[vr_energy_cogging] = out.cogging_energy;
+    reals[vr_amplifier1_u] = dynamics.voltage[0];
+    reals[vr_amplifier2_u] = dynamics.voltage[1];
+    reals[vr_amplifier1_x_I] = dynamics.full.amplifier_integrator[0];
+    reals[vr_amplifier2_x_I] = dynamics.full.amplifier_integrator[1];
     const bool accounting = params.layout.energy_slot >= 0;
     const double* flows = point.state + (accounting ? params.layout.energy_slot : 0);
     reals[vr_energy_electrical_in] = accounting ? flows[kElectricalIn] : 0.0;
@@ -77,6 +81,8 @@ void publish_outputs(const OutputPoint& point, double (&reals)[kRealVariableCoun
     integers[vi_motor1_limited] = modes.motor_limited[0];
     integers[vi_motor2_limited] = modes.motor_limited[1];
     integers[vi_elevation_stop_contact] = modes.elevation_stop;
+    integers[vi_motor1_amplifier_saturated] = modes.amplifier_saturated[0];
+    integers[vi_motor2_amplifier_saturated] = modes.amplifier_saturated[1];
     for (int body = 0; body < 4; ++body)
         integers[kBodyStickSlip[body]] = friction_mode_indicator(modes.friction[body], out.full.rate[body]);
     publish_counters(point, reals, integers);
@@ -94,6 +100,7 @@ void full_state_vector(const ModelParameters& params, const Dynamics& d, const d
     }
     for (int k = 0; k < kEnergyFlowCount; ++k)
         states[kStateSize + k] = layout.energy_slot >= 0 ? state[layout.energy_slot + k] : 0.0;
+    for (int axis = 0; axis < 2; ++axis) states[kAmplifierStates + axis] = d.full.amplifier_integrator[axis];
 }
 
 void full_state_derivative(const ModelParameters& params, const Modes& modes, const Dynamics& d,
@@ -109,6 +116,13 @@ void full_state_derivative(const ModelParameters& params, const Modes& modes, co
             out[kCurrents + axis] = derivative[slot];
         } else if (modes.motor_limited[axis] != 0) {
             out[kCurrents + axis] = 0.0;
+        } else if (current_driven(params, axis)) {
+            // The commanded current is held; the bus-limited one (u = +-U_L) moves with the rotor's speed.
+            const MotorParameters& motor = params.motor[axis];
+            out[kCurrents + axis] = modes.amplifier_saturated[axis] == 0
+                                        ? 0.0
+                                        : -motor.back_emf_constant * d.full_acceleration[rotor_index(axis)] /
+                                              motor.resistance;
         } else {
             // A quasi-static motor's current (u - k_e w) / R moves with its rotor's speed (u is held).
             const MotorParameters& motor = params.motor[axis];
@@ -118,6 +132,8 @@ void full_state_derivative(const ModelParameters& params, const Modes& modes, co
     }
     for (int k = 0; k < kEnergyFlowCount; ++k)
         out[kStateSize + k] = layout.energy_slot >= 0 ? derivative[layout.energy_slot + k] : 0.0;
+    for (int axis = 0; axis < 2; ++axis)
+        out[kAmplifierStates + axis] = layout.amplifier_slot[axis] >= 0 ? derivative[layout.amplifier_slot[axis]] : 0.0;
 }
 
 void clamp_published_to_bounds(const ModelParameters& params, double (&reals)[kRealVariableCount]) {

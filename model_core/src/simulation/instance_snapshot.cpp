@@ -55,6 +55,8 @@ void GimbalInstance::save_run(SnapshotContent& snap) {
         snap.voltage[axis] = in.voltage[axis];
         snap.commanded_voltage[axis] = in.commanded_voltage[axis];
         snap.voltage_rate[axis] = in.voltage_rate[axis];
+        snap.current_command[axis] = in.current_command[axis];
+        snap.commanded_current[axis] = in.commanded_current[axis];
     }
     write_base_motion(in.base, snap.base);
     snap.arc_start_time = in.step_start_time;
@@ -148,6 +150,8 @@ GimbalStatus GimbalInstance::rebuild_run(const SnapshotContent& snap, std::uniqu
         in.voltage[axis] = snap.voltage[axis];
         in.commanded_voltage[axis] = snap.commanded_voltage[axis];
         in.voltage_rate[axis] = snap.voltage_rate[axis];
+        in.current_command[axis] = snap.current_command[axis];
+        in.commanded_current[axis] = snap.commanded_current[axis];
     }
     in.base = read_base_motion(snap.base);
     in.step_start_time = snap.arc_start_time;

@@ -14,8 +14,8 @@ static_assert(vr_los_omega_3 - vr_alpha == 16 && vr_theta_b2 == vr_alpha + 11 &&
 
 // The input of index k (0 .. 16) within the step inputs. A voltage is the one applied (after the
 // clamp), so that perturbing it bypasses the clamp; the clamp's own derivative is applied apart.
-double& input_slot(StepInputs& inputs, int k) {
-    if (k < 2) return inputs.voltage[k];
+double& input_slot(const ModelParameters& params, StepInputs& inputs, int k) {
+    if (k < 2) return params.fidelity.drive[k] == DriveMode::current ? inputs.current_command[k] : inputs.voltage[k];
     const int group = (k - 2) / 3, component = (k - 2) % 3;
     BaseMotion& base = inputs.base;
     Vec3* vectors[5] = {&base.attitude, &base.attitude_rate, &base.attitude_accel, &base.velocity_a,
@@ -57,6 +57,8 @@ void name_states(const StateLayout& layout, LinearModel& out) {
         if (layout.current_slot[axis] >= 0) out.state_variable[layout.current_slot[axis]] = axis == 0 ? vr_i_R1 : vr_i_R2;
         if (layout.backlash_slot[axis] >= 0)
             out.state_variable[layout.backlash_slot[axis]] = axis == 0 ? vr_theta_b1 : vr_theta_b2;
+        if (layout.amplifier_slot[axis] >= 0)
+            out.state_variable[layout.amplifier_slot[axis]] = axis == 0 ? vr_amplifier1_x_I : vr_amplifier2_x_I;
     }
 }
 
@@ -69,7 +71,7 @@ void input_columns(const ModelParameters& params, const StepInputs& inputs, cons
     double y_plus[kLinearOutputCount], y_minus[kLinearOutputCount];
     for (int k = 0; k < kLinearInputCount; ++k) {
         StepInputs shifted = inputs;
-        double& value = input_slot(shifted, k);
+        double& value = input_slot(params, shifted, k);
         const double centre = value, step = difference_step(centre);
         value = centre + step;
         state_rates(params, shifted, modes, time, state, plus);
@@ -117,7 +119,16 @@ void linearize(const ModelParameters& params, const StepInputs& given_inputs, co
     // A held voltage at or beyond its clamp does not respond to a small change (voltage_clamp.hpp,
     // held_clamp_side): its column is 0 and the mode says clamped, on the side of the limit.
     double voltage_passes[2];
+    for (int k = 0; k < kLinearInputCount; ++k) out.input_variable[k] = static_cast<RealVariable>(kLinearFirstInput + k);
     for (int axis = 0; axis < 2; ++axis) {
+        if (params.fidelity.drive[axis] == DriveMode::current) {
+            // Current drive: the column is the current command's; one at or beyond +-i_L passes nothing.
+            out.input_variable[axis] = axis == 0 ? vr_i_R1_cmd : vr_i_R2_cmd;
+            const double limit = params.motor[axis].current_limit;
+            inputs.current_command[axis] = std::clamp(inputs.commanded_current[axis], -limit, limit);
+            voltage_passes[axis] = std::fabs(inputs.commanded_current[axis]) >= limit ? 0.0 : 1.0;
+            continue;
+        }
         const double commanded = inputs.commanded_voltage[axis];
         inputs.voltage[axis] = clamp_voltage(params.motor[axis], commanded);
         const int side = held_clamp_side(params.motor[axis], commanded);

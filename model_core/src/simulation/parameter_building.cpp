@@ -103,6 +103,9 @@ static_assert(GearModel_rigid == static_cast<int>(GearModel::rigid) &&
 static_assert(MotorModel_quasi_static == static_cast<int>(MotorModel::quasi_static) &&
                   MotorModel_inductive == static_cast<int>(MotorModel::inductive) && items_are("MotorModel", 0, 1),
               "MotorModel items: quasi_static, inductive, and the validation accepts 0..1");
+static_assert(DriveMode_voltage == static_cast<int>(DriveMode::voltage) &&
+                  DriveMode_current == static_cast<int>(DriveMode::current) && items_are("DriveMode", 0, 1),
+              "DriveMode items: voltage, current, and the validation accepts 0..1");
 static_assert(GearStart_in_mesh_unless_given == static_cast<int>(GearStart::in_mesh_unless_given) &&
                   GearStart_in_mesh == static_cast<int>(GearStart::in_mesh) &&
                   GearStart_as_given == static_cast<int>(GearStart::as_given) &&
@@ -125,7 +128,9 @@ static_assert(variable_table::joins(variable_table::kInteger[vi_gear1_model].dec
                   variable_table::joins(variable_table::kInteger[vi_motor2_model].declared_type, "MotorModel", "") &&
                   variable_table::joins(variable_table::kInteger[vi_solver_method].declared_type, "IntegrationMethod", "") &&
                   variable_table::joins(variable_table::kInteger[vi_gear1_start].declared_type, "GearStart", "") &&
-                  variable_table::joins(variable_table::kInteger[vi_gear2_start].declared_type, "GearStart", ""),
+                  variable_table::joins(variable_table::kInteger[vi_gear2_start].declared_type, "GearStart", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_motor1_drive].declared_type, "DriveMode", "") &&
+                  variable_table::joins(variable_table::kInteger[vi_motor2_drive].declared_type, "DriveMode", ""),
               "the structural selectors are declared with the Enumeration types they are validated against");
 
 // An Enumeration-typed parameter takes exactly its type's items; the refusal lists them (the start
@@ -255,6 +260,32 @@ bool read_drive_train(Checker& check, ModelParameters& params) {
     return true;
 }
 
+// The servo amplifiers of current drive (switching_elements/amplifier_saturation.hpp). f_c > 0 and
+// K_p, K_i >= 0 are the variables' own bounds (checked whatever the drive, so that a bad value is refused
+// when it is set); a gain left at 0 is derived from the bandwidth by pole-zero cancellation.
+bool read_amplifiers(Checker& check, const bool (&flags)[kBooleanVariableCount], ModelParameters& params) {
+    const double (&values)[kRealVariableCount] = check.values;
+    struct AmplifierVariables { RealVariable f_c, K_p, K_i; BooleanVariable feedforward; };
+    const AmplifierVariables amplifiers[2] = {
+        {vr_amplifier1_f_c, vr_amplifier1_K_p, vr_amplifier1_K_i, vb_amplifier1_back_emf_feedforward},
+        {vr_amplifier2_f_c, vr_amplifier2_K_p, vr_amplifier2_K_i, vb_amplifier2_back_emf_feedforward},
+    };
+    for (int j = 0; j < 2; ++j) {
+        const AmplifierVariables& a = amplifiers[j];
+        AmplifierParameters& amplifier = params.amplifier[j];
+        amplifier.bandwidth = values[a.f_c];
+        amplifier.proportional_gain = values[a.K_p] > 0.0 ? values[a.K_p]
+                                                          : cancelling_proportional_gain(params.motor[j], values[a.f_c]);
+        amplifier.integral_gain = values[a.K_i] > 0.0 ? values[a.K_i]
+                                                      : cancelling_integral_gain(params.motor[j], values[a.f_c]);
+        amplifier.back_emf_feedforward = flags[a.feedforward];
+        if (!check.require(a.f_c, std::isfinite(amplifier.proportional_gain) && std::isfinite(amplifier.integral_gain),
+                           "the gains derived from it (2*pi*f_c*L, 2*pi*f_c*R) overflow"))
+            return false;
+    }
+    return true;
+}
+
 // The cable restraints and the cogging (multibody/disturbance_torques.hpp). Their bounds (k, c,
 // T_cogging >= 0, cogging_periods >= 1) were checked with the other single-variable rules.
 void read_disturbances(const double (&values)[kRealVariableCount], const int (&integers)[kIntegerVariableCount],
@@ -309,10 +340,12 @@ void read_fidelity(const int (&integers)[kIntegerVariableCount], const bool (&fl
                    ModelParameters& params) {
     const IntegerVariable gear_models[2] = {vi_gear1_model, vi_gear2_model};
     const IntegerVariable motor_models[2] = {vi_motor1_model, vi_motor2_model};
+    const IntegerVariable drives[2] = {vi_motor1_drive, vi_motor2_drive};
     for (int j = 0; j < 2; ++j) {
         const int gear_model = integers[gear_models[j]], motor_model = integers[motor_models[j]];
         params.fidelity.gear[j] = static_cast<GearModel>(gear_model);
         params.fidelity.motor[j] = static_cast<MotorModel>(motor_model);
+        params.fidelity.drive[j] = static_cast<DriveMode>(integers[drives[j]]);
     }
     params.fidelity.dry_friction = flags[vb_dry_friction];
     params.fidelity.fixed_base = flags[vb_base_fixed];
@@ -325,7 +358,9 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
     Checker check{values, error};
     if (!check_single_variable_rules(check, integers) || !read_bodies(check, params)) return false;
     params.energy_accounting = flags[vb_energy_accounting];
-    if (!read_drive_train(check, params) || !read_solver(integers, params, error)) return false;
+    if (!read_drive_train(check, params) || !read_amplifiers(check, flags, params) ||
+        !read_solver(integers, params, error))
+        return false;
     read_disturbances(values, integers, params.disturbances);
     if (!read_elevation_stop(check, flags, params.elevation_stop)) return false;
     read_fidelity(integers, flags, params);

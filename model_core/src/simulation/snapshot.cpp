@@ -284,6 +284,11 @@ constexpr Field kFields[] = {
     field<&C::dwell_until>("dwell_until", "end of the chattering hold", kAlways, finite()),
     field<&C::rapid_events>("rapid_events", "rapid events", kAlways, count()),
     field<&C::zeno_holds>("zeno_holds", "chattering holds", kAlways, count()),
+    // Format 11: current drive.
+    field<&C::modes, &Modes::amplifier_saturated>("modes.amplifier_saturated", "amplifier saturation mode", kInit,
+                                                  range(-1, 1)),
+    field<&C::current_command>("current_command", "current command", kInit, finite()),
+    field<&C::commanded_current>("commanded_current", "commanded current", kInit, finite()),
 };
 constexpr std::size_t kFieldCount = sizeof kFields / sizeof kFields[0];
 
@@ -409,6 +414,10 @@ void check_against_model(const SnapshotContent& content, SnapshotCheck& check) {
     }
     if (check.ok() && !params.elevation_stop.present && content.modes.elevation_stop != 0)
         check.fail("an elevation stop mode is set but the elevation stop is off");
+    for (int axis = 0; axis < 2 && check.ok(); ++axis) {
+        if (params.fidelity.drive[axis] != DriveMode::current && content.modes.amplifier_saturated[axis] != 0)
+            check.fail("motor " + std::to_string(axis + 1) + " is in voltage drive but has an amplifier saturation mode");
+    }
     for (int body = 0; body < 4 && check.ok(); ++body) {
         if (!params.fidelity.dry_friction && content.modes.friction[body] != FrictionMode::none)
             check.fail("a friction mode is set but dry friction is off");

@@ -13,6 +13,13 @@ bool current_state_row(const ModelParameters& params, const Modes& modes, int ax
     if (params.layout.current_slot[axis] < 0 || modes.motor_limited[axis] != 0) return false;
     const MotorParameters& motor = params.motor[axis];
     row = Row12::Zero();
+    if (current_driven(params, axis)) {
+        const AmplifierSlopes slopes = amplifier_slopes(params, modes, axis);
+        row.segment<4>(kRateColumn) =
+            (slopes.rotor_rate - motor.back_emf_constant) / motor.inductance * T.row(rotor_index(axis));
+        row(kCurrentColumn + axis) = (slopes.current - motor.resistance) / motor.inductance;
+        return true;
+    }
     row.segment<4>(kRateColumn) = -motor.back_emf_constant / motor.inductance * T.row(rotor_index(axis));
     row(kCurrentColumn + axis) = -motor.resistance / motor.inductance;
     return true;

@@ -20,12 +20,16 @@ SwitchingElementSet::SwitchingElementSet(const ModelParameters& params) : state_
     for (int axis = 0; axis < 2; ++axis)
         if (params.layout.backlash_slot[axis] >= 0) add<ElementKind::gear_backlash>(backlash_, axis);
     for (int axis = 0; axis < 2; ++axis) add<ElementKind::voltage_clamp>(clamps_, axis);
+    // Only a current-driven motor's amplifier acts; in voltage drive its indicators are constants 1.
+    for (int axis = 0; axis < 2; ++axis)
+        if (current_driven(params, axis)) add<ElementKind::amplifier_saturation>(amplifiers_, axis);
     for (int axis = 0; axis < 2; ++axis) add<ElementKind::current_limiter>(limiters_, axis);
     for (int body = 0; body < 4; ++body)
         if (params.coordinate_friction[body].present()) add<ElementKind::dry_friction>(friction_, body);
     for (const auto& e : stops_) elements_.push_back(&e);
     for (const auto& e : backlash_) elements_.push_back(&e);
     for (const auto& e : clamps_) elements_.push_back(&e);
+    for (const auto& e : amplifiers_) elements_.push_back(&e);
     for (const auto& e : limiters_) elements_.push_back(&e);
     for (const auto& e : friction_) elements_.push_back(&e);
 }
@@ -55,7 +59,11 @@ void SwitchingElementSet::decide(const SwitchingContext& context, const Modes& p
         element.decide(context, previous, modes, state, crossings);
         clamp_changed = clamp_changed || element.changed(previous, modes);
     }
-    // The limiters' steady current depends on the voltage the clamps now apply.
+    for (const AmplifierSaturationElement& element : amplifiers_) {
+        element.decide(context, previous, modes, state, crossings);
+        clamp_changed = clamp_changed || element.changed(previous, modes);
+    }
+    // The limiters' steady current depends on the voltage the clamps and the amplifiers now apply.
     if (clamp_changed) refresh();
     for (const CurrentLimiterElement& element : limiters_) element.decide(context, previous, modes, state, crossings);
     for (const DryFrictionElement& element : friction_) element.decide(context, previous, modes, state, crossings);

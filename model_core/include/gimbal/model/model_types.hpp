@@ -21,7 +21,12 @@ enum StateIndex : int {
     kBacklash = 10,   // theta_b1, theta_b2
     kStateSize = 12,
     kEnergyFlowCount = 5,  // electrical in, resistive, viscous, shaft damping, dry friction
-    kMaxStateSize = kStateSize + kEnergyFlowCount
+    // The current amplifiers' integrators x_I (a current-commanded inductive motor only), after the energy
+    // accumulators in the Model Exchange state vector (indices 17, 18); in the integrated state vector
+    // they sit before the energy accumulators (StateLayout::amplifier_slot).
+    kAmplifierStates = kStateSize + kEnergyFlowCount,
+    kAmplifierIntegratorCount = 2,
+    kMaxStateSize = kStateSize + kEnergyFlowCount + kAmplifierIntegratorCount
 };
 
 enum EnergyFlow : int { kElectricalIn = 0, kResistive, kViscous, kShaftDamping, kDryFriction };
@@ -32,10 +37,14 @@ enum class GearModel : int { rigid = 0, compliant = 1, backlash = 2 };
 // load unless a start value other than 0 was given, always in mesh, or at its start values as given.
 enum class GearStart : int { in_mesh_unless_given = 0, in_mesh = 1, as_given = 2 };
 enum class MotorModel : int { quasi_static = 0, inductive = 1 };
+// What a motor's input commands (motor<j>.drive, docs/physics.md section 4.6): the armature voltage u_R<j>
+// (default), or the armature current i_R<j>_cmd through the servo amplifier's current loop.
+enum class DriveMode : int { voltage = 0, current = 1 };
 
 struct Fidelity {
     GearModel gear[2] = {GearModel::backlash, GearModel::backlash};
     MotorModel motor[2] = {MotorModel::inductive, MotorModel::inductive};
+    DriveMode drive[2] = {DriveMode::voltage, DriveMode::voltage};
     bool dry_friction = true;
     bool fixed_base = false;
 };
@@ -65,6 +74,7 @@ struct StateLayout {
     int rate_slot[4];
     int current_slot[2];
     int backlash_slot[2];
+    int amplifier_slot[2];  // the amplifier's integrator x_I: a current-commanded inductive motor only
     int energy_slot;  // first of kEnergyFlowCount, or -1
     int size;
     bool canonical;   // every quantity present, in StateIndex order (full fidelity): no slot lookups
@@ -76,6 +86,7 @@ struct StateLayout {
 struct ModelParameters {
     MultibodyModel multibody;
     MotorParameters motor[2];
+    AmplifierParameters amplifier[2];  // used by a current-commanded motor (fidelity.drive) only
     GearParameters gear[2];
     double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
     DryFrictionParameters dry_friction[4];      // per body, as given
@@ -122,6 +133,7 @@ struct Modes {
     int voltage_clamped[2] = {0, 0}; // a ramped voltage held at -U_L / +U_L (0: follows the ramp)
     FrictionMode friction[4] = {FrictionMode::none, FrictionMode::none, FrictionMode::none, FrictionMode::none};
     int elevation_stop = 0;          // -1 resting on the lower stop, 0 free (or no stop), +1 resting on the upper
+    int amplifier_saturated[2] = {0, 0};  // current drive: -1 output held at -U_L, 0 free, +1 held at +U_L
 };
 
 // Inputs over one communication step: voltages held (or, when the master gives their derivatives,
@@ -130,6 +142,8 @@ struct StepInputs {
     double voltage[2] = {0, 0};            // commanded at the step start, clamped to +-U_L
     double commanded_voltage[2] = {0, 0};  // as set, unclamped
     double voltage_rate[2] = {0, 0};       // fmi2SetRealInputDerivatives, order 1
+    double current_command[2] = {0, 0};    // current drive: commanded at the step start, clamped to +-i_L
+    double commanded_current[2] = {0, 0};  // as set, unclamped
     BaseMotion base;                       // at the step start
     double step_start_time = 0.0;
 };
@@ -139,6 +153,7 @@ struct FullState {
     Vec4 angle, rate;
     double current[2];   // the armature current (algebraic for a quasi-static motor, held at +-i_L when limited)
     double backlash[2];  // 0 without backlash
+    double amplifier_integrator[2];  // x_I of a current-commanded inductive motor's amplifier, else 0
 };
 
 // Everything the right-hand side, the event functions and the outputs need, at one (t, x, modes).
@@ -158,6 +173,8 @@ struct Dynamics {
     double voltage[2];              // applied
     Mat4 reduced_mass;              // padded coordinates
     double stop_torque;             // the elevation end stop's reaction on the payload while it rests there
+    double amplifier_demand[2];     // current drive: the amplifier's output before its bus limit (u_unsat), else 0
+    double amplifier_rate[2];       // dx_I/dt (0 while saturated, without an integrator, or in voltage drive)
 };
 
 // Derivatives of the full generalized forces (or accelerations) with respect to the full state:

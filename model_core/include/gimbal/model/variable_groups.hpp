@@ -98,18 +98,20 @@ inline constexpr IntegerVariable kEventCounters[7] = {
 // The continuous states of the Model Exchange interface, in the order of its state vector (and of
 // <Derivatives>): the full state of section "State" in docs/physics.md and the energy accumulators,
 // whatever the fidelity; kStateDerivatives[k] is der(kContinuousStates[k]).
-inline constexpr int kContinuousStateCount = 17;
+// The current amplifiers' integrators come last (kAmplifierStates): appended, so that the 17 states
+// before them keep their places.
+inline constexpr int kContinuousStateCount = kMaxStateSize;
 inline constexpr RealVariable kContinuousStates[kContinuousStateCount] = {
     vr_alpha,     vr_alpha_m,     vr_beta,     vr_beta_m,     vr_alpha_dot, vr_alpha_m_dot,
     vr_beta_dot,  vr_beta_m_dot,  vr_i_R1,     vr_i_R2,       vr_theta_b1,  vr_theta_b2,
     vr_energy_electrical_in, vr_energy_resistive, vr_energy_viscous, vr_energy_shaft_damping,
-    vr_energy_dry_friction,
+    vr_energy_dry_friction, vr_amplifier1_x_I, vr_amplifier2_x_I,
 };
 inline constexpr RealVariable kStateDerivatives[kContinuousStateCount] = {
     vr_der_alpha,     vr_der_alpha_m,     vr_der_beta,     vr_der_beta_m,     vr_der_alpha_dot, vr_der_alpha_m_dot,
     vr_der_beta_dot,  vr_der_beta_m_dot,  vr_der_i_R1,     vr_der_i_R2,       vr_der_theta_b1,  vr_der_theta_b2,
     vr_der_energy_electrical_in, vr_der_energy_resistive, vr_der_energy_viscous, vr_der_energy_shaft_damping,
-    vr_der_energy_dry_friction,
+    vr_der_energy_dry_friction, vr_der_amplifier1_x_I, vr_der_amplifier2_x_I,
 };
 
 // ---------------------------------------------------------------------------------------------------

@@ -15,6 +15,25 @@ struct MotorParameters {
     double voltage_limit = 0.0;      // V
 };
 
+// The servo amplifier of a current-commanded motor (docs/physics.md section 4.6): an analog PI current
+// loop whose output is limited by the bus voltage (the motor's voltage_limit, motor<j>.U_L). The gains
+// are the ones in use: amplifier<j>.K_p and K_i as given, or derived from the bandwidth when given as 0.
+struct AmplifierParameters {
+    double bandwidth = 2000.0;          // f_c, Hz
+    double proportional_gain = 0.0;     // K_p, V/A
+    double integral_gain = 0.0;         // K_i, V/(A.s)
+    bool back_emf_feedforward = true;   // adds k_emf * rotor speed to the output
+};
+
+// Pole-zero cancellation: K_p = 2 pi f_c L, K_i = 2 pi f_c R make the locked-rotor current loop
+// (K_p s + K_i) / (L s^2 + (R + K_p) s + K_i) = 2 pi f_c / (s + 2 pi f_c), first order at f_c.
+inline double cancelling_proportional_gain(const MotorParameters& motor, double bandwidth) {
+    return 2.0 * 3.14159265358979323846 * bandwidth * motor.inductance;
+}
+inline double cancelling_integral_gain(const MotorParameters& motor, double bandwidth) {
+    return 2.0 * 3.14159265358979323846 * bandwidth * motor.resistance;
+}
+
 struct GearParameters {
     double ratio = 1.0;         // rotor angle / load angle
     double stiffness = 0.0;     // N.m/rad

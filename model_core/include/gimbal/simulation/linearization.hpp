@@ -17,16 +17,22 @@ constexpr RealVariable kLinearFirstInput = vr_u_R1;
 constexpr int kLinearInputCount = vr_base_a_a_3 - vr_u_R1 + 1;
 constexpr RealVariable kLinearFirstOutput = vr_alpha;
 constexpr int kLinearOutputCount = vr_los_omega_3 - vr_alpha + 1;
+// The integrated states without the energy accumulators: at most the 12 of the full model and the two
+// current amplifiers' integrators.
+constexpr int kLinearMaxStates = kStateSize + kAmplifierIntegratorCount;
 
 struct LinearModel {
     // The integrated states without the energy accumulators (they feed nothing back), each named by
     // the output variable that carries it.
     int state_count = 0;
-    RealVariable state_variable[kStateSize] = {};
+    RealVariable state_variable[kLinearMaxStates] = {};
+    // The input of each column of B and D: the FMU's Real inputs from u_R1 on, but a current-driven
+    // motor's column is its current command i_R<j>_cmd instead of its voltage.
+    RealVariable input_variable[kLinearInputCount] = {};
     // Row-major with the maximal sizes as leading dimensions; only state_count rows/columns are used.
-    double A[kStateSize][kStateSize] = {};
-    double B[kStateSize][kLinearInputCount] = {};
-    double C[kLinearOutputCount][kStateSize] = {};
+    double A[kLinearMaxStates][kLinearMaxStates] = {};
+    double B[kLinearMaxStates][kLinearInputCount] = {};
+    double C[kLinearOutputCount][kLinearMaxStates] = {};
     double D[kLinearOutputCount][kLinearInputCount] = {};
     // In force at the point: the model holds until one of them switches. voltage_clamped also marks a
     // held voltage at or beyond +-U_L (the core's own mode covers ramps only).

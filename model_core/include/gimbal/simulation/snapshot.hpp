@@ -50,6 +50,9 @@ struct SnapshotContent {
     double dwell_until;
     std::int32_t rapid_events;
     std::int64_t zeno_holds;
+    // Format 11: current drive's running current commands (the amplifiers' modes are in `modes`).
+    double current_command[2];
+    double commanded_current[2];
 };
 
 // Serialized: a 4-byte magic ("G2AX"), the 4-byte format number, then the fields in table order, each
@@ -60,7 +63,11 @@ constexpr std::uint32_t kSnapshotMagic = 0x47324158;
 // Format 9: format 8's fields with the Integer table grown by gear1.start and gear2.start.
 // Format 10: format 9's fields with the elevation end stop: its variables (4 Real, 1 Integer, 1 Boolean)
 // and its 2 event indicators lengthen the tables, and its mode sits in Modes' former tail padding.
-constexpr std::uint32_t kSnapshotFormat = 10;
+// Format 11: format 10's fields with current drive: its variables (14 Real, 4 Integer, 2 Boolean), its 4
+// event indicators and 2 more state slots lengthen the tables; the amplifiers' modes and the running
+// current commands are rows at the end. (A format-10 state comes from an FMU with another GUID, which the
+// FMU-state record's header refuses first.)
+constexpr std::uint32_t kSnapshotFormat = 11;
 
 std::size_t snapshot_bytes();
 // The bytes of a content (every gap zero).

@@ -26,6 +26,16 @@ inline StepInputs read_step_inputs(const ModelParameters& params, const double (
         inputs.voltage[axis] = clamp_voltage(params.motor[axis], inputs.commanded_voltage[axis]);
         inputs.voltage_rate[axis] = voltage_rate[axis];
     }
+    // Current drive: the current command, clamped to +-i_L like a voltage to +-U_L; the voltage input
+    // is not used (nor ramped), so that the voltage clamp never acts.
+    const RealVariable commands[2] = {vr_i_R1_cmd, vr_i_R2_cmd};
+    for (int axis = 0; axis < 2; ++axis) {
+        if (params.fidelity.drive[axis] != DriveMode::current) continue;
+        inputs.commanded_voltage[axis] = inputs.voltage[axis] = inputs.voltage_rate[axis] = 0.0;
+        const double limit = params.motor[axis].current_limit;
+        inputs.commanded_current[axis] = reals[commands[axis]];
+        inputs.current_command[axis] = std::clamp(reals[commands[axis]], -limit, limit);
+    }
     inputs.base.attitude = read_vector(reals, kBaseMotion.attitude);
     inputs.base.attitude_rate = read_vector(reals, kBaseMotion.attitude_rate);
     inputs.base.attitude_accel = read_vector(reals, kBaseMotion.attitude_accel);
@@ -39,6 +49,7 @@ inline StepInputs read_step_inputs(const ModelParameters& params, const double (
 // master's own arithmetic may differ from ours in the last bits, hence the tolerance.
 inline bool voltages_continue(const StepInputs& running, const StepInputs& next, double time) {
     for (int axis = 0; axis < 2; ++axis) {
+        if (running.current_command[axis] != next.current_command[axis]) return false;
         if (running.voltage_rate[axis] == 0.0 && next.voltage_rate[axis] == 0.0) {
             if (running.voltage[axis] != next.voltage[axis]) return false;
             continue;
@@ -68,7 +79,9 @@ inline bool continues_running_inputs(const StepInputs& running, const StepInputs
 inline bool voltages_changed(const StepInputs& running, const StepInputs& next) {
     return next.voltage_rate[0] != running.voltage_rate[0] || next.voltage_rate[1] != running.voltage_rate[1] ||
            next.commanded_voltage[0] != running.commanded_voltage[0] ||
-           next.commanded_voltage[1] != running.commanded_voltage[1];
+           next.commanded_voltage[1] != running.commanded_voltage[1] ||
+           next.commanded_current[0] != running.commanded_current[0] ||
+           next.commanded_current[1] != running.commanded_current[1];
 }
 
 // After a step that ended early at `time`: the inputs as the step carried them there (the carrier's

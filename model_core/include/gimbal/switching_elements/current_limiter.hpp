@@ -8,6 +8,7 @@
 //   guards: 2 (indicators 8-11)                            counter: EventCounters::current_limit[axis]
 #pragma once
 
+#include "gimbal/switching_elements/amplifier_saturation.hpp"
 #include "gimbal/switching_elements/switching_element.hpp"
 #include "gimbal/switching_elements/voltage_clamp.hpp"
 
@@ -21,6 +22,7 @@ inline double armature_current(const ModelParameters& params, const Modes& modes
     const int limited = modes.motor_limited[axis];
     if (limited != 0) return limited * motor.current_limit;
     if (params.layout.current_slot[axis] >= 0) return state[params.layout.current_slot[axis]];
+    if (current_driven(params, axis)) return quasi_static_driven_current(params, inputs, modes, axis, rotor_rate);
     return unlimited_steady_current(motor, applied_voltage(params, inputs, modes, axis, time), rotor_rate);
 }
 
@@ -30,7 +32,22 @@ inline double motor_circuit(const ModelParameters& params, const StepInputs& inp
                             int axis, Dynamics& out) {
     const MotorParameters& motor = params.motor[axis];
     const double rotor_rate = out.full.rate[rotor_index(axis)];
-    const double voltage = applied_voltage(params, inputs, modes, axis, time);
+    out.amplifier_demand[axis] = 0.0;
+    out.amplifier_rate[axis] = 0.0;
+    double voltage;
+    if (current_driven(params, axis)) {
+        // The amplifier's output (amplifier_saturation.hpp) and its integrator, frozen while held.
+        const double current = out.full.current[axis];
+        const double demand =
+            amplifier_demand(params, inputs, axis, current, out.full.amplifier_integrator[axis], rotor_rate);
+        out.amplifier_demand[axis] = demand;
+        voltage = amplifier_output(params, modes, axis, demand);
+        if (params.layout.amplifier_slot[axis] >= 0 && modes.amplifier_saturated[axis] == 0)
+            out.amplifier_rate[axis] =
+                params.amplifier[axis].integral_gain * (inputs.current_command[axis] - current);
+    } else {
+        voltage = applied_voltage(params, inputs, modes, axis, time);
+    }
     out.voltage[axis] = voltage;
     out.steady_current[axis] = unlimited_steady_current(motor, voltage, rotor_rate);
     out.current_rate[axis] = 0.0;
@@ -47,12 +64,17 @@ inline void add_motor_force_derivatives(const ModelParameters& params, const Mod
     const int rotor = rotor_index(axis);
     if (params.layout.current_slot[axis] >= 0) {
         force(rotor, kCurrentColumn + axis) += motor.torque_constant;
+    } else if (current_driven(params, axis)) {
+        // The commanded current does not depend on the state; the bus-limited one falls with the back-emf.
+        if (modes.amplifier_saturated[axis] != 0)
+            force(rotor, kRateColumn + rotor) -= motor.torque_constant * motor.back_emf_constant / motor.resistance;
     } else {
         force(rotor, kRateColumn + rotor) -= motor.torque_constant * motor.back_emf_constant / motor.resistance;
     }
 }
 
-// The row of d(di/dt)/d(state) of a free inductive circuit (q_full = T q_padded); false otherwise.
+// The row of d(di/dt)/d(state) of a free inductive circuit (q_full = T q_padded); false otherwise. In
+// current drive the amplifier's output adds its slopes (amplifier_slopes); d(di/dt)/dx_I is theirs.
 bool current_state_row(const ModelParameters& params, const Modes& modes, int axis, const Mat4& T, Row12& row);
 
 class CurrentLimiterElement final : public SwitchingElement {

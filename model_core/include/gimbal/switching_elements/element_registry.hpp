@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gimbal/function_ref.hpp"
+#include "gimbal/switching_elements/amplifier_saturation.hpp"
 #include "gimbal/switching_elements/current_limiter.hpp"
 #include "gimbal/switching_elements/dry_friction.hpp"
 #include "gimbal/switching_elements/elevation_stop.hpp"
@@ -67,7 +68,7 @@ public:
 
     // Re-selects every element's mode, in dependency order: the contacts first (the end stop, whose
     // impulse moves the rates every other element reads, before the gears), then the voltage
-    // clamps, the limiters (whose steady current depends on the clamped voltage), then friction
+    // clamps and the current amplifiers' bus limits, the limiters (whose steady current depends on the clamped voltage), then friction
     // (whose torques depend on everything before). `refresh` re-evaluates context.dynamics at
     // (time, state) under the modes chosen so far, where a later decision depends on them.
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
@@ -90,6 +91,7 @@ private:
     std::vector<ElevationStopElement> stops_;
     std::vector<BacklashElement> backlash_;
     std::vector<VoltageClampElement> clamps_;
+    std::vector<AmplifierSaturationElement> amplifiers_;
     std::vector<CurrentLimiterElement> limiters_;
     std::vector<DryFrictionElement> friction_;
     std::vector<const SwitchingElement*> elements_;  // all of them, in decision order
