@@ -30,7 +30,8 @@ def test_the_table_has_the_fmus_units(gimbal_fmu):
     for variable in gimbal_fmu.model_description.modelVariables:
         if variable.causality in ("input", "output"):
             assert unit_of(variable.name) == model_description_unit(variable), variable.name
-    runner_signals = {"time", "u_R1_cmd", "u_R2_cmd", "u_R1_asked", "u_R2_asked", "alpha_ref", "beta_ref",
+    runner_signals = {"time", "u_R1_cmd", "u_R2_cmd", "u_R1_asked", "u_R2_asked", "i_R1_ctrl", "i_R2_ctrl",
+                      "i_R1_asked", "i_R2_asked", "alpha_ref", "beta_ref",
                       "alpha_error", "beta_error", "los_azimuth", "los_elevation", "los_error", "los_error_xel",
                       "los_error_el", "heave", "base.omega2[1]", "base.omega2[2]", "base.omega2[3]",
                       "target_azimuth", "target_elevation", "target_range", "alpha_cmd", "beta_cmd", "alpha_cmd_dot",

@@ -44,8 +44,12 @@ def test_scene_runs_and_writes_csv_and_png(path, fmu_path, tmp_path):
     stop = float(scene.test.get("stop_time", min(scene.stop_time, 0.3)))
     result, csv_path, png_path = run_scene_file(path, fmu_path, tmp_path, stop_time=stop)
     header = csv_path.read_text().splitlines()[0].split(",")
-    for column in ("time [s]", "alpha [rad]", "beta [rad]", "i_R1 [A]", "i_R2 [A]", "theta_b1 [rad]", "u_R1 [V]",
-                   "u_R1_cmd [V]", "los.omega[1] [rad/s]", "base.gamma [rad]", "los_error [rad]"):
+    # the motor commands by each motor's drive: a voltage, or a current command to the FMU's amplifier
+    current = {int(j) for j in ("1", "2") if int(scene.fidelity.get(f"motor{j}.drive", 0)) == 1}
+    commands = [label for j in (1, 2) for label in (
+        (f"i_R{j}_cmd [A]", f"i_R{j}_ctrl [A]", f"amplifier{j}.u [V]") if j in current else (f"u_R{j} [V]", f"u_R{j}_cmd [V]"))]
+    for column in ("time [s]", "alpha [rad]", "beta [rad]", "i_R1 [A]", "i_R2 [A]", "theta_b1 [rad]",
+                   "los.omega[1] [rad/s]", "base.gamma [rad]", "los_error [rad]", *commands):
         assert column in header
     data = np.loadtxt(csv_path, delimiter=",", skiprows=1, ndmin=2)
     assert data[-1, 0] == pytest.approx(stop)

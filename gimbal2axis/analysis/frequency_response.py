@@ -75,6 +75,9 @@ class Excitation:
     axis: str                 # "1" / "2" (motor) or "roll" / "pitch" / "yaw"
     amplitude: float          # V, or rad/s (rate amplitude of the carrier)
     offset: float = 0.0       # V, a constant voltage added (voltage only)
+    # the excited motor's drive (master/drives.py): in "current" drive the open-loop excitation is its current
+    # command i_R<axis>_cmd [A] (amplitude and offset in A) and an injection adds to its current command
+    drive: str = "voltage"
 
     def __post_init__(self):
         if self.kind not in ("voltage", "base", "injection"):
@@ -88,7 +91,7 @@ class Excitation:
     def input_signal(self) -> str:
         """The signal the gains are referred to: for an injection the injected sine D itself."""
         if self.kind == "voltage":
-            return f"u_R{self.axis}"
+            return f"u_R{self.axis}" if self.drive == "voltage" else f"i_R{self.axis}_cmd"
         return BASE_AXES[self.axis] if self.kind == "base" else injection_signal(self.axis)
 
     def default_outputs(self) -> list[str]:
@@ -104,9 +107,10 @@ def injection_signal(axis: str) -> str:
     return f"injection_R{axis}"
 
 
-def command_signal(axis: str) -> str:
-    """The recorded computed voltage of motor `axis`: A = U + D during an injection."""
-    return f"u_R{axis}_cmd"
+def command_signal(axis: str, drive: str = "voltage") -> str:
+    """The recorded computed voltage of motor `axis` (its current command in current drive): A = U + D
+    during an injection."""
+    return f"u_R{axis}_cmd" if drive == "voltage" else f"i_R{axis}_ctrl"
 
 
 class InjectingController:
@@ -315,7 +319,6 @@ def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
     """The controller of the run: None (the scene's own), Replay of the sine (voltage), or the scene's
     own wrapped by InjectingController (injection)."""
     from ..scene.controllers import Replay
-    from ..scene.scene import parameter_value
 
     h = run_scene.step_size
     if excitation.kind == "voltage":
@@ -325,7 +328,9 @@ def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
         voltages[:, int(excitation.axis) - 1] = excitation.offset + excitation.amplitude * np.sin(2 * math.pi * f * t)
         return Replay(voltages)
     if excitation.kind == "injection":
-        u_limit = tuple(float(parameter_value(run_scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+        from ..master.drives import scene_drives
+
+        u_limit = tuple(drive.limit for drive in scene_drives(run_scene, fmu))
         return InjectingController(run_scene.controller(u_limit), excitation.axis, excitation.amplitude, f)
     return None
 
@@ -491,11 +496,14 @@ def marks_summary(rows: list[dict]) -> str | None:
 def _injection_rows(common: dict, sig: dict, window: slice, t: np.ndarray, f: float, axis: str, D: complex) -> list:
     """'loop_gain' = -U / A (A = the recorded command, U = A - D the controller's own output; all samples
     at t_k, so no hold correction: the prediction is of samples too) and 'sensitivity' = A / D."""
-    a = np.asarray(sig[command_signal(axis)])[window]
+    from ..master.drives import command_columns
+
+    command = command_columns(sig, int(axis)).commanded
+    a = np.asarray(sig[command])[window]
     d = np.asarray(sig[injection_signal(axis)])[window]
     u = a - d
     A, U = fundamental(a, t, f), fundamental(u, t, f)
-    loop_gain = _gain_row(dict(common, input=command_signal(axis), input_amplitude=abs(A)), LOOP_GAIN, -U / A, u, U,
+    loop_gain = _gain_row(dict(common, input=command, input_amplitude=abs(A)), LOOP_GAIN, -U / A, u, U,
                           t, f)
     return [loop_gain, _gain_row(common, SENSITIVITY, A / D, a, A, t, f)]
 

@@ -53,6 +53,15 @@ from .frequency_response import BASE_AXES, LINEAR_CURVE, LOS_OUTPUTS
 CARRIER_ANGLE_INDEX = {"pitch": 0, "yaw": 1, "roll": 2}   # delta, psi, gamma
 LOOP_OUTPUTS = ["alpha", "beta", "los.omega[1]", "los.omega[3]"]
 VOLTAGES = ["u_R1", "u_R2"]
+# The motors' commands as the record of a run and the linear model name them: a voltage, or in current drive
+# (motor<j>.drive = current, master/drives.py) the current command.
+MOTOR_COMMANDS = VOLTAGES + ["i_R1_cmd", "i_R2_cmd"]
+
+
+def motor_command_columns(inputs: list[str]) -> list[int]:
+    """The columns of the two motors' commands among a linear model's inputs: u_R<j>, or i_R<j>_cmd for a
+    motor in current drive."""
+    return [inputs.index(f"u_R{j}") if f"u_R{j}" in inputs else inputs.index(f"i_R{j}_cmd") for j in (1, 2)]
 JACOBIAN_STEP_RAD = 1e-6
 SETTLE_S = 5.0   # s at rest before linearizing: the loop's integrators have taken up the gravity torque
 SETTLE_RETRY_FACTOR = 4.0   # a loop not at rest by then gets one run this many times longer
@@ -156,7 +165,7 @@ def operating_point(scene, fmu, fidelity: dict | None, settle_s: float = SETTLE_
                              f"(is the loop unstable with these gains?)")
     values = start_values(at_rest, fmu, np.zeros(15))
     values.update(merged)
-    values.update({name: float(signals[name][-1]) for name in fmu.states + VOLTAGES if name in signals})
+    values.update({name: float(signals[name][-1]) for name in fmu.states + MOTOR_COMMANDS if name in signals})
     return values
 
 
@@ -253,7 +262,7 @@ def closed_loop_transition(loop: IsolationLoop) -> np.ndarray:
     step of the loop applied to each unit vector)."""
     plant, h, d = loop.plant, loop.h, loop.delay
     n = plant.Phi.shape[0]
-    voltage_columns = [plant.inputs.index(name) for name in VOLTAGES]
+    voltage_columns = motor_command_columns(plant.inputs)
     hold_input, direct = plant.MB[0][:, voltage_columns], plant.D[:, voltage_columns]
     gains = {key: np.array([getattr(axis, key) for axis in loop.axes]) for key in ("kp", "ki", "kd", "k_gyro")}
     smoothing = np.array([h / (axis.tau + h) for axis in loop.axes])
@@ -314,7 +323,7 @@ def voltage_transfer(loop: IsolationLoop, z: complex, resolvent: np.ndarray | No
     plant = loop.plant
     if resolvent is None:
         resolvent = np.linalg.inv(z * np.eye(plant.Phi.shape[0]) - plant.Phi)
-    voltage_columns = [plant.inputs.index(name) for name in VOLTAGES]
+    voltage_columns = motor_command_columns(plant.inputs)
     path = plant.C @ resolvent @ plant.MB[0][:, voltage_columns] + plant.D[:, voltage_columns] / z
     return path * z ** -loop.delay
 
@@ -458,12 +467,13 @@ def loop_gain_rows(loop: IsolationLoop, axis: str, frequencies) -> list[dict]:
     from .frequency_response import LOOP_GAIN, command_signal, injection_signal
 
     gains = loop_gain_gains(loop, axis, frequencies)
+    drive = "current" if f"i_R{axis}_cmd" in loop.plant.inputs else "voltage"
     rows = []
     for index, f in enumerate(np.atleast_1d(np.asarray(frequencies, float))):
         for name, values in gains.items():
             G = complex(values[index])
             rows.append(dict(curve=LINEAR_CURVE, output=name, requested_hz=float(f), frequency_hz=float(f),
-                             input=command_signal(axis) if name == LOOP_GAIN else injection_signal(axis),
+                             input=command_signal(axis, drive) if name == LOOP_GAIN else injection_signal(axis),
                              gain=abs(G), gain_db=20 * math.log10(abs(G)) if G != 0 else -math.inf,
                              phase_deg=math.degrees(math.atan2(G.imag, G.real)), coherence=1.0))
     return rows

@@ -62,13 +62,14 @@ def measure(scene, fmu, repeat: int) -> dict:
     None when a replay did not reproduce its run."""
     import numpy as np
 
+    from ..master.drives import command_columns
     from ..scene.controllers import Replay
 
     samples: dict = {}
     for _ in range(repeat):
         for loop in LOOPS:
             cpu, whole, result = loop_cpu(scene, fmu, loop == "compiled")
-            commands = np.column_stack([result.signals["u_R1_cmd"], result.signals["u_R2_cmd"]])
+            commands = np.column_stack([result.signals[command_columns(result.signals, j).commanded] for j in (1, 2)])
             replay, _, replayed = loop_cpu(scene, fmu, loop == "compiled", Replay(commands))
             if not same_outputs(result, replayed, fmu):
                 return None

@@ -118,9 +118,21 @@ def check_frequencies(frequencies, scene, dwell) -> None:
     fr.check_resolvable([max(frequencies)], scene.step_size, dwell, what="--fmax")
 
 
-def unit_of(mode: str) -> str:
-    """The unit of --amplitude."""
-    return "deg/s" if mode == "isolation" else "V"
+def unit_of(mode: str, drive: str = "voltage") -> str:
+    """The unit of --amplitude: a motor's current command's in current drive."""
+    return "deg/s" if mode == "isolation" else ("V" if drive == "voltage" else "A")
+
+
+def motor_drive(scene, fmu_file, axis: str) -> str:
+    """"voltage" or "current": the drive of motor `axis` in the scene (master/drives.py); "voltage" for an
+    axis that is not a motor's (refused later, with its own message)."""
+    from ..fmu import FMU
+    from ..master.drives import scene_drives
+
+    if axis not in ("1", "2"):
+        return "voltage"
+    with FMU(fmu_file) as fmu:
+        return scene_drives(scene, fmu)[int(axis) - 1].kind
 
 
 def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
@@ -145,7 +157,7 @@ def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
         return lambda rows: function(loop, excitation.axis, sorted({r["frequency_hz"] for r in rows}))
     if excitation.kind == "injection":
         margins = isolation.predicted_margins(loop, excitation.axis)
-        summary = f"linear model, loop gain at u_R{excitation.axis}: {margins.describe()}"
+        summary = f"linear model, loop gain at {fr.command_signal(excitation.axis, excitation.drive)}: {margins.describe()}"
         return (isolation.loop_gain_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.loop_gain_rows),
                 summary)
     return (isolation.isolation_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.isolation_rows),
@@ -226,7 +238,10 @@ def operating_point_changes(rows: list[dict], scene, fmu_file, excitation) -> di
         for row in rows:
             if row["curve"] == fr.LINEAR_CURVE or row["output"] not in reference.outputs:
                 continue
-            alpha, beta = math.radians(row["alpha_mean_deg"]), math.radians(row["beta_mean_deg"])
+            # within half a turn (a start angle beyond it is refused as degrees): the same configuration, as an
+            # axis that walked round during the dwell (a torque-driven one, in current drive) left it
+            alpha, beta = (math.remainder(math.radians(row[key]), 2 * math.pi) for key in ("alpha_mean_deg",
+                                                                                          "beta_mean_deg"))
             # the rotors follow their loads there (start_values), not the angles the scene may give them
             initial = {k: v for k, v in scene.initial.items() if k not in ("alpha_m", "beta_m")}
             moved_scene = scene.with_changes(initial={**initial, "alpha": alpha, "beta": beta})
@@ -266,7 +281,7 @@ def add_arguments(parser) -> None:
                         help="open-loop, loop-gain: motor 1 or 2 (default 1); isolation: roll, pitch or yaw "
                              "(default roll)")
     parser.add_argument("--amplitude", type=float, nargs="+", default=None, metavar="A",
-                        help="open-loop: voltage amplitude in V (default 1); isolation: carrier rate amplitude "
+                        help="open-loop: voltage amplitude in V (default 1; a current command in A for a motor in current drive, --set motor<j>.drive=1); isolation: carrier rate amplitude "
                              "in deg/s (default 1); loop-gain: injected voltage amplitude in V (default 0.2). Several: a curve per amplitude (the nonlinear model's "
                              "describing function changes with it; the linear one does not)")
     parser.add_argument("--offset", type=float, default=0.0, help="open-loop: constant voltage added, V")
@@ -316,11 +331,16 @@ def measure_and_write(args) -> int:
     dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
     check_frequencies(frequencies, scene, dwell)
     amplitudes = args.amplitude or [0.2 if args.mode == "loop-gain" else 1.0]
+    drive = motor_drive(scene, fmu, args.axis or "1") if args.mode != "isolation" else "voltage"
+    if args.mode != "open-loop" and scene.moving_target is not None:
+        raise SceneError(f"{scene.name}: its [target] moves (type = \"{scene.target_spec.get('type', '?')}\"), and "
+                         f"freqresp {args.mode} measures the closed loop about one operating point: give the scene a "
+                         f"fixed [target] (type = \"direction\") or no target")
     if args.mode == "open-loop":
         axis = args.axis or "1"
         if axis not in fr.MOTOR_AXES:
             raise SceneError(f"--axis {axis!r}: open-loop drives motor 1 or 2")
-        excitations = [fr.Excitation("voltage", axis, a, args.offset) for a in amplitudes]
+        excitations = [fr.Excitation("voltage", axis, a, args.offset, drive) for a in amplitudes]
         scene = scene.with_changes(base_motion_spec={"type": "fixed"},
                                    fidelity={**scene.fidelity, "base.fixed": True},
                                    controller_spec={"type": "none"})
@@ -329,7 +349,7 @@ def measure_and_write(args) -> int:
         axis = args.axis or "1"
         if axis not in fr.MOTOR_AXES:
             raise SceneError(f"--axis {axis!r}: loop-gain injects at motor 1 or 2")
-        excitations = [fr.Excitation("injection", axis, a) for a in amplitudes]
+        excitations = [fr.Excitation("injection", axis, a, drive=drive) for a in amplitudes]
         outputs = None
     else:
         axis = args.axis or "roll"
@@ -369,7 +389,7 @@ def measure_and_write(args) -> int:
     try:
         for each, amplitude in zip(excitations, amplitudes):
             for label, fidelity in variants:
-                curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode)}"
+                curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode, excitation.drive)}"
                 rows += fr.sweep(scene, fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
     finally:
         if client is not None:
@@ -385,11 +405,11 @@ def measure_and_write(args) -> int:
     fr.write_csv(rows, csv_path)
     shown = ", ".join(f"{a:g}" for a in amplitudes)
     if excitation.kind == "injection":
-        title = (f"{scene.name}: loop gain L = -U/A at u_R{axis}_cmd (other axis closed) and sensitivity A/D, "
+        title = (f"{scene.name}: loop gain L = -U/A at {fr.command_signal(axis, excitation.drive)} (other axis closed) and sensitivity A/D, "
                  f"injection {shown} V")
     else:
         title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
-                 f"{shown} {unit_of(args.mode)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
+                 f"{shown} {unit_of(args.mode, excitation.drive)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
     plotted_rows, plotted_lines = rows, lines
     if excitation.kind == "injection":   # the LOS rate per D (-90 dB) would squeeze L and S: it is in the CSV
         shown_outputs = (fr.LOOP_GAIN, fr.SENSITIVITY)

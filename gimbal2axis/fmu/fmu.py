@@ -17,7 +17,8 @@ from ..errors import SceneError
 # The structural switches a scene's [fidelity] table takes: the scene format's vocabulary, checked when
 # a scene file is loaded (before any FMU is opened); check_against_fmu then checks each against the
 # model description. The states, by contrast, are read from the model description (FMU.states).
-FIDELITY = ["gear1.model", "gear2.model", "motor1.model", "motor2.model", "dry_friction", "base.fixed"]
+FIDELITY = ["gear1.model", "gear2.model", "motor1.model", "motor2.model", "dry_friction", "base.fixed", "motor1.drive",
+            "motor2.drive"]
 
 
 def state_names(model_description) -> list[str]:

@@ -37,7 +37,7 @@ from ..errors import SceneError
 from .master import (FMUCallFailed, Plan, RawCalls, clamp_count, failure_error, failure_message, initialize,
                      recorded_signals)
 from .results import RunResult
-from ..scene.scene import Scene, parameter_value
+from ..scene.scene import Scene
 
 
 def _is_number(value) -> bool:
@@ -141,7 +141,7 @@ def run_lockstep(scenes: list, fmu, instances: list | None = None) -> list:
     for i, scene in enumerate(scenes):
         try:
             plan = Plan(scene, fmu, None, controllers.Controller())   # the placeholder is never called
-            u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
+            u_limit = tuple(drive.limit for drive in plan.drives)
         except SceneError as exc:
             outcomes[i] = exc
             continue

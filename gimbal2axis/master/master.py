@@ -23,6 +23,7 @@ from ..errors import FMUCallFailed, SceneError  # FMUCallFailed: also importable
 from ..fmu import FMU
 from ..scene.controllers import AXES, ControllerError
 from ..progress import Progress
+from .drives import command_columns, command_signals, scene_drives
 from .results import RunResult
 from ..scene.scene import Scene, check_against_fmu, check_run_length, parameter_value, start_values
 
@@ -107,8 +108,8 @@ class Plan:
         check_memory(scene, fmu, self)
         self.times = np.arange(self.n + 1) * self.h
         self.base = self.motion.sample(self.times)
-        u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
-        self.controller = controller or scene.controller(u_limit)
+        self.drives = scene_drives(scene, fmu)
+        self.controller = controller or scene.controller(tuple(drive.limit for drive in self.drives))
         self.sensors = scene.sensors()
         self.delay = scene.delay_steps
         # What the IMU measures (the sensors' noise of the whole run drawn here), and from it the
@@ -164,7 +165,8 @@ def check_memory(scene: Scene, fmu: FMU, plan) -> None:
 def choose_records(plan, fmu: FMU) -> None:
     """What a run records and sets, on `plan` (a Plan or a streaming.StreamPlan): the outputs' names
     and value references, the columns the sensors read, the inputs' value references."""
-    plan.real_names = real_outputs(fmu)
+    plan.real_names = real_outputs(fmu) + [name for drive in plan.drives if drive.kind == "current"
+                                           for name in drive.amplifier_outputs if fmu.has(name)]
     plan.mode_names = [name for name in mode_outputs(fmu, plan.scene)
                        if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
     for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]", "alpha_dot", "beta_dot"):
@@ -175,8 +177,8 @@ def choose_records(plan, fmu: FMU) -> None:
     plan.i_alpha, plan.i_beta = plan.real_names.index("alpha"), plan.real_names.index("beta")
     plan.i_gyro = [plan.real_names.index(f"los.omega[{j}]") for j in (1, 2, 3)]
     plan.i_joint_rates = [plan.real_names.index(name) for name in ("alpha_dot", "beta_dot")]
-    plan.input_vrs = [fmu.vr("u_R1"), fmu.vr("u_R2")] + ([] if plan.motion.fixed else
-                                                         [fmu.vr(b) for b in BASE_INPUTS])
+    plan.input_vrs = [fmu.vr(drive.input_name) for drive in plan.drives] + ([] if plan.motion.fixed else
+                                                                            [fmu.vr(b) for b in BASE_INPUTS])
 
 
 def initialize(slave, scene: Scene, fmu: FMU, plan: Plan) -> None:
@@ -298,12 +300,15 @@ def failure_message(scene: Scene, plan: Plan, exc: Exception, log: list | None) 
 
 
 class ClampCount:
-    """How often the controller's voltages were clamped to +-U_L, per axis, accumulated over a run
-    (or its chunks): the steps whose applied command differs from what the controller asked, of all
-    steps, and the largest |voltage| asked on that axis."""
+    """How often the controller's commands were clamped (voltages to +-U_L, current commands to
+    +-i_L: master/drives.py), per axis, accumulated over a run (or its chunks): the steps whose applied
+    command differs from what the controller asked, of all steps, and the largest |command| asked on
+    that axis."""
 
-    def __init__(self):
+    def __init__(self, drives=None):
         self.clamped, self.steps, self.max_asked = [0, 0], 0, [0.0, 0.0]
+        self.kinds = [("voltage", "V") if drive is None or drive.kind == "voltage" else ("current command", "A")
+                      for drive in (drives or (None, None))]
 
     def add(self, asked: np.ndarray, commanded: np.ndarray) -> None:
         """`asked`, `commanded`: (rows, 2), the controller's outputs before and after the clamp."""
@@ -314,18 +319,19 @@ class ClampCount:
                 self.max_asked[axis] = max(self.max_asked[axis], float(np.max(np.abs(asked[:, axis]))))
 
     def summary(self) -> str | None:
-        """"voltage clamped on 1,234 of 60,000 steps (azimuth), max asked 1e+06 V; ..." or None when
-        nothing was clamped."""
-        parts = [f"voltage clamped on {self.clamped[axis]:,} of {self.steps:,} steps ({AXES[axis]}), max asked "
-                 f"{self.max_asked[axis]:.4g} V" for axis in (0, 1) if self.clamped[axis]]
+        """"voltage clamped on 1,234 of 60,000 steps (azimuth), max asked 1e+06 V; ..." ("current command
+        clamped ..., max asked 12 A" for a motor in current drive) or None when nothing was clamped."""
+        parts = [f"{self.kinds[axis][0]} clamped on {self.clamped[axis]:,} of {self.steps:,} steps ({AXES[axis]}), "
+                 f"max asked {self.max_asked[axis]:.4g} {self.kinds[axis][1]}" for axis in (0, 1) if self.clamped[axis]]
         return "; ".join(parts) or None
 
 
 def clamp_count(signals: dict) -> ClampCount:
-    """The ClampCount of a run's recorded signals (recorded_signals)."""
-    count = ClampCount()
-    count.add(np.column_stack([signals["u_R1_asked"], signals["u_R2_asked"]]),
-              np.column_stack([signals["u_R1_cmd"], signals["u_R2_cmd"]]))
+    """The ClampCount of a run's recorded signals (recorded_signals), each axis by the columns of its drive."""
+    drives = [command_columns(signals, motor) for motor in (1, 2)]
+    count = ClampCount(drives)
+    count.add(np.column_stack([signals[drive.asked] for drive in drives]),
+              np.column_stack([signals[drive.commanded] for drive in drives]))
     return count
 
 
@@ -350,9 +356,8 @@ def recorded_signals(plan: Plan, rows: int | None = None) -> dict:
     signals = {"time": times}
     signals.update({name: plan.rec_real[:rows, j] for j, name in enumerate(plan.real_names)})
     signals.update({name: plan.rec_mode[:rows, j].astype(float) for j, name in enumerate(plan.mode_names)})
-    signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0],
-                    "u_R2_cmd": u_cmd[:, 1], "u_R1_asked": u_asked[:, 0], "u_R2_asked": u_asked[:, 1],
-                    "alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
+    signals.update(command_signals(plan.drives, u_applied, u_cmd, u_asked))
+    signals.update({"alpha_ref": refs[:, 0], "beta_ref": refs[:, 1]})
     signals.update({name: plan.base[:rows, j] for j, name in enumerate(BASE_INPUTS)})
     signals["heave"] = plan.motion.position(times)[:, 2]
     return signals

@@ -13,6 +13,7 @@ import textwrap
 import numpy as np
 
 from . import spectra
+from .drives import command_columns
 
 DEG = 180.0 / math.pi
 # The error angle between two unit vectors of doubles is exact to ~1e-15 rad: below 1e-12 rad
@@ -32,7 +33,7 @@ def signal_unit(name: str) -> tuple[float, str]:
     if name in ("alpha", "beta", "alpha_m", "beta_m", "alpha_ref", "beta_ref", "los_azimuth", "los_elevation",
                 "base.delta", "base.psi", "base.gamma"):
         return DEG, "deg"
-    if name.startswith("u_R"):
+    if name.startswith("u_R") or (name.startswith("amplifier") and name.endswith((".u", ".x_I"))):
         return 1.0, "V"
     if name.startswith("i_R"):
         return 1.0, "A"
@@ -49,8 +50,10 @@ def default_panels(result) -> dict:
     if not np.all(np.isnan(s["alpha_ref"])):
         panels["angles"] += ["alpha_ref", "beta_ref"]
     panels["rates"] = ["alpha_dot", "beta_dot", "los.omega[1]", "los.omega[3]"]
-    panels["voltages"] = ["u_R1", "u_R2"]
-    panels["currents"] = ["i_R1", "i_R2"]
+    drives = [command_columns(s, motor) for motor in (1, 2)]
+    # the armature voltages (in current drive the amplifier's output), the currents with their commands
+    panels["voltages"] = [drive.voltage_column for drive in drives if drive.voltage_column in s]
+    panels["currents"] = ["i_R1", "i_R2"] + [drive.applied for drive in drives if drive.kind == "current"]
     panels["backlash"] = [n for n in ("theta_b1", "theta_b2") if n in s]
     if result.has_target:
         panels["line-of-sight error"] = ["los_error"]
@@ -61,7 +64,9 @@ def default_panels(result) -> dict:
 
 LABELS = {"alpha": "alpha (azimuth)", "beta": "beta (elevation)", "alpha_ref": "alpha set point",
           "beta_ref": "beta set point", "los.omega[1]": "gyro x (elevation)", "los.omega[3]": "gyro z (cross-elev.)",
-          "u_R1": "u_R1 applied", "u_R2": "u_R2 applied", "base.delta": "pitch delta", "base.psi": "yaw psi",
+          "u_R1": "u_R1 applied", "u_R2": "u_R2 applied", "amplifier1.u": "u_R1 by the amplifier",
+          "amplifier2.u": "u_R2 by the amplifier", "i_R1_cmd": "i_R1 commanded", "i_R2_cmd": "i_R2 commanded",
+          "base.delta": "pitch delta", "base.psi": "yaw psi",
           "base.gamma": "roll gamma", "los_error": "LOS error",
           "los_error_xel": "LOS error, cross-elevation", "los_error_el": "LOS error, elevation"}
 
@@ -241,7 +246,7 @@ def plot_spectrum(result, path: pathlib.Path) -> bool:
 
 # The signals the tracking figure draws (a run with a moving target: results.tracking_signals).
 TRACKING_PLOT_SIGNALS = ("time", "los_error", "target_elevation", "beta_cmd", "alpha_cmd_dot", "beta_cmd_dot",
-                         "alpha_dot", "beta_dot", "i_R1", "i_R2")
+                         "alpha_dot", "beta_dot", "i_R1", "i_R2", "i_R1_cmd", "i_R2_cmd")
 TRACKING_PLOT_POINTS = 20000   # samples drawn at most (evenly strided): the figure's pixels hold fewer
 
 
@@ -288,6 +293,9 @@ def tracking_figure(scene, columns: dict, title_prefix: str = ""):
     for name in ("i_R1", "i_R2"):
         if name in columns:
             ax.plot(t, columns[name], lw=0.9, label=f"{name} (motor {name[-1]})")
+    for name, color in (("i_R1_cmd", "navy"), ("i_R2_cmd", "saddlebrown")):   # current drive: what was commanded
+        if name in columns:
+            ax.plot(t, columns[name], "--", color=color, lw=0.9, label=f"{name} (commanded)")
     ax.set_ylabel("currents\n[A]", fontsize="small")
     ax.set_xlabel("time [s]", fontsize="small")
     for ax in axes:

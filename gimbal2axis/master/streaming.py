@@ -36,8 +36,9 @@ from ..errors import SceneError
 from ..fmu import FMU
 from ..progress import Progress
 from ..scene.base_motion import INPUTS as BASE_INPUTS
-from ..scene.scene import TRACKING_SIGNALS, Scene, check_against_fmu, check_run_length, parameter_value
+from ..scene.scene import TRACKING_SIGNALS, Scene, check_against_fmu, check_run_length
 from . import compiled_loop, spectra, units
+from .drives import command_signals, scene_drives
 from ..scene.controllers import ControllerError
 from .master import (ClampCount, FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records,
                      failure_error, failure_message, initialize, moving_target_accelerations)
@@ -68,8 +69,8 @@ class StreamPlan:
         self.n = int(round(self.t_end / self.h))
         check_run_length(scene, self.t_end)
         self.motion = scene.base_motion()
-        u_limit = tuple(float(parameter_value(scene, fmu, f"motor{j}.U_L")) for j in (1, 2))
-        self.controller = controller or scene.controller(u_limit)
+        self.drives = scene_drives(scene, fmu)
+        self.controller = controller or scene.controller(tuple(drive.limit for drive in self.drives))
         self.sensors = scene.sensors()
         self.delay = scene.delay_steps
         choose_records(self, fmu)
@@ -117,10 +118,8 @@ class StreamPlan:
         signals = {"time": times}
         signals.update({name: self.rec_real[:count, j].copy() for j, name in enumerate(self.real_names)})
         signals.update({name: self.rec_mode[:count, j].astype(float) for j, name in enumerate(self.mode_names)})
-        signals.update({"u_R1": u_applied[:, 0], "u_R2": u_applied[:, 1], "u_R1_cmd": u_cmd[:, 0].copy(),
-                        "u_R2_cmd": u_cmd[:, 1].copy(), "u_R1_asked": self.u_asked[:count, 0].copy(),
-                        "u_R2_asked": self.u_asked[:count, 1].copy(), "alpha_ref": self.refs[:count, 0].copy(),
-                        "beta_ref": self.refs[:count, 1].copy()})
+        signals.update(command_signals(self.drives, u_applied, u_cmd.copy(), self.u_asked[:count].copy()))
+        signals.update({"alpha_ref": self.refs[:count, 0].copy(), "beta_ref": self.refs[:count, 1].copy()})
         signals.update({name: self.base[:count, j] for j, name in enumerate(BASE_INPUTS)})
         signals["heave"] = self.motion.position_rows(self.first, count, self.h)[:, 2]
         return signals
@@ -527,7 +526,7 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     slave = fmu.instantiate(scene.name, log)
     bar = Progress(plan.t_end, enabled=progress)
     stopped, decimator = None, None
-    clamp = ClampCount()
+    clamp = ClampCount(plan.drives)
     try:
         plan.load_chunk(0, plan.chunk_rows)
         wall0 = time.perf_counter()

@@ -269,7 +269,9 @@ MEASUREMENT_FIELDS = (
 CONTEXT_FIELDS = (
     ("step_size", "s", "the communication step h: step() is called at t_k = k h"),
     ("u_limit", "V", "(U_L1, U_L2): the motors' voltage limits; the master clamps step()'s voltages to +-U_L "
-                     "(counted, and recorded as u_R1_asked / u_R1_cmd)"),
+                     "(counted, and recorded as u_R1_asked / u_R1_cmd). For a motor in current drive "
+                     "(motor<j>.drive = current) step() returns its current command [A] instead, and its "
+                     "limit here is motor<j>.i_L [A] (recorded as i_R1_asked / i_R1_ctrl)"),
     ("target", "-", "the line-of-sight target, a unit vector in frame G, or None when the scene has no [target]"),
     ("delay_steps", "-", "steps between a voltage's computation and its application (1: computed at t_k, "
                          "applied over [t_k+1, t_k+2])"),

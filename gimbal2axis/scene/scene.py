@@ -450,6 +450,7 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
 TRACKING_SIGNALS = ("target_azimuth", "target_elevation", "target_range", "alpha_cmd", "beta_cmd", "alpha_cmd_dot",
                     "beta_cmd_dot", "alpha_cmd_ddot", "beta_cmd_ddot")
 DERIVED_SIGNALS = {"u_R1", "u_R2", "u_R1_cmd", "u_R2_cmd", "u_R1_asked", "u_R2_asked",
+                   "i_R1_ctrl", "i_R2_ctrl", "i_R1_asked", "i_R2_asked",
                    "alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_error",
                    "los_azimuth", "los_elevation", "heave", "los_error_xel", "los_error_el",
                    "base.omega2[1]", "base.omega2[2]", "base.omega2[3]"} | set(TRACKING_SIGNALS) | {f"base.{n}" for n in (

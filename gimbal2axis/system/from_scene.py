@@ -11,6 +11,7 @@ import pathlib
 import numpy as np
 
 from ..errors import SceneError
+from ..master.drives import scene_drives
 from ..fmu import FMU
 from ..scene import parameter_value, start_values
 from ..scene.controller_fmu import controller_fmu_parameters
@@ -67,6 +68,11 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
     fmus = {name: FMU(path) for name, path in paths.items()}
     try:
         gimbal = fmus["gimbal"]
+        current = [drive.motor for drive in scene_drives(scene, gimbal) if drive.kind == "current"]
+        if current:
+            raise SceneError(f"{scene.name}: motor{current[0]}.drive = current, but the controller FMU commands "
+                             f"voltages (u_R1, u_R2): a system of these FMUs runs voltage-driven motors only; run "
+                             f"the scene with `gimbal2axis run`")
         motion = scene.base_motion()
         base = motion.sample(np.array([0.0, 1e-6]))
         gimbal_values = start_values(scene, gimbal, base[0], base[1])

@@ -4,7 +4,8 @@ FMU extracted once per worker, its instance reused through fmi2Reset), with the 
 objective and constraints need besides a sweep's:
 
   i_frac_peak            max |i_R| / motor.i_L over both motors (the current-limit constraint)
-  u_sat_s                time the controller asked for |u| >= motor.U_L (the larger of the two motors), s
+  u_sat_s                time the controller asked for |u| >= motor.U_L (the larger of the two motors), s;
+                         for a motor in current drive, for a current command |i| >= motor.i_L
   psd_band_<lo>_<hi>Hz_<axis>_rms_mrad   the LOS error's RMS in [lo, hi) Hz from the run's own PSD
                          (Welch, the scene's psd_resolution_hz; axis both = root-sum-square of xel and el)
 """
@@ -22,6 +23,7 @@ SATURATION_TOLERANCE = 1e-9   # relative: an asked voltage this close to U_L cou
 def extra_metrics(result, fmu, from_s: float | None, bands: dict) -> dict:
     """The tuning's metrics of one run (see the module's doc)."""
     from ..master import spectra
+    from ..master.drives import command_columns
     from ..scene.scene import parameter_value
 
     s, scene = result.signals, result.scene
@@ -33,10 +35,11 @@ def extra_metrics(result, fmu, from_s: float | None, bands: dict) -> dict:
     dt = scene.step_size
     for j in (1, 2):
         i_limit = float(parameter_value(scene, fmu, f"motor{j}.i_L"))
-        u_limit = float(parameter_value(scene, fmu, f"motor{j}.U_L"))
+        drive = command_columns(s, j)
+        limit = float(parameter_value(scene, fmu, f"motor{j}.U_L")) if drive.kind == "voltage" else i_limit
         fractions.append(float(np.max(np.abs(s[f"i_R{j}"]))) / i_limit)
-        asked = s.get(f"u_R{j}_asked", s[f"u_R{j}"])
-        saturated.append(float(np.count_nonzero(np.abs(asked) >= u_limit * (1 - SATURATION_TOLERANCE))) * dt)
+        asked = s.get(drive.asked, s[drive.applied])
+        saturated.append(float(np.count_nonzero(np.abs(asked) >= limit * (1 - SATURATION_TOLERANCE))) * dt)
     row["i_frac_peak"] = max(fractions)
     row["u_sat_s"] = max(saturated)
     if bands:

@@ -23,7 +23,10 @@ SwitchingElementSet::SwitchingElementSet(const ModelParameters& params) : state_
     // Only a current-driven motor's amplifier acts; in voltage drive its indicators are constants 1.
     for (int axis = 0; axis < 2; ++axis)
         if (current_driven(params, axis)) add<ElementKind::amplifier_saturation>(amplifiers_, axis);
-    for (int axis = 0; axis < 2; ++axis) add<ElementKind::current_limiter>(limiters_, axis);
+    // A current-driven motor's current is limited by its amplifier, which clamps the command to +-i_L: an
+    // ideal limiter at the same level would only meet a current the loop brings onto it tangentially.
+    for (int axis = 0; axis < 2; ++axis)
+        if (!current_driven(params, axis)) add<ElementKind::current_limiter>(limiters_, axis);
     for (int body = 0; body < 4; ++body)
         if (params.coordinate_friction[body].present()) add<ElementKind::dry_friction>(friction_, body);
     for (const auto& e : stops_) elements_.push_back(&e);
