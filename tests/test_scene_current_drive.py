@@ -1,4 +1,4 @@
-"""The scene runner with current-commanded drives (motor<j>.drive = current, gimbal2axis/master/drives.py):
+"""The scene runner with current-commanded drives (motor<j>.drive = current, gimbal2axis/scene/drives.py):
 the controller's output goes to the FMU's current command i_R<j>_cmd, clamped to +-i_L; the record names
 each command column by what it holds (i_R<j>_cmd, i_R<j>_ctrl, i_R<j>_asked in A, the amplifier's voltage
 amplifier<j>.u), both loops and the streamed run give the same bits, a mixed scene keeps the voltage
@@ -13,7 +13,7 @@ import pytest
 
 from gimbal2axis import FMU, SceneError, load_scene, run
 from gimbal2axis.master import run_scene_file
-from gimbal2axis.master.drives import command_columns
+from gimbal2axis.scene.drives import command_columns
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 SCENES = REPO / "scenes"
@@ -174,3 +174,42 @@ def test_open_loop_frequency_response_of_a_current_command_follows_the_linear_mo
         assert float(simulated["gain"]) == pytest.approx(float(linear["gain"]), rel=0.02)
         assert abs(float(simulated["phase_deg"]) - float(linear["phase_deg"])) < 2.0
         assert -95.0 < float(linear["phase_deg"]) < -85.0   # an integrator
+
+
+def test_linearize_at_a_time_of_a_current_driven_run_takes_its_current_commands(tmp_path, fmu):
+    from gimbal2axis.cli.linearize import inputs_at_end
+
+    scene = load_scene(scene_file(tmp_path, drive2=0))
+    signals = run(scene, fmu, stop_time=0.2).signals
+    inputs = inputs_at_end(scene, signals)
+    assert inputs == {"i_R1_cmd": signals["i_R1_cmd"][-1], "u_R2": signals["u_R2"][-1]}
+    done = subprocess.run([sys.executable, "-m", "gimbal2axis", "linearize", "--scene", str(scene.path), "--at-time",
+                           "0.2", "--out", str(tmp_path / "lin.npz"), "--bode", "i_R1_cmd:alpha_dot"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
+    model = np.load(tmp_path / "lin.npz", allow_pickle=False)
+    assert list(model["inputs"][:2]) == ["i_R1_cmd", "u_R2"]
+
+
+@pytest.mark.parametrize("drive2, name, message", [
+    (1, "u_R2_cmd", "motor2 is in current drive (motor2.drive), so its record has 'i_R2_ctrl' instead (A"),
+    (0, "i_R2_asked", "motor2 is in voltage drive (motor2.drive), so its record has 'u_R2_asked' instead (V"),
+    (0, "i_R2_cmd", "motor2 is in voltage drive (motor2.drive), so its record has 'u_R2' instead (V"),
+    (1, "energy_accounting", "is an FMU parameter of type Boolean that a run does not record"),
+])
+def test_a_plot_of_a_column_the_record_cannot_have_is_refused_naming_the_one_it_has(tmp_path, fmu, drive2, name,
+                                                                                     message):
+    path = scene_file(tmp_path, drive2=drive2)
+    path.write_text(path.read_text() + f'[plot]\nmine = ["{name}"]\n')
+    with pytest.raises(SceneError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        run(load_scene(path), fmu, stop_time=0.01)
+
+
+def test_an_fmu_variable_a_plot_names_is_recorded_for_it(tmp_path, fmu_path):
+    path = scene_file(tmp_path)
+    path.write_text(path.read_text() + '[plot]\nwork = ["solver.steps", "motor1.R", "i_R1_cmd"]\n')
+    result, csv_path, png = run_scene_file(path, fmu_path, tmp_path / "out", stop_time=0.05)
+    steps = result.signals["solver.steps"]
+    assert steps[-1] > steps[0] and np.all(np.diff(steps) >= 0)
+    assert np.all(result.signals["motor1.R"] == 2.0)
+    assert "solver.steps [1]" in csv_path.read_text().splitlines()[0].split(",") and png.is_file()

@@ -75,7 +75,7 @@ class Excitation:
     axis: str                 # "1" / "2" (motor) or "roll" / "pitch" / "yaw"
     amplitude: float          # V, or rad/s (rate amplitude of the carrier)
     offset: float = 0.0       # V, a constant voltage added (voltage only)
-    # the excited motor's drive (master/drives.py): in "current" drive the open-loop excitation is its current
+    # the excited motor's drive (scene/drives.py): in "current" drive the open-loop excitation is its current
     # command i_R<axis>_cmd [A] (amplitude and offset in A) and an injection adds to its current command
     drive: str = "voltage"
 
@@ -328,7 +328,7 @@ def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
         voltages[:, int(excitation.axis) - 1] = excitation.offset + excitation.amplitude * np.sin(2 * math.pi * f * t)
         return Replay(voltages)
     if excitation.kind == "injection":
-        from ..master.drives import scene_drives
+        from ..scene.drives import scene_drives
 
         u_limit = tuple(drive.limit for drive in scene_drives(run_scene, fmu))
         return InjectingController(run_scene.controller(u_limit), excitation.axis, excitation.amplitude, f)
@@ -496,7 +496,7 @@ def marks_summary(rows: list[dict]) -> str | None:
 def _injection_rows(common: dict, sig: dict, window: slice, t: np.ndarray, f: float, axis: str, D: complex) -> list:
     """'loop_gain' = -U / A (A = the recorded command, U = A - D the controller's own output; all samples
     at t_k, so no hold correction: the prediction is of samples too) and 'sensitivity' = A / D."""
-    from ..master.drives import command_columns
+    from ..scene.drives import command_columns
 
     command = command_columns(sig, int(axis)).commanded
     a = np.asarray(sig[command])[window]

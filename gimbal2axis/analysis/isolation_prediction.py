@@ -54,7 +54,7 @@ CARRIER_ANGLE_INDEX = {"pitch": 0, "yaw": 1, "roll": 2}   # delta, psi, gamma
 LOOP_OUTPUTS = ["alpha", "beta", "los.omega[1]", "los.omega[3]"]
 VOLTAGES = ["u_R1", "u_R2"]
 # The motors' commands as the record of a run and the linear model name them: a voltage, or in current drive
-# (motor<j>.drive = current, master/drives.py) the current command.
+# (motor<j>.drive = current, scene/drives.py) the current command.
 MOTOR_COMMANDS = VOLTAGES + ["i_R1_cmd", "i_R2_cmd"]
 
 

@@ -62,7 +62,7 @@ def measure(scene, fmu, repeat: int) -> dict:
     None when a replay did not reproduce its run."""
     import numpy as np
 
-    from ..master.drives import command_columns
+    from ..scene.drives import command_columns
     from ..scene.controllers import Replay
 
     samples: dict = {}

@@ -124,10 +124,10 @@ def unit_of(mode: str, drive: str = "voltage") -> str:
 
 
 def motor_drive(scene, fmu_file, axis: str) -> str:
-    """"voltage" or "current": the drive of motor `axis` in the scene (master/drives.py); "voltage" for an
+    """"voltage" or "current": the drive of motor `axis` in the scene (scene/drives.py); "voltage" for an
     axis that is not a motor's (refused later, with its own message)."""
     from ..fmu import FMU
-    from ..master.drives import scene_drives
+    from ..scene.drives import scene_drives
 
     if axis not in ("1", "2"):
         return "voltage"

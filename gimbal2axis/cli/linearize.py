@@ -113,11 +113,13 @@ def scene_point(scene_path: str, fmu_file, at_time: float | None, overrides: dic
 
 def inputs_at_end(scene, signals: dict) -> dict:
     """The inputs of the step that would start at the run's end: the voltages applied from there (the
-    controller's commands of `delay_steps` before) and the carrier's motion there. The instance itself
-    still holds those of the step that ended."""
+    controller's commands of `delay_steps` before; a current-driven motor's current command) and the
+    carrier's motion there. The instance itself still holds those of the step that ended."""
+    from ..scene.drives import command_columns
     from ..scene.base_motion import INPUTS as BASE_INPUTS
 
-    inputs = {"u_R1": float(signals["u_R1"][-1]), "u_R2": float(signals["u_R2"][-1])}
+    applied = [command_columns(signals, motor).applied for motor in (1, 2)]
+    inputs = {name: float(signals[name][-1]) for name in applied}
     if not (scene.fidelity.get("base.fixed", False) or scene.base_motion().fixed):
         inputs.update({name: float(signals[name][-1]) for name in BASE_INPUTS})
     return inputs

@@ -23,7 +23,7 @@ from ..errors import FMUCallFailed, SceneError  # FMUCallFailed: also importable
 from ..fmu import FMU
 from ..scene.controllers import AXES, ControllerError
 from ..progress import Progress
-from .drives import command_columns, command_signals, scene_drives
+from ..scene.drives import command_columns, command_signals, scene_drives
 from .results import RunResult
 from ..scene.scene import Scene, check_against_fmu, check_run_length, parameter_value, start_values
 
@@ -169,6 +169,16 @@ def choose_records(plan, fmu: FMU) -> None:
                                            for name in drive.amplifier_outputs if fmu.has(name)]
     plan.mode_names = [name for name in mode_outputs(fmu, plan.scene)
                        if fmu.has(name) and fmu.variables[name].type in ("Integer", "Enumeration")]
+    # an FMU variable the scene's [plot] names is recorded too (a solver counter, a parameter, an output
+    # the runner leaves out), so that the plot draws what was asked (check_against_fmu refuses the rest)
+    for name in sorted({n for names in plan.scene.plot.values() for n in names}):
+        if not fmu.has(name) or name in plan.real_names or name in plan.mode_names or name in BASE_INPUTS:
+            continue
+        kind = fmu.variables[name].type
+        if kind == "Real" and fmu.variables[name].causality != "input":
+            plan.real_names.append(name)
+        elif kind in ("Integer", "Enumeration"):
+            plan.mode_names.append(name)
     for needed in ("alpha", "beta", "los.omega[1]", "los.omega[2]", "los.omega[3]", "alpha_dot", "beta_dot"):
         if needed not in plan.real_names:
             raise SceneError(f"{fmu.path} has no output '{needed}', which the sensors need")
@@ -301,7 +311,7 @@ def failure_message(scene: Scene, plan: Plan, exc: Exception, log: list | None) 
 
 class ClampCount:
     """How often the controller's commands were clamped (voltages to +-U_L, current commands to
-    +-i_L: master/drives.py), per axis, accumulated over a run (or its chunks): the steps whose applied
+    +-i_L: scene/drives.py), per axis, accumulated over a run (or its chunks): the steps whose applied
     command differs from what the controller asked, of all steps, and the largest |command| asked on
     that axis."""
 

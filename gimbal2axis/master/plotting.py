@@ -13,7 +13,7 @@ import textwrap
 import numpy as np
 
 from . import spectra
-from .drives import command_columns
+from ..scene.drives import command_columns
 
 DEG = 180.0 / math.pi
 # The error angle between two unit vectors of doubles is exact to ~1e-15 rad: below 1e-12 rad

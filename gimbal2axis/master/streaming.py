@@ -38,7 +38,7 @@ from ..progress import Progress
 from ..scene.base_motion import INPUTS as BASE_INPUTS
 from ..scene.scene import TRACKING_SIGNALS, Scene, check_against_fmu, check_run_length
 from . import compiled_loop, spectra, units
-from .drives import command_signals, scene_drives
+from ..scene.drives import command_signals, scene_drives
 from ..scene.controllers import ControllerError
 from .master import (ClampCount, FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records,
                      failure_error, failure_message, initialize, moving_target_accelerations)

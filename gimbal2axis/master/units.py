@@ -47,7 +47,7 @@ _FMU_UNITS = {
 _RUNNER_UNITS = {
     "time": "s",
     "u_R1_cmd": "V", "u_R2_cmd": "V", "u_R1_asked": "V", "u_R2_asked": "V",
-    # a motor in current drive (master/drives.py): the controller's current commands
+    # a motor in current drive (scene/drives.py): the controller's current commands
     "i_R1_ctrl": "A", "i_R2_ctrl": "A", "i_R1_asked": "A", "i_R2_asked": "A",
     **{name: "rad" for name in ("alpha_ref", "beta_ref", "alpha_error", "beta_error", "los_azimuth",
                                 "los_elevation", "los_error", "los_error_xel", "los_error_el")},

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import analysis, geometry
-from .base_motion import Recorded, make_base_motion
+from .base_motion import INPUTS as BASE_INPUT_NAMES, Recorded, make_base_motion
 from .controllers import make_controller
 from .. import target as moving_targets
 from ..target import spec as target_spec_table
@@ -437,7 +437,23 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
                                  f"{did_you_mean(name, fmu.states + [a + '_deg' for a in ANGLE_STATES])}")
         fmu.check("initial", scene.initial, {"output", "local"})
         names = {n for names in scene.plot.values() for n in names}
+        from .drives import other_drive_columns, scene_drives
+
+        drives = scene_drives(scene, fmu)
+        recorded_inputs = set(BASE_INPUT_NAMES) | {drive.applied for drive in drives}
+        for drive in drives:
+            for name, instead in other_drive_columns(drive).items():
+                if name in names:
+                    raise SceneError(f"[plot] '{name}': motor{drive.motor} is in {drive.kind} drive (motor{drive.motor}"
+                                     f".drive), so its record has '{instead}' instead ({drive.unit}; "
+                                     f"docs/scenes.md, \"Current-commanded drives\")")
         for name in sorted(names):
+            if fmu.has(name) and name not in DERIVED_SIGNALS and (
+                    fmu.variables[name].type not in ("Real", "Integer", "Enumeration") or
+                    (fmu.variables[name].causality == "input" and name not in recorded_inputs)):
+                raise SceneError(f"[plot] '{excerpt(name)}' is an FMU {fmu.variables[name].causality} of type "
+                                 f"{fmu.variables[name].type} that a run does not record: a plot draws Real, "
+                                 f"Integer and Enumeration variables the FMU computes, and the runner's signals")
             if not fmu.has(name) and name not in DERIVED_SIGNALS:
                 raise SceneError(f"[plot] '{excerpt(name)}' is neither an FMU variable nor a signal of the runner "
                                  f"({sorted(DERIVED_SIGNALS)}){did_you_mean(name, list(fmu.variables) + sorted(DERIVED_SIGNALS))}")

@@ -11,7 +11,7 @@ import pathlib
 import numpy as np
 
 from ..errors import SceneError
-from ..master.drives import scene_drives
+from ..scene.drives import scene_drives
 from ..fmu import FMU
 from ..scene import parameter_value, start_values
 from ..scene.controller_fmu import controller_fmu_parameters

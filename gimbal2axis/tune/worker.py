@@ -23,7 +23,7 @@ SATURATION_TOLERANCE = 1e-9   # relative: an asked voltage this close to U_L cou
 def extra_metrics(result, fmu, from_s: float | None, bands: dict) -> dict:
     """The tuning's metrics of one run (see the module's doc)."""
     from ..master import spectra
-    from ..master.drives import command_columns
+    from ..scene.drives import command_columns
     from ..scene.scene import parameter_value
 
     s, scene = result.signals, result.scene

@@ -58,7 +58,8 @@ def _drive(motor: int, kind: str, limit: float) -> Drive:
 
 def scene_drives(scene, fmu) -> tuple[Drive, Drive]:
     """Each motor's drive in `scene` run on `fmu`, with its limit (the scene's value, else the FMU's start)."""
-    from ..scene.scene import SceneError, parameter_value
+    from ..errors import SceneError
+    from .scene import parameter_value
 
     drives = []
     for motor in (1, 2):
@@ -93,3 +94,12 @@ def command_signals(drives, applied, commanded, asked) -> dict:
         signals[drive.commanded] = commanded[:, axis]
         signals[drive.asked] = asked[:, axis]
     return signals
+
+
+def other_drive_columns(drive: Drive) -> dict:
+    """{column: what to name instead} of the record's command columns a motor of the other drive would
+    have: what a [plot] of this scene cannot draw."""
+    other = _drive(drive.motor, "current" if drive.kind == "voltage" else "voltage", float("nan"))
+    own = {"applied": drive.applied, "commanded": drive.commanded, "asked": drive.asked}
+    columns = {getattr(other, role): name for role, name in own.items()}
+    return {column: name for column, name in columns.items() if column not in own.values()}
