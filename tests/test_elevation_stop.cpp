@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "core_settings.hpp"
 #include "gimbal/gimbal_c_api.h"
 #include "gimbal/model/variables.hpp"
 
@@ -28,26 +29,8 @@ using namespace gimbal;
 
 namespace {
 
-std::string g_last_error;
-
-void record(void*, GimbalStatus status, const char*, const char* message) {
-    if (status >= GIMBAL_DISCARD) g_last_error = message;
-    if (std::getenv("ELEVATION_STOP_LOG")) std::fprintf(stderr, "[%d] %s\n", status, message);
-}
-int always(void*, const char*) { return 1; }
-
-struct Setting {
-    GimbalType type;
-    unsigned vr;
-    double value;
-};
-
-Setting real(RealVariable vr, double value) { return {GIMBAL_REAL, static_cast<unsigned>(vr), value}; }
-Setting integer(IntegerVariable vi, int value) { return {GIMBAL_INTEGER, static_cast<unsigned>(vi), double(value)}; }
-Setting flag(BooleanVariable vb, bool value) { return {GIMBAL_BOOLEAN, static_cast<unsigned>(vb), value ? 1.0 : 0.0}; }
-
-const char* const kMethodNames[] = {"CVODE BDF",     "CVODE BDF (dq)", "CVODE Adams", "ARKODE ERK",
-                                    "automatic",     "Dormand-Prince", "RODAS4",      "real time"};
+using namespace core_settings;
+std::string& g_last_error = last_error;
 
 // An instance with these values; method -1: Model Exchange. Null when initialization refused (the
 // message in g_last_error).
