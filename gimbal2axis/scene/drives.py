@@ -34,10 +34,6 @@ class Drive(NamedTuple):
     asked: str          # ... of the controller's output at t_k, before the clamp
 
     @property
-    def quantity(self) -> str:
-        return "voltage" if self.kind == "voltage" else "current command"
-
-    @property
     def amplifier_outputs(self) -> tuple[str, str]:
         """The FMU's outputs of this motor's servo amplifier (current drive): its output voltage and integrator."""
         return f"amplifier{self.motor}.u", f"amplifier{self.motor}.x_I"
@@ -79,10 +75,6 @@ def command_columns(signals, motor: int) -> Drive:
     voltage. The limit is not known from the record (nan)."""
     current = f"i_R{motor}_cmd" in signals or f"i_R{motor}_ctrl" in signals
     return _drive(motor, "current" if current else "voltage", float("nan"))
-
-
-RECORD_UNITS = {**{f"u_R{j}{suffix}": "V" for j in (1, 2) for suffix in ("", "_cmd", "_asked")},
-                **{f"i_R{j}{suffix}": "A" for j in (1, 2) for suffix in ("_cmd", "_ctrl", "_asked")}}
 
 
 def command_signals(drives, applied, commanded, asked) -> dict:
