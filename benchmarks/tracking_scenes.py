@@ -6,9 +6,10 @@ time.process_time, the median of `--repeat` runs) and its real-time factor the s
 Beside them, the current-drive flyby (track_flyby_keyhole_current) in two more variants:
 - its quasi-static reduction (motor<j>.model = quasi_static: the amplifier an ideal current source
   limited by the bus, no current state, no 2 kHz pole; docs/physics.md section 4.6);
-- at solver.rtol 1e-10, atol 1e-12: the reference its default tolerance (1e-6) and the reduction are
-  measured against (the largest differences of alpha, beta [rad] and los_error [mrad] over the run, and of
-  the time lost near the keyhole).
+- RODAS4 alone (solver.method 6) and the real-time method (7: RODAS4 in 8 or 16 fixed substeps per
+  step), against the automatic method's choice (Dormand-Prince, switching to RODAS4 while stiff);
+- at solver.rtol 1e-10, atol 1e-12: the reference every variant is measured against (the largest
+  differences of alpha, beta [rad], los_error [mrad] and i_R1 [A] over the run).
 The FMU's work comes from its counters (solver.steps, solver.rhs_evaluations, events.total), read from
 the instance after the run.
 
@@ -30,6 +31,9 @@ COUNTERS = ["solver.steps", "solver.rhs_evaluations", "events.total"]
 CURRENT_FLYBY = "track_flyby_keyhole_current"
 VARIANTS = {
     "quasi-static reduction": {"motor1.model": 0, "motor2.model": 0},
+    "RODAS4 only": {"solver.method": 6},
+    "real-time method, 8 substeps": {"solver.method": 7, "solver.substeps": 8},
+    "real-time method, 16 substeps": {"solver.method": 7, "solver.substeps": 16},
     "rtol 1e-10 (reference)": {"solver.rtol": 1e-10, "solver.atol": 1e-12},
 }
 
@@ -65,7 +69,8 @@ def differences(result, reference) -> dict:
     a, b = result.signals, reference.signals
     return {"alpha_rad": float(np.max(np.abs(a["alpha"] - b["alpha"]))),
             "beta_rad": float(np.max(np.abs(a["beta"] - b["beta"]))),
-            "los_error_mrad": float(np.max(np.abs(result.signal("los_error") - reference.signal("los_error")))) * 1e3}
+            "los_error_mrad": float(np.max(np.abs(result.signal("los_error") - reference.signal("los_error")))) * 1e3,
+            "i_R1_A": float(np.max(np.abs(a["i_R1"] - b["i_R1"])))}
 
 
 def main() -> int:
@@ -91,7 +96,8 @@ def main() -> int:
             results[name], rows[name] = measure(scene, fmu, args.stop_time, 1 if "reference" in label else args.repeat)
             print(f"{name}: {rows[name]['real_time_factor']:.1f}x real time", flush=True)
     reference = results[f"{CURRENT_FLYBY}, rtol 1e-10 (reference)"]
-    for name in (CURRENT_FLYBY, f"{CURRENT_FLYBY}, quasi-static reduction"):
+    compared = [CURRENT_FLYBY] + [f"{CURRENT_FLYBY}, {label}" for label in VARIANTS if "reference" not in label]
+    for name in compared:
         rows[name]["against_reference"] = differences(results[name], reference)
     voltage_cpu = rows["track_flyby_keyhole"]["cpu_s"]
     print(f"\n{'scene':58s} {'CPU [s]':>8s} {'x real time':>11s} {'vs voltage':>10s} {'steps':>9s} {'rhs':>10s} "
@@ -101,10 +107,10 @@ def main() -> int:
         print(f"{name:58s} {row['cpu_s']:8.3f} {row['real_time_factor']:11.1f} {ratio:10.2f} {row['solver.steps']:9d} "
               f"{row['solver.rhs_evaluations']:10d} {row['events.total']:7d} {row['los_rms_mrad']:8.4g} "
               f"{row['time_lost_near_keyhole_s']:15.3g}")
-    for name in (CURRENT_FLYBY, f"{CURRENT_FLYBY}, quasi-static reduction"):
+    for name in compared:
         d = rows[name]["against_reference"]
         print(f"{name} against the reference: alpha {d['alpha_rad']:.2g} rad, beta {d['beta_rad']:.2g} rad, "
-              f"los_error {d['los_error_mrad']:.2g} mrad")
+              f"los_error {d['los_error_mrad']:.2g} mrad, i_R1 {d['i_R1_A']:.2g} A")
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps({"machine": platform.processor() or platform.machine(), "repeat": args.repeat,
