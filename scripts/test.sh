@@ -23,14 +23,16 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   ctest --test-dir "$asan_dir" --output-on-failure --parallel "$test_jobs"
   # Left out here: the tests whose time goes to Python (the independent reference solution, the run
-  # command's streaming, signals and long runs) or to Dask worker processes (sweeps, tuning); they run
-  # in the release pass below.
+  # command's streaming, signals and long runs, the sensors page's comparison of 36 runs: 369 s under the
+  # sanitizers) or to Dask worker processes (sweeps, tuning); they run in the release pass below.
   # libstdc++ is preloaded too: ASan's exception interceptor must find it at start-up, and Python
   # only loads it later (with matplotlib's C++ extensions, which throw).
   LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
     GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
     "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider "${parallel[@]}" \
-    --deselect tests/test_reference_solution.py --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
+    --deselect tests/test_reference_solution.py \
+    --deselect tests/test_report.py::test_the_table_in_the_sensors_page_is_what_the_example_comparison_gives \
+    --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
     --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py \
     --ignore tests/test_run_partial.py --ignore tests/test_long_run.py --ignore tests/test_tune.py
   unset ASAN_OPTIONS UBSAN_OPTIONS
