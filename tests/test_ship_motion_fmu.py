@@ -196,8 +196,11 @@ def test_a_step_a_few_ulps_off_is_the_same_grid_step(ship_fmu):
 def test_outputs_connect_one_to_one_to_the_gimbals_base_inputs(ship_fmu, fmu_path):
     gimbal = {v.name: v for v in fmpy.read_model_description(str(fmu_path)).modelVariables}
     outputs = [v for v in ship_fmu.model_description.modelVariables if v.causality == "output"]
-    assert [v.name for v in outputs] == INPUTS
-    for v in outputs:
+    # the motion's outputs, then the target's, which feed the controller FMU (tests/test_system_target.py)
+    assert [v.name for v in outputs[:len(INPUTS)]] == INPUTS
+    assert [v.name for v in outputs[len(INPUTS):]] == [f"target.{q}[{i}]" for q in ("position", "velocity",
+                                                                                    "acceleration") for i in (1, 2, 3)]
+    for v in outputs[:len(INPUTS)]:
         assert gimbal[v.name].causality == "input"
         assert (v.unit, v.displayUnit) == (gimbal[v.name].unit, gimbal[v.name].displayUnit), v.name
 

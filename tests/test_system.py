@@ -67,7 +67,9 @@ def test_the_osp_structure_connects_every_input_by_variable_groups(system, tmp_p
     root = ET.parse(structure).getroot()
     ns = "{http://opensimulationplatform.com/MSMI/OSPSystemStructure}"
     connections = root.find(ns + "Connections")
-    assert len(connections.findall(ns + "VariableGroupConnection")) == 12
+    # the carrier's five groups to the gimbal, six to the controller (its attitude, rate and acceleration,
+    # the target's position, velocity and acceleration), the gimbal's three to the controller, two voltages
+    assert len(connections.findall(ns + "VariableGroupConnection")) == 5 + 6 + 3 + 2
     assert connections.findall(ns + "VariableConnection") == []
     for name in ("Gimbal2Axis", "Gimbal2Axis_ShipMotion", "Gimbal2Axis-Controller"):
         assert (tmp_path / "osp" / f"{name}_OspModelDescription.xml").is_file()

@@ -137,14 +137,15 @@ def test_what_cannot_be_right_is_refused_naming_the_key_or_the_line(tmp_path, ta
         load_scene(write(tmp_path, target, extra))
 
 
-def test_a_good_track_loads_and_the_controller_fmu_says_it_has_no_moving_target(tmp_path):
+def test_a_good_track_loads_and_the_controller_fmu_points_at_it_through_its_target_inputs(tmp_path):
     (tmp_path / "boat.csv").write_text("# a comment line\n" + TRACK_HEADER + GOOD_ROWS)
     scene = load_scene(write(tmp_path, 'type = "track"\nfile = "boat.csv"',
                              CARRIER + '[controller]\ntype = "pid"\nreference = "target"\n'
                              '[controller.azimuth]\nkp = 1.0\n[controller.elevation]\nkp = 1.0\n'))
     assert scene.moving_target.kind == "track" and scene.target is None
-    with pytest.raises(SceneError, match="fixed .*direction only, not a moving target"):
-        controller_fmu_parameters(scene, (10.0, 10.0))
+    values = controller_fmu_parameters(scene, (10.0, 10.0))
+    # the target's position comes in through the inputs (tests/test_system_target.py), not as a direction
+    assert values["target.moving"] is True and "target.azimuth" not in values
 
 
 def test_a_local_north_east_down_point_is_where_it_says(tmp_path):

@@ -65,30 +65,11 @@ static void state_feedback(GimbalController* c, double h, double alpha, double b
     }
 }
 
-void gimbal_controller_step(GimbalController* c, long k, double h, const double measured[5], const double* set_point,
-                            double u[2], double reference[2]) {
-    if (c->kind == kNone) {
-        u[0] = c->voltage[0], u[1] = c->voltage[1];
-        c->asked[0] = u[0], c->asked[1] = u[1];
-        return;
-    }
-    if (c->kind == kReplay) {
-        u[0] = c->replayed[2 * k], u[1] = c->replayed[2 * k + 1];
-        c->asked[0] = u[0], c->asked[1] = u[1];
-        return;
-    }
+/* The PID or state feedback toward the set points r, their rates, and with a moving target their
+ * accelerations and the gyro's rates on track (NULL otherwise). */
+static void control(GimbalController* c, double h, const double measured[5], const double r[2], const double r_dot[2],
+                    const double* r_ddot, const double* on_track, double u[2], double reference[2]) {
     const double alpha = measured[0], beta = measured[1];
-    double r[2], r_dot[2];
-    const double* r_ddot = NULL;     /* the set points' accelerations, with a moving target */
-    const double* on_track = NULL;   /* the gyro's rates on track (x2, z2), with a moving target */
-    if (set_point != NULL) {
-        r[0] = set_point[0], r[1] = set_point[1], r_dot[0] = set_point[2], r_dot[1] = set_point[3];
-    } else {
-        r[0] = prepared_set_point(&c->set_points, k, 0, alpha), r[1] = prepared_set_point(&c->set_points, k, 1, beta);
-        r_dot[0] = c->set_points.rates[2 * k], r_dot[1] = c->set_points.rates[2 * k + 1];
-        if (c->set_points.accelerations != NULL) r_ddot = c->set_points.accelerations + 2 * k;
-        if (c->set_points.gyro_rates != NULL) on_track = c->set_points.gyro_rates + 2 * k;
-    }
     reference[0] = r[0], reference[1] = r[1];
     /* The payload gyro gives the inertial rate about the elevation axis (gyro[0]) and the
        cross-elevation rate (gyro[2]); divided by cos(beta), the azimuth rate that moves the line of
@@ -103,4 +84,41 @@ void gimbal_controller_step(GimbalController* c, long k, double h, const double 
         return;
     }
     state_feedback(c, h, alpha, beta, w_az, w_el, r, u);
+}
+
+void gimbal_controller_step(GimbalController* c, long k, double h, const double measured[5], const double* set_point,
+                            double u[2], double reference[2]) {
+    if (c->kind == kNone) {
+        u[0] = c->voltage[0], u[1] = c->voltage[1];
+        c->asked[0] = u[0], c->asked[1] = u[1];
+        return;
+    }
+    if (c->kind == kReplay) {
+        u[0] = c->replayed[2 * k], u[1] = c->replayed[2 * k + 1];
+        c->asked[0] = u[0], c->asked[1] = u[1];
+        return;
+    }
+    const double alpha = measured[0];
+    double r[2], r_dot[2];
+    const double* r_ddot = NULL;     /* the set points' accelerations, with a moving target */
+    const double* on_track = NULL;   /* the gyro's rates on track (x2, z2), with a moving target */
+    if (set_point != NULL) {
+        r[0] = set_point[0], r[1] = set_point[1], r_dot[0] = set_point[2], r_dot[1] = set_point[3];
+    } else {
+        r[0] = prepared_set_point(&c->set_points, k, 0, alpha), r[1] = prepared_set_point(&c->set_points, k, 1, measured[1]);
+        r_dot[0] = c->set_points.rates[2 * k], r_dot[1] = c->set_points.rates[2 * k + 1];
+        if (c->set_points.accelerations != NULL) r_ddot = c->set_points.accelerations + 2 * k;
+        if (c->set_points.gyro_rates != NULL) on_track = c->set_points.gyro_rates + 2 * k;
+    }
+    control(c, h, measured, r, r_dot, r_ddot, on_track, u, reference);
+}
+
+void gimbal_controller_track(GimbalController* c, double h, const double measured[5], const double set_point[4],
+                             const double accelerations[2], const double on_track[2], double u[2], double reference[2]) {
+    if (c->kind != kPid && c->kind != kStateFeedback) {
+        gimbal_controller_step(c, 0, h, measured, set_point, u, reference);
+        return;
+    }
+    const double r[2] = {set_point[0], set_point[1]}, r_dot[2] = {set_point[2], set_point[3]};
+    control(c, h, measured, r, r_dot, accelerations, on_track, u, reference);
 }

@@ -1,5 +1,7 @@
 #include "gimbal_kernel/set_points.h"
 
+#include "gimbal_kernel/pointing.h"
+
 #include <math.h>
 
 static const double kTwoPi = 2.0 * 3.14159265358979311599796346854; /* 2 * math.pi */
@@ -13,18 +15,10 @@ void gimbal_target_direction(double azimuth, double elevation, double direction[
 /* The target in frame 0 (0TG t = Ry(-gamma) Rz(-psi) Rx(-delta) t, as geometry.gimbal_angles_for),
  * then the angles: of the two solutions the one with |beta| <= 90 deg. */
 void gimbal_target_angles(const double target[3], const double attitude[3], double angles[2]) {
-    double x = target[0], y = target[1], z = target[2];
-    double c = cos(attitude[0]), s = sin(attitude[0]);
-    const double y1 = c * y + s * z, z1 = -s * y + c * z;
-    y = y1, z = z1;
-    c = cos(attitude[1]), s = sin(attitude[1]);
-    const double x2 = c * x + s * y, y2 = -s * x + c * y;
-    x = x2, y = y2;
-    c = cos(attitude[2]), s = sin(attitude[2]);
-    const double x3 = c * x - s * z, z3 = s * x + c * z;
-    x = x3, z = z3;
-    angles[0] = atan2(-x, y);
-    angles[1] = atan2(z, hypot(x, y));
+    double v[3];
+    gimbal_inertial_to_base(target, attitude, v);
+    angles[0] = atan2(-v[0], v[1]);
+    angles[1] = atan2(v[2], hypot(v[0], v[1]));
 }
 
 void gimbal_target_set_point(const double target[3], const double attitude[3], const double attitude_rate[3],

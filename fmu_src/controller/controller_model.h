@@ -31,7 +31,8 @@ int controller_model_check(const ControllerModel* model, char* message, size_t s
 void controller_model_start(ControllerModel* model);
 
 /* Communication point `model->step` with step h: the sensors read the inputs, the controller
- * computes the voltages and set points into the outputs. */
-void controller_model_step(ControllerModel* model, double h);
+ * computes the voltages and set points into the outputs. 1; 2 when a moving target's inputs gave no
+ * direction to point at, and the step held the measured angles instead (`message` says which and why). */
+int controller_model_step(ControllerModel* model, double h, char* message, size_t size);
 
 #endif

@@ -119,7 +119,8 @@ static FmiStatus exit_initialization(FmiInstance* instance, const char* function
 
 static FmiStatus do_step(FmiInstance* instance, const char* function, double point, double step) {
     ControllerModel* model = model_of(instance);
-    controller_model_step(model, step);
+    char why[512];
+    const int held = controller_model_step(model, step, why, sizeof why) == 2;
     /* A step far below the controller's sampling (h = 5e-324: its backward differences divide by h)
      * or gains that overflow leave no usable command: the host gets an error, never a NaN voltage. */
     for (int k = OUT_U_R1; k <= OUT_BETA_REF; ++k) {
@@ -130,6 +131,10 @@ static FmiStatus do_step(FmiInstance* instance, const char* function, double poi
         return FMI_ERROR;
     }
     instance->time = point + step;
+    if (held) {
+        fmi_log(instance, FMI_WARNING, "logStatusWarning", "%s: at t = %.17g s: %s", function, point, why);
+        return FMI_WARNING;
+    }
     return FMI_OK;
 }
 
@@ -175,7 +180,7 @@ static FmiStatus restore(void* model, const unsigned char* bytes) {
     return FMI_OK;
 }
 
-static const char* const kLogCategories[] = {"logStatusError", "logAll"};
+static const char* const kLogCategories[] = {"logStatusError", "logStatusWarning", "logAll"};
 
 /* The controller's step never fails but into the error state, so fmi2GetStatus is asked only after
  * successful steps (status_states): it is fmi2OK. */

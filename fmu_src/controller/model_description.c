@@ -18,6 +18,8 @@ static const struct {
     {"1", 0, 0, 0, 0, 0, NULL},        {"rad", 0, 0, 0, 0, 1, "deg"},     {"rad/s", 0, 0, -1, 0, 1, "deg/s"},
     {"s", 0, 0, 1, 0, 0, NULL},        {"V", 1, 2, -3, -1, 0, NULL},      {"V/rad", 1, 2, -3, -1, -1, NULL},
     {"V.s/rad", 1, 2, -2, -1, -1, NULL}, {"V/(rad.s)", 1, 2, -4, -1, -1, NULL},
+    {"V.s2/rad", 1, 2, -1, -1, -1, NULL}, {"rad/s2", 0, 0, -2, 0, 1, "deg/s2"}, {"m", 0, 1, 0, 0, 0, NULL},
+    {"m/s", 0, 1, -1, 0, 0, NULL},     {"m/s2", 0, 1, -2, 0, 0, NULL},
 };
 
 /* The same in FMI 2.0 and FMI 3.0. */

@@ -12,7 +12,11 @@
  *
  * With motion = 1 the outputs are a recording's splines (recorded_motion.h) at the same grid times,
  * read at the end of initialization from recording_file (recording_file.h finds it); a step past the
- * recording's end is refused, as the scene runner refuses a recording that does not cover its run. */
+ * recording's end is refused, as the scene runner refuses a recording that does not cover its run.
+ *
+ * With target = 1 the target outputs are the splines of a table of the target's position relative to
+ * the gimbal (recorded_target.h), read from target_file at the end of initialization and evaluated at
+ * the same grid times, refused past its end as the recording is. */
 #include <limits.h>
 #include <math.h>
 #include <stddef.h>
@@ -22,6 +26,7 @@
 
 #include "fmi_layer/small_cosim_model.h"
 #include "gimbal_kernel/recorded_motion.h"
+#include "gimbal_kernel/recorded_target.h"
 #include "recording_file.h"
 #include "ship_motion.h"
 #include "ship_motion_guid.h"
@@ -31,14 +36,16 @@ typedef struct {
     FmiInstance common; /* first: fmi_instantiate allocates the Instance around it */
     ShipMotionParameters parameters;
     char* recording_file;             /* the String parameter's value, the instance's copy */
+    char* target_file;                /* the same of target_file */
     char* resources;                  /* the resources folder, NULL when fmuResourceLocation names none */
     ShipMotion motion;
     GimbalRecordedMotion* recording; /* motion = 1: the file's splines, once prepared */
+    GimbalRecordedTarget* target;    /* target = 1: the table's splines, once prepared */
     int prepared;       /* motion or recording holds what `parameters` say */
     double start_time;
     double step;        /* 0 until the first doStep */
     long row;           /* the grid row of the current communication point */
-    double outputs[SHIP_MOTION_OUTPUTS];
+    double outputs[SHIP_REAL_OUTPUTS]; /* the motion's, then the target's */
 } Instance;
 _Static_assert(offsetof(Instance, common) == 0, "the FmiInstance must be the Instance's first member");
 
@@ -118,11 +125,8 @@ static int finite_row(Instance* instance, const double row[], const char* functi
     return 1;
 }
 
-/* What the current parameters say (the sea state's components or the recording), and row 0 (the
- * outputs before the first step). */
-static FmiStatus prepare(Instance* instance, const char* function) {
-    if (instance->prepared) return FMI_OK;
-    if (instance->parameters.motion == SHIP_MOTION_RECORDED) return prepare_recording(instance, function);
+/* The sea state's components of the parameters, and row 0. */
+static FmiStatus prepare_sea_state(Instance* instance, const char* function) {
     char message[512];
     if (ship_motion_check(&instance->parameters, message, sizeof message) != 0)
         REFUSE(instance, "%s: %s", function, message);
@@ -139,10 +143,63 @@ static FmiStatus prepare(Instance* instance, const char* function) {
     return FMI_OK;
 }
 
+/* The target's table of target_file, checked to cover the experiment as the recording is, and row 0. */
+static FmiStatus prepare_target(Instance* instance, const char* function) {
+    char message[1024];
+    char* path = recording_path(instance->resources, instance->target_file, message, sizeof message);
+    if (path == NULL) REFUSE(instance, "%s: target_file: %s", function, message);
+    size_t length = 0;
+    char* text = recording_read(path, &length, message, sizeof message);
+    if (text == NULL) {
+        free(path);
+        REFUSE(instance, "%s: target_file: %s", function, message);
+    }
+    const int status = gimbal_recorded_target_read(text, length, &instance->target, message, sizeof message);
+    free(text);
+    if (status != GIMBAL_RECORDED_TARGET_READ) {
+        fmi_log_error(&instance->common, "%s: target table %s: %s", function, path, message);
+        free(path);
+        return FMI_ERROR;
+    }
+    const double start = gimbal_recorded_target_start(instance->target);
+    const double end = gimbal_recorded_target_end(instance->target);
+    const double duration = instance->common.stop_time - instance->start_time;
+    if (start > 0.0 || (instance->common.stop_time_defined && end < duration)) {
+        fmi_log_error(&instance->common, "%s: target table %s covers [%g, %g] s, not [0, %g] s", function, path, start,
+                      end, instance->common.stop_time_defined ? duration : end);
+        free(path);
+        gimbal_recorded_target_free(instance->target);
+        instance->target = NULL;
+        return FMI_ERROR;
+    }
+    free(path);
+    gimbal_recorded_target_row(instance->target, 0.0, instance->outputs + SHIP_REAL_TARGET);
+    return FMI_OK;
+}
+
+static void unprepare(Instance* instance);
+
+/* What the current parameters say (the sea state's components or the recording, and the target's
+ * table), and row 0 (the outputs before the first step). */
+static FmiStatus prepare(Instance* instance, const char* function) {
+    if (instance->prepared) return FMI_OK;
+    const FmiStatus status = instance->parameters.motion == SHIP_MOTION_RECORDED
+                                 ? prepare_recording(instance, function)
+                                 : prepare_sea_state(instance, function);
+    if (status != FMI_OK) return status;
+    if (instance->parameters.target == SHIP_TARGET_RECORDED && prepare_target(instance, function) != FMI_OK) {
+        unprepare(instance);
+        return FMI_ERROR;
+    }
+    return FMI_OK;
+}
+
 static void unprepare(Instance* instance) {
     ship_motion_release(&instance->motion);
     gimbal_recorded_motion_free(instance->recording);
     instance->recording = NULL;
+    gimbal_recorded_target_free(instance->target);
+    instance->target = NULL;
     instance->prepared = 0;
 }
 
@@ -154,9 +211,16 @@ static Instance* ship(FmiInstance* instance) { return (Instance*)instance; }
 static int reset_instance(Instance* instance) {
     unprepare(instance);
     char* file = copy_text(kShipStringVariables[SHIP_STRING_RECORDING_FILE].start);
-    if (file == NULL) return -1;
+    char* target_file = copy_text(kShipStringVariables[SHIP_STRING_TARGET_FILE].start);
+    if (file == NULL || target_file == NULL) {
+        free(file);
+        free(target_file);
+        return -1;
+    }
     free(instance->recording_file);
     instance->recording_file = file;
+    free(instance->target_file);
+    instance->target_file = target_file;
     ship_motion_start_parameters(&instance->parameters);
     instance->start_time = 0.0;
     instance->common.time = 0.0;
@@ -165,7 +229,7 @@ static int reset_instance(Instance* instance) {
     instance->common.stop_time_defined = 0;
     instance->common.stop_time = 0.0;
     instance->common.last_step_status = FMI_OK;
-    for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) instance->outputs[k] = 0.0;
+    for (int k = 0; k < SHIP_REAL_OUTPUTS; ++k) instance->outputs[k] = 0.0;
     instance->common.state = instance->common.face->instantiated_state;
     return 0;
 }
@@ -182,12 +246,13 @@ static void release(FmiInstance* common) {
     Instance* instance = ship(common);
     unprepare(instance);
     free(instance->recording_file);
+    free(instance->target_file);
     free(instance->resources);
 }
 
 static FmiStatus reset(FmiInstance* common, const char* function) {
     if (reset_instance(ship(common)) != 0)
-        REFUSE(ship(common), "%s: out of memory for recording_file's start value", function);
+        REFUSE(ship(common), "%s: out of memory for the start values of recording_file and target_file", function);
     return FMI_OK;
 }
 
@@ -251,9 +316,14 @@ static FmiStatus set_integer(FmiInstance* instance, const char* function, unsign
     return FMI_OK;
 }
 
+/* The instance's copy of String variable vr. */
+static char** string_value(Instance* instance, unsigned vr) {
+    return vr == SHIP_STRING_TARGET_FILE ? &instance->target_file : &instance->recording_file;
+}
+
 static FmiStatus get_string(FmiInstance* instance, const char* function, unsigned vr, void* value) {
-    (void)function, (void)vr; /* recording_file is the only String variable */
-    *(const char**)value = ship(instance)->recording_file; /* valid until it is set again or the instance is freed */
+    (void)function;
+    *(const char**)value = *string_value(ship(instance), vr); /* valid until it is set again or the instance is freed */
     return FMI_OK;
 }
 
@@ -267,8 +337,9 @@ static FmiStatus set_string(FmiInstance* common, const char* function, unsigned 
     Instance* instance = ship(common);
     char* copy = copy_text(*(const char* const*)value);
     if (copy == NULL) REFUSE(instance, "%s: out of memory for %s", function, kShipStringVariables[vr].name);
-    free(instance->recording_file);
-    instance->recording_file = copy;
+    char** stored = string_value(instance, vr);
+    free(*stored);
+    *stored = copy;
     return FMI_OK;
 }
 
@@ -288,6 +359,25 @@ static FmiStatus exit_initialization(FmiInstance* common, const char* function) 
     return FMI_OK;
 }
 
+/* Whether the target's table (if any) reaches the next row's time on the grid of `step`: refused,
+ * as a recording's end, before the step changes anything. */
+static FmiStatus target_covers(Instance* instance, const char* function, double step, double end_time) {
+    if (instance->target == NULL) return FMI_OK;
+    const double motion_time = (double)(instance->row + 1) * step;
+    const double end = gimbal_recorded_target_end(instance->target);
+    if (motion_time > end + 1e-12 * fmax(1.0, fabs(end)) + 1e-6 * step)
+        REFUSE(instance, "%s: step to t = %.17g s (the table's time %.17g s) passes the target table's end at %.17g s",
+               function, end_time, motion_time, end);
+    return FMI_OK;
+}
+
+/* The target outputs at the current row (after the step counted it). */
+static void target_row(Instance* instance) {
+    if (instance->target != NULL)
+        gimbal_recorded_target_row(instance->target, (double)instance->row * instance->step,
+                                   instance->outputs + SHIP_REAL_TARGET);
+}
+
 /* A step of motion = 1: the recording's splines at the next row's time. */
 static FmiStatus step_recording(Instance* instance, const char* function, double step, double end_time) {
     /* The grid's time, not the master's: the motion starts at t = 0 whatever startTime is. */
@@ -300,6 +390,7 @@ static FmiStatus step_recording(Instance* instance, const char* function, double
     instance->row += 1;
     instance->common.time = end_time;
     gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
+    target_row(instance);
     instance->common.last_step_status = FMI_OK;
     return FMI_OK;
 }
@@ -326,6 +417,7 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
                function, step_size, instance->step);
     const double step = instance->step != 0.0 ? instance->step : step_size;
     if (instance->row >= LONG_MAX - 1) REFUSE(instance, "%s: the grid's %ld rows are used up", function, instance->row);
+    if (target_covers(instance, function, step, end_time) != FMI_OK) return FMI_ERROR;
     if (instance->recording != NULL) return step_recording(instance, function, step, end_time);
     if (instance->step == 0.0) {
         if (ship_motion_set_step(&instance->motion, step) != 0) {
@@ -345,6 +437,7 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     instance->row += 1;
     instance->common.time = end_time;
     memcpy(instance->outputs, row, sizeof row);
+    target_row(instance);
     instance->common.last_step_status = FMI_OK;
     return FMI_OK;
 }
@@ -364,8 +457,9 @@ typedef struct {
     ShipMotionParameters parameters;
     double start_time, stop_time, step;
     int64_t row;
-    double outputs[SHIP_MOTION_OUTPUTS];
+    double outputs[SHIP_REAL_OUTPUTS];
     char recording_file[kSnapshotFileCapacity];
+    char target_file[kSnapshotFileCapacity];
 } ShipSnapshot;
 
 static const char* calling(const Instance* instance) {
@@ -378,10 +472,13 @@ static FmiStatus save(void* model, unsigned char* bytes) {
     Instance* instance = (Instance*)model;
     ShipSnapshot snapshot;
     memset(&snapshot, 0, sizeof snapshot);
-    const size_t length = strlen(instance->recording_file);
+    const size_t length = strlen(instance->recording_file), target_length = strlen(instance->target_file);
     if (length >= sizeof snapshot.recording_file)
         REFUSE(instance, "%s: recording_file has %zu characters, an FMU state holds %zu at most", calling(instance),
                length, sizeof snapshot.recording_file - 1);
+    if (target_length >= sizeof snapshot.target_file)
+        REFUSE(instance, "%s: target_file has %zu characters, an FMU state holds %zu at most", calling(instance),
+               target_length, sizeof snapshot.target_file - 1);
     snapshot.initialized = (instance->common.state & instance->common.face->before_initialized_states) == 0;
     snapshot.prepared = instance->prepared;
     snapshot.stop_time_defined = instance->common.stop_time_defined;
@@ -392,6 +489,7 @@ static FmiStatus save(void* model, unsigned char* bytes) {
     snapshot.row = instance->row;
     memcpy(snapshot.outputs, instance->outputs, sizeof snapshot.outputs);
     memcpy(snapshot.recording_file, instance->recording_file, length + 1);
+    memcpy(snapshot.target_file, instance->target_file, target_length + 1);
     memcpy(bytes, &snapshot, sizeof snapshot);
     return FMI_OK;
 }
@@ -403,6 +501,8 @@ static const char* snapshot_problem(ShipSnapshot* snapshot) {
     if (snapshot->initialized && !snapshot->prepared) return "it is initialized without a prepared motion";
     if (memchr(snapshot->recording_file, '\0', sizeof snapshot->recording_file) == NULL)
         return "its recording_file is not a terminated string";
+    if (memchr(snapshot->target_file, '\0', sizeof snapshot->target_file) == NULL)
+        return "its target_file is not a terminated string";
     for (unsigned vr = SHIP_REAL_OUTPUTS; vr < SHIP_REAL_COUNT; ++vr) {
         const double x = *ship_real_parameter(&snapshot->parameters, vr);
         const ShipRealVariable* variable = &kShipRealVariables[vr];
@@ -419,7 +519,7 @@ static const char* snapshot_problem(ShipSnapshot* snapshot) {
         return "its times or its step are not finite";
     if (snapshot->row < 0 || snapshot->row >= LONG_MAX - 1 || (snapshot->row > 0 && snapshot->step == 0.0))
         return "its grid row is not one a step reached";
-    for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k)
+    for (int k = 0; k < SHIP_REAL_OUTPUTS; ++k)
         if (!isfinite(snapshot->outputs[k])) return "an output is not finite";
     return NULL;
 }
@@ -439,29 +539,40 @@ static FmiStatus restore(void* model, const unsigned char* bytes) {
     Instance restored = *instance; /* the instance's identity, for prepare's messages */
     memset(&restored.motion, 0, sizeof restored.motion);
     restored.recording = NULL;
+    restored.target = NULL;
     restored.prepared = 0;
     restored.parameters = snapshot.parameters;
     restored.start_time = snapshot.start_time;
     restored.common.stop_time = snapshot.stop_time;
     restored.common.stop_time_defined = snapshot.stop_time_defined;
     restored.recording_file = copy_text(snapshot.recording_file);
-    if (restored.recording_file == NULL) REFUSE(instance, "%s: out of memory for recording_file", calling(instance));
+    restored.target_file = copy_text(snapshot.target_file);
+    if (restored.recording_file == NULL || restored.target_file == NULL) {
+        free(restored.recording_file);
+        free(restored.target_file);
+        REFUSE(instance, "%s: out of memory for recording_file and target_file", calling(instance));
+    }
     if (snapshot.prepared && prepare(&restored, calling(instance)) != FMI_OK) {
         free(restored.recording_file);
+        free(restored.target_file);
         return FMI_ERROR;
     }
     if (restored.prepared && restored.recording == NULL && snapshot.step != 0.0 &&
         ship_motion_set_step(&restored.motion, snapshot.step) != 0) {
         unprepare(&restored);
         free(restored.recording_file);
+        free(restored.target_file);
         REFUSE(instance, "%s: out of memory for the rotation tables of step %g", calling(instance), snapshot.step);
     }
     unprepare(instance);
     free(instance->recording_file);
     instance->recording_file = restored.recording_file;
+    free(instance->target_file);
+    instance->target_file = restored.target_file;
     instance->parameters = restored.parameters;
     instance->motion = restored.motion;
     instance->recording = restored.recording;
+    instance->target = restored.target;
     instance->prepared = restored.prepared;
     instance->start_time = snapshot.start_time;
     instance->step = snapshot.step;

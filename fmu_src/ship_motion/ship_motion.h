@@ -20,6 +20,9 @@ enum { SHIP_MOTION_OUTPUTS = 15 };
 /* What the outputs are: the sea state of the parameters, or a recording (recorded_motion.h). */
 enum { SHIP_MOTION_SEA_STATE = 0, SHIP_MOTION_RECORDED = 1 };
 
+/* What the target outputs are: none (0), or a table of the target's position (recorded_target.h). */
+enum { SHIP_TARGET_NONE = 0, SHIP_TARGET_RECORDED = 1 };
+
 extern const char* const kShipDofNames[SHIP_MOTION_DOFS];
 
 typedef struct {
@@ -31,6 +34,7 @@ typedef struct {
     double band_lower, band_upper;                  /* the frequency band, in multiples of the peak frequency */
     int seed;
     int motion;                                     /* SHIP_MOTION_SEA_STATE or SHIP_MOTION_RECORDED */
+    int target;                                     /* SHIP_TARGET_NONE or SHIP_TARGET_RECORDED */
 } ShipMotionParameters;
 
 typedef struct {

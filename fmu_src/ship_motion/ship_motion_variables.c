@@ -15,6 +15,13 @@
     {dof ".gamma", SHIP_PARAMETER, "1", "", gamma, 1.0, 0,                                                           \
      "JONSWAP peak enhancement of the " dof " spectrum (1: Pierson-Moskowitz)"}
 
+/* target = 1: the table's x, y, z and their derivatives (connect to the controller's inputs of the
+ * same names); 0 otherwise. */
+#define TARGET_OUTPUTS(quantity, unit, what)                                                                         \
+    {"target." quantity "[1]", SHIP_OUTPUT, unit, "", 0, -HUGE_VAL, 0, what ", x component in G (target = 1; else 0)"}, \
+    {"target." quantity "[2]", SHIP_OUTPUT, unit, "", 0, -HUGE_VAL, 0, what ", y component in G (target = 1; else 0)"}, \
+    {"target." quantity "[3]", SHIP_OUTPUT, unit, "", 0, -HUGE_VAL, 0, what ", z component in G (target = 1; else 0)"}
+
 const ShipRealVariable kShipRealVariables[SHIP_REAL_COUNT] = {
     {"base.delta", SHIP_OUTPUT, "rad", "deg", 0, -HUGE_VAL, 0, "carrier pitch angle delta (connect to the gimbal's base.delta)"},
     {"base.psi", SHIP_OUTPUT, "rad", "deg", 0, -HUGE_VAL, 0, "carrier yaw angle psi (connect to the gimbal's base.psi)"},
@@ -31,6 +38,9 @@ const ShipRealVariable kShipRealVariables[SHIP_REAL_COUNT] = {
     {"base.a_a[1]", SHIP_OUTPUT, "m/s2", "", 0, -HUGE_VAL, 0, "acceleration of point a, x component in G (sway; gravity not in it)"},
     {"base.a_a[2]", SHIP_OUTPUT, "m/s2", "", 0, -HUGE_VAL, 0, "acceleration of point a, y component in G (surge; gravity not in it)"},
     {"base.a_a[3]", SHIP_OUTPUT, "m/s2", "", 0, -HUGE_VAL, 0, "acceleration of point a, z component in G (heave; gravity not in it)"},
+    TARGET_OUTPUTS("position", "m", "the target's position relative to the gimbal"),
+    TARGET_OUTPUTS("velocity", "m/s", "the rate of the target's position"),
+    TARGET_OUTPUTS("acceleration", "m/s2", "the second derivative of the target's position"),
     DOF_PARAMETERS("pitch", 1, DEGREES(2.0), 7.0, 3.3),
     DOF_PARAMETERS("yaw", 1, DEGREES(1.0), 12.0, 1.0),
     DOF_PARAMETERS("roll", 1, DEGREES(5.0), 9.0, 3.3),
@@ -55,12 +65,17 @@ const ShipIntegerVariable kShipIntegerVariables[SHIP_INTEGER_COUNT] = {
     {"seed", 7, 0, 2147483647, "seed of the frequencies' places in their bins and of the phases (numpy's default_rng([seed, index of the degree of freedom]))"},
     {"motion", SHIP_MOTION_SEA_STATE, SHIP_MOTION_SEA_STATE, SHIP_MOTION_RECORDED,
      "what the outputs are: 0 the sea state of the parameters, 1 the recording in recording_file (splined)"},
+    {"target", SHIP_TARGET_NONE, SHIP_TARGET_NONE, SHIP_TARGET_RECORDED,
+     "the target outputs: 0 none (zeros), 1 the table in target_file (splined), from t = 0 on the grid as the motion"},
 };
 
 const ShipStringVariable kShipStringVariables[SHIP_STRING_COUNT] = {
     {"recording_file", SHIP_EXAMPLE_RECORDING,
      "the recorded motion (CSV: time and any of delta, psi, gamma or pitch_deg, yaw_deg, roll_deg, their _dot and "
      "_ddot, x, y, z) when motion = 1: absolute, or relative to the FMU's resources folder"},
+    {"target_file", SHIP_TARGET_TABLE,
+     "the target's table (CSV: time, x, y, z [m], the target from the gimbal in G, optionally x_dot ... z_dot, x_ddot "
+     "... z_ddot) when target = 1: absolute, or relative to the FMU's resources folder"},
 };
 
 double* ship_real_parameter(ShipMotionParameters* parameters, unsigned value_reference) {
@@ -83,6 +98,7 @@ int* ship_integer_parameter(ShipMotionParameters* parameters, unsigned value_ref
     if (value_reference < SHIP_INTEGER_SEED) return &parameters->components[value_reference];
     if (value_reference == SHIP_INTEGER_SEED) return &parameters->seed;
     if (value_reference == SHIP_INTEGER_MOTION) return &parameters->motion;
+    if (value_reference == SHIP_INTEGER_TARGET) return &parameters->target;
     return NULL;
 }
 

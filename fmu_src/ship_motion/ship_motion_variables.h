@@ -4,6 +4,7 @@
 #ifndef SHIP_MOTION_VARIABLES_H
 #define SHIP_MOTION_VARIABLES_H
 
+#include "gimbal_kernel/recorded_target.h"
 #include "ship_motion.h"
 
 typedef enum { SHIP_OUTPUT, SHIP_PARAMETER } ShipCausality;
@@ -25,9 +26,11 @@ typedef struct {
     const char* description;
 } ShipIntegerVariable;
 
-/* Real value references: the outputs in the order of the gimbal's base inputs, then the parameters. */
+/* Real value references: the outputs in the order of the gimbal's base inputs, the target's outputs
+ * (recorded_target.h's order: position, velocity, acceleration), then the parameters. */
 enum {
-    SHIP_REAL_OUTPUTS = SHIP_MOTION_OUTPUTS,
+    SHIP_REAL_TARGET = SHIP_MOTION_OUTPUTS,
+    SHIP_REAL_OUTPUTS = SHIP_MOTION_OUTPUTS + GIMBAL_RECORDED_TARGET_OUTPUTS,
     SHIP_REAL_SIGNIFICANT_AMPLITUDE = SHIP_REAL_OUTPUTS, /* + 3 * degree of freedom */
     SHIP_REAL_PEAK_PERIOD,                               /* + 3 * degree of freedom */
     SHIP_REAL_GAMMA,                                     /* + 3 * degree of freedom */
@@ -43,11 +46,22 @@ typedef struct {
     const char* description;
 } ShipStringVariable;
 
-/* Integer value references: the components per degree of freedom, the seed, the kind of motion. */
-enum { SHIP_INTEGER_COMPONENTS = 0, SHIP_INTEGER_SEED = SHIP_MOTION_DOFS, SHIP_INTEGER_MOTION, SHIP_INTEGER_COUNT };
+/* Integer value references: the components per degree of freedom, the seed, the kind of motion, the
+ * kind of target. */
+enum {
+    SHIP_INTEGER_COMPONENTS = 0,
+    SHIP_INTEGER_SEED = SHIP_MOTION_DOFS,
+    SHIP_INTEGER_MOTION,
+    SHIP_INTEGER_TARGET,
+    SHIP_INTEGER_COUNT
+};
 
-/* String value references: the recording's file (the FMU instance keeps its own copy of the value). */
-enum { SHIP_STRING_RECORDING_FILE = 0, SHIP_STRING_COUNT };
+/* String value references: the recording's file, the target's table (the FMU instance keeps its own
+ * copy of each value). */
+enum { SHIP_STRING_RECORDING_FILE = 0, SHIP_STRING_TARGET_FILE, SHIP_STRING_COUNT };
+
+/* The target table's file name that `gimbal2axis system` puts in the FMU's resources folder. */
+#define SHIP_TARGET_TABLE "target_track.csv"
 
 /* The example recording in the FMU's resources folder (fmu_src/ship_motion/resources/). */
 #define SHIP_EXAMPLE_RECORDING "ship_recording.csv"

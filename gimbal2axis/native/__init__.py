@@ -51,6 +51,7 @@ def _declare(loaded) -> None:
         "gimbal_target_direction": ([double, double, pointer], None),
         "gimbal_target_set_points": ([long, pointer, pointer, pointer, pointer, pointer], None),
         "gimbal_angle_nearest_turn": ([double, double], double),
+        "gimbal_pointing_command": ([pointer] * 7, integer),
         "gimbal_sensors_measure": ([pointer, long, pointer], None),
         "gimbal_gyro_measure": ([pointer, long, pointer, pointer], None),
         "gimbal_gyro_series": ([pointer, long, pointer, pointer], None),

@@ -11,7 +11,7 @@ import math
 from ..errors import SceneError
 
 KINDS = ("none", "pid", "state_feedback")   # controller.kind 0, 1, 2
-PID_GAINS = ("kp", "ki", "kd", "k_gyro", "k_ff")
+PID_GAINS = ("kp", "ki", "kd", "k_gyro", "k_ff", "k_acc")
 
 
 def _controller_values(controller, target_spec) -> dict:
@@ -23,16 +23,15 @@ def _controller_values(controller, target_spec) -> dict:
     if list(controller.refs) != ["target", "target"]:
         raise SceneError("the controller FMU sets its points toward the [target] only: [controller] needs "
                          "reference = 'target' on both axes")
-    if "type" in target_spec:   # a moving target (gimbal2axis/target): its position is not an FMU input yet
-        raise SceneError(f"the controller FMU points at a fixed [target] direction only, not a moving target "
-                         f"(type = {target_spec['type']!r}): run the scene with gimbal2axis run")
-    values["target.azimuth"] = math.radians(target_spec["azimuth_deg"])
-    values["target.elevation"] = math.radians(target_spec["elevation_deg"])
+    if "type" in target_spec:
+        # a moving target (gimbal2axis/target): its position comes in through the FMU's target inputs
+        # (the ship-motion FMU's target table, ship_motion_fmu.target_table)
+        values["target.moving"] = True
+    else:
+        values["target.azimuth"] = math.radians(target_spec["azimuth_deg"])
+        values["target.elevation"] = math.radians(target_spec["elevation_deg"])
     if controller.kind == "pid":
         for name, axis in zip(("azimuth", "elevation"), controller.axes):
-            if axis.k_acc != 0.0:   # a moving target's acceleration feed-forward, which the FMU does not take
-                raise SceneError(f"the controller FMU has no acceleration feed-forward: controller.{name}.k_acc "
-                                 f"= {axis.k_acc:g} must be 0 there")
             values.update({f"{name}.{gain}": getattr(axis, gain) for gain in PID_GAINS})
             values[f"{name}.d_filter_s"], values[f"{name}.i_limit"] = axis.tau, axis.i_limit
         return values

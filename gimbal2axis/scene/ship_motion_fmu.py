@@ -51,3 +51,33 @@ def recording_parameters(scene) -> dict:
         raise SceneError(f"[base_motion] type = {shown(spec.get('type', 'fixed'))} is not a recording")
     motion = scene.base_motion()   # the scene's own checks, with their messages
     return {"motion": 1, "recording_file": str(motion.path)}
+
+
+TARGET_TABLE = "target_track.csv"   # the name the FMU's target_file starts with (ship_motion_variables.h)
+TARGET_SAMPLE_S = 0.05              # the table's spacing, rounded to a whole number of communication steps
+TARGET_COLUMNS = ("x", "y", "z", "x_dot", "y_dot", "z_dot", "x_ddot", "y_ddot", "z_ddot")
+
+
+def target_table(scene, stop_time: float, step: float) -> bytes:
+    """The ship-motion FMU's target table of `scene`'s moving target (its target = 1): the target's
+    position relative to the gimbal in G with its rates and accelerations, as the scene runner
+    computes them (gimbal2axis/target), at every multiple of the spacing from t = 0 until past the
+    stop time (the FMU splines between the rows: the relative motion of a ship and a coastal point, an
+    aircraft's straight line or a recorded track is smooth on that scale); numbers as Python's repr,
+    so that the FMU reads the same doubles."""
+    import numpy as np
+
+    target = scene.moving_target
+    if target is None:
+        raise SceneError("the scene's [target] does not move: the ship-motion FMU has no target table to give")
+    spacing = step * max(1, round(TARGET_SAMPLE_S / step))
+    rows = max(4, int(np.ceil(stop_time / spacing)) + 2)
+    times = np.arange(rows) * spacing
+    from ..target.motion import Track
+    for track in (getattr(target, "track", None), getattr(target.carrier, "track", None)):
+        if isinstance(track, Track):
+            track.check_covers("[target]", float(times[-1]))
+    p, p_dot, p_ddot = target.relative(times)
+    columns = np.vstack([times, p, p_dot, p_ddot]).T
+    lines = ["time," + ",".join(TARGET_COLUMNS)] + [",".join(repr(float(x)) for x in row) for row in columns]
+    return ("\n".join(lines) + "\n").encode("ascii")

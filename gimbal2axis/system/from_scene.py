@@ -1,5 +1,6 @@
 """A scene with a sea state and a built-in controller as a system of three FMUs: the ship-motion FMU
-(the scene's sea state), the gimbal FMU (the scene's fidelity, parameters and start values, as the
+(the scene's sea state, and a moving target's position from the gimbal as a table in its resources),
+the gimbal FMU (the scene's fidelity, parameters and start values, as the
 scene runner sets them) and the controller FMU (the scene's controller, target and sensors), each
 input connected to the output of the same name, and the OSP variable groups connected group to
 group. In an engine that steps every FMU from the values of the communication point before (Jacobi:
@@ -15,14 +16,16 @@ from ..scene.drives import scene_drives
 from ..fmu import FMU
 from ..scene import parameter_value, start_values
 from ..scene.controller_fmu import controller_fmu_parameters
-from ..scene.ship_motion_fmu import ship_motion_fmu_parameters
+from ..scene.ship_motion_fmu import TARGET_TABLE, ship_motion_fmu_parameters, target_table
 from .structure import Component, Connection, System
 
 FMUS = {"ship": "Gimbal2Axis-ShipMotion.fmu", "gimbal": "Gimbal2Axis.fmu", "controller": "Gimbal2Axis-Controller.fmu"}
 CARRIER_GROUPS = ["carrier_attitude", "carrier_attitude_rate", "carrier_attitude_acceleration", "carrier_velocity",
                   "carrier_acceleration"]
 GROUPS = [("ship", g, "gimbal", g) for g in CARRIER_GROUPS] + \
-    [("ship", g, "controller", g) for g in ("carrier_attitude", "carrier_attitude_rate")] + \
+    [("ship", g, "controller", g) for g in ("carrier_attitude", "carrier_attitude_rate",
+                                             "carrier_attitude_acceleration", "target_position", "target_velocity",
+                                             "target_acceleration")] + \
     [("gimbal", g, "controller", g) for g in ("gimbal_angles", "gimbal_rates", "line_of_sight_rate")] + \
     [("controller", f"motor{j}_voltage", "gimbal", f"motor{j}_voltage") for j in (1, 2)]
 
@@ -79,8 +82,15 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
         u_limit = tuple(float(parameter_value(scene, gimbal, f"motor{j}.U_L")) for j in (1, 2))
         values = {"ship": ship_motion_fmu_parameters(scene), "gimbal": gimbal_values,
                   "controller": controller_fmu_parameters(scene, u_limit)}
-        components = [Component(name, paths[name], values[name], _description(paths[name], fmus[name]))
-                      for name in FMUS]
+        resources = {name: {} for name in FMUS}
+        if scene.moving_target is not None:
+            # the target's position from the gimbal, tabulated for the run, in the ship-motion FMU's
+            # resources: its target outputs feed the controller's target inputs
+            values["ship"]["target"] = 1
+            resources["ship"][TARGET_TABLE] = target_table(scene, scene.stop_time if stop_time is None else stop_time,
+                                                           scene.step_size)
+        components = [Component(name, paths[name], values[name], _description(paths[name], fmus[name]),
+                                resources[name]) for name in FMUS]
         connections = _connections(fmus)
     finally:
         for fmu in fmus.values():

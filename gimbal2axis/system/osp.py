@@ -9,7 +9,7 @@ import shutil
 import xml.etree.ElementTree as ET
 from xml.sax.saxutils import quoteattr
 
-from .structure import System
+from .structure import System, write_fmu
 
 NAMESPACE = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
 
@@ -70,7 +70,7 @@ def write_osp(system: System, out: pathlib.Path) -> pathlib.Path:
     out.mkdir(parents=True, exist_ok=True)
     simulators, grouped = [], set()
     for component in system.components:
-        shutil.copyfile(component.fmu, out / component.fmu.name)
+        write_fmu(component, out / component.fmu.name)
         if component.osp_description is not None:
             shutil.copyfile(component.osp_description, out / component.osp_description.name)
         values = "".join(f"\n                <InitialValue variable={quoteattr(name)}>{_value(value)}</InitialValue>"

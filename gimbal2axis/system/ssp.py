@@ -12,12 +12,13 @@ component, not once on the system, because libcosim applies only a component's o
 from __future__ import annotations
 
 import pathlib
+import tempfile
 import zipfile
 from xml.sax.saxutils import quoteattr
 
 from fmpy import read_model_description
 
-from .structure import System
+from .structure import System, write_fmu
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -114,5 +115,11 @@ def write_ssp(system: System, path: pathlib.Path) -> pathlib.Path:
             if component.start_values:
                 archive.writestr(parameter_file(component.name),
                                  parameter_set(f"{system.name}.{component.name}", component.start_values))
-            archive.write(component.fmu, f"resources/{component.fmu.name}")
+            if component.resources:
+                with tempfile.TemporaryDirectory() as folder:
+                    fmu = pathlib.Path(folder) / component.fmu.name
+                    write_fmu(component, fmu)
+                    archive.write(fmu, f"resources/{component.fmu.name}")
+            else:
+                archive.write(component.fmu, f"resources/{component.fmu.name}")
     return path

@@ -3,6 +3,8 @@ description if it has one) and connections from an output to an input, on one co
 from __future__ import annotations
 
 import pathlib
+import shutil
+import zipfile
 from dataclasses import dataclass, field
 
 
@@ -12,6 +14,9 @@ class Component:
     fmu: pathlib.Path
     start_values: dict = field(default_factory=dict)   # variable name -> float, int or bool
     osp_description: pathlib.Path | None = None        # <modelName>_OspModelDescription.xml
+    # files the system adds to the FMU's resources folder (name -> bytes): the ship-motion FMU's
+    # target table of a scene's moving target
+    resources: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -35,3 +40,17 @@ class System:
 
     def component(self, name: str) -> Component:
         return next(c for c in self.components if c.name == name)
+
+
+def write_fmu(component: Component, path: pathlib.Path) -> None:
+    """The component's FMU at `path`, with its added resources (resources/<name>) when it has any."""
+    if not component.resources:
+        shutil.copyfile(component.fmu, path)
+        return
+    with zipfile.ZipFile(component.fmu) as original, zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as copy:
+        added = {f"resources/{name}" for name in component.resources}
+        for item in original.infolist():
+            if item.filename not in added:
+                copy.writestr(item, original.read(item))
+        for name, data in component.resources.items():
+            copy.writestr(f"resources/{name}", data)

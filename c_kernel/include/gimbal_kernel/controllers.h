@@ -68,6 +68,16 @@ int gimbal_controller_kind(const char* name);
 void gimbal_controller_step(GimbalController* controller, long k, double h, const double measured[5],
                             const double* set_point, double u[2], double reference[2]);
 
+/* The step of a controller toward a moving target whose set points come one row at a time (the
+ * controller FMU's pointing command, gimbal_kernel/pointing.h): set_point (r1, r2, r1_dot, r2_dot)
+ * as in gimbal_controller_step, accelerations (r1_ddot, r2_ddot) fed forward by the PID's k_acc, and
+ * on_track, the payload's inertial rate on track about x2 and z2, which the gyro terms act on the
+ * departure from (GimbalSetPoints says the same of a whole run's rows). Kinds none and replay step
+ * as gimbal_controller_step does at communication point 0. */
+void gimbal_controller_track(GimbalController* controller, double h, const double measured[5],
+                             const double set_point[4], const double accelerations[2], const double on_track[2],
+                             double u[2], double reference[2]);
+
 #ifdef __cplusplus
 }
 #endif
