@@ -73,6 +73,7 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
         gimbal = fmus["gimbal"]
         current = [drive.motor for drive in scene_drives(scene, gimbal) if drive.kind == "current"]
         if current:
+            # (and libcosim, the engine of the OSP structure, sets no FMI 2.0 Enumeration such as motor<j>.drive)
             raise SceneError(f"{scene.name}: motor{current[0]}.drive = current, but the controller FMU commands "
                              f"voltages (u_R1, u_R2): a system of these FMUs runs voltage-driven motors only; run "
                              f"the scene with `gimbal2axis run`")
