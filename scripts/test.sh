@@ -9,6 +9,8 @@ repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${GIMBAL_BUILD_DIR:-$repo/build}"
 test_jobs="${GIMBAL_TEST_JOBS:-$(nproc)}"
 parallel=(-n "$test_jobs" --dist loadfile)
+# The tests that build an FMU from its sources/ (fmpy's build: CMake) use every core too.
+export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-$test_jobs}"
 bash "$repo/scripts/setup.sh"
 cd "$repo"
 

@@ -141,6 +141,14 @@ def test_limit_warning_counts_grid_points_and_samples(tmp_path):
     assert load_sweep(REPO / "sweeps" / "gains_1000.toml").limit_warning() is None
 
 
+def test_a_sweep_over_a_motors_drive_warns_that_the_gains_change_their_unit(tmp_path):
+    for name in ("motor1.drive", "fidelity.motor2.drive"):
+        text = f'stop_time = 0.04\n[grid]\n"{name}" = [0, 1]\n'
+        warning = load_sweep(write(tmp_path, text)).drive_warning()
+        assert f"{name} is swept" in warning and "amperes per unit where it is current-driven" in warning
+    assert load_sweep(write(tmp_path, LIMITED)).drive_warning() is None
+
+
 def _start_then_signal(fmu_path, out, sweep, sig, whole_group):
     """Starts a sweep on a local cluster of 2 worker processes and, once a case is finished, sends
     `sig` to it (or, as a terminal's Ctrl-C does, to its whole process group)."""

@@ -9,6 +9,7 @@ import pathlib
 import zipfile
 
 import fmpy
+from fmpy.fmi1 import FMICallException
 import numpy as np
 import pytest
 
@@ -143,3 +144,37 @@ def test_a_target_with_no_direction_holds_the_angles_with_a_warning_naming_its_i
     assert list(result["set_point.alpha"][1:3]) == [0.25, 0.25] and list(result["set_point.beta"][1:3]) == [0.1, 0.1]
     assert result["set_point.alpha"][3] == pytest.approx(0.25, abs=1e-12)
     assert result["set_point.beta"][3] == pytest.approx(np.arctan2(100.0, 1000.0), abs=1e-12)
+
+
+def test_the_controller_tracks_alike_in_fmi_2_and_fmi_3_and_refuses_a_nan_target(build_dir, tmp_path):
+    """The controller FMU's two versions through the same inputs toward an aircraft passing 10 m
+    beside the zenith: the same voltages bit for bit, the keyhole's command in them; a NaN in a
+    target input refused in both, naming it."""
+    from gimbal2axis.fmu import FMU
+    from test_controller_fmu import start_controller
+    from test_small_fmus_fmi3 import Fmi3Twin
+    scene = flyby_through_the_keyhole(tmp_path)
+    times = np.arange(400) * 5e-3
+    p, p_dot, p_ddot = scene.moving_target.relative(times)
+    parameters = {"target.moving": True, "azimuth.kp": 400.0, "azimuth.k_ff": 4.8, "azimuth.k_acc": 0.18,
+                  "elevation.kp": 400.0, "elevation.k_acc": 0.16}
+    voltages = {}
+    for version, fmu in (("2.0", FMU(build_dir / "Gimbal2Axis-Controller.fmu")),
+                         ("3.0", Fmi3Twin(build_dir / "Gimbal2Axis-Controller-fmi3.fmu", tmp_path / "fmi3"))):
+        log = []
+        slave = start_controller(fmu, parameters, log)
+        names = TARGET_OUTPUTS
+        rows = []
+        for k, t in enumerate(times):
+            values = np.concatenate([p[:, k], p_dot[:, k], p_ddot[:, k]])
+            slave.setReal([fmu.vr(name) for name in names], list(values))
+            slave.doStep(t, 5e-3)
+            rows.append(slave.getReal([fmu.vr("u_R1"), fmu.vr("u_R2"), fmu.vr("set_point.alpha")]))
+        with pytest.raises(FMICallException):
+            slave.setReal([fmu.vr("target.position[2]")], [float("nan")])
+        assert any("target.position[2] = nan is not finite" in str(entry) for entry in log), log
+        slave.freeInstance()
+        voltages[version] = np.array(rows)
+    assert np.array_equal(voltages["2.0"], voltages["3.0"])
+    # the command's azimuth swings through the keyhole (the gimbal at rest: the kp term saturates)
+    assert np.ptp(voltages["2.0"][:, 2]) > 2.0 and np.max(np.abs(voltages["2.0"][:, 0])) == pytest.approx(24.0)

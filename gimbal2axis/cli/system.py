@@ -1,7 +1,7 @@
 """Write a scene as a system of FMUs for other co-simulation engines.
 
-The scene's sea state becomes the ship-motion FMU, its built-in controller (with its target and
-sensors) the controller FMU, and with the gimbal FMU they make one system, written as an OSP system
+The scene's sea state becomes the ship-motion FMU (with a moving target's position from the gimbal
+as a table in its resources), its built-in controller (with its target and sensors) the controller FMU, and with the gimbal FMU they make one system, written as an OSP system
 structure (<out>/osp/OspSystemStructure.xml with the three FMUs and their OSP model descriptions: run
 it with libcosim or the OSP tools) and as an SSP archive (<out>/<scene>.ssp: FMPy, OMSimulator). In
 either engine the voltage computed at t_k acts over [t_k+1, t_k+2], the scene's delay_steps = 1.

@@ -314,9 +314,9 @@ def cases_to_run(cases: list, existing: list, redo: str | None) -> tuple[list, i
 def announce(plan: Plan, options: SweepOptions) -> None:
     """On stderr: the sweep's warning (a `cases` limit that drops grid points), and with progress,
     how many cases run where."""
-    warning = plan.sweep.limit_warning()
-    if warning:
-        print(f"sweep: warning: {warning}", file=sys.stderr)
+    for warning in (plan.sweep.limit_warning(), plan.sweep.drive_warning()):
+        if warning:
+            print(f"sweep: warning: {warning}", file=sys.stderr)
     if options.progress:
         todo = plan.todo
         where = ("" if not todo else " serially" if options.serial else

@@ -49,6 +49,7 @@ import itertools
 import json
 import math
 import pathlib
+import re
 import zlib
 from dataclasses import dataclass, field
 
@@ -119,6 +120,17 @@ class Sweep:
         if self.cases_limit is not None:
             cases = cases[:self.cases_limit]
         return cases
+
+    def drive_warning(self) -> str | None:
+        """A sweep over a motor's drive (voltage or current) with the controller's gains as they are:
+        the same numbers are volts per unit in one case and amperes in the other (docs/scenes.md,
+        "Current-commanded drives"); in words, None when no drive is swept."""
+        swept = [name for name in self.parameters if re.fullmatch(r"(?:fidelity\.)?motor[12]\.drive", name)]
+        if not swept:
+            return None
+        return (f"{', '.join(swept)} is swept: the controller's gains and limits are volts per unit where a "
+                f"motor is voltage-driven and amperes per unit where it is current-driven, the same numbers "
+                f"in both; sweep a scene per drive with its own gains to compare tuned loops")
 
     def limit_warning(self) -> str | None:
         """What a `cases` limit below grid points x samples leaves out, in words; None when nothing."""
