@@ -95,33 +95,33 @@ static FmiStatus impl_SetContinuousStates(fmi2Component c, const fmi2Real x[], s
     return gimbal_status(gimbal_core_set_continuous_states(gimbal_core_of(instance), x));
 }
 
-static FmiStatus impl_GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
+/* The core's vectors the host reads: one check (state, count, pointer) and the core's reader. */
+typedef GimbalStatus (*CoreVectorReader)(GimbalCore* core, double* values);
+static FmiStatus read_vector(fmi2Component c, Function id, fmi2Real values[], size_t given, size_t expected,
+                             const char* argument, const char* count_name, CoreVectorReader read) {
     FmiInstance* instance = (FmiInstance*)c;
-    if (!check_vector(instance, FN_GetDerivatives, derivatives, nx, GIMBAL_CONTINUOUS_STATES, "derivatives", "nx"))
-        return FMI_ERROR;
-    return gimbal_status(gimbal_core_get_derivatives(gimbal_core_of(instance), derivatives));
+    if (!check_vector(instance, id, values, given, expected, argument, count_name)) return FMI_ERROR;
+    return gimbal_status(read(gimbal_core_of(instance), values));
+}
+
+static FmiStatus impl_GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
+    return read_vector(c, FN_GetDerivatives, derivatives, nx, GIMBAL_CONTINUOUS_STATES, "derivatives", "nx",
+                       gimbal_core_get_derivatives);
 }
 
 static FmiStatus impl_GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
-    FmiInstance* instance = (FmiInstance*)c;
-    if (!check_vector(instance, FN_GetEventIndicators, eventIndicators, ni, GIMBAL_EVENT_INDICATORS, "eventIndicators",
-                      "ni"))
-        return FMI_ERROR;
-    return gimbal_status(gimbal_core_get_event_indicators(gimbal_core_of(instance), eventIndicators));
+    return read_vector(c, FN_GetEventIndicators, eventIndicators, ni, GIMBAL_EVENT_INDICATORS, "eventIndicators", "ni",
+                       gimbal_core_get_event_indicators);
 }
 
 static FmiStatus impl_GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
-    FmiInstance* instance = (FmiInstance*)c;
-    if (!check_vector(instance, FN_GetContinuousStates, x, nx, GIMBAL_CONTINUOUS_STATES, "x", "nx")) return FMI_ERROR;
-    return gimbal_status(gimbal_core_get_continuous_states(gimbal_core_of(instance), x));
+    return read_vector(c, FN_GetContinuousStates, x, nx, GIMBAL_CONTINUOUS_STATES, "x", "nx",
+                       gimbal_core_get_continuous_states);
 }
 
 static FmiStatus impl_GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
-    FmiInstance* instance = (FmiInstance*)c;
-    if (!check_vector(instance, FN_GetNominalsOfContinuousStates, x_nominal, nx, GIMBAL_CONTINUOUS_STATES, "x_nominal",
-                      "nx"))
-        return FMI_ERROR;
-    return gimbal_status(gimbal_core_get_nominal_states(gimbal_core_of(instance), x_nominal));
+    return read_vector(c, FN_GetNominalsOfContinuousStates, x_nominal, nx, GIMBAL_CONTINUOUS_STATES, "x_nominal", "nx",
+                       gimbal_core_get_nominal_states);
 }
 
 /* Unknowns are state derivatives or outputs, knowns states or inputs (FMI 2.0, section 3.2.1): the core

@@ -530,43 +530,36 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 cont
     IN_FMU_FP_ENVIRONMENT(fmi3Status, set_continuous_states(OWN_INSTANCE, continuousStates, n));
 }
 
-static fmi3Status get_derivatives(FmiInstance* i, fmi3Float64 dx[], size_t n) {
-    if (!me_vector(i, "fmi3GetContinuousStateDerivatives", S_EVALUATE, dx, n, GIMBAL_CONTINUOUS_STATES, "derivatives"))
-        return fmi3Error;
-    return from_core(gimbal_core_get_derivatives(gimbal_core_of(i), dx));
+/* The core's vectors the host reads: one check (state, count, pointer) and the core's reader. */
+typedef GimbalStatus (*CoreVectorReader)(GimbalCore* core, double* values);
+static fmi3Status read_vector(FmiInstance* i, const char* f, int states, fmi3Float64 values[], size_t given,
+                              size_t expected, const char* argument, CoreVectorReader read) {
+    if (!me_vector(i, f, states, values, given, expected, argument)) return fmi3Error;
+    return from_core(read(gimbal_core_of(i), values));
 }
+
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t n) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_derivatives(OWN_INSTANCE, derivatives, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, read_vector(OWN_INSTANCE, "fmi3GetContinuousStateDerivatives", S_EVALUATE,
+                                                  derivatives, n, GIMBAL_CONTINUOUS_STATES, "derivatives",
+                                                  gimbal_core_get_derivatives));
 }
 
-static fmi3Status get_event_indicators(FmiInstance* i, fmi3Float64 z[], size_t n) {
-    if (!me_vector(i, "fmi3GetEventIndicators", S_INITIALIZATION | S_EVALUATE, z, n, GIMBAL_EVENT_INDICATORS,
-                   "eventIndicators"))
-        return fmi3Error;
-    return from_core(gimbal_core_get_event_indicators(gimbal_core_of(i), z));
-}
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t n) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_event_indicators(OWN_INSTANCE, eventIndicators, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, read_vector(OWN_INSTANCE, "fmi3GetEventIndicators", S_INITIALIZATION | S_EVALUATE,
+                                                  eventIndicators, n, GIMBAL_EVENT_INDICATORS, "eventIndicators",
+                                                  gimbal_core_get_event_indicators));
 }
 
-static fmi3Status get_continuous_states(FmiInstance* i, fmi3Float64 x[], size_t n) {
-    if (!me_vector(i, "fmi3GetContinuousStates", S_INITIALIZATION | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
-                   "continuousStates"))
-        return fmi3Error;
-    return from_core(gimbal_core_get_continuous_states(gimbal_core_of(i), x));
-}
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t n) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_continuous_states(OWN_INSTANCE, continuousStates, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, read_vector(OWN_INSTANCE, "fmi3GetContinuousStates", S_INITIALIZATION | S_EVALUATE,
+                                                  continuousStates, n, GIMBAL_CONTINUOUS_STATES, "continuousStates",
+                                                  gimbal_core_get_continuous_states));
 }
 
-static fmi3Status get_nominals(FmiInstance* i, fmi3Float64 x[], size_t n) {
-    if (!me_vector(i, "fmi3GetNominalsOfContinuousStates", S_INSTANTIATED | S_EVALUATE, x, n, GIMBAL_CONTINUOUS_STATES,
-                   "nominals"))
-        return fmi3Error;
-    return from_core(gimbal_core_get_nominal_states(gimbal_core_of(i), x));
-}
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t n) {
-    IN_FMU_FP_ENVIRONMENT(fmi3Status, get_nominals(OWN_INSTANCE, nominals, n));
+    IN_FMU_FP_ENVIRONMENT(fmi3Status, read_vector(OWN_INSTANCE, "fmi3GetNominalsOfContinuousStates",
+                                                  S_INSTANTIATED | S_EVALUATE, nominals, n, GIMBAL_CONTINUOUS_STATES,
+                                                  "nominals", gimbal_core_get_nominal_states));
 }
 
 static fmi3Status count(FmiInstance* i, const char* f, size_t* n, size_t value) {
