@@ -71,18 +71,47 @@ static void no_own_allocation(void* model) { (void)model; }
 
 static const char* const kLogCategories[] = {"logStatusError", "logAll"};
 
-/* The recording of recording_file, checked to cover the experiment from t = 0 (the grid's time; a
- * stopTime, when given, to its end), and row 0. */
+/* The text of `file` (absolute, or relative to the resources folder) into *text (its length into
+ * *length) and its path into *path, both the caller's to free; 0, logged (after `prefix`), when it
+ * cannot be found or read. */
+static int read_file(Instance* instance, const char* function, const char* prefix, const char* file, char** path,
+                     char** text, size_t* length) {
+    char message[1024];
+    *path = recording_path(instance->resources, file, message, sizeof message);
+    if (*path == NULL) {
+        fmi_log_error(&instance->common, "%s: %s%s", function, prefix, message);
+        return 0;
+    }
+    *text = recording_read(*path, length, message, sizeof message);
+    if (*text == NULL) {
+        fmi_log_error(&instance->common, "%s: %s%s", function, prefix, message);
+        free(*path);
+        return 0;
+    }
+    return 1;
+}
+
+/* Whether a table over [start, end] covers the experiment from t = 0 (the grid's time; a stopTime,
+ * when given, to its end); else 0, logged naming `what` at `path`. */
+static int covers_experiment(Instance* instance, const char* function, const char* what, const char* path, double start,
+                             double end) {
+    const double duration = instance->common.stop_time - instance->start_time;
+    if (!(start > 0.0 || (instance->common.stop_time_defined && end < duration))) return 1;
+    if (instance->common.stop_time_defined)
+        fmi_log_error(&instance->common, "%s: %s %s covers [%g, %g] s, not [0, %g] s", function, what, path, start, end,
+                      duration);
+    else
+        fmi_log_error(&instance->common, "%s: %s %s covers [%g, %g] s, not t = 0, where the outputs start", function,
+                      what, path, start, end);
+    return 0;
+}
+
+/* The recording of recording_file, checked to cover the experiment, and row 0. */
 static FmiStatus prepare_recording(Instance* instance, const char* function) {
     char message[1024];
-    char* path = recording_path(instance->resources, instance->recording_file, message, sizeof message);
-    if (path == NULL) REFUSE(instance, "%s: %s", function, message);
+    char *path, *text;
     size_t length = 0;
-    char* text = recording_read(path, &length, message, sizeof message);
-    if (text == NULL) {
-        free(path);
-        REFUSE(instance, "%s: %s", function, message);
-    }
+    if (!read_file(instance, function, "", instance->recording_file, &path, &text, &length)) return FMI_ERROR;
     const int status = gimbal_recorded_motion_read(text, length, &instance->recording, message, sizeof message);
     free(text);
     if (status != GIMBAL_RECORDED_MOTION_READ) {
@@ -90,17 +119,8 @@ static FmiStatus prepare_recording(Instance* instance, const char* function) {
         free(path);
         return FMI_ERROR;
     }
-    const double start = gimbal_recorded_motion_start(instance->recording);
-    const double end = gimbal_recorded_motion_end(instance->recording);
-    const double duration = instance->common.stop_time - instance->start_time;
-    if (start > 0.0 || (instance->common.stop_time_defined && end < duration)) {
-        if (instance->common.stop_time_defined)
-            fmi_log_error(&instance->common, "%s: recorded motion %s covers [%g, %g] s, not [0, %g] s",
-                        function, path, start, end, duration);
-        else
-            fmi_log_error(&instance->common,
-                        "%s: recorded motion %s covers [%g, %g] s, not t = 0, where the outputs start", function, path,
-                        start, end);
+    if (!covers_experiment(instance, function, "recorded motion", path, gimbal_recorded_motion_start(instance->recording),
+                           gimbal_recorded_motion_end(instance->recording))) {
         free(path);
         gimbal_recorded_motion_free(instance->recording);
         instance->recording = NULL;
@@ -146,14 +166,9 @@ static FmiStatus prepare_sea_state(Instance* instance, const char* function) {
 /* The target's table of target_file, checked to cover the experiment as the recording is, and row 0. */
 static FmiStatus prepare_target(Instance* instance, const char* function) {
     char message[1024];
-    char* path = recording_path(instance->resources, instance->target_file, message, sizeof message);
-    if (path == NULL) REFUSE(instance, "%s: target_file: %s", function, message);
+    char *path, *text;
     size_t length = 0;
-    char* text = recording_read(path, &length, message, sizeof message);
-    if (text == NULL) {
-        free(path);
-        REFUSE(instance, "%s: target_file: %s", function, message);
-    }
+    if (!read_file(instance, function, "target_file: ", instance->target_file, &path, &text, &length)) return FMI_ERROR;
     const int status = gimbal_recorded_target_read(text, length, &instance->target, message, sizeof message);
     free(text);
     if (status != GIMBAL_RECORDED_TARGET_READ) {
@@ -161,12 +176,8 @@ static FmiStatus prepare_target(Instance* instance, const char* function) {
         free(path);
         return FMI_ERROR;
     }
-    const double start = gimbal_recorded_target_start(instance->target);
-    const double end = gimbal_recorded_target_end(instance->target);
-    const double duration = instance->common.stop_time - instance->start_time;
-    if (start > 0.0 || (instance->common.stop_time_defined && end < duration)) {
-        fmi_log_error(&instance->common, "%s: target table %s covers [%g, %g] s, not [0, %g] s", function, path, start,
-                      end, instance->common.stop_time_defined ? duration : end);
+    if (!covers_experiment(instance, function, "target table", path, gimbal_recorded_target_start(instance->target),
+                           gimbal_recorded_target_end(instance->target))) {
         free(path);
         gimbal_recorded_target_free(instance->target);
         instance->target = NULL;
