@@ -1,4 +1,4 @@
-"""The small FMUs' one FMI 2.0 Co-Simulation face (fmu_src/fmi_layer/small_fmi2_cosim.c): the
+"""The FMI 2.0 face of every FMU (fmu_src/fmi_layer/fmi2_functions.c), here the small FMUs': the
 ship-motion and the controller FMU, each a model file and its table behind it, answer the calls the
 face owns alike (the refusals of what their model descriptions declare absent, the status calls, an
 unknown value reference), each message naming the function and the culprit; and the status calls

@@ -1,6 +1,6 @@
 """The ship-motion and controller FMUs for FMI 3.0 (build/Gimbal2Axis-ShipMotion-fmi3.fmu,
 build/Gimbal2Axis-Controller-fmi3.fmu): the small FMUs' one FMI 3.0 face
-(fmu_src/fmi_layer/small_fmi3_cosim.c) over the same model tables as their FMI 2.0 twins. Driven by
+(fmu_src/fmi_layer/fmi3_functions.c) over the same model tables as their FMI 2.0 twins. Driven by
 fmpy, each gives its twin's outputs bit for bit (the ship motion in sea-state and recorded mode, the
 controller in the closed loop of tests/test_controller_fmu.py, both run by the FMI 2.0 tests' own
 functions through an adapter), validates, takes and restores FMU states (also serialized, also in

@@ -1,7 +1,7 @@
 /* The small FMUs' FMI 3.0 value references: FMI 3.0 gives every variable its own value reference,
  * FMI 2.0 numbers each type from 0. A Float64 keeps its FMI 2.0 Real's reference, an Int32, a Boolean
  * and a String their FMI 2.0 reference plus their type's base (as the gimbal's, gimbal_c_api.h).
- * Shared by the FMI 3.0 face (fmi_layer/small_fmi3_cosim.c) and the model-description generators. */
+ * Shared by the FMI 3.0 face (fmi_layer/fmi3_functions.c) and the model-description generators. */
 #ifndef GIMBAL_SMALL_FMI3_VALUE_REFERENCES_H
 #define GIMBAL_SMALL_FMI3_VALUE_REFERENCES_H
 

@@ -51,12 +51,12 @@ function(link_small_fmu_binary target exports)
 endfunction()
 
 # add_small_cosimulation_fmu_binary(<model identifier>
-#     SOURCES <the model file defining kSmallCosimModel>... LIBRARIES <the model's libraries>...
+#     SOURCES <the model file defining kFmuModel>... LIBRARIES <the model's libraries>...
 #     VARIABLE_TABLE <file> GUID_HEADER <name>_guid.h.in GUID_VARIABLE <variable>)
 # Two shared libraries named <model identifier> (no "lib" prefix), the model file over the FMI
-# instance layer: target <model identifier>, the FMI 2.0 one (fmu_src/fmi_layer/small_fmi2_cosim.c,
+# instance layer: target <model identifier>, the FMI 2.0 one (fmu_src/fmi_layer/fmi2_functions.c,
 # only fmi2* exported), and target <model identifier>_fmi3 in fmi3/, the FMI 3.0 one
-# (small_fmi3_cosim.c, only fmi3* exported). Sets <variable> here and in the caller's scope to the
+# (fmi3_functions.c, only fmi3* exported). Sets <variable> here and in the caller's scope to the
 # FMU's GUID (the FMI 3.0 instantiation token too), a name-based UUID of the identifier, the version
 # and the variable table (so that it changes with them), and configures GUID_HEADER with it into
 # generated/.
@@ -72,9 +72,9 @@ function(add_small_cosimulation_fmu_binary identifier)
   configure_file(${ARG_GUID_HEADER} ${PROJECT_BINARY_DIR}/generated/${_header} @ONLY)
 
   set(_layer ${PROJECT_SOURCE_DIR}/fmu_src/fmi_layer)
-  set(_shared ${_layer}/small_cosim.c ${_layer}/fmi_instance.c ${PROJECT_SOURCE_DIR}/fmu_src/fmu_state.c)
-  add_library(${identifier} SHARED ${ARG_SOURCES} ${_layer}/small_fmi2_cosim.c ${_layer}/fmi2_face.c ${_shared})
-  add_library(${identifier}_fmi3 SHARED ${ARG_SOURCES} ${_layer}/small_fmi3_cosim.c ${_layer}/fmi3_face.c
+  set(_shared ${_layer}/fmu_model.c ${_layer}/fmi_instance.c ${PROJECT_SOURCE_DIR}/fmu_src/fmu_state.c)
+  add_library(${identifier} SHARED ${ARG_SOURCES} ${_layer}/fmi2_functions.c ${_layer}/fmi2_face.c ${_shared})
+  add_library(${identifier}_fmi3 SHARED ${ARG_SOURCES} ${_layer}/fmi3_functions.c ${_layer}/fmi3_face.c
               ${_layer}/fmi3_not_offered.c ${_shared})
   link_small_fmu_binary(${identifier} ${PROJECT_SOURCE_DIR}/fmu_src/exports.map)
   link_small_fmu_binary(${identifier}_fmi3 ${PROJECT_SOURCE_DIR}/fmu_src/exports_fmi3.map)

@@ -1,6 +1,5 @@
-/* The controller FMU's model file: controller_model.c behind the small FMUs' FMI 2.0 and FMI 3.0
- * Co-Simulation faces (fmi_layer/small_cosim_model.h), which check the states, pointers and value
- * references and export the fmi2* or fmi3* functions; here are the controller's values, parameter
+/* The controller FMU's model file: controller_model.c behind the FMI 2.0 and FMI 3.0 faces
+ * (fmi_layer/fmu_model.h), which check the states, pointers and value references and export the fmi2* or fmi3* functions; here are the controller's values, parameter
  * checks and step, and its FMU-state snapshot (offered by the FMI 3.0 FMU). */
 #include <math.h>
 #include <stddef.h>
@@ -8,7 +7,7 @@
 
 #include "controller_guid.h"
 #include "controller_model.h"
-#include "fmi_layer/small_cosim_model.h"
+#include "fmi_layer/fmu_model.h"
 
 /* The model follows the FmiInstance in one allocation (fmi_instantiate's, zeroed): the snapshot calls,
  * which the layer hands the model, can then log through the instance. */
@@ -117,7 +116,8 @@ static FmiStatus exit_initialization(FmiInstance* instance, const char* function
     return FMI_OK;
 }
 
-static FmiStatus do_step(FmiInstance* instance, const char* function, double point, double step) {
+static FmiStatus do_step(FmiInstance* instance, const char* function, double point, double step, int* ended_early) {
+    (void)ended_early; /* no mode changes: never early */
     ControllerModel* model = model_of(instance);
     char why[512];
     const int held = controller_model_step(model, step, why, sizeof why) == 2;
@@ -184,7 +184,7 @@ static const char* const kLogCategories[] = {"logStatusError", "logStatusWarning
 
 /* The controller's step never fails but into the error state, so fmi2GetStatus is asked only after
  * successful steps (status_states): it is fmi2OK. */
-const SmallCosimModel kSmallCosimModel = {
+const FmuModel kFmuModel = {
     .layer = {CONTROLLER_GUID, sizeof(ControllerInstance), kLogCategories,
               (int)(sizeof kLogCategories / sizeof kLogCategories[0]), create_model, no_own_allocation, NULL,
               snapshot_size, save, check_snapshot, restore},

@@ -27,6 +27,7 @@ const FmiFace kFmi2Face = {
     .resource_location_is_uri = 1,
     .instantiated_state = STATE_INSTANTIATED,
     .any_state = ANY_STATE,
+    .step_failed_state = STATE_STEP_FAILED,
     .error_state = STATE_ERROR,
     .before_initialized_states = STATE_INSTANTIATED | STATE_INITIALIZATION,
     .state_name = state_name,

@@ -27,6 +27,7 @@ const FmiFace kFmi3Face = {
     .resource_location_is_uri = 0,
     .instantiated_state = S_INSTANTIATED,
     .any_state = S_ANY,
+    .step_failed_state = S_STEP_DISCARDED,
     .error_state = S_ERROR,
     .before_initialized_states = S_INSTANTIATED | S_INITIALIZATION,
     .state_name = state_name,

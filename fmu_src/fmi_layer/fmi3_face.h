@@ -1,9 +1,8 @@
 /* The FMI 3.0 face of the FMI instance layer: FMI 3.0's states, as bits of one mask each, the masks
  * of the states the standard's groups of functions may be called in, and the face's table (its
- * logger, state names, FMU-state record identity), for the FMI 3.0 functions of every FMU (the
- * gimbal's gimbal_fmi3.c, the small FMUs' small_fmi3_cosim.c), with what they share: the refusals
- * (here), the exported FMU-state functions (fmi3_face.c), and the functions none of them offers
- * (fmi3_not_offered.c). */
+ * logger, state names, FMU-state record identity), for the FMI 3.0 functions of every FMU
+ * (fmi3_functions.c), with the refusals (here), the exported FMU-state functions (fmi3_face.c), and
+ * the functions no FMU offers (fmi3_not_offered.c). */
 #ifndef GIMBAL_FMI3_FACE_H
 #define GIMBAL_FMI3_FACE_H
 

@@ -47,6 +47,7 @@ typedef struct {
     int instantiated_state;
     int any_state;                  /* every state bit of the version */
     int error_state;
+    int step_failed_state;          /* Co-Simulation after a discarded step */
     int before_initialized_states;  /* instantiated and initialization mode */
     const char* (*state_name)(int state);
     /* FMU states: the record's magic, what its header may hold, the calls' names and argument name. */

@@ -1,6 +1,6 @@
-/* The ship-motion FMU's model file: ship_motion.h and the recorded motion behind the small FMUs' FMI
- * 2.0 and FMI 3.0 Co-Simulation faces (fmi_layer/small_cosim_model.h), which check the states,
- * pointers and value references and export the fmi2* or fmi3* functions; here are the checks of the
+/* The ship-motion FMU's model file: ship_motion.h and the recorded motion behind the FMI 2.0 and FMI
+ * 3.0 faces (fmi_layer/fmu_model.h), which check the states, pointers and value references and
+ * export the fmi2* or fmi3* functions; here are the checks of the
  * values, the clock, the rows, and the FMU-state snapshot (offered by the FMI 3.0 FMU).
  *
  * The clock: the outputs after k steps are row k of the grid at t = k h from the motion's start, h
@@ -24,7 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi_layer/small_cosim_model.h"
+#include "fmi_layer/fmu_model.h"
 #include "gimbal_kernel/recorded_motion.h"
 #include "gimbal_kernel/recorded_target.h"
 #include "recording_file.h"
@@ -408,7 +408,8 @@ static FmiStatus step_recording(Instance* instance, const char* function, double
 
 /* The master's point becomes the FMU's time (the face checked it); the outputs stay the rows of the
  * grid, counted, whatever clock the master keeps. */
-static FmiStatus do_step(FmiInstance* common, const char* function, double point, double step_size) {
+static FmiStatus do_step(FmiInstance* common, const char* function, double point, double step_size, int* ended_early) {
+    (void)ended_early; /* no mode changes: never early */
     Instance* instance = ship(common);
     const double end_time = point + step_size;
     /* A master whose clock rounds differently from its step (an SSP engine that ends on its stop time
@@ -594,7 +595,7 @@ static FmiStatus restore(void* model, const unsigned char* bytes) {
 
 /* A failed step leaves the error state, in which the values and the step's status can still be read
  * and the instance terminated. */
-const SmallCosimModel kSmallCosimModel = {
+const FmuModel kFmuModel = {
     .layer = {SHIP_MOTION_GUID, sizeof(Instance), kLogCategories, (int)(sizeof kLogCategories / sizeof kLogCategories[0]),
               model_fields, no_own_allocation, NULL, snapshot_size, save, check_snapshot, restore},
     .get_states = STATE_INITIALIZATION | STATE_STEP_COMPLETE | STATE_TERMINATED | STATE_ERROR,

@@ -1,0 +1,160 @@
+/* What the FMI 2.0 and FMI 3.0 faces do alike over an FMU's table (fmu_model.h): the value access,
+ * instantiation's and reset's part of the model, the experiment's times, the step's bookkeeping, the
+ * derivatives' arguments, Model Exchange's checks. The faces own their versions' state checks and
+ * signatures. */
+#include "fmi_layer/fmu_model.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+static const FmuModel* const kModel = &kFmuModel;
+
+FmiInstance* fmu_model_instantiated(FmiInstance* instance, const char* function, const char* resource_location) {
+    if (instance == NULL || kModel->instantiated == NULL) return instance;
+    if (kModel->instantiated(instance, resource_location) != 0) {
+        fmi_log_error(instance, "%s: out of memory", function);
+        fmu_model_free_instance(instance);
+        return NULL;
+    }
+    return instance;
+}
+
+void fmu_model_free_instance(FmiInstance* instance) {
+    if (instance == NULL) return;
+    if (kModel->release != NULL) kModel->release(instance);
+    fmi_free_instance(instance);
+}
+
+/* ---------------------------------------------------------------- values */
+
+static int arrays_given(const FmiInstance* instance, const char* function, size_t nvr, const void* vr, const void* values) {
+    return nvr == 0 || (fmi_not_null(instance, function, vr, "vr") && fmi_not_null(instance, function, values, "value"));
+}
+
+static int reference_known(const FmiInstance* instance, const char* function, const FmuVariables* variables,
+                           const char* type, unsigned base, unsigned vr) {
+    if (vr >= base && vr - base < variables->count && (variables->known == NULL || variables->known(vr - base)))
+        return 1;
+    const int vowel = type[0] == 'I';
+    fmi_log_error(instance, "%s: value reference %u is not a%s %s variable%s", function, vr, vowel ? "n" : "", type,
+                  variables->count == 0 ? " (this FMU has none)" : "");
+    return 0;
+}
+
+/* A model's int from a host's element of another layout (a C bool, an Int64), and back. */
+static int model_int(const void* element, FmuValueLayout layout) {
+    return layout == FMU_VALUES_C_BOOL ? (*(const bool*)element ? 1 : 0) : (int)*(const int64_t*)element;
+}
+
+static int int64_fits(const FmiInstance* instance, const char* function, unsigned vr, const void* element) {
+    const int64_t value = *(const int64_t*)element;
+    if (value >= INT32_MIN && value <= INT32_MAX) return 1;
+    fmi_log_error(instance, "%s: value reference %u: %lld lies outside the Int32 range", function, vr, (long long)value);
+    return 0;
+}
+
+FmiStatus fmu_model_get(FmiInstance* instance, const char* function, const FmuVariables* variables,
+                        const char* type, unsigned base, const unsigned vr[], size_t nvr, void* values, size_t size,
+                        FmuValueLayout layout) {
+    if (!arrays_given(instance, function, nvr, vr, values)) return FMI_ERROR;
+    if (variables->get_all != NULL) return nvr == 0 ? FMI_OK : variables->get_all(instance, function, vr, nvr, values);
+    for (size_t i = 0; i < nvr; ++i) {
+        if (!reference_known(instance, function, variables, type, base, vr[i])) return FMI_ERROR;
+        unsigned char* element = (unsigned char*)values + i * size;
+        int converted = 0;
+        const FmiStatus status = variables->get(instance, function, vr[i] - base,
+                                                layout == FMU_VALUES_AS_THE_MODELS ? (void*)element : (void*)&converted);
+        if (status > FMI_WARNING) return status;
+        if (layout == FMU_VALUES_C_BOOL) *(bool*)element = converted != 0;
+        if (layout == FMU_VALUES_INT64) *(int64_t*)element = converted;
+    }
+    return FMI_OK;
+}
+
+FmiStatus fmu_model_set(FmiInstance* instance, const char* function, const FmuVariables* variables,
+                        const char* type, unsigned base, const unsigned vr[], size_t nvr, const void* values,
+                        size_t size, FmuValueLayout layout) {
+    if (!arrays_given(instance, function, nvr, vr, values)) return FMI_ERROR;
+    if (variables->set_all != NULL) {
+        if (nvr == 0) return FMI_OK;
+        const FmiStatus status = variables->set_all(instance, function, vr, nvr, values);
+        if (status <= FMI_WARNING && kModel->values_set != NULL) kModel->values_set(instance);
+        return status;
+    }
+    for (int setting = 0; setting <= 1; ++setting) { /* check every value, then set them */
+        for (size_t i = 0; i < nvr; ++i) {
+            const unsigned char* element = (const unsigned char*)values + i * size;
+            const int converted = layout == FMU_VALUES_AS_THE_MODELS ? 0 : model_int(element, layout);
+            const void* value = layout == FMU_VALUES_AS_THE_MODELS ? (const void*)element : (const void*)&converted;
+            if (!setting) {
+                if (!reference_known(instance, function, variables, type, base, vr[i]) ||
+                    (layout == FMU_VALUES_INT64 && !int64_fits(instance, function, vr[i], element)) ||
+                    !variables->settable(instance, function, vr[i] - base, value))
+                    return FMI_ERROR;
+                continue;
+            }
+            const FmiStatus status = variables->set(instance, function, vr[i] - base, value);
+            if (status > FMI_WARNING) return status;
+        }
+    }
+    if (nvr > 0 && kModel->values_set != NULL) kModel->values_set(instance);
+    return FMI_OK;
+}
+
+/* ---------------------------------------------------------------- initialization and reset */
+
+FmiStatus fmu_model_start_experiment(FmiInstance* instance, const char* function, int tolerance_defined,
+                                     double tolerance, double start, int stop_defined, double stop) {
+    if (!fmi_experiment_times_valid(instance, function, start, stop_defined, stop)) return FMI_ERROR;
+    if (kModel->tolerance != NULL) {
+        const FmiStatus status = kModel->tolerance(instance, function, tolerance_defined, tolerance);
+        if (status > FMI_WARNING) return status;
+    }
+    instance->time = start, instance->stop_time = stop, instance->stop_time_defined = stop_defined ? 1 : 0;
+    if (kModel->experiment_start != NULL) kModel->experiment_start(instance, start);
+    return FMI_OK;
+}
+
+FmiStatus fmu_model_reset(FmiInstance* instance, const char* function) {
+    if (kModel->reset == NULL) return fmi_reset(instance);
+    const FmiStatus status = kModel->reset(instance, function);
+    if (status != FMI_OK) return status;
+    instance->time = 0.0, instance->stop_time = 0.0, instance->stop_time_defined = 0;
+    instance->last_successful_time = 0.0;
+    instance->last_step_status = FMI_OK;
+    instance->state = instance->face->instantiated_state;
+    return FMI_OK;
+}
+
+FmiStatus fmu_model_exit_initialization(FmiInstance* instance, const char* function, int stepping_state) {
+    const FmiStatus status = kModel->exit_initialization(instance, function);
+    if (status > FMI_WARNING) return status;
+    instance->last_successful_time = instance->time;
+    instance->state = stepping_state;
+    return status;
+}
+
+FmiStatus fmu_model_do_step(FmiInstance* instance, const char* function, double point, double step, int* ended_early) {
+    *ended_early = 0;
+    const FmiStatus status = kModel->do_step(instance, function, point, step, ended_early);
+    if (status <= FMI_WARNING) instance->last_successful_time = instance->time;
+    return status;
+}
+
+/* ---------------------------------------------------------------- Model Exchange */
+
+int fmu_model_exchange_instance(FmiInstance* instance, const char* function) {
+    if (instance->model_exchange) return 1;
+    fmi_log_error(instance, "%s is a Model Exchange function: instance '%s' was instantiated for Co-Simulation",
+                  function, instance->name);
+    return 0;
+}
+
+int fmu_model_count_is(FmiInstance* instance, const char* function, size_t given, size_t expected,
+                       const char* count_name) {
+    if (given == expected) return 1;
+    fmi_log_error(instance, "%s: %s = %zu, but the model has %zu (modelDescription.xml)", function, count_name, given,
+                  expected);
+    return 0;
+}
