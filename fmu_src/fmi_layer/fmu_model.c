@@ -72,34 +72,45 @@ FmiStatus fmu_model_get(FmiInstance* instance, const char* function, const FmuVa
     return FMI_OK;
 }
 
+/* One value of a set: the model's value of the host's element (converted into `converted` when the
+ * layouts differ), and whether it may be set (its reference, its range, the model's check). */
+static const void* model_value(const unsigned char* element, FmuValueLayout layout, int* converted) {
+    if (layout == FMU_VALUES_AS_THE_MODELS) return element;
+    *converted = model_int(element, layout);
+    return converted;
+}
+
+static int value_settable(FmiInstance* instance, const char* function, const FmuVariables* variables,
+                          const char* type, unsigned base, unsigned vr, const unsigned char* element,
+                          FmuValueLayout layout) {
+    int converted = 0;
+    return reference_known(instance, function, variables, type, base, vr) &&
+           (layout != FMU_VALUES_INT64 || int64_fits(instance, function, vr, element)) &&
+           variables->settable(instance, function, vr - base, model_value(element, layout, &converted));
+}
+
 FmiStatus fmu_model_set(FmiInstance* instance, const char* function, const FmuVariables* variables,
                         const char* type, unsigned base, const unsigned vr[], size_t nvr, const void* values,
                         size_t size, FmuValueLayout layout) {
     if (!arrays_given(instance, function, nvr, vr, values)) return FMI_ERROR;
+    if (nvr == 0) return FMI_OK;
+    const unsigned char* elements = (const unsigned char*)values;
+    FmiStatus status = FMI_OK;
     if (variables->set_all != NULL) {
-        if (nvr == 0) return FMI_OK;
-        const FmiStatus status = variables->set_all(instance, function, vr, nvr, values);
-        if (status <= FMI_WARNING && kModel->values_set != NULL) kModel->values_set(instance);
-        return status;
-    }
-    for (int setting = 0; setting <= 1; ++setting) { /* check every value, then set them */
-        for (size_t i = 0; i < nvr; ++i) {
-            const unsigned char* element = (const unsigned char*)values + i * size;
-            const int converted = layout == FMU_VALUES_AS_THE_MODELS ? 0 : model_int(element, layout);
-            const void* value = layout == FMU_VALUES_AS_THE_MODELS ? (const void*)element : (const void*)&converted;
-            if (!setting) {
-                if (!reference_known(instance, function, variables, type, base, vr[i]) ||
-                    (layout == FMU_VALUES_INT64 && !int64_fits(instance, function, vr[i], element)) ||
-                    !variables->settable(instance, function, vr[i] - base, value))
-                    return FMI_ERROR;
-                continue;
-            }
-            const FmiStatus status = variables->set(instance, function, vr[i] - base, value);
-            if (status > FMI_WARNING) return status;
+        status = variables->set_all(instance, function, vr, nvr, (const double*)values);
+    } else {
+        for (size_t i = 0; i < nvr; ++i) /* every value checked before any is set */
+            if (!value_settable(instance, function, variables, type, base, vr[i], elements + i * size, layout))
+                return FMI_ERROR;
+        for (size_t i = 0; i < nvr && status <= FMI_WARNING; ++i) {
+            int converted = 0;
+            const FmiStatus set = variables->set(instance, function, vr[i] - base,
+                                                 model_value(elements + i * size, layout, &converted));
+            if (set > status) status = set;
         }
     }
-    if (nvr > 0 && kModel->values_set != NULL) kModel->values_set(instance);
-    return FMI_OK;
+    if (status <= FMI_WARNING && kModel->values_set != NULL) kModel->values_set(instance);
+    return status;
 }
 
 /* ---------------------------------------------------------------- initialization and reset */
