@@ -48,14 +48,16 @@ DEFAULT_REVISIONS = ["72cbcfa", "HEAD"]
 # At 72cbcfa these are exactly the files the issue's 3,731 lines add up to. First match wins.
 PLUMBING = [
     ("fmu_src/fmi_layer/*", "layer", "the FMI instance layer, written once (HEAD)"),
-    ("fmu_src/gimbal_fmu/*", "gimbal", "the gimbal's FMI 2.0 and 3.0 faces and its model table (HEAD)"),
+    ("fmu_src/gimbal_fmu/*", "gimbal", "the gimbal's model file and tables (its FMI faces until 6054b9c)"),
     ("fmu_src/fmi2_*.c", "gimbal", "the gimbal's FMI 2.0 functions (72cbcfa)"),
     ("fmu_src/fmi3_*.c", "gimbal", "the gimbal's FMI 3.0 functions (72cbcfa)"),
     ("fmu_src/fmu_instance.h", "gimbal", "the gimbal's FMI 2.0 instance (72cbcfa)"),
     ("fmu_src/common/cosim_instance.*", "layer", "the small FMUs' shared instance (72cbcfa)"),
     ("fmu_src/common/communication_point.h", "layer", "the communication-point rule of every FMU"),
     ("fmu_src/fmu_state.*", "layer", "the FMU-state record"),
-    ("fmu_src/*/fmi2_*.c", "small FMUs", "a small FMU's exported FMI 2.0 functions"),
+    ("fmu_src/common/fmi3_value_references.h", "layer", "the small FMUs' FMI 3.0 value references"),
+    ("fmu_src/*/fmi2_*.c", "small FMUs", "a small FMU's exported FMI 2.0 functions (its model file until 6054b9c)"),
+    ("fmu_src/*/*_fmu_model.c", "small FMUs", "a small FMU's model file: its tables for the faces"),
     ("fmu_src/*/fmi3_*.c", "small FMUs", "a small FMU's exported FMI 3.0 functions"),
 ]
 GROUPS = ["layer", "gimbal", "small FMUs"]  # what is shared, the gimbal's own, the small FMUs' own

@@ -1,6 +1,6 @@
 /* The controller FMU's model: its variables' values, and the C kernel's sensors and controller
  * (c_kernel/) that the scene runner's compiled loop runs, stepped once per communication
- * point. No FMI here: fmi2_controller.c is the interface around it. */
+ * point. No FMI here: controller_fmu_model.c is the interface around it. */
 #ifndef GIMBAL_CONTROLLER_MODEL_H
 #define GIMBAL_CONTROLLER_MODEL_H
 

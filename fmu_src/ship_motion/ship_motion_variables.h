@@ -1,4 +1,4 @@
-/* The ship-motion FMU's variables: one table, which the FMI wrapper (fmi2_ship_motion.c) checks and
+/* The ship-motion FMU's variables: one table, which the FMI wrapper (ship_motion_fmu_model.c) checks and
  * serves values by and the generator (model_description_generator.c) writes modelDescription.xml from.
  * A variable's value reference is its index in its table. */
 #ifndef SHIP_MOTION_VARIABLES_H
