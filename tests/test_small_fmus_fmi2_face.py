@@ -3,6 +3,8 @@ ship-motion and the controller FMU, each a model file and its table behind it, a
 face owns alike (the refusals of what their model descriptions declare absent, the status calls, an
 unknown value reference), each message naming the function and the culprit; and the status calls
 report the step the model took."""
+import ctypes
+
 import pytest
 from fmpy.fmi1 import FMICallException
 
@@ -72,3 +74,19 @@ def test_status_calls_report_the_step_taken(small_fmu):
             "fmi2GetStatus is not allowed in state 'instantiated'")
     slave.freeInstance()
     assert all(entry.status != 3 for entry in log[:-1]), log
+
+
+def test_model_exchange_functions_are_refused_naming_the_interfaces_offered(small_fmu):
+    """The face every FMU shares exports FMI 2.0's Model Exchange functions too; a Co-Simulation-only
+    model's table has none, and each call says so instead of reaching a model that is not there."""
+    log = []
+    slave = initialized(small_fmu, log)
+    derivatives = (ctypes.c_double * 1)()
+    get_derivatives, enter_event_mode = slave.dll.fmi2GetDerivatives, slave.dll.fmi2EnterEventMode
+    get_derivatives.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t]
+    enter_event_mode.argtypes = [ctypes.c_void_p]
+    assert get_derivatives(slave.component, derivatives, 1) == 3
+    assert log[-1].text == "fmi2GetDerivatives: a Model Exchange function; this FMU offers Co-Simulation only"
+    assert enter_event_mode(slave.component) == 3
+    assert log[-1].text == "fmi2EnterEventMode: a Model Exchange function; this FMU offers Co-Simulation only"
+    slave.freeInstance()

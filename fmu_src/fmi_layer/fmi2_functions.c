@@ -228,6 +228,10 @@ static fmi2Status set_real_input_derivatives(fmi2Component c, const fmi2ValueRef
 /* The state masks let a Co-Simulation instance through in the states both interfaces share
  * (instantiated, initialization mode): these functions are Model Exchange's alone. */
 static FmiInstance* model_exchange_usable(fmi2Component c, const char* function, int states) {
+    if (kModel->model_exchange == NULL) {
+        not_offered(c, function, "a Model Exchange function; this FMU offers Co-Simulation only");
+        return NULL;
+    }
     FmiInstance* instance = usable(c, function, states);
     return instance != NULL && fmu_model_exchange_instance(instance, function) ? instance : NULL;
 }

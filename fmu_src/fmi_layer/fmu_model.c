@@ -59,6 +59,7 @@ FmiStatus fmu_model_get(FmiInstance* instance, const char* function, const FmuVa
                         FmuValueLayout layout) {
     if (!arrays_given(instance, function, nvr, vr, values)) return FMI_ERROR;
     if (variables->get_all != NULL) return nvr == 0 ? FMI_OK : variables->get_all(instance, function, vr, nvr, values);
+    FmiStatus worst = FMI_OK;
     for (size_t i = 0; i < nvr; ++i) {
         if (!reference_known(instance, function, variables, type, base, vr[i])) return FMI_ERROR;
         unsigned char* element = (unsigned char*)values + i * size;
@@ -66,10 +67,11 @@ FmiStatus fmu_model_get(FmiInstance* instance, const char* function, const FmuVa
         const FmiStatus status = variables->get(instance, function, vr[i] - base,
                                                 layout == FMU_VALUES_AS_THE_MODELS ? (void*)element : (void*)&converted);
         if (status > FMI_WARNING) return status;
+        if (status > worst) worst = status;
         if (layout == FMU_VALUES_C_BOOL) *(bool*)element = converted != 0;
         if (layout == FMU_VALUES_INT64) *(int64_t*)element = converted;
     }
-    return FMI_OK;
+    return worst;
 }
 
 /* One value of a set: the model's value of the host's element (converted into `converted` when the
@@ -149,6 +151,7 @@ FmiStatus fmu_model_exit_initialization(FmiInstance* instance, const char* funct
 FmiStatus fmu_model_do_step(FmiInstance* instance, const char* function, double point, double step, int* ended_early) {
     *ended_early = 0;
     const FmiStatus status = kModel->do_step(instance, function, point, step, ended_early);
+    instance->last_step_status = status; /* what fmi2GetStatus says */
     if (status <= FMI_WARNING) instance->last_successful_time = instance->time;
     return status;
 }

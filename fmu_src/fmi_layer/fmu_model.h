@@ -96,7 +96,7 @@ typedef struct {
     FmiStatus (*exit_initialization)(FmiInstance* instance, const char* function);
     /* A step the face checked (state, communication point): the model's outputs at point + step (or,
      * with instance->early_return_allowed, at the first mode change inside it: *ended_early = 1), the
-     * instance's time, last_step_status and, when it fails, its state (what fmi2GetStatus says). */
+     * instance's time and, when it fails, its state; the face records the status (fmi2GetStatus). */
     FmiStatus (*do_step)(FmiInstance* instance, const char* function, double point, double step, int* ended_early);
     /* After a successful set of one value or more. NULL: nothing to do. */
     void (*values_set)(FmiInstance* instance);

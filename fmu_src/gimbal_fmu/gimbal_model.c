@@ -74,7 +74,6 @@ static FmiStatus do_step(FmiInstance* instance, const char* function, double poi
     const FmiStatus status = gimbal_status(instance->early_return_allowed
                                                ? gimbal_core_do_step_until_mode_change(core, point, step, &elapsed)
                                                : gimbal_core_do_step(core, point, step));
-    instance->last_step_status = status;
     if (status > FMI_WARNING) {
         instance->state = status == FMI_DISCARD ? instance->face->step_failed_state : instance->face->error_state;
         return status;
@@ -172,6 +171,7 @@ static FmiStatus update_discrete_states(FmiInstance* instance, FmuDiscreteUpdate
     GimbalDiscreteUpdate core_update;
     const FmiStatus status =
         gimbal_status(gimbal_core_update_discrete_states(gimbal_core_of(instance), &core_update));
+    if (status > FMI_WARNING) return status;
     update->states_changed = core_update.states_changed;
     update->next_time_defined = core_update.next_time_defined;
     update->next_time = core_update.next_time;

@@ -40,50 +40,60 @@ static FmiStatus set_float64(FmiInstance* instance, const char* function, const 
 
 FmiStatus gimbal_get_reals(FmiInstance* instance, const char* function, const unsigned vr[], size_t nvr, double values[]) {
     (void)function; /* the core names a reference it has no Real of */
-    for (size_t i = 0; i < nvr; ++i) {
+    FmiStatus worst = FMI_OK;
+    for (size_t i = 0; i < nvr && worst <= FMI_WARNING; ++i) {
         const FmiStatus status = gimbal_status(gimbal_core_get_real(gimbal_core_of(instance), vr[i], &values[i]));
-        if (status > FMI_WARNING) return status;
+        if (status > worst) worst = status;
     }
-    return FMI_OK;
+    return worst;
 }
 
 static int is_event_indicator(unsigned vr) {
     return vr >= FMI3_FIRST_EVENT_INDICATOR && vr < FMI3_FIRST_EVENT_INDICATOR + GIMBAL_EVENT_INDICATORS;
 }
 
-/* The Reals, `time` and the event indicators, which the core computes all at once: read once per call.
- * Co-Simulation locates the events itself: no indicator is exposed (each reads 1). */
+static FmiStatus float64_value(FmiInstance* instance, const char* function, unsigned vr, double* value) {
+    GimbalVariableInfo info;
+    if (vr >= FMI3_INTEGER_BASE || !gimbal_variable_info(GIMBAL_REAL, vr, &info)) {
+        fmi_log_error(instance, "%s: value reference %u is not a Float64 variable", function, vr);
+        return FMI_ERROR;
+    }
+    return gimbal_status(gimbal_core_get_real(gimbal_core_of(instance), vr, value));
+}
+
+/* The core computes the event indicators all at once: read once per call (`*read`). Co-Simulation
+ * locates the events itself: no indicator is exposed (each reads 1). */
+static FmiStatus event_indicator(FmiInstance* instance, unsigned vr, double indicators[], int* read, double* value) {
+    if (!*read) {
+        for (int z = 0; z < GIMBAL_EVENT_INDICATORS; ++z) indicators[z] = 1.0;
+        if (instance->model_exchange) {
+            const FmiStatus status =
+                gimbal_status(gimbal_core_get_event_indicators(gimbal_core_of(instance), indicators));
+            if (status > FMI_WARNING) return status;
+        }
+        *read = 1;
+    }
+    *value = indicators[vr - FMI3_FIRST_EVENT_INDICATOR];
+    return FMI_OK;
+}
+
+/* The Reals, `time` and the event indicators. */
 static FmiStatus get_float64(FmiInstance* instance, const char* function, const unsigned vr[], size_t nvr,
                              double values[]) {
     double indicators[GIMBAL_EVENT_INDICATORS];
     int indicators_read = 0;
-    for (size_t k = 0; k < nvr; ++k) {
-        if (vr[k] == FMI3_TIME) {
+    FmiStatus worst = FMI_OK;
+    for (size_t k = 0; k < nvr && worst <= FMI_WARNING; ++k) {
+        FmiStatus status = FMI_OK;
+        if (vr[k] == FMI3_TIME)
             values[k] = instance->time;
-            continue;
-        }
-        if (!is_event_indicator(vr[k])) {
-            GimbalVariableInfo info;
-            if (vr[k] >= FMI3_INTEGER_BASE || !gimbal_variable_info(GIMBAL_REAL, vr[k], &info)) {
-                fmi_log_error(instance, "%s: value reference %u is not a Float64 variable", function, vr[k]);
-                return FMI_ERROR;
-            }
-            const FmiStatus status = gimbal_status(gimbal_core_get_real(gimbal_core_of(instance), vr[k], &values[k]));
-            if (status > FMI_WARNING) return status;
-            continue;
-        }
-        if (!indicators_read) {
-            for (int z = 0; z < GIMBAL_EVENT_INDICATORS; ++z) indicators[z] = 1.0;
-            if (instance->model_exchange) {
-                const FmiStatus status =
-                    gimbal_status(gimbal_core_get_event_indicators(gimbal_core_of(instance), indicators));
-                if (status > FMI_WARNING) return status;
-            }
-            indicators_read = 1;
-        }
-        values[k] = indicators[vr[k] - FMI3_FIRST_EVENT_INDICATOR];
+        else if (is_event_indicator(vr[k]))
+            status = event_indicator(instance, vr[k], indicators, &indicators_read, &values[k]);
+        else
+            status = float64_value(instance, function, vr[k], &values[k]);
+        if (status > worst) worst = status;
     }
-    return FMI_OK;
+    return worst;
 }
 
 /* ---------------------------------------------------------------- Integers (FMI 3.0: Int32, and Int64 for the
@@ -92,7 +102,10 @@ static FmiStatus get_float64(FmiInstance* instance, const char* function, const 
 /* A settable variable of the type; else logged, 0. */
 static int settable(FmiInstance* instance, const char* function, GimbalType type, unsigned vr) {
     GimbalVariableInfo info;
-    if (!gimbal_variable_info(type, vr, &info)) return 0; /* the faces let only known references through */
+    if (!gimbal_variable_info(type, vr, &info)) {
+        fmi_log_error(instance, "%s: value reference %u is not a variable of its type", function, vr);
+        return 0;
+    }
     if (gimbal_variable_settable(instance, &info)) return 1;
     fmi_log_error(instance, "%s: %s cannot be set in state '%s'", function, info.name,
                   instance->face->state_name(instance->state));
@@ -123,7 +136,10 @@ int gimbal_integer_known(unsigned vr) {
  * refused naming the variable and the type it is. */
 static int of_kind(FmiInstance* instance, const char* function, unsigned vr, int enumeration) {
     GimbalVariableInfo info;
-    gimbal_variable_info(GIMBAL_INTEGER, vr, &info); /* known: the faces let only known references through */
+    if (!gimbal_variable_info(GIMBAL_INTEGER, vr, &info)) {
+        fmi_log_error(instance, "%s: value reference %u is not an Integer variable", function, vr);
+        return 0;
+    }
     if ((info.declared_type[0] != '\0') == enumeration) return 1;
     fmi_log_error(instance, "%s: %s is %s", function, info.name,
                   enumeration ? "an Int32 variable" : "an Enumeration (fmi3GetInt64/fmi3SetInt64)");
