@@ -165,13 +165,16 @@ static fmi2Status get_string_status(fmi2Component c, fmi2StatusKind kind, fmi2St
     return (fmi2Status)call
 
 static fmi2Status get_fmu_state(fmi2Component c, fmi2FMUstate* state) {
-    FMU_STATE_CALL("fmi2GetFMUstate", FMU_STATE_STATES, "canGetAndSetFMUstate", fmi_get_fmu_state(instance, "fmi2GetFMUstate", state));
+    FMU_STATE_CALL("fmi2GetFMUstate", FMU_STATE_STATES, "canGetAndSetFMUstate",
+                   fmi_get_fmu_state(instance, "fmi2GetFMUstate", state));
 }
 static fmi2Status set_fmu_state(fmi2Component c, fmi2FMUstate state) {
-    FMU_STATE_CALL("fmi2SetFMUstate", FMU_STATE_STATES, "canGetAndSetFMUstate", fmi_set_fmu_state(instance, "fmi2SetFMUstate", state));
+    FMU_STATE_CALL("fmi2SetFMUstate", FMU_STATE_STATES, "canGetAndSetFMUstate",
+                   fmi_set_fmu_state(instance, "fmi2SetFMUstate", state));
 }
 static fmi2Status free_fmu_state(fmi2Component c, fmi2FMUstate* state) {
-    FMU_STATE_CALL("fmi2FreeFMUstate", ANY_STATE, "canGetAndSetFMUstate", fmi_free_fmu_state(instance, "fmi2FreeFMUstate", state));
+    FMU_STATE_CALL("fmi2FreeFMUstate", ANY_STATE, "canGetAndSetFMUstate",
+                   fmi_free_fmu_state(instance, "fmi2FreeFMUstate", state));
 }
 static fmi2Status serialized_fmu_state_size(fmi2Component c, fmi2FMUstate state, size_t* size) {
     FMU_STATE_CALL("fmi2SerializedFMUstateSize", ANY_STATE, "canSerializeFMUstate",

@@ -62,11 +62,21 @@ static const FmuVariables* variables_of(Type3 type, unsigned* base) {
     static const FmuVariables kNone = {0};
     const Fmi3Variables* own = kModel->fmi3;
     switch (type) {
-        case FLOAT64: *base = own ? own->float64_base : SMALL_FMI3_FLOAT64_BASE; return own ? &own->float64 : &kModel->real;
-        case INT32: *base = own ? own->int32_base : SMALL_FMI3_INT32_BASE; return own ? &own->int32 : &kModel->integer;
-        case INT64: *base = own ? own->int64_base : 0; return own ? &own->int64 : &kNone;
-        case BOOLEAN: *base = own ? own->boolean_base : SMALL_FMI3_BOOLEAN_BASE; return own ? &own->boolean : &kModel->boolean;
-        default: *base = own ? own->string_base : SMALL_FMI3_STRING_BASE; return own ? &own->string : &kModel->string;
+        case FLOAT64:
+            *base = own ? own->float64_base : SMALL_FMI3_FLOAT64_BASE;
+            return own ? &own->float64 : &kModel->real;
+        case INT32:
+            *base = own ? own->int32_base : SMALL_FMI3_INT32_BASE;
+            return own ? &own->int32 : &kModel->integer;
+        case INT64:
+            *base = own ? own->int64_base : 0;
+            return own ? &own->int64 : &kNone;
+        case BOOLEAN:
+            *base = own ? own->boolean_base : SMALL_FMI3_BOOLEAN_BASE;
+            return own ? &own->boolean : &kModel->boolean;
+        default:
+            *base = own ? own->string_base : SMALL_FMI3_STRING_BASE;
+            return own ? &own->string : &kModel->string;
     }
 }
 
@@ -339,9 +349,9 @@ static fmi3Status read_vector(fmi3Instance handle, const char* function, int sta
     const FmuModelExchange* model = kModel->model_exchange;
     if (model == NULL) return not_offered(handle, function, kCoSimulationOnly);
     const int indicators = vector == EVENT_INDICATORS;
-    FmiInstance* instance =
-        model_exchange_usable(handle, function, states, values, n, indicators ? model->event_indicators : model->continuous_states,
-                              argument, indicators ? "nEventIndicators" : "nContinuousStates");
+    const size_t expected = indicators ? model->event_indicators : model->continuous_states;
+    FmiInstance* instance = model_exchange_usable(handle, function, states, values, n, expected, argument,
+                                                  indicators ? "nEventIndicators" : "nContinuousStates");
     if (instance == NULL) return fmi3Error;
     switch (vector) {
         case DERIVATIVES: return (fmi3Status)model->get_derivatives(instance, values);
