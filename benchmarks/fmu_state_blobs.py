@@ -21,81 +21,106 @@ import fmpy
 from fmpy.fmi2 import FMU2Model, FMU2Slave
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
+STATES = 19  # the gimbal's continuous states (Model Exchange)
+
+
 def record(out, name, blob):
     out[name] = hashlib.sha256(bytes(blob)).hexdigest()
+
 
 def vr_of(md, name):
     return next(v.valueReference for v in md.modelVariables if v.name == name)
 
+
+def opened(path, cls, identifier):
+    """The model description and an instance of `cls` of the FMU at `path`, named "blob"."""
+    md = fmpy.read_model_description(path)
+    return md, cls(guid=md.guid, unzipDirectory=fmpy.extract(path), modelIdentifier=identifier, instanceName="blob")
+
+
+def voltages(k):
+    """The voltages of step k: u_R1 switching every 40 steps, u_R2 held."""
+    return [3.0 if (k // 40) % 2 else -2.0, 1.5]
+
+
+def euler_steps(f, get_derivatives):
+    """50 explicit Euler steps of 0.1 ms from t = 0.25 s, as a host's continuous-time solver would take."""
+    x, dx = (ctypes.c_double * STATES)(), (ctypes.c_double * STATES)()
+    f.getContinuousStates(x, STATES)
+    for k in range(50):
+        f.setTime(0.25 + k * 1e-4)
+        get_derivatives(dx, STATES)
+        for i in range(STATES):
+            x[i] += 1e-4 * dx[i]
+        f.setContinuousStates(x, STATES)
+
+
 def gimbal2(build, out, kind):
-    path = f"{build}/Gimbal2Axis.fmu"
-    md = fmpy.read_model_description(path); d = fmpy.extract(path)
-    cls = FMU2Slave if kind == "cs" else FMU2Model
-    f = cls(guid=md.guid, unzipDirectory=d, modelIdentifier="Gimbal2Axis", instanceName="blob")
+    md, f = opened(f"{build}/Gimbal2Axis.fmu", FMU2Slave if kind == "cs" else FMU2Model, "Gimbal2Axis")
+    inputs = [vr_of(md, "u_R1"), vr_of(md, "u_R2")]
     f.instantiate()
     f.setupExperiment(startTime=0.25)
-    u1, u2 = vr_of(md, "u_R1"), vr_of(md, "u_R2")
-    f.enterInitializationMode(); f.exitInitializationMode()
+    f.enterInitializationMode()
+    f.exitInitializationMode()
     record(out, f"fmi2-{kind}-initialized", f.serializeFMUstate(f.getFMUstate()))
     if kind == "cs":
-        t = 0.25
         for k in range(300):
-            f.setReal([u1, u2], [3.0 if (k // 40) % 2 else -2.0, 1.5]); f.doStep(t, 1e-3); t = 0.25 + (k + 1) * 1e-3
+            f.setReal(inputs, voltages(k))
+            f.doStep(0.25 + k * 1e-3, 1e-3)
     else:
-        f.newDiscreteStates(); f.enterContinuousTimeMode()
-        x = (ctypes.c_double * 19)(); dx = (ctypes.c_double * 19)()
-        f.getContinuousStates(x, 19)
-        for k in range(50):
-            f.setTime(0.25 + k * 1e-4); f.getDerivatives(dx, 19)
-            for i in range(19): x[i] += 1e-4 * dx[i]
-            f.setContinuousStates(x, 19)
+        f.newDiscreteStates()
+        f.enterContinuousTimeMode()
+        euler_steps(f, f.getDerivatives)
     record(out, f"fmi2-{kind}-running", f.serializeFMUstate(f.getFMUstate()))
     f.terminate()
     record(out, f"fmi2-{kind}-terminated", f.serializeFMUstate(f.getFMUstate()))
     f.freeInstance()
 
+
 def gimbal3(build, out, kind, event_mode=False, early=False):
-    path = f"{build}/Gimbal2Axis-fmi3.fmu"
-    md = fmpy.read_model_description(path); d = fmpy.extract(path)
-    cls = FMU3Slave if kind == "cs" else FMU3Model
-    f = cls(guid=md.guid, unzipDirectory=d, modelIdentifier="Gimbal2Axis", instanceName="blob")
-    if kind == "cs": f.instantiate(eventModeUsed=event_mode, earlyReturnAllowed=early)
-    else: f.instantiate()
-    u1, u2 = vr_of(md, "u_R1"), vr_of(md, "u_R2")
-    f.enterInitializationMode(startTime=0.25); f.exitInitializationMode()
+    md, f = opened(f"{build}/Gimbal2Axis-fmi3.fmu", FMU3Slave if kind == "cs" else FMU3Model, "Gimbal2Axis")
+    inputs = [vr_of(md, "u_R1"), vr_of(md, "u_R2")]
+    if kind == "cs":
+        f.instantiate(eventModeUsed=event_mode, earlyReturnAllowed=early)
+    else:
+        f.instantiate()
+    f.enterInitializationMode(startTime=0.25)
+    f.exitInitializationMode()
     tag = f"fmi3-{kind}-{int(event_mode)}{int(early)}"
     record(out, tag + "-initialized", f.serializeFMUState(f.getFMUState()))
     if kind == "cs":
         if event_mode:
-            f.updateDiscreteStates(); f.enterStepMode()
+            f.updateDiscreteStates()
+            f.enterStepMode()
         t = 0.25
         for k in range(300):
-            f.setFloat64([u1, u2], [3.0 if (k // 40) % 2 else -2.0, 1.5])
-            r = f.doStep(t, 1e-3)
-            t = r[3] if early else 0.25 + (k + 1) * 1e-3
-            if early and event_mode and r[0]:
-                f.enterEventMode(); f.updateDiscreteStates(); f.enterStepMode()
+            f.setFloat64(inputs, voltages(k))
+            event, _, _, reached = f.doStep(t, 1e-3)
+            t = reached if early else 0.25 + (k + 1) * 1e-3  # an early return ends the step at `reached`
+            if early and event_mode and event:
+                f.enterEventMode()
+                f.updateDiscreteStates()
+                f.enterStepMode()
     else:
-        f.updateDiscreteStates(); f.enterContinuousTimeMode()
-        x = (ctypes.c_double * 19)(); dx = (ctypes.c_double * 19)()
-        f.getContinuousStates(x, 19)
-        for k in range(50):
-            f.setTime(0.25 + k * 1e-4); f.getContinuousStateDerivatives(dx, 19)
-            for i in range(19): x[i] += 1e-4 * dx[i]
-            f.setContinuousStates(x, 19)
+        f.updateDiscreteStates()
+        f.enterContinuousTimeMode()
+        euler_steps(f, f.getContinuousStateDerivatives)
     record(out, tag + "-running", f.serializeFMUState(f.getFMUState()))
     f.terminate()
     record(out, tag + "-terminated", f.serializeFMUState(f.getFMUState()))
     f.freeInstance()
 
+
 def small3(build, out, file, identifier):
-    path = f"{build}/{file}"
-    md = fmpy.read_model_description(path); d = fmpy.extract(path)
-    f = FMU3Slave(guid=md.guid, unzipDirectory=d, modelIdentifier=identifier, instanceName="blob")
-    f.instantiate(); f.enterInitializationMode(startTime=0.0); f.exitInitializationMode()
-    for k in range(100): f.doStep(k * 1e-3, 1e-3)
+    _, f = opened(f"{build}/{file}", FMU3Slave, identifier)
+    f.instantiate()
+    f.enterInitializationMode(startTime=0.0)
+    f.exitInitializationMode()
+    for k in range(100):
+        f.doStep(k * 1e-3, 1e-3)
     record(out, file + "-running", f.serializeFMUState(f.getFMUState()))
     f.freeInstance()
+
 
 def states_of(build: str) -> dict:
     out = {}
