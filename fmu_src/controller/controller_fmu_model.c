@@ -1,5 +1,6 @@
 /* The controller FMU's model file: controller_model.c behind the FMI 2.0 and FMI 3.0 faces
- * (fmi_layer/fmu_model.h), which check the states, pointers and value references and export the fmi2* or fmi3* functions; here are the controller's values, parameter
+ * (fmi_layer/fmu_model.h), which check the states, pointers and value references and export the
+ * fmi2* or fmi3* functions; here are the controller's values, parameter
  * checks and step, and its FMU-state snapshot (offered by the FMI 3.0 FMU). */
 #include <math.h>
 #include <stddef.h>

@@ -402,7 +402,6 @@ static FmiStatus step_recording(Instance* instance, const char* function, double
     instance->common.time = end_time;
     gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
     target_row(instance);
-    instance->common.last_step_status = FMI_OK;
     return FMI_OK;
 }
 
@@ -417,7 +416,6 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
      * step. The rows stay where they are; only the time follows the master. */
     if (instance->step != 0.0 && step_size < kClockRoundingOfStep * instance->step) {
         instance->common.time = end_time;
-        instance->common.last_step_status = FMI_OK;
         return FMI_OK;
     }
     /* A master that keeps time in integer nanoseconds (libcosim) passes steps a few units in the last
@@ -434,7 +432,6 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     if (instance->step == 0.0) {
         if (ship_motion_set_step(&instance->motion, step) != 0) {
             instance->common.state = instance->common.face->error_state;
-            instance->common.last_step_status = FMI_ERROR;
             REFUSE(instance, "%s: out of memory for the rotation tables of step %g", function, step);
         }
         instance->step = step;
@@ -443,14 +440,12 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     ship_motion_row(&instance->motion, instance->row + 1, row);
     if (!finite_row(instance, row, function, end_time)) {
         instance->common.state = instance->common.face->error_state;
-        instance->common.last_step_status = FMI_ERROR;
         return FMI_ERROR;
     }
     instance->row += 1;
     instance->common.time = end_time;
     memcpy(instance->outputs, row, sizeof row);
     target_row(instance);
-    instance->common.last_step_status = FMI_OK;
     return FMI_OK;
 }
 
