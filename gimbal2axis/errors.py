@@ -13,6 +13,9 @@ EXCERPT_CHARS = 80
 # Names longer than this get no close-match search: difflib's cost grows with the length, and no
 # name of the scene format or of the FMU is anywhere near it.
 LONGEST_NAME_TO_MATCH = 200
+# The longest line a command prints as its error (one_line): a message of the product's own with a
+# few excerpts in it fits.
+LONGEST_MESSAGE_CHARS = 1000
 
 
 class SceneError(ValueError):
@@ -21,6 +24,20 @@ class SceneError(ValueError):
 
 class SceneWarning(UserWarning):
     """A scene that runs, but probably not as its author meant; the message names the key."""
+
+
+class StopSignal(BaseException):
+    """Raised by a command's own SIGINT or SIGTERM handler (cli/failures.py): the user's signal to the
+    process. The wrappers of user code (a controller's reset and step) let it pass and turn every other
+    BaseException (sys.exit, a KeyboardInterrupt the user's code raised itself) into the code's failure."""
+
+
+class Interrupted(StopSignal, KeyboardInterrupt):
+    """SIGINT (Ctrl-C), raised where the command cannot end at its next step."""
+
+
+class Terminated(StopSignal):
+    """SIGTERM, raised where the command cannot end at its next step."""
 
 
 class FMUCallFailed(Exception):
@@ -32,20 +49,54 @@ class FMUCallFailed(Exception):
         self.function = function
 
 
-def excerpt(text: str, limit: int = EXCERPT_CHARS) -> str:
-    """`text` itself when short, else its first `limit` characters and '…(N characters)'."""
+def excerpt(text, limit: int = EXCERPT_CHARS) -> str:
+    """`text` as a message embeds it: each character that is not printable written as repr writes it
+    (NUL as \\x00, a newline as \\n, the ESC of a terminal's colour codes as \\x1b), so that a message
+    stays one line that cannot rewrite the terminal; its first `limit` characters (as written) and
+    '…(N characters)' when it is longer."""
     text = str(text)
+    head = text[:limit]
+    if head.isprintable():
+        return _cut(text, limit)
+    pieces, used, taken = [], 0, 0
+    for character in head:
+        piece = character if character.isprintable() else repr(character)[1:-1]
+        if used + len(piece) > limit:
+            break
+        pieces.append(piece)
+        used, taken = used + len(piece), taken + 1
+    return "".join(pieces) + ("" if taken == len(text) else f"…({len(text)} characters)")
+
+
+def one_line(message, limit: int = LONGEST_MESSAGE_CHARS) -> str:
+    """A whole message as a command prints it: escaped and cut as `excerpt` does, at `limit`
+    characters; the last defence against a multi-line or megabyte text that no check caught."""
+    return excerpt(message, limit)
+
+
+def _cut(text: str, limit: int) -> str:
     if len(text) <= limit:
         return text
     return f"{text[:limit]}…({len(text)} characters)"
+
+
+def safe_repr(value) -> str:
+    """repr(value), or what the value is when its repr fails (an int of more than 4300 digits, a
+    user's object whose __repr__ raises)."""
+    try:
+        return repr(value)
+    except Exception:
+        if isinstance(value, int):
+            return f"an integer of {value.bit_length()} bits"
+        return f"a {type(value).__name__} object"
 
 
 def shown(value, limit: int = EXCERPT_CHARS) -> str:
     """A value as a message quotes it: its repr, cut to an excerpt (a string, a list or a table as
     long as the user made it)."""
     if isinstance(value, str):
-        return repr(excerpt(value, limit))
-    return excerpt(repr(value), limit)
+        return repr(_cut(value, limit))
+    return excerpt(safe_repr(value), limit)
 
 
 def did_you_mean(name, known) -> str:
@@ -60,24 +111,11 @@ def did_you_mean(name, known) -> str:
     return " (did you mean " + " or ".join(f"'{match}'" for match in matches) + "?)"
 
 
-def read_toml(path, error: type = SceneError) -> dict:
-    """The parsed TOML file at `path`; an `error` (the exception type to raise) naming the file when
-    it cannot be read or is not TOML."""
-    import tomllib
-
-    try:
-        with open(path, "rb") as f:
-            return tomllib.load(f)
-    except OSError as exc:
-        raise error(f"{path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise error(f"{path}: not a text file (TOML is UTF-8)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise error(f"{path}: not valid TOML: {excerpt(exc, 2 * EXCERPT_CHARS)}") from None
-
-
 def check_keys(where: str, table: dict, allowed: set) -> None:
-    """Refuses keys of `table` not in `allowed`, each quoted as an excerpt, with the close matches."""
+    """Refuses keys of `table` not in `allowed`, each quoted as an excerpt, with the close matches; and
+    a `table` that is not a table (a value where the file needs [where] or { ... })."""
+    if not isinstance(table, dict):
+        raise SceneError(f"[{where}] must be a table, got {shown(table)}")
     unknown = sorted(set(table) - set(allowed), key=str)
     if unknown:
         listed = "[" + ", ".join(shown(key) for key in unknown[:5]) + (", …" if len(unknown) > 5 else "") + "]"
@@ -99,6 +137,14 @@ def is_number_text(text: str) -> bool:
         return math.isfinite(float(text))
     except ValueError:
         return False
+
+
+def within(where: str, value, low: float, high: float) -> float:
+    """A finite number in [low, high], both included; else a refusal naming the range."""
+    value = number(where, value)
+    if not low <= value <= high:
+        raise SceneError(f"{where} = {value:g} is outside [{low:g}, {high:g}]")
+    return value
 
 
 def positive(where: str, value) -> float:

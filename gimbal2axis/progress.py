@@ -57,7 +57,8 @@ def terminal_columns(stream) -> int:
 class Progress:
     """`update(t)` with the simulated time reached; `close()` at the end."""
 
-    def __init__(self, total_time: float, enabled: bool = True, stream=sys.stderr, quiet_for: float = 1.0):
+    def __init__(self, total_time: float, enabled: bool = True, stream=None, quiet_for: float = 1.0):
+        stream = sys.stderr if stream is None else stream   # the stderr of now, not of the first import
         # The rate tqdm shows is simulated seconds per wall second: the real-time factor.
         # miniters=0: every update is looked at (tqdm would otherwise guess how many to skip)
         common = dict(total=total_time, disable=not enabled, file=stream, delay=quiet_for, unit="s", unit_scale=False,

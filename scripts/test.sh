@@ -25,7 +25,8 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   ctest --test-dir "$asan_dir" --output-on-failure --parallel "$test_jobs"
   # Left out here: the tests whose time goes to Python (the independent reference solution, the run
-  # command's streaming, signals and long runs, the sensors page's comparison of 36 runs: 369 s under the
+  # command's streaming, signals, failure paths and long runs, the fuzzing of the input files under a
+  # memory limit (RLIMIT_AS, which AddressSanitizer's shadow memory cannot live under), the input bounds, the sensors page's comparison of 36 runs: 369 s under the
   # sanitizers; the README's commands and the reports, the notebook, the symbolic derivation, the
   # 40-MB scene key, the gyro's Allan deviations, the target geometry in numpy; the documentation,
   # layout and build checks; the command line's messages, exit statuses and progress; the frequency
@@ -52,7 +53,10 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
     --ignore tests/test_linearize_command.py --ignore tests/test_system_command.py \
     --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
     --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py \
-    --ignore tests/test_run_partial.py --ignore tests/test_long_run.py --ignore tests/test_tune.py
+    --ignore tests/test_run_partial.py --ignore tests/test_long_run.py --ignore tests/test_tune.py \
+    --ignore tests/test_run_failure_paths.py --ignore tests/test_toml_fuzz.py --ignore tests/test_input_bounds.py \
+    --ignore tests/test_culprit_messages.py --ignore tests/test_target_inputs.py \
+    --ignore tests/test_sweep_failure_paths.py --ignore tests/test_html_escaping.py
   unset ASAN_OPTIONS UBSAN_OPTIONS
   echo "[test] sanitizer pass clean; now the release build"
 fi

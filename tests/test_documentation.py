@@ -205,3 +205,38 @@ def test_user_facing_files_point_to_the_physics_page_not_outside_the_repository(
     offenders = [str(f.relative_to(REPO)) for f in files
                  if f.is_file() and re.search(r"shared/(spec|seed)", f.read_text(encoding="utf-8", errors="replace"))]
     assert offenders == [], f"references to files outside the repository: {offenders}"
+
+
+# How the pages state the number of event indicators, and what each says it is, from the count n.
+EVENT_INDICATOR_CLAIMS = {
+    r"(\d+) (?:scalar )?event indicators": lambda n: n,
+    r"event indicators \((\d+)": lambda n: n,
+    r'numberOfEventIndicators="(\d+)"': lambda n: n,
+    r"the (\d+) `<EventIndicator>`s": lambda n: n,
+    r"3002 \.\. (\d+)": lambda n: 3001 + n,   # FMI 3.0's value references of the indicators
+}
+
+
+def test_every_page_states_the_event_indicator_count_of_the_built_model_descriptions(fmu_path, build_dir):
+    """The count is the generator's (model_core's switching_elements.def, docs/architecture.md): the
+    pages are checked against the model descriptions the build wrote, so no number goes stale."""
+    from fmpy import read_model_description
+    count = read_model_description(str(fmu_path)).numberOfEventIndicators
+    fmi3 = read_model_description(str(build_dir / "Gimbal2Axis-fmi3.fmu"))
+    indicators = [v for v in fmi3.modelVariables if v.name.startswith("event_indicators[")]
+    assert len(fmi3.eventIndicators) == len(indicators) == count
+    assert [v.valueReference for v in indicators] == list(range(3002, 3002 + count))
+    wrong, stated = [], 0
+    for page in sorted((REPO / "docs").glob("*.md")):
+        text = " ".join(page.read_text(encoding="utf-8").split())   # a claim may span lines
+        for pattern, expected in EVENT_INDICATOR_CLAIMS.items():
+            for match in re.finditer(pattern, text):
+                stated += 1
+                if int(match.group(1)) != expected(count):
+                    wrong.append(f"{page.name}: '{match.group(0)}' (the build's: {expected(count)})")
+        for index in re.findall(r"`event_indicators\[(\d+)\]`", text):
+            stated += 1
+            if int(index) not in (1, count):
+                wrong.append(f"{page.name}: `event_indicators[{index}]` (the last is [{count}])")
+    assert wrong == [], wrong
+    assert stated >= 8   # the pages do state it (fmi_interfaces.md, interface.md, fmi_behaviour.md)

@@ -14,7 +14,7 @@ ROOT = "gimbal2axis"
 # A module may import from its own part and from parts of a lower rank; parts of the same rank (sweep,
 # analysis, report, system) not from each other. __init__ (the package's front: its public API) and __main__ (the
 # command) are the package file's own.
-RANK = {"errors": 0, "version": 0, "progress": 1, "native": 1, "locations": 1, "fmu": 2, "target": 2.5, "scene": 3, "master": 4,
+RANK = {"errors": 0, "limits": 0.5, "version": 0, "progress": 1, "native": 1, "locations": 1, "fmu": 2, "target": 2.5, "scene": 3, "master": 4,
         "__init__": 4.5, "analysis": 5, "sweep": 5, "report": 5, "system": 5, "tune": 5.5, "cli": 6, "__main__": 7}
 
 

@@ -20,7 +20,8 @@ from fmpy.validation import validate_fmu
 from scipy.interpolate import CubicSpline
 
 from gimbal2axis import FMU, load_scene, native
-from gimbal2axis.errors import SceneError, read_toml
+from gimbal2axis.errors import SceneError
+from gimbal2axis.limits import read_toml
 from gimbal2axis.scene.base_motion import INPUTS, Recorded, make_base_motion
 from gimbal2axis.scene.ship_motion_fmu import recording_parameters, ship_motion_fmu_parameters
 

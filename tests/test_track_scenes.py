@@ -123,12 +123,14 @@ CARRIER = "[target.carrier]\nlatitude_deg = 59.8\nlongitude_deg = 10.5\n"
     ('type = "track"\nfile = "boat.csv"', CARRIER, TRACK_HEADER + GOOD_ROWS.replace("0.5,59.9", "0.5,N59.9"),
      r"line 4 \(data row 3\), column 'latitude_deg' is not a number: 'N59.9'"),
     ('type = "track"\nfile = "boat.csv"', CARRIER, TRACK_HEADER + GOOD_ROWS.replace("1.0,59.9", "0.2,59.9"),
-     r"line 5 \(data row 4\): time 0.2 s does not increase"),
+     r"'time' must increase strictly, but line 5 has 0.2 after 0.5"),
     ('type = "track"\nfile = "boat.csv"', CARRIER, TRACK_HEADER + GOOD_ROWS.replace("2.0,59.9", "1.02,59.9"),
      r"covers \[-1, 1.02\] s, not \[-0.05, 1.05\] s"),
     ('type = "track"\nfile = "boat.csv"', CARRIER, "t,lat,lon\n1,2,3\n", "not a recorded track: .* no 'time' column"),
     ('type = "track"\nfile = "boat.csv"', CARRIER, "time;latitude_deg\n", "semicolons"),
-    ('type = "track"\nfile = "boat.csv"', CARRIER, "time,x_m\n0,1\n", "a track needs time and either latitude_deg"),
+    ('type = "track"\nfile = "boat.csv"', CARRIER, "time,x_m\n0,1\n1,1\n2,1\n3,1\n",
+     "a track needs time and either latitude_deg"),
+    ('type = "track"\nfile = "boat.csv"', CARRIER, "time,x_m\n0,1\n", "1 data rows; a cubic spline needs at least 4"),
 ])
 def test_what_cannot_be_right_is_refused_naming_the_key_or_the_line(tmp_path, target, extra, track, message):
     if track is not None:

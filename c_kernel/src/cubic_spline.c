@@ -87,6 +87,18 @@ int gimbal_cubic_spline_fit(long n, const double* x, const double* y, double* co
     return singular;
 }
 
+long gimbal_cubic_spline_first_overflow(long n, const double* x, const double* coefficients) {
+    for (long i = 0; i + 1 < n; ++i) {
+        /* With |d| <= reach and reach >= 1, every partial sum of Horner's scheme, and of the
+         * derivatives' (factors 3 and 6 at most), is at most 6 sum|c_k| reach^3 in magnitude. */
+        const double* c = coefficients + 4 * i;
+        const double reach = fmax(1.0, 2.0 * (x[i + 1] - x[i]));
+        const double bound = 6.0 * (fabs(c[0]) + fabs(c[1]) + fabs(c[2]) + fabs(c[3])) * reach * reach * reach;
+        if (!isfinite(bound)) return i;
+    }
+    return -1;
+}
+
 /* The interval i with x_i <= t < x_{i+1}; the first one before x_0, the last one from x_{n-2} on. */
 static long interval_of(long n, const double* x, double t) {
     long low = 0, high = n - 2;

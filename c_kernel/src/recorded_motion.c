@@ -91,25 +91,16 @@ static int check_columns(const GimbalCsvTable* table, char* message, size_t size
     return GIMBAL_RECORDED_MOTION_BAD_COLUMNS;
 }
 
-/* A spline through column `column` of the table (scaled by `scale`): its index, or -1 when out of memory. */
-static int add_spline(GimbalRecordedMotion* motion, const GimbalCsvTable* table, int column, double scale) {
-    const long n = table->rows;
-    double* samples = malloc(sizeof(double) * (size_t)n);
-    double* coefficients = malloc(sizeof(double) * (size_t)gimbal_cubic_spline_coefficient_count(n));
-    if (samples == NULL || coefficients == NULL) {
-        free(samples);
+/* A spline through column `column` of the table (scaled by `scale`): its index (>= 0); -1 when out of
+ * memory; -2 when the column's spline overflows (the reason in `message`). */
+static int add_spline(GimbalRecordedMotion* motion, const GimbalCsvTable* table, const long* lines, int column,
+                      double scale, char* message, size_t size) {
+    double* coefficients = malloc(sizeof(double) * (size_t)gimbal_cubic_spline_coefficient_count(table->rows));
+    if (coefficients == NULL) return -1;
+    const int status = gimbal_csv_table_spline(table, lines, motion->time, column, scale, coefficients, message, size);
+    if (status != 0) {
         free(coefficients);
-        return -1;
-    }
-    for (long i = 0; i < n; ++i) {
-        const double value = table->values[(size_t)i * (size_t)table->columns + (size_t)column];
-        samples[i] = scale == 1.0 ? value : value * scale;
-    }
-    const int status = gimbal_cubic_spline_fit(n, motion->time, samples, coefficients);
-    free(samples);
-    if (status != 0) { /* not 1: the table has >= 4 rows, strictly increasing times */
-        free(coefficients);
-        return -1;
+        return status < 0 ? -1 : -2;
     }
     motion->coefficients[motion->splines] = coefficients;
     return motion->splines++;
@@ -120,8 +111,10 @@ static void set_output(GimbalRecordedMotion* motion, int output, int spline, int
     motion->output_derivative[output] = derivative;
 }
 
-/* The splines of a checked table. 0, or -1 when out of memory. */
-static int build(GimbalRecordedMotion* motion, const GimbalCsvTable* table) {
+/* The splines of a checked table: 0; -1 when out of memory; -2 when a column's spline overflows
+ * (the reason in `message`). */
+static int build(GimbalRecordedMotion* motion, const GimbalCsvTable* table, const long* lines, char* message,
+                 size_t size) {
     char name[64];
     /* Degrees as Python's math.radians converts them: x * (pi / 180). */
     const double radians_per_degree = 3.141592653589793 / 180.0;
@@ -129,23 +122,23 @@ static int build(GimbalRecordedMotion* motion, const GimbalCsvTable* table) {
         const int radians = gimbal_csv_table_column(table, kAngles[i]);
         const int degrees = gimbal_csv_table_column(table, kAnglesInDegrees[i]);
         if (radians < 0 && degrees < 0) continue;
-        const int angle = radians >= 0 ? add_spline(motion, table, radians, 1.0)
-                                       : add_spline(motion, table, degrees, radians_per_degree);
-        if (angle < 0) return -1;
+        const int angle = radians >= 0 ? add_spline(motion, table, lines, radians, 1.0, message, size)
+                                       : add_spline(motion, table, lines, degrees, radians_per_degree, message, size);
+        if (angle < 0) return angle;
         set_output(motion, i, angle, 0);
         for (int order = 1; order <= 2; ++order) {
             snprintf(name, sizeof name, "%s%s", kAngles[i], order == 1 ? "_dot" : "_ddot");
             const int given = gimbal_csv_table_column(table, name);
-            const int spline = given >= 0 ? add_spline(motion, table, given, 1.0) : angle;
-            if (spline < 0) return -1;
+            const int spline = given >= 0 ? add_spline(motion, table, lines, given, 1.0, message, size) : angle;
+            if (spline < 0) return spline;
             set_output(motion, 3 * order + i, spline, given >= 0 ? 0 : order);
         }
     }
     for (int i = 0; i < 3; ++i) {
         const int column = gimbal_csv_table_column(table, kPositions[i]);
         if (column < 0) continue;
-        const int spline = add_spline(motion, table, column, 1.0);
-        if (spline < 0) return -1;
+        const int spline = add_spline(motion, table, lines, column, 1.0, message, size);
+        if (spline < 0) return spline;
         motion->position_spline[i] = spline;
         set_output(motion, 9 + i, spline, 1);
         set_output(motion, 12 + i, spline, 2);
@@ -164,7 +157,8 @@ int gimbal_recorded_motion_read(const char* text, size_t length, GimbalRecordedM
                                 size_t size) {
     *motion = NULL;
     GimbalCsvTable table;
-    int status = gimbal_csv_table_read(text, length, &table, message, size);
+    long* lines;
+    int status = gimbal_csv_table_read_with_lines(text, length, &table, &lines, message, size);
     if (status != 0) return status < 0 ? GIMBAL_RECORDED_MOTION_OUT_OF_MEMORY : GIMBAL_RECORDED_MOTION_BAD_TABLE;
     status = check_columns(&table, message, size);
     GimbalRecordedMotion* built = status == 0 ? calloc(1, sizeof *built) : NULL;
@@ -176,12 +170,15 @@ int gimbal_recorded_motion_read(const char* text, size_t length, GimbalRecordedM
         if (built->time != NULL)
             for (long i = 0; i < table.rows; ++i)
                 built->time[i] = table.values[(size_t)i * (size_t)table.columns + (size_t)table.time_column];
-        if (built->time == NULL || build(built, &table) != 0) {
+        const int splined = built->time == NULL ? -1 : build(built, &table, lines, message, size);
+        if (splined != 0) {
             gimbal_recorded_motion_free(built);
             built = NULL;
         }
+        if (splined == -2) status = GIMBAL_RECORDED_MOTION_BAD_TABLE;
     }
     gimbal_csv_table_free(&table);
+    free(lines);
     if (status != 0) return status;
     if (built == NULL) {
         snprintf(message, size, "out of memory for the recording's splines");

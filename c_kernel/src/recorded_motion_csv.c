@@ -1,5 +1,7 @@
 #include "gimbal_kernel/recorded_motion_csv.h"
 
+#include "gimbal_kernel/cubic_spline.h"
+
 #include <ctype.h>
 #include <locale.h>
 #include <math.h>
@@ -270,7 +272,34 @@ static int read_row(const Line* line, long row, GimbalCsvTable* table, char* mes
     return 0;
 }
 
-static int read_table(const Line* lines, long count, GimbalCsvTable* table,
+static double cell(const GimbalCsvTable* table, long row, int column) {
+    return table->values[(size_t)row * (size_t)table->columns + (size_t)column];
+}
+
+/* Strictly increasing times, each step within [GIMBAL_CSV_LEAST_TIME_STEP,
+ * GIMBAL_CSV_LARGEST_TIME_STEP]: a subnormal step would divide a change into an infinite rate, one
+ * near the largest double overflow the spline's sums of steps. */
+static int check_time_steps(const GimbalCsvTable* table, const long* lines, char* message, size_t size) {
+    const int c = table->time_column;
+    for (long row = 1; row < table->rows; ++row) {
+        const double before = cell(table, row - 1, c), now = cell(table, row, c);
+        if (!(now > before))
+            return refuse(message, size, "'time' must increase strictly, but line %ld has %g after %g", lines[row],
+                          now, before);
+        const double step = now - before;
+        const int below = step < GIMBAL_CSV_LEAST_TIME_STEP;
+        if (below || !(step <= GIMBAL_CSV_LARGEST_TIME_STEP))
+            return refuse(message, size,
+                          "line %ld (data row %ld), column 'time': %g s is %g s after line %ld's %g s, %s %g s",
+                          lines[row], row + 1, now, step, lines[row - 1], before,
+                          below ? "below the least time step," : "above the largest time step,",
+                          below ? GIMBAL_CSV_LEAST_TIME_STEP : GIMBAL_CSV_LARGEST_TIME_STEP);
+    }
+    return 0;
+}
+
+/* The table of the lines, the line of each row into row_lines (count - 1 of them at most). */
+static int read_table(const Line* lines, long count, GimbalCsvTable* table, long* row_lines,
                       char* message, size_t size) {
     if (count == 0)
         return refuse(message, size, "the file is empty (expected a header such as 'time,gamma' and rows of numbers)");
@@ -278,32 +307,91 @@ static int read_table(const Line* lines, long count, GimbalCsvTable* table,
     if (status != 0) return status;
     table->values = malloc(sizeof(double) * (size_t)table->columns * (size_t)(count > 1 ? count - 1 : 1));
     if (table->values == NULL) return -1;
-    for (long row = 1; row < count; ++row)
+    for (long row = 1; row < count; ++row) {
         if ((status = read_row(&lines[row], row, table, message, size)) != 0) return status;
+        row_lines[row - 1] = lines[row].number;
+    }
     table->rows = count - 1;
     if (table->rows < MINIMUM_ROWS)
         return refuse(message, size, "%ld data rows; a cubic spline needs at least %d", table->rows, MINIMUM_ROWS);
-    const int c = table->time_column;
-    for (long row = 1; row < table->rows; ++row) {
-        const double before = table->values[(size_t)(row - 1) * (size_t)table->columns + (size_t)c];
-        const double now = table->values[(size_t)row * (size_t)table->columns + (size_t)c];
-        if (!(now > before))
-            return refuse(message, size, "'time' must increase strictly, but line %ld has %g after %g", lines[row + 1].number,
-                          now, before);
-    }
-    return 0;
+    return check_time_steps(table, row_lines, message, size);
 }
 
-int gimbal_csv_table_read(const char* text, size_t length, GimbalCsvTable* table, char* message, size_t size) {
+int gimbal_csv_table_read_with_lines(const char* text, size_t length, GimbalCsvTable* table, long** row_lines,
+                                     char* message, size_t size) {
     memset(table, 0, sizeof *table);
+    *row_lines = NULL;
     const long invalid = first_non_utf8((const unsigned char*)text, length);
     if (invalid >= 0) return refuse(message, size, "not a text file (byte %ld is not UTF-8)", invalid);
     if (length >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) text += 3, length -= 3;
     Line* lines = NULL;
     const long count = split_lines(text, length, &lines);
     if (count < 0) return -1;
-    const int status = read_table(lines, count, table, message, size);
+    *row_lines = malloc(sizeof(long) * (size_t)(count > 1 ? count - 1 : 1));
+    const int status = *row_lines == NULL ? -1 : read_table(lines, count, table, *row_lines, message, size);
     free(lines);
-    if (status != 0) gimbal_csv_table_free(table);
+    if (status != 0) {
+        gimbal_csv_table_free(table);
+        free(*row_lines);
+        *row_lines = NULL;
+    }
     return status;
+}
+
+int gimbal_csv_table_read(const char* text, size_t length, GimbalCsvTable* table, char* message, size_t size) {
+    long* row_lines;
+    const int status = gimbal_csv_table_read_with_lines(text, length, table, &row_lines, message, size);
+    free(row_lines);
+    return status;
+}
+
+/* Room left above a change, a rate and an acceleration between two rows for the spline's sums of
+ * them (its slopes solve a system of a few such terms per row). */
+static const double kSplineRoom = 64.0;
+
+/* The first row (> 0) whose change from the row before, its rate or its acceleration over the time
+ * step overflows, kSplineRoom included; 0 when none does. */
+static long first_overflowing_change(long rows, const double* time, const double* samples) {
+    for (long row = 1; row < rows; ++row) {
+        const double step = time[row] - time[row - 1];
+        const double change = samples[row] - samples[row - 1];
+        const double rate = change / step;
+        if (!isfinite(kSplineRoom * change) || !isfinite(kSplineRoom * rate) || !isfinite(kSplineRoom * rate / step))
+            return row;
+    }
+    return 0;
+}
+
+static int refuse_column(const GimbalCsvTable* table, const long* lines, int column, long row, const char* why,
+                         char* message, size_t size) {
+    const char* name = table->names[column];
+    const Excerpt excerpt = excerpt_of(name, strlen(name));
+    const double step = cell(table, row, table->time_column) - cell(table, row - 1, table->time_column);
+    return refuse(message, size, "line %ld (data row %ld), column '%.*s%s': %g after line %ld's %g, %g s earlier: %s",
+                  lines[row], row + 1, excerpt.length, name, excerpt.suffix, cell(table, row, column), lines[row - 1],
+                  cell(table, row - 1, column), step, why);
+}
+
+int gimbal_csv_table_spline(const GimbalCsvTable* table, const long* row_lines, const double* time, int column,
+                            double scale, double* coefficients, char* message, size_t size) {
+    const long n = table->rows;
+    double* samples = malloc(sizeof(double) * (size_t)n);
+    if (samples == NULL) return -1;
+    for (long i = 0; i < n; ++i) samples[i] = scale == 1.0 ? cell(table, i, column) : cell(table, i, column) * scale;
+    const long overflowing = first_overflowing_change(n, time, samples);
+    const int fitted = overflowing > 0 ? 1 : gimbal_cubic_spline_fit(n, time, samples, coefficients);
+    free(samples);
+    if (fitted < 0) return -1;
+    if (overflowing > 0)
+        return refuse_column(table, row_lines, column, overflowing,
+                             "the change, its rate or its acceleration overflows a double", message, size);
+    /* Not 1 for n < 4 (the table has more): a singular system, which strictly increasing steps
+     * within the bounds do not give; refused all the same rather than splined wrong. */
+    if (fitted > 0)
+        return refuse_column(table, row_lines, column, n - 1, "the spline's system is singular", message, size);
+    const long interval = gimbal_cubic_spline_first_overflow(n, time, coefficients);
+    if (interval >= 0)
+        return refuse_column(table, row_lines, column, interval + 1, "the spline between these rows overflows a double",
+                             message, size);
+    return 0;
 }

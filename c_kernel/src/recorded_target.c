@@ -36,22 +36,18 @@ static int check_columns(const GimbalCsvTable* table, char* message, size_t size
     return 0;
 }
 
-/* The spline of column `column`: its coefficients, or NULL when out of memory. */
-static double* fit_column(const GimbalRecordedTarget* target, const GimbalCsvTable* table, int column) {
-    const long n = table->rows;
-    double* samples = malloc(sizeof(double) * (size_t)n);
-    double* coefficients = malloc(sizeof(double) * (size_t)gimbal_cubic_spline_coefficient_count(n));
-    if (samples != NULL && coefficients != NULL) {
-        for (long i = 0; i < n; ++i) samples[i] = table->values[(size_t)i * (size_t)table->columns + (size_t)column];
-        /* the table has >= 4 rows and strictly increasing times: only memory can fail */
-        if (gimbal_cubic_spline_fit(n, target->time, samples, coefficients) == 0) {
-            free(samples);
-            return coefficients;
-        }
+/* The spline of column `column` into *coefficients: 0; -1 when out of memory; 1 when it overflows
+ * (the reason in `message`). */
+static int fit_column(const GimbalRecordedTarget* target, const GimbalCsvTable* table, const long* lines, int column,
+                      double** coefficients, char* message, size_t size) {
+    *coefficients = malloc(sizeof(double) * (size_t)gimbal_cubic_spline_coefficient_count(table->rows));
+    if (*coefficients == NULL) return -1;
+    const int status = gimbal_csv_table_spline(table, lines, target->time, column, 1.0, *coefficients, message, size);
+    if (status != 0) {
+        free(*coefficients);
+        *coefficients = NULL;
     }
-    free(samples);
-    free(coefficients);
-    return NULL;
+    return status;
 }
 
 void gimbal_recorded_target_free(GimbalRecordedTarget* target) {
@@ -61,39 +57,47 @@ void gimbal_recorded_target_free(GimbalRecordedTarget* target) {
     free(target);
 }
 
-static GimbalRecordedTarget* build(const GimbalCsvTable* table) {
+/* The splines of a checked table into *built: 0; -1 when out of memory; 1 when a column's spline
+ * overflows (the reason in `message`). */
+static int build(const GimbalCsvTable* table, const long* lines, GimbalRecordedTarget** built, char* message,
+                 size_t size) {
     GimbalRecordedTarget* target = calloc(1, sizeof *target);
-    if (target == NULL) return NULL;
+    if (target == NULL) return -1;
     target->samples = table->rows;
     target->time = malloc(sizeof(double) * (size_t)table->rows);
     if (target->time == NULL) {
         gimbal_recorded_target_free(target);
-        return NULL;
+        return -1;
     }
     for (long i = 0; i < table->rows; ++i)
         target->time[i] = table->values[(size_t)i * (size_t)table->columns + (size_t)table->time_column];
     for (int k = 0; k < GIMBAL_RECORDED_TARGET_OUTPUTS; ++k) {
         const int column = gimbal_csv_table_column(table, kColumns[k]);
         if (column < 0) continue;
-        target->coefficients[k] = fit_column(target, table, column);
-        if (target->coefficients[k] == NULL) {
+        const int status = fit_column(target, table, lines, column, &target->coefficients[k], message, size);
+        if (status != 0) {
             gimbal_recorded_target_free(target);
-            return NULL;
+            return status;
         }
     }
-    return target;
+    *built = target;
+    return 0;
 }
 
 int gimbal_recorded_target_read(const char* text, size_t length, GimbalRecordedTarget** target, char* message,
                                 size_t size) {
     *target = NULL;
     GimbalCsvTable table;
-    int status = gimbal_csv_table_read(text, length, &table, message, size);
+    long* lines;
+    int status = gimbal_csv_table_read_with_lines(text, length, &table, &lines, message, size);
     if (status != 0) return status < 0 ? GIMBAL_RECORDED_TARGET_OUT_OF_MEMORY : GIMBAL_RECORDED_TARGET_BAD_TABLE;
     status = check_columns(&table, message, size);
-    GimbalRecordedTarget* built = status == 0 ? build(&table) : NULL;
+    GimbalRecordedTarget* built = NULL;
+    const int splined = status == 0 ? build(&table, lines, &built, message, size) : 0;
     gimbal_csv_table_free(&table);
+    free(lines);
     if (status != 0) return status;
+    if (splined > 0) return GIMBAL_RECORDED_TARGET_BAD_TABLE;
     if (built == NULL) {
         snprintf(message, size, "out of memory for the target's splines");
         return GIMBAL_RECORDED_TARGET_OUT_OF_MEMORY;

@@ -7,8 +7,10 @@
  * the first doStep's step size; the motion is that of the scene runner's grid from t = 0 (the FMU
  * does not depend on the absolute start time, nor on how the master keeps its clock: its time is the
  * master's last point plus the step, communication_point.h). A doStep with another step size is
- * refused: its outputs would no longer be the grid's rows (canHandleVariableCommunicationStepSize=
- * "false"); one far below the grid's step is the master's clock rounding and moves no row.
+ * refused, unless it ends on the grid's next point start + k h (a master's last step to its stop
+ * time): its outputs would no longer be the grid's rows (canHandleVariableCommunicationStepSize=
+ * "false"); one far below the grid's step, or ending on the grid's current point, is the master's
+ * clock rounding and moves no row (communication_point.h: communication_grid_rows).
  *
  * With motion = 1 the outputs are a recording's splines (recorded_motion.h) at the same grid times,
  * read at the end of initialization from recording_file (recording_file.h finds it); a step past the
@@ -24,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/communication_point.h"
 #include "fmi_layer/fmu_model.h"
 #include "gimbal_kernel/recorded_motion.h"
 #include "gimbal_kernel/recorded_target.h"
@@ -48,9 +51,6 @@ typedef struct {
     double outputs[SHIP_REAL_OUTPUTS]; /* the motion's, then the target's */
 } Instance;
 _Static_assert(offsetof(Instance, common) == 0, "the FmiInstance must be the Instance's first member");
-
-/* Below this fraction of the grid's step, a step is the master's clock rounding (see do_step). */
-static const double kClockRoundingOfStep = 1e-6;
 
 #define REFUSE(instance, ...)                               \
     do {                                                    \
@@ -96,7 +96,7 @@ static int read_file(Instance* instance, const char* function, const char* prefi
 static int covers_experiment(Instance* instance, const char* function, const char* what, const char* path, double start,
                              double end) {
     const double duration = instance->common.stop_time - instance->start_time;
-    if (!(start > 0.0 || (instance->common.stop_time_defined && end < duration))) return 1;
+    if (!(start > 0.0 || end < 0.0 || (instance->common.stop_time_defined && end < duration))) return 1;
     if (instance->common.stop_time_defined)
         fmi_log_error(&instance->common, "%s: %s %s covers [%g, %g] s, not [0, %g] s", function, what, path, start, end,
                       duration);
@@ -132,17 +132,29 @@ static FmiStatus prepare_recording(Instance* instance, const char* function) {
     return FMI_OK;
 }
 
+/* Where the motion outputs come from, for finite_row's messages. */
+static const char kSeaState[] = "the sea state's parameters give";
+static const char kRecording[] = "the recording's splines give";
+
 /* Parameters that pass their checks can still give no finite motion (amplitudes near the largest
- * double, whose rates and accelerations overflow): the row is refused, naming the first output that
- * is not finite, and the outputs keep their last values; the host never reads a NaN. */
-static int finite_row(Instance* instance, const double row[], const char* function, double time) {
-    for (int k = 0; k < SHIP_MOTION_OUTPUTS; ++k) {
+ * double, whose rates and accelerations overflow), and the tables' splines are checked where they
+ * are read, not at every time a step asks for: a row (its first `count` outputs, the motion's from
+ * `motion_from`) is refused, naming the first output that is not finite, and the outputs keep their
+ * last values; the host never reads a NaN with status OK. */
+static int finite_row(Instance* instance, const double row[], int count, const char* function, double time,
+                      const char* motion_from) {
+    for (int k = 0; k < count; ++k) {
         if (isfinite(row[k])) continue;
-        fmi_log_error(&instance->common, "%s: %s = %g at t = %.17g: the sea state's parameters give no finite motion",
-                      function, kShipRealVariables[k].name, row[k], time);
+        fmi_log_error(&instance->common, "%s: %s = %g at t = %.17g: %s no finite value", function,
+                      kShipRealVariables[k].name, row[k], time,
+                      k < SHIP_REAL_TARGET ? motion_from : "the target table's splines give");
         return 0;
     }
     return 1;
+}
+
+static const char* motion_source(const Instance* instance) {
+    return instance->recording != NULL ? kRecording : kSeaState;
 }
 
 /* The sea state's components of the parameters, and row 0. */
@@ -154,7 +166,7 @@ static FmiStatus prepare_sea_state(Instance* instance, const char* function) {
         REFUSE(instance, "%s: out of memory for the sea state's components", function);
     double row[SHIP_MOTION_OUTPUTS];
     ship_motion_row(&instance->motion, 0, row);
-    if (!finite_row(instance, row, function, instance->start_time)) {
+    if (!finite_row(instance, row, SHIP_MOTION_OUTPUTS, function, instance->start_time, kSeaState)) {
         ship_motion_release(&instance->motion);
         return FMI_ERROR;
     }
@@ -199,6 +211,11 @@ static FmiStatus prepare(Instance* instance, const char* function) {
                                  : prepare_sea_state(instance, function);
     if (status != FMI_OK) return status;
     if (instance->parameters.target == SHIP_TARGET_RECORDED && prepare_target(instance, function) != FMI_OK) {
+        unprepare(instance);
+        return FMI_ERROR;
+    }
+    if (!finite_row(instance, instance->outputs, SHIP_REAL_OUTPUTS, function, instance->start_time,
+                    motion_source(instance))) {
         unprepare(instance);
         return FMI_ERROR;
     }
@@ -382,11 +399,23 @@ static FmiStatus target_covers(Instance* instance, const char* function, double 
     return FMI_OK;
 }
 
-/* The target outputs at the current row (after the step counted it). */
-static void target_row(Instance* instance) {
-    if (instance->target != NULL)
-        gimbal_recorded_target_row(instance->target, (double)instance->row * instance->step,
-                                   instance->outputs + SHIP_REAL_TARGET);
+/* The target outputs (if any) of the row at `motion_time` into row[SHIP_REAL_TARGET ...]. */
+static void target_row(const Instance* instance, double motion_time, double row[SHIP_REAL_OUTPUTS]) {
+    if (instance->target != NULL) gimbal_recorded_target_row(instance->target, motion_time, row + SHIP_REAL_TARGET);
+}
+
+/* The step's new row, when finite, becomes the outputs at end_time; else refused (the error state). */
+static FmiStatus commit_row(Instance* instance, const char* function, const double row[SHIP_REAL_OUTPUTS], double step,
+                            double end_time) {
+    if (!finite_row(instance, row, SHIP_REAL_OUTPUTS, function, end_time, motion_source(instance))) {
+        instance->common.state = instance->common.face->error_state;
+        return FMI_ERROR;
+    }
+    instance->step = step;
+    instance->row += 1;
+    instance->common.time = end_time;
+    memcpy(instance->outputs, row, sizeof instance->outputs);
+    return FMI_OK;
 }
 
 /* A step of motion = 1: the recording's splines at the next row's time. */
@@ -397,12 +426,11 @@ static FmiStatus step_recording(Instance* instance, const char* function, double
     if (motion_time > end + 1e-12 * fmax(1.0, fabs(end)) + 1e-6 * step)
         REFUSE(instance, "%s: step to t = %.17g s (the recording's time %.17g s) passes the recording's end at %.17g s",
                function, end_time, motion_time, end);
-    instance->step = step;
-    instance->row += 1;
-    instance->common.time = end_time;
-    gimbal_recorded_motion_row(instance->recording, motion_time, instance->outputs);
-    target_row(instance);
-    return FMI_OK;
+    double row[SHIP_REAL_OUTPUTS];
+    memcpy(row, instance->outputs, sizeof row);
+    gimbal_recorded_motion_row(instance->recording, motion_time, row);
+    target_row(instance, motion_time, row);
+    return commit_row(instance, function, row, step, end_time);
 }
 
 /* The master's point becomes the FMU's time (the face checked it); the outputs stay the rows of the
@@ -412,19 +440,28 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
     Instance* instance = ship(common);
     const double end_time = point + step_size;
     /* A master whose clock rounds differently from its step (an SSP engine that ends on its stop time
-     * with a last step of 5e-11 s) takes a step far below the grid's: the clock's rounding, not a
-     * step. The rows stay where they are; only the time follows the master. */
-    if (instance->step != 0.0 && step_size < kClockRoundingOfStep * instance->step) {
-        instance->common.time = end_time;
-        return FMI_OK;
+     * with a last step of 5e-11 s, one that sums t += h and ends a drift short of its stop time) takes
+     * a step that ends on the current row's grid point: the clock's rounding, not a step. The rows
+     * stay where they are; only the time follows the master. A master in integer nanoseconds (libcosim)
+     * passes steps a few ulp off h, one that sums t += h ends its last step a drift short of h, on the
+     * next row's grid point: the same grid step (communication_point.h). More than that is another
+     * step, which the grid cannot give. */
+    if (instance->step != 0.0) {
+        const double h = instance->step;
+        const double current = instance->start_time + (double)instance->row * h;
+        const double next = instance->start_time + (double)(instance->row + 1) * h;
+        const int rows = communication_grid_rows(point, step_size, h, current, next);
+        if (rows == 0) {
+            instance->common.time = end_time;
+            return FMI_OK;
+        }
+        if (rows < 0)
+            REFUSE(instance,
+                   "%s: communicationStepSize = %.17g differs from the first step's %.17g, and the step's end %.17g is "
+                   "not a point of the grid (%.17g, %.17g): the outputs are the rows of one grid "
+                   "(canHandleVariableCommunicationStepSize=\"false\")",
+                   function, step_size, h, end_time, current, next);
     }
-    /* A master that keeps time in integer nanoseconds (libcosim) passes steps a few units in the last
-     * place off h: the same grid step. More than that is another step, which the grid cannot give. */
-    if (instance->step != 0.0 && !(fabs(step_size - instance->step) <= 1e-9 * instance->step))
-        REFUSE(instance,
-               "%s: communicationStepSize = %.17g differs from the first step's %.17g: the outputs are the rows "
-               "of one grid (canHandleVariableCommunicationStepSize=\"false\")",
-               function, step_size, instance->step);
     const double step = instance->step != 0.0 ? instance->step : step_size;
     if (instance->row >= LONG_MAX - 1) REFUSE(instance, "%s: the grid's %ld rows are used up", function, instance->row);
     if (target_covers(instance, function, step, end_time) != FMI_OK) return FMI_ERROR;
@@ -436,17 +473,15 @@ static FmiStatus do_step(FmiInstance* common, const char* function, double point
         }
         instance->step = step;
     }
-    double row[SHIP_MOTION_OUTPUTS];
+    double row[SHIP_REAL_OUTPUTS];
+    memcpy(row, instance->outputs, sizeof row);
     ship_motion_row(&instance->motion, instance->row + 1, row);
-    if (!finite_row(instance, row, function, end_time)) {
+    if (!finite_row(instance, row, SHIP_MOTION_OUTPUTS, function, end_time, kSeaState)) {
         instance->common.state = instance->common.face->error_state;
         return FMI_ERROR;
     }
-    instance->row += 1;
-    instance->common.time = end_time;
-    memcpy(instance->outputs, row, sizeof row);
-    target_row(instance);
-    return FMI_OK;
+    target_row(instance, (double)(instance->row + 1) * step, row);
+    return commit_row(instance, function, row, step, end_time);
 }
 
 /* ---------------------------------------------------------------- FMU states */

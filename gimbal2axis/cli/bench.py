@@ -24,7 +24,7 @@ import pathlib
 import sys
 import time
 
-from ..errors import SceneError
+from ..errors import SceneError, one_line
 from ..locations import fmu_path
 from .defaults import scene_file
 
@@ -124,7 +124,7 @@ def execute(args) -> int:
         with FMU(fmu_path(args.fmu)) as fmu:
             best = measure(scene, fmu, args.repeat)
     except SceneError as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        print(one_line(f"{PROG}: error: {exc}"), file=sys.stderr)
         return 2
     if best is None:
         print(f"{PROG}: a replay did not reproduce its run's outputs", file=sys.stderr)

@@ -17,7 +17,7 @@ import signal
 import sys
 from contextlib import contextmanager
 
-from ..errors import SceneError
+from ..errors import SceneError, Terminated, one_line
 
 EXIT_DONE, EXIT_FAILED_CHECK = 0, 1
 EXIT_ERROR, EXIT_FAILED_PARTIAL, EXIT_INTERRUPTED, EXIT_TERMINATED = 2, 3, 130, 143
@@ -38,21 +38,17 @@ def exit_status_help(statuses: dict) -> str:
         for status, meaning in sorted(statuses.items()))
 
 
-class Terminated(Exception):
-    """SIGTERM outside a run that could end at its next step (or a second one during it)."""
-
-
 def run_reporting_failures(prog: str, work) -> int:
     """work()'s exit status, or the status of its refusal (SceneError), of a file it could not write
     (OSError) or of Ctrl-C or SIGTERM, each said in one line."""
     try:
         return work()
     except SceneError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
+        print(one_line(f"{prog}: error: {exc}"), file=sys.stderr)
         return EXIT_ERROR
     except OSError as exc:   # writing the results (the directory was writable a moment ago)
         where = f"{exc.filename}: " if exc.filename else ""
-        print(f"{prog}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        print(one_line(f"{prog}: error: {where}{exc.strerror or exc}"), file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
@@ -68,13 +64,12 @@ SIGNAL_STOPS = {signal.SIGINT: ("interrupted", "interrupted by SIGINT (Ctrl-C)")
 
 @contextmanager
 def signals_end_the_run(stop):
-    """While inside: SIGINT and SIGTERM ask `stop` (a master.StopRequest) to end the run at its next
-    step, so that what it recorded is written; a second signal ends at once (KeyboardInterrupt or
-    Terminated: nothing written). The handlers before are restored on leaving."""
+    """While inside: SIGINT and SIGTERM go to `stop` (a master.StopRequest), which ends the run at its
+    next step while it steps, so that what it recorded is written, and raises errors.Interrupted or
+    Terminated in any other phase or on a repeated signal; the record is kept either way. The handlers
+    before are restored on leaving."""
     def handle(signum, frame):
-        if stop.kind is not None:
-            raise KeyboardInterrupt if signum == signal.SIGINT else Terminated()
-        stop.request(*SIGNAL_STOPS[signum])
+        stop.signal_received(*SIGNAL_STOPS[signum])
 
     previous = {signum: signal.signal(signum, handle) for signum in SIGNAL_STOPS}
     try:

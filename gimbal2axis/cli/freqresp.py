@@ -45,7 +45,7 @@ import sys
 import time
 import warnings
 
-from ..errors import SceneError
+from ..errors import SceneError, excerpt, shown
 from ..locations import fmu_path
 from .defaults import scene_file
 from .failures import run_reporting_failures
@@ -73,9 +73,9 @@ def with_overrides(scene, assignments: list[str], fmu_file):
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep:
-            raise SceneError(f"--set {item!r}: expected NAME=VALUE")
+            raise SceneError(f"--set {shown(item)}: expected NAME=VALUE")
         if name not in variables:
-            raise SceneError(f"--set: '{name}' is not a variable of {fmu_file}{did_you_mean(name, variables)}")
+            raise SceneError(f"--set: '{excerpt(name)}' is not a variable of {fmu_file}{did_you_mean(name, variables)}")
         if variables[name].causality not in SETTABLE_CAUSALITIES:
             raise SceneError(f"--set: '{name}' is {variables[name].causality!r}, not a parameter or fidelity "
                              f"switch (freqresp drives the inputs itself){did_you_mean(name, parameters_of_fmu)}")
@@ -83,7 +83,7 @@ def with_overrides(scene, assignments: list[str], fmu_file):
         try:
             value = True if low == "true" else False if low == "false" else float(text)
         except ValueError:
-            raise SceneError(f"--set {item!r}: {text!r} is not a number, true or false") from None
+            raise SceneError(f"--set {shown(item)}: {shown(text)} is not a number, true or false") from None
         if isinstance(value, float) and value.is_integer() and name in FIDELITY:
             value = int(value)
         (fidelity if name in FIDELITY else parameters)[name] = value
@@ -339,7 +339,7 @@ def measure_and_write(args) -> int:
     if args.mode == "open-loop":
         axis = args.axis or "1"
         if axis not in fr.MOTOR_AXES:
-            raise SceneError(f"--axis {axis!r}: open-loop drives motor 1 or 2")
+            raise SceneError(f"--axis {shown(axis)}: open-loop drives motor 1 or 2")
         excitations = [fr.Excitation("voltage", axis, a, args.offset, drive) for a in amplitudes]
         scene = scene.with_changes(base_motion_spec={"type": "fixed"},
                                    fidelity={**scene.fidelity, "base.fixed": True},
@@ -348,13 +348,13 @@ def measure_and_write(args) -> int:
     elif args.mode == "loop-gain":
         axis = args.axis or "1"
         if axis not in fr.MOTOR_AXES:
-            raise SceneError(f"--axis {axis!r}: loop-gain injects at motor 1 or 2")
+            raise SceneError(f"--axis {shown(axis)}: loop-gain injects at motor 1 or 2")
         excitations = [fr.Excitation("injection", axis, a, drive=drive) for a in amplitudes]
         outputs = None
     else:
         axis = args.axis or "roll"
         if axis not in fr.BASE_AXES:
-            raise SceneError(f"--axis {axis!r}: isolation moves the carrier in roll, pitch or yaw")
+            raise SceneError(f"--axis {shown(axis)}: isolation moves the carrier in roll, pitch or yaw")
         excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
         outputs = None
     excitation = excitations[0]
@@ -383,7 +383,11 @@ def measure_and_write(args) -> int:
     client = cluster = None
     if not args.serial:
         from ..sweep import make_client
-        client, cluster = make_client(args.scheduler, workers=args.workers)
+        from ..sweep.spec import SweepError
+        try:
+            client, cluster = make_client(args.scheduler, workers=args.workers)
+        except SweepError as exc:   # --scheduler, --workers refused: one line, as the scene's refusals
+            raise SceneError(str(exc)) from None
     rows = []
     wall = time.perf_counter()
     try:
@@ -403,13 +407,13 @@ def measure_and_write(args) -> int:
     name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
     csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
     fr.write_csv(rows, csv_path)
-    shown = ", ".join(f"{a:g}" for a in amplitudes)
+    amplitudes_text = ", ".join(f"{a:g}" for a in amplitudes)
     if excitation.kind == "injection":
         title = (f"{scene.name}: loop gain L = -U/A at {fr.command_signal(axis, excitation.drive)} (other axis closed) and sensitivity A/D, "
-                 f"injection {shown} V")
+                 f"injection {amplitudes_text} V")
     else:
         title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
-                 f"{shown} {unit_of(args.mode, excitation.drive)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
+                 f"{amplitudes_text} {unit_of(args.mode, excitation.drive)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
     plotted_rows, plotted_lines = rows, lines
     if excitation.kind == "injection":   # the LOS rate per D (-90 dB) would squeeze L and S: it is in the CSV
         shown_outputs = (fr.LOOP_GAIN, fr.SENSITIVITY)

@@ -29,7 +29,7 @@ import sys
 import warnings
 
 from ..analysis.names import did_you_mean
-from ..errors import SceneError
+from ..errors import SceneError, excerpt, shown
 from ..locations import fmu_path
 from .failures import run_reporting_failures
 
@@ -44,12 +44,12 @@ def parse_assignments(assignments: list[str]) -> dict:
     for item in assignments:
         name, sep, text = item.partition("=")
         if not sep:
-            raise SceneError(f"--set {item!r}: expected NAME=VALUE")
+            raise SceneError(f"--set {shown(item)}: expected NAME=VALUE")
         low = text.strip().lower()
         try:
             values[name.strip()] = True if low == "true" else False if low == "false" else float(text)
         except ValueError:
-            raise SceneError(f"--set {item!r}: {text!r} is not a number, true or false") from None
+            raise SceneError(f"--set {shown(item)}: {shown(text)} is not a number, true or false") from None
     return angles_in_radians(values)
 
 
@@ -77,6 +77,7 @@ def scene_point(scene_path: str, fmu_file, at_time: float | None, overrides: dic
     from ..fmu import FMU
     from ..master import Plan, run
     from ..scene import start_values
+    from ..limits import steps_of
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
@@ -97,7 +98,7 @@ def scene_point(scene_path: str, fmu_file, at_time: float | None, overrides: dic
         if bad:
             raise SceneError(f"--at-time: only inputs can be changed at a running simulation's point, not {bad} "
                              f"(change parameters in the scene)")
-        steps = at_time / scene.step_size
+        steps = steps_of("--at-time", at_time, scene.step_size)
         if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
             raise SceneError(f"--at-time {at_time:g}: not a whole number of the scene's steps ({scene.step_size:g} s)")
         scene = scene.with_changes(stop_time=at_time)
@@ -128,7 +129,7 @@ def inputs_at_end(scene, signals: dict) -> dict:
 def parse_pair(pair: str) -> tuple[str, str]:
     source, sep, target = pair.partition(":")
     if not sep or not source or not target:
-        raise SceneError(f"--bode {pair!r}: expected INPUT:OUTPUT, e.g. u_R1:alpha_dot")
+        raise SceneError(f"--bode {shown(pair)}: expected INPUT:OUTPUT, e.g. u_R1:alpha_dot")
     return source, target
 
 
@@ -192,7 +193,7 @@ def check_names(overrides: dict, known) -> None:
     """Refuses a --set name the gimbal model does not have, naming the option and the close matches."""
     for name in overrides:
         if name not in known:
-            raise SceneError(f"--set: '{name}' is not a variable of the gimbal model"
+            raise SceneError(f"--set: '{excerpt(name)}' is not a variable of the gimbal model"
                              f"{did_you_mean(name, known)}")
 
 

@@ -15,7 +15,7 @@ import sys
 import tempfile
 import warnings
 
-from ..errors import SceneError, SceneWarning
+from ..errors import SceneError, SceneWarning, StopSignal, one_line
 from ..locations import fmu_path
 from .defaults import scene_file
 from .failures import (EXIT_DONE, EXIT_ERROR, EXIT_FAILED_CHECK, EXIT_FAILED_PARTIAL, EXIT_FOR_STOP, EXIT_INTERRUPTED,
@@ -104,8 +104,20 @@ def execute(args) -> int:
 
 def _run(args) -> int:
     # here, not at the top: `gimbal2axis --help` and the other subcommands do without numpy and fmpy
+    from ..master.master import StopRequest
+
+    stop = StopRequest()
+    with signals_end_the_run(stop):   # from the start: no phase of the run may ignore Ctrl-C
+        try:
+            return _run_scene(args, stop)
+        except StopSignal:
+            stop.stepping = False
+            return _stopped_outside_steps(args, stop)
+
+
+def _run_scene(args, stop) -> int:
     from ..master import run_scene_file
-    from ..master.master import STOP_KINDS, StopRequest
+    from ..master.master import STOP_KINDS
     from ..scene import load_scene
 
     scene_path = scene_file(args.scene, DEFAULT_SCENE, "the scene file: gimbal2axis run SCENE.toml")
@@ -115,12 +127,11 @@ def _run(args) -> int:
     fmu = fmu_path(args.fmu)
     out = pathlib.Path(args.out)
     check_output_directory(out, scene.name)
-    stop = StopRequest()
+    args.scene_name = scene.name
     try:
-        with signals_end_the_run(stop):
-            result, csv_path, png_path = run_scene_file(scene_path, fmu, out, progress=not args.quiet,
-                                                        stop_time=args.stop_time, keep_partial=True, stop=stop,
-                                                        stream=True)
+        result, csv_path, png_path = run_scene_file(scene_path, fmu, out, progress=not args.quiet,
+                                                    stop_time=args.stop_time, keep_partial=True, stop=stop,
+                                                    stream=True)
     except SceneError as exc:
         if stop.kind is None and args.traceback and getattr(exc, "details", None):   # a user controller's
             print(f"{PROG}: error: {exc}\n{exc.details}", end="", file=sys.stderr)
@@ -128,24 +139,42 @@ def _run(args) -> int:
         if stop.kind is None:
             raise
         # stopped before the first communication point (nothing recorded, nothing written)
-        print(f"{PROG}: {STOP_KINDS[stop.kind]} before the run started: {exc}", file=sys.stderr)
+        print(one_line(f"{PROG}: {STOP_KINDS[stop.kind]} before the run started: {exc}"), file=sys.stderr)
         return EXIT_FOR_STOP[stop.kind]
+    status_path = csv_path.with_name(scene.name + "_run.json")
     if not args.quiet:
         print(result.summary())
-        print(f"wrote {csv_path}, {csv_path.with_suffix('.parquet')} and {png_path}")
+        print(f"wrote {', '.join(str(path) for path in result.files_written)}")
     if result.stopped is not None:
         stopped = result.stopped
         kept = (f"the results for [0, {stopped.time:g}] s are in {csv_path} and .parquet, marked partial in "
-                f"{csv_path.with_name(scene.name + '_run.json')}")
+                f"{status_path}")
         if stopped.kind == "failed":   # the reason says where and why
-            print(f"{PROG}: error: {stopped.reason}; {kept}", file=sys.stderr)
+            print(one_line(f"{PROG}: error: {stopped.reason}; {kept}"), file=sys.stderr)
             if args.traceback and stopped.details:   # a user controller's exception
                 print(stopped.details, end="", file=sys.stderr)
         else:
-            print(f"{PROG}: {stop.reason} at t = {stopped.time:g} s; {kept}", file=sys.stderr)
+            print(one_line(f"{PROG}: {stop.reason} at t = {stopped.time:g} s; {kept}"), file=sys.stderr)
         return EXIT_FOR_STOP[stopped.kind]
+    if result.not_written:
+        missing = "; ".join(f"{name}: {why}" for name, why in result.not_written.items())
+        print(f"{PROG}: error: the run is complete and its record written, but not {missing} (said in "
+              f"{status_path})", file=sys.stderr)
+        return EXIT_FAILED_PARTIAL
     failures = result.requirement_failures() if args.check else []
     if failures:   # also when --quiet: the reason for exit status 1
-        print(f"{PROG}: requirements not met: {'; '.join(failures)}", file=sys.stderr)
+        print(one_line(f"{PROG}: requirements not met: {'; '.join(failures)}"), file=sys.stderr)
         return EXIT_FAILED_CHECK
     return EXIT_DONE
+
+
+def _stopped_outside_steps(args, stop) -> int:
+    """A signal raised where the run could not end at a step (loading, a repeated signal, the record's
+    merge, the plots): the record as far as it was written is kept, and _run.json says how far."""
+    from ..master.master import STOP_KINDS
+
+    status_path = getattr(stop, "record_status_path", None)   # set once this run's record took the name over
+    where = f"; the record is kept as far as it goes, as {status_path} says" if status_path else \
+        "; nothing was written (an earlier run's files are as they were)"
+    print(f"{PROG}: {stop.reason or STOP_KINDS.get(stop.kind, 'interrupted')}{where}", file=sys.stderr)
+    return EXIT_FOR_STOP.get(stop.kind, EXIT_INTERRUPTED)

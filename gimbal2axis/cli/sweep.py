@@ -12,7 +12,7 @@ Several sweeps may write one table at the same time: each merges its rows in und
 import signal
 import sys
 
-from ..errors import SceneError
+from ..errors import SceneError, one_line
 from ..locations import fmu_path
 
 SUMMARY = "run a parameter sweep or Monte Carlo study of a scene on Dask"
@@ -40,10 +40,12 @@ example:
 """
 
 
-def _terminated(signum, frame):
-    from ..sweep.runner import Stopped
+def _stopped(signum, frame):
+    """Ctrl-C and SIGTERM as StopSignals (runner.stop_signal): the wrappers of a user controller's
+    code let them pass, where they fail the case for a KeyboardInterrupt the code raised itself."""
+    from ..sweep.runner import stop_signal
 
-    raise Stopped("terminated (SIGTERM)")
+    raise stop_signal(signum)
 
 
 def add_arguments(parser) -> None:
@@ -81,14 +83,15 @@ def execute(args) -> int:
     from ..sweep import SweepError, SweepOptions, run_sweep
     from ..sweep.runner import Stopped
 
-    signal.signal(signal.SIGTERM, _terminated)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _stopped)
     try:
         options = SweepOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
                                serial=args.serial, redo=args.redo, progress=not args.quiet,
                                checkpoint_s=args.save_every)
         outcome = run_sweep(args.scene, args.sweep, fmu_path(args.fmu), args.out, options)
     except (SceneError, SweepError) as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        print(one_line(f"{PROG}: error: {exc}"), file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
         if not getattr(exc, "reported", False):

@@ -19,7 +19,7 @@ uninterrupted one would.
 import signal
 import sys
 
-from ..errors import SceneError
+from ..errors import SceneError, one_line
 from ..locations import fmu_path
 
 SUMMARY = "tune controller gains (or any parameters) with an optimizer over the sweep engine"
@@ -43,10 +43,12 @@ example:
 """
 
 
-def _terminated(signum, frame):
-    from ..sweep.runner import Stopped
+def _stopped(signum, frame):
+    """Ctrl-C and SIGTERM as StopSignals (runner.stop_signal): the wrappers of a user controller's
+    code let them pass, where they fail the case for a KeyboardInterrupt the code raised itself."""
+    from ..sweep.runner import stop_signal
 
-    raise Stopped("terminated (SIGTERM)")
+    raise stop_signal(signum)
 
 
 def add_arguments(parser) -> None:
@@ -80,13 +82,17 @@ def execute(args) -> int:
         args.command_parser.error("--workers must be >= 1")
     if args.trials is not None and args.trials < 1:
         args.command_parser.error("--trials must be >= 1")
+    from ..limits import MAX_TUNE_TRIALS
+    if args.trials is not None and args.trials > MAX_TUNE_TRIALS:
+        args.command_parser.error(f"--trials {args.trials} is over the limit of {MAX_TUNE_TRIALS:,} candidates")
     if not args.save_every >= 0:
         args.command_parser.error("--save-every must be >= 0 seconds")
     from ..sweep import SweepError
     from ..sweep.runner import Stopped
     from ..tune.engine import TuneOptions, describe_candidate, plan, run_tuning
 
-    signal.signal(signal.SIGTERM, _terminated)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _stopped)
     options = TuneOptions(scheduler=args.scheduler, workers=args.workers, processes=not args.threads,
                           serial=args.serial, progress=not args.quiet, checkpoint_s=args.save_every,
                           trials=args.trials)
@@ -116,7 +122,7 @@ def execute(args) -> int:
         finally:
             evaluator.close(interrupted)
     except (SceneError, SweepError) as exc:
-        print(f"{PROG}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        print(one_line(f"{PROG}: error: {' '.join(str(exc).split())}"), file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
         print(f"\ntune: {str(exc) or 'interrupted'}; the evaluations finished so far are kept in "

@@ -8,11 +8,12 @@ import math
 import pathlib
 import shutil
 import tempfile
+import zipfile
 from typing import Callable, Iterable, NamedTuple
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import SceneError, excerpt
 
 # The structural switches a scene's [fidelity] table takes: the scene format's vocabulary, checked when
 # a scene file is loaded (before any FMU is opened); check_against_fmu then checks each against the
@@ -93,19 +94,30 @@ class FMU:
     """
 
     def __init__(self, path: pathlib.Path | str, workdir: pathlib.Path | str | None = None):
+        import xml.etree.ElementTree as ElementTree
+
         from fmpy import extract, read_model_description
 
         self.path = pathlib.Path(path)
         if not self.path.is_file():
             raise SceneError(f"{self.path}: no such FMU (build it: cmake --build build, or bash scripts/setup.sh)")
-        self.model_description = read_model_description(str(self.path))
-        self.variables = {v.name: v for v in self.model_description.modelVariables}
-        self.states = state_names(self.model_description)
-        self.mode_outputs = mode_outputs(self.path)
+        try:
+            self.model_description = read_model_description(str(self.path))
+            self.variables = {v.name: v for v in self.model_description.modelVariables}
+            self.states = state_names(self.model_description)
+            self.mode_outputs = mode_outputs(self.path)
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile, ElementTree.ParseError) as exc:
+            # a truncated download, a file being rebuilt, something else named .fmu
+            raise SceneError(f"{self.path}: not a readable FMU ({type(exc).__name__}: {excerpt(exc)})") from None
         # what an instance loads (binaries/, resources/, the model description), not the FMU's sources
         # and documentation: 300 files whose writing was a fifth of a 60-s run's time
-        self.unzipdir = extract(str(self.path), unzipdir=tempfile.mkdtemp(prefix="gimbal_fmu_", dir=workdir),
-                                include=lambda name: not name.startswith(("sources/", "documentation/")))
+        unzipdir = tempfile.mkdtemp(prefix="gimbal_fmu_", dir=workdir)
+        try:
+            self.unzipdir = extract(str(self.path), unzipdir=unzipdir,
+                                    include=lambda name: not name.startswith(("sources/", "documentation/")))
+        except (OSError, zipfile.BadZipFile) as exc:
+            shutil.rmtree(unzipdir, ignore_errors=True)
+            raise SceneError(f"{self.path}: cannot extract the FMU ({type(exc).__name__}: {excerpt(exc)})") from None
 
     def close(self) -> None:
         shutil.rmtree(self.unzipdir, ignore_errors=True)

@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 from ..scene import controllers
-from ..errors import SceneError
+from ..errors import SceneError, StopSignal
 from .master import (FMUCallFailed, Plan, RawCalls, clamp_count, failure_error, failure_message, initialize,
                      recorded_signals)
 from .results import RunResult
@@ -216,7 +216,9 @@ def _run(cases: list) -> None:
         user, label, path, context = _make_user(cases)
         try:
             user.reset(context)
-        except Exception as exc:
+        except StopSignal:
+            raise
+        except BaseException as exc:   # sys.exit, a KeyboardInterrupt of its own: the code's failure
             raise controllers.user_exception(label, "reset()", exc, path, 0.0) from None
     except Exception as exc:   # a SceneError as it is; others as master.run reports them, at t = 0
         return _fail_all(alive, exc)
@@ -267,7 +269,9 @@ def _run(cases: list) -> None:
         try:
             try:
                 returned = user.step(t, m)
-            except Exception as exc:
+            except StopSignal:
+                raise
+            except BaseException as exc:
                 raise controllers.user_exception(label, "step()", exc, path, t) from None
             voltages = controllers.batch_voltages(label, t, returned, count).tolist()
             references = controllers.batch_reference(label, user, count).tolist()

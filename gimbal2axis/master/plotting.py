@@ -13,6 +13,8 @@ import textwrap
 import numpy as np
 
 from . import spectra
+from ..errors import excerpt
+from ..limits import TITLE_DESCRIPTION_CHARS
 from ..scene.drives import command_columns
 
 DEG = 180.0 / math.pi
@@ -20,6 +22,20 @@ DEG = 180.0 / math.pi
 # (1e-9 mrad) it is zero (a run that starts on target), and a log axis down to there would squash
 # every real error into the top of the panel.
 ROUND_OFF_MRAD = 1e-9
+
+
+def drawn(text: str, limit: int | None = None) -> str:
+    """User text (a title, a description, a panel's name) as a figure draws it: cut to `limit` characters
+    (the wrapping and the layout of a long text take minutes), and literal: matplotlib reads text between
+    two '$' as mathtext, whose parser refuses most text (an unknown \\name raises when the figure is saved)."""
+    return (excerpt(text, limit) if limit else text).replace("$", r"\$")
+
+
+def run_title(scene) -> str:
+    """The scene's title and the first line of its description, cut."""
+    lines = scene.description.strip().splitlines()
+    description = excerpt(lines[0], TITLE_DESCRIPTION_CHARS) if lines else ""
+    return f"{scene.title}: {description}" if description else scene.title
 
 
 def signal_unit(name: str) -> tuple[float, str]:
@@ -130,20 +146,20 @@ def figure(result, limits: dict | None = None):
             if name in limits:
                 for sign in (1, -1):
                     ax.axhline(sign * limits[name] * scale, color="gray", lw=0.7, ls="--")
-        ax.set_ylabel(f"{panel}\n[{', '.join(sorted(u for u in units if u)) or '-'}]", fontsize="small")
+        ax.set_ylabel(f"{drawn(panel, 40)}\n[{', '.join(sorted(u for u in units if u)) or '-'}]", fontsize="small")
         ax.grid(True, alpha=0.3, which="both")
         # outside the axes: a legend box inside would cover samples
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0, fontsize="x-small")
     axes[-1, 0].set_xlabel("time [s]")
     if t[-1] > t[0]:   # a record of one point keeps matplotlib's margins around it
         axes[-1, 0].set_xlim(t[0], t[-1])
-    title = f"{scene.title}: {scene.description}" if scene.description else scene.title
+    title = run_title(scene)
     if scene.title != scene.name:
         title = f"{title} ({scene.path.name})"
     stopped = getattr(result, "stopped", None)
     if stopped is not None:
         title = f"PARTIAL: {stopped.kind} at t = {stopped.time:g} s of {result.requested_stop_time:g} s. {title}"
-    fig.suptitle("\n".join(textwrap.wrap(title, 130)), fontsize="medium")
+    fig.suptitle("\n".join(textwrap.wrap(drawn(title), 130)), fontsize="medium")
     fig.tight_layout()
     return fig
 
@@ -226,7 +242,7 @@ def spectrum_figure(result):
         if ax.get_legend_handles_labels()[0]:
             ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0, fontsize="x-small")
     axes[-1].set_xlabel("frequency [Hz]")
-    fig.suptitle(f"{result.scene.title}: line-of-sight error in the frequency domain", fontsize="medium")
+    fig.suptitle(f"{drawn(result.scene.title)}: line-of-sight error in the frequency domain", fontsize="medium")
     fig.tight_layout()
     return fig
 
@@ -307,7 +323,7 @@ def tracking_figure(scene, columns: dict, title_prefix: str = ""):
             ax.set_xlim(t[0], t[-1])
     kinds = {"earth_point": "a point on the Earth", "flyby": "an aircraft's flyby", "track": "a recorded track"}
     title = f"{title_prefix}{scene.title}: tracking {kinds[spec['type']]}"
-    fig.suptitle("\n".join(textwrap.wrap(title, 130)), fontsize="medium")
+    fig.suptitle("\n".join(textwrap.wrap(drawn(title), 130)), fontsize="medium")
     fig.tight_layout()
     return fig
 
@@ -320,11 +336,9 @@ def plot_tracking(result, path: pathlib.Path, parquet_path: pathlib.Path | None 
     if scene.moving_target is None:
         return False
     if parquet_path is not None:
-        import pyarrow.parquet as pq
+        from .record_files import record_columns
 
-        available = set(pq.ParquetFile(parquet_path).schema_arrow.names)
-        table = pq.read_table(parquet_path, columns=[n for n in TRACKING_PLOT_SIGNALS if n in available])
-        columns = {name: table.column(name).to_numpy() for name in table.column_names}
+        columns = record_columns(parquet_path, TRACKING_PLOT_SIGNALS)
     else:
         columns = {name: np.asarray(result.signal(name), dtype=float) for name in TRACKING_PLOT_SIGNALS
                    if name in result.signals or name in result.derived}

@@ -24,7 +24,6 @@ metadata "gimbal2axis.status").
 """
 from __future__ import annotations
 
-import json
 import math
 import pathlib
 import shutil
@@ -32,16 +31,17 @@ import time
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import SceneError, StopSignal
 from ..fmu import FMU
 from ..progress import Progress
 from ..scene.base_motion import INPUTS as BASE_INPUTS
 from ..scene.scene import TRACKING_SIGNALS, Scene, check_against_fmu, check_run_length
-from . import compiled_loop, spectra, units
+from . import compiled_loop, spectra
 from ..scene.drives import command_signals, scene_drives
 from ..scene.controllers import ControllerError
 from .master import (ClampCount, FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records,
                      failure_error, failure_message, initialize, moving_target_accelerations)
+from .record_files import RunRecord, record_tables
 from .results import AXIS_ERRORS, CARRIER_RATES, ISOLATION_AXES, RunResult
 
 # Communication points per chunk: 2^14 rows of ~60 doubles are 7.9 MB of record, some 50 MB with
@@ -241,51 +241,6 @@ class Metrics:
         return self.sums[name][part] / self.count[part]
 
 
-class RecordFiles:
-    """<name>.parquet (every row, one row group per chunk) and <name>.csv (rows at the output
-    interval and the last row, as RunResult.write_csv), written as the chunks come."""
-
-    def __init__(self, out: pathlib.Path, name: str, every: int):
-        self.parquet_path, self.csv_path = out / f"{name}.parquet", out / f"{name}.csv"
-        self.every, self.writer, self.csv, self.names = every, None, None, None
-        self.last_row, self.last_written = None, None
-
-    def append(self, first: int, columns: dict) -> None:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        if self.writer is None:
-            self.names = list(columns)
-            table = pa.table({name: columns[name] for name in self.names})
-            # no dictionary encoding: it took 60 % of the write's time and finds nothing to share in
-            # measured signals; snappy still saves a fifth to a quarter of the size
-            self.writer = pq.ParquetWriter(self.parquet_path, units.with_units(table.schema), use_dictionary=False)
-            self.csv = open(self.csv_path, "w")
-            self.csv.write(units.csv_header(self.names) + "\n")
-        else:
-            table = pa.table({name: columns[name] for name in self.names})
-        self.writer.write_table(table, row_group_size=len(table))
-        count = len(columns["time"])
-        rows = np.flatnonzero(np.arange(first, first + count) % self.every == 0)
-        # the CSV's rows and the chunk's last (the run's last row when it is the last chunk)
-        picked = rows if rows.size and rows[-1] == count - 1 else np.r_[rows, count - 1]
-        data = np.column_stack([np.asarray(columns[name], dtype=float)[picked] for name in self.names])
-        if rows.size:
-            np.savetxt(self.csv, data[:rows.size], delimiter=",", fmt="%.12g")
-            self.last_written = first + rows[-1]
-        self.last_row, self.last_step = data[-1:].copy(), first + count - 1
-
-    def close(self, status: dict) -> None:
-        """The CSV's last row (when the output interval skipped it) and the Parquet file's metadata."""
-        if self.writer is None:
-            return
-        if self.last_written != self.last_step:
-            np.savetxt(self.csv, self.last_row, delimiter=",", fmt="%.12g")
-        self.csv.close()
-        self.writer.add_key_value_metadata({"gimbal2axis.status": json.dumps(status)})
-        self.writer.close()
-
-
 class StreamedResult(RunResult):
     """A RunResult whose record is on disk: `signals` holds the plots' signals decimated to the
     minimum and maximum per pixel column (exact when the run has fewer points than that), the
@@ -455,8 +410,6 @@ def spectra_from_file(parquet_path: pathlib.Path, scene: Scene, metrics: Metrics
     """The Welch accumulators of the line-of-sight error's spectra and of the isolation estimate over
     the metrics window, fed from the file a row group (a chunk) at a time, its spectral columns only;
     None where there is nothing to estimate."""
-    import pyarrow.parquet as pq
-
     window_start = metrics.window_start if metrics.part() == "window" else -math.inf
     samples = metrics.count[metrics.part()]
     psd_names = list(AXIS_ERRORS) if has_target else []
@@ -471,10 +424,8 @@ def spectra_from_file(parquet_path: pathlib.Path, scene: Scene, metrics: Metrics
     isolation = spectra.WelchAccumulator(fs, scene.analysis.isolation_resolution_hz, samples,
                                          {name: metrics.mean(name) for name in isolation_names}, pairs) \
         if isolation_names else None
-    file = pq.ParquetFile(parquet_path)
     wanted = ["time"] + psd_names + isolation_names
-    for group in range(file.num_row_groups):
-        batch = file.read_row_group(group, columns=wanted, use_threads=False)
+    for batch in record_tables(parquet_path, wanted):
         columns = {name: batch.column(name).to_numpy() for name in wanted}
         del batch
         window = columns["time"] >= window_start - 1e-12
@@ -500,18 +451,29 @@ def release_freed_memory() -> None:
             libc.malloc_trim(0)
 
 
+def record_for(scene: Scene, out: pathlib.Path, stop_time: float | None, stop: StopRequest | None) -> RunRecord:
+    """The RunRecord a streamed run of `scene` writes into `out`."""
+    t_end = scene.stop_time if stop_time is None else stop_time
+    every = max(1, int(round(scene.output_interval / scene.step_size)))
+    return RunRecord(out, scene.name, every, {"scene": scene.name, "stop_time_s": t_end,
+                                               "step_size_s": scene.step_size}, stop)
+
+
 def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = False, stop_time: float | None = None,
                  controller=None, compiled: bool | None = None, stop: StopRequest | None = None,
-                 chunk_rows: int = CHUNK_ROWS) -> StreamedResult:
-    """Runs `scene` chunk by chunk, writing <out>/<name>.parquet and <name>.csv as it goes; returns a
-    StreamedResult (for the summary, plots and spectra). A failure in the loop or a `stop` request
-    ends the files at the last whole point and the result says so (stopped); a failure before the
-    first point (or at initialization) raises SceneError, as does a run the disk cannot hold."""
+                 chunk_rows: int = CHUNK_ROWS, record: RunRecord | None = None) -> StreamedResult:
+    """Runs `scene` chunk by chunk, writing <out>/<name>.parquet and <name>.csv as it goes (a RunRecord:
+    record_files.py); returns a StreamedResult (for the summary, plots and spectra). A failure in the
+    loop (the FMU's, the controller's, a full disk's) or a `stop` request ends the files at the last
+    whole chunk or point and the result says so (stopped); a failure before the first point (or at
+    initialization) raises SceneError and leaves an earlier run's files as they were, as does a run
+    the disk cannot hold. The result's wall_time is the run's whole: preparing, stepping, writing."""
+    wall0 = time.perf_counter()
     stop = stop or StopRequest()
     plan = StreamPlan(scene, fmu, stop_time, controller, chunk_rows)
     check_fits(plan, scene, out)
     loop_kind = choose_loop(plan.controller, compiled)
-    files = RecordFiles(out, scene.name, max(1, int(round(scene.output_interval / plan.h))))
+    record = record or record_for(scene, out, stop_time, stop)
     has_target = scene.target_spec is not None
     spectral = (list(AXIS_ERRORS) if has_target else []) + \
         ([] if plan.motion.fixed else [CARRIER_RATES[i - 1] for i in ISOLATION_AXES] +
@@ -525,82 +487,87 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     log: list = []
     slave = fmu.instantiate(scene.name, log)
     bar = Progress(plan.t_end, enabled=progress)
-    stopped, decimator = None, None
+    stopped, decimator, loop = None, None, None
     clamp = ClampCount(plan.drives)
+    stop.stepping = True   # from here to the record's end, a first signal asks the run to end at its next step
     try:
         plan.load_chunk(0, plan.chunk_rows)
-        wall0 = time.perf_counter()
         try:
             initialize(slave, scene, fmu, plan)
             plan.controller.start(plan.h, scene.name)
         except ControllerError as exc:   # the user's reset() raised
             raise failure_error(failure_message(scene, plan, exc, log), exc) from None
-        except SceneError:
+        except (SceneError, StopSignal):
             raise
         except Exception as exc:
             raise SceneError(failure_message(scene, plan, exc, log)) from None
-        # The summary's wall time: initialization and the loops, as master.run's (the chunks'
-        # preparation and writing are the streaming's own cost, in the command's wall time).
-        loop_wall = time.perf_counter() - wall0
         calls = RawCalls(slave)
         loop = compiled_loop.CompiledLoop(slave, calls, plan, chunked=True) if loop_kind == "compiled" else None
         for first in range(0, plan.n + 1, plan.chunk_rows):
             count = min(plan.chunk_rows, plan.n + 1 - first)
-            if first > 0:
-                plan.load_chunk(first, count)
-            failure = None
-            loop_start = time.perf_counter()
-            try:
-                if loop is not None:
-                    compiled_chunk(loop, plan, first, first + count - 1, stop, bar)
-                else:
-                    python_chunk(slave, calls, plan, first, first + count - 1, stop, bar)
-            except Exception as exc:
-                failure = exc
-            loop_wall += time.perf_counter() - loop_start
+            failure = step_chunk(plan, loop, slave, calls, first, count, stop, bar)
             recorded = plan.rows - first
             if recorded > 0:
-                columns = _derived_columns(scene, plan.chunk_signals(recorded), not plan.motion.fixed)
-                files.append(first, columns)
-                metrics.add(columns)
-                clamp.add(plan.u_asked[:recorded], plan.u_cmd[plan.delay:plan.delay + recorded])
-                if decimator is None:
-                    decimator = Decimator(plot_names(scene, list(columns)), plan.t_end, plan.n + 1)
-                decimator.add(columns)
-                del columns
+                try:
+                    columns = _derived_columns(scene, plan.chunk_signals(recorded), not plan.motion.fixed)
+                    record.append(first, columns, plan.h)
+                except SceneError:   # another scene's files are where this one's would go (check_no_collision)
+                    raise
+                except StopSignal:   # a repeated signal before the chunk was written: the record ends before it
+                    plan.rows, recorded = first, 0
+                except Exception as exc:   # a full disk, say: the record ends at its last whole chunk
+                    plan.rows, recorded = first, 0
+                    failure = failure or RecordWriteFailed(exc, first * plan.h)
+                else:
+                    metrics.add(columns)
+                    clamp.add(plan.u_asked[:recorded], plan.u_cmd[plan.delay:plan.delay + recorded])
+                    if decimator is None:
+                        decimator = Decimator(plot_names(scene, list(columns)), plan.t_end, plan.n + 1)
+                    decimator.add(columns)
+                    del columns
             if failure is not None:
-                message = failure_message(scene, plan, failure, log)
+                message = record_failure_message(scene, plan, failure, log)
                 if plan.rows == 0:
+                    if record.taken_over:   # the first chunk could not be written: the earlier run's files are gone
+                        record.close_without_merge()
+                        record.write_status({"status": "failed", "partial": True, "recorded_until_s": None,
+                                             "reason": message, "files": []})
                     raise failure_error(message, failure)
                 stopped = Stop("failed", (plan.rows - 1) * plan.h, message, getattr(failure, "details", None))
                 break
-            if recorded < count:
+            if recorded < count or stop.kind is not None:
                 if plan.rows == 0:
                     raise SceneError(f"{scene.name}: {stop.reason} before the first communication point: nothing "
                                      "recorded")
+                if stop.kind is None:   # cannot be: a chunk ends short only when asked to stop
+                    raise AssertionError("a chunk ended short without a stop request")
                 stopped = Stop(stop.kind, (plan.rows - 1) * plan.h, f"{scene.name}: {stop.reason}")
                 break
         bar.close(complete=stopped is None)
         if stopped is None:
             slave.terminate()
     except BaseException:
-        files.close({"status": "failed before the first point"})
-        for path in (files.parquet_path, files.csv_path):
-            path.unlink(missing_ok=True)
+        stop.stepping = False
         raise
     finally:
         slave.freeInstance()
-    wall = loop_wall
     end = plan.t_end if stopped is None else stopped.time
     status = {"status": "complete" if stopped is None else stopped.kind, "partial": stopped is not None,
               "stop_time_s": plan.t_end, "recorded_until_s": end, "reason": None if stopped is None else stopped.reason}
-    files.close(status)
+    stop.stepping, stop.phase = False, "finishing the record"   # a signal from here on raises at once
+    record.close(status)
+    record.write_status({**status, "files": [record.csv_path.name, record.parquet_path.name]})
+    wall = time.perf_counter() - wall0
     del plan, loop   # the chunk's tables
-    files.last_row = None
     release_freed_memory()
+    if record.pending_signal is not None:   # a signal while merging: the folder of chunks is the record
+        raise record.pending_signal
+    if stop.kind is not None and (stop.signals > 1 or stopped is None):   # a signal the loop did not see
+        stop.raise_stop()
+    stop.phase = "computing the spectra and drawing the plots"
 
     # The spectra, from the file (the plots' signals were decimated as the chunks came).
-    psd, isolation = spectra_from_file(files.parquet_path, scene, metrics, scene.step_size, has_target)
+    psd, isolation = spectra_from_file(record.parquet_path, scene, metrics, scene.step_size, has_target)
     release_freed_memory()
     found = {name: psd.spectrum(name) for name in AXIS_ERRORS} if psd is not None and psd.segments else {}
     estimates, carrier = {}, {}
@@ -611,7 +578,39 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     t_window = (metrics.first_in_window if metrics.part() == "window" else 0.0, end)
     result = StreamedResult(scene, decimator.signals(), wall, end, metrics, found, estimates, carrier, t_window)
     result.stopped, result.requested_stop_time = stopped, status["stop_time_s"]
-    result.loop, result.parquet_path, result.csv_path = loop_kind, files.parquet_path, files.csv_path
+    result.loop, result.parquet_path, result.csv_path = loop_kind, record.parquet_path, record.csv_path
     result.status = status
     result.voltage_clamp = clamp
     return result
+
+
+class RecordWriteFailed(Exception):
+    """Writing a chunk of the record failed (a full disk, a file system gone read-only)."""
+
+    def __init__(self, cause: Exception, time_s: float):
+        where = f"{cause.filename}: " if isinstance(cause, OSError) and cause.filename else ""
+        text = cause.strerror if isinstance(cause, OSError) and cause.strerror else f"{type(cause).__name__}: {cause}"
+        super().__init__(f"writing the record failed at t = {time_s:.6g} s: {where}{text}")
+
+
+def record_failure_message(scene: Scene, plan: StreamPlan, failure: Exception, log: list) -> str:
+    if isinstance(failure, RecordWriteFailed):
+        return f"{scene.name}: {failure}"
+    return failure_message(scene, plan, failure, log)
+
+
+def step_chunk(plan: StreamPlan, loop, slave, calls, first: int, count: int, stop: StopRequest, bar):
+    """Steps the chunk's rows first .. first + count - 1 (plan.rows: how many are recorded whole);
+    the exception that ended it early, None when it ran whole or was asked to stop (a signal: stop.kind)."""
+    try:
+        if first > 0:
+            plan.load_chunk(first, count)
+        if loop is not None:
+            compiled_chunk(loop, plan, first, first + count - 1, stop, bar)
+        else:
+            python_chunk(slave, calls, plan, first, first + count - 1, stop, bar)
+    except StopSignal:   # a repeated signal, raised inside the loop: the request is in stop.kind
+        pass
+    except BaseException as exc:   # the FMU's refusal, the controller's exception (any: sys.exit too), no memory
+        return exc
+    return None

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError, check_keys, positive, read_toml
+from ..errors import SceneError, check_keys, positive
+from ..limits import read_toml
 from ..master import run
 from ..scene import load_scene
 from ..scene.gyro import GyroModel

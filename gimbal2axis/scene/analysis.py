@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..errors import SceneError, check_keys, excerpt, number, positive, shown
+from ..limits import MAX_ANALYSIS_BANDS, MAX_STEPS, over_limit
 
 # 2-s segments: fine enough to separate the sea's band (below 1 Hz) from the loop's and the gears'
 # (several Hz up), coarse enough that a 10-s window averages 9 segments and a 60-s one 59.
@@ -45,12 +46,17 @@ def parse(table: dict, step_size: float) -> AnalysisSettings:
     isolation = positive("analysis.isolation_resolution_hz",
                          table.get("isolation_resolution_hz", DEFAULT_ISOLATION_RESOLUTION_HZ))
     for key, value in (("psd_resolution_hz", resolution), ("isolation_resolution_hz", isolation)):
+        # a Welch segment of 1 / resolution seconds: its samples are counted, allocated and transformed
+        if not 1.0 / value / step_size <= MAX_STEPS:
+            raise SceneError(f"analysis.{key} = {value:g} Hz asks for Welch segments of {1.0 / value:g} s, over the "
+                             f"limit of {MAX_STEPS:,} steps of {step_size:g} s")
         if value >= nyquist:
             raise SceneError(f"analysis.{key} = {value:g} Hz is not below the Nyquist frequency {nyquist:g} Hz "
                              f"(1 / (2 step_size)): the spectrum would have no bins")
     bands_table = table.get("bands", {})
     if not isinstance(bands_table, dict):
         raise SceneError("analysis.bands must be a table ([analysis.bands]) of name = [f_lo, f_hi] in Hz")
+    over_limit("analysis.bands: the number of bands", len(bands_table), MAX_ANALYSIS_BANDS)
     bands = {name: _band(name, value, nyquist) for name, value in bands_table.items()}
     return AnalysisSettings(resolution, isolation, bands, "psd_resolution_hz" in table)
 

@@ -17,8 +17,9 @@ import weakref
 import numpy as np
 
 from .. import native
+from ..limits import MAX_RECORDING_BYTES, MAX_SEA_STATE_COMPONENTS, TooLarge, over_limit, read_bounded
 from ..errors import (SceneError, check_keys as _check_keys, choice, integer, non_negative, number, positive as _positive,
-                      shown)
+                      shown, within)
 
 INPUTS = ["base.delta", "base.psi", "base.gamma",
           "base.delta_dot", "base.psi_dot", "base.gamma_dot",
@@ -32,6 +33,14 @@ TRANSLATION_AXES = {"sway": 0, "surge": 1, "heave": 2}   # x_G, y_G, z_G: the bo
 MOTION_KINDS = ("fixed", "sinusoids", "sea_state", "recorded")
 SEA_STATE_DEFAULTS = {"components": 100, "seed": 1}    # of a [base_motion] sea state that does not say
 DEFAULT_GAMMA = 3.3                                     # JONSWAP's mean peak enhancement
+# The range of each number of a sea state's or a sinusoid's table, both ends included: beyond them
+# the motion is no carrier's (a wave of 1e-300 s has no finite spectrum, a heave of 1e6 m no
+# finite acceleration), so a value outside is refused by its key.
+KEY_RANGES = {"significant_amplitude_deg": (0.0, 180.0), "significant_amplitude_m": (0.0, 1000.0),
+              "peak_period_s": (1e-3, 1e6), "gamma": (1.0, 100.0),
+              "amplitude_deg": (-360.0, 360.0), "amplitude_m": (-1000.0, 1000.0), "period_s": (1e-3, 1e6),
+              "frequency_hz": (1e-6, 1e3), "phase_deg": (-360.0, 360.0), "offset_deg": (-360.0, 360.0),
+              "velocity_m_s": (-1e4, 1e4)}
 
 
 class BaseMotion:
@@ -204,13 +213,13 @@ def seed_words(*integers: int) -> np.ndarray:
     """The entropy of numpy's default_rng([seed, index]) as the uint32 words numpy makes of it: each
     integer (>= 0) as its base-2**32 digits, least significant first (0 as one word 0), concatenated."""
     words = []
-    for integer in integers:
-        if integer < 0:
-            raise ValueError(f"a seed must be >= 0, not {integer}")
-        digits = [0] if integer == 0 else []
-        while integer > 0:
-            digits.append(integer & 0xFFFFFFFF)
-            integer >>= 32
+    for seed in integers:
+        if seed < 0:
+            raise ValueError(f"a seed must be >= 0, not {seed}")
+        digits = [0] if seed == 0 else []
+        while seed > 0:
+            digits.append(seed & 0xFFFFFFFF)
+            seed >>= 32
         words.extend(digits)
     return np.array(words, dtype=np.uint32)
 
@@ -254,9 +263,11 @@ class Recorded(BaseMotion):
     def __init__(self, path: pathlib.Path):
         self.path = path
         try:
-            self._text = path.read_bytes()
+            self._text = read_bounded(path, MAX_RECORDING_BYTES, "a recorded motion")
         except OSError as exc:
             raise SceneError(f"base_motion: recorded motion {path}: cannot read it: {exc.strerror}") from None
+        except TooLarge as exc:
+            raise SceneError(f"base_motion: recorded motion {exc}") from None
         self._open()
 
     def _open(self) -> None:
@@ -312,9 +323,15 @@ class Recorded(BaseMotion):
 _RECORDING_BAD_TABLE, _RECORDING_BAD_COLUMNS = 1, 2
 
 
+def _within(where: str, key: str, value) -> float:
+    """The finite number `value` of `where`.`key` within KEY_RANGES[key]."""
+    return within(f"{where}.{key}", value, *KEY_RANGES[key])
+
+
 def _sine_terms(axis: str, spec, angle: bool):
     """One table or a list of tables {amplitude_deg | amplitude_m, period_s | frequency_hz, phase_deg}."""
     specs = spec if isinstance(spec, list) else [spec]
+    over_limit(f"base_motion.{axis}: the number of sinusoids", len(specs), MAX_SEA_STATE_COMPONENTS)
     amplitude, omega, phase = [], [], []
     unit = "amplitude_deg" if angle else "amplitude_m"
     for item in specs:
@@ -326,13 +343,14 @@ def _sine_terms(axis: str, spec, angle: bool):
             raise SceneError(f"base_motion.{axis}: missing '{unit}'")
         if ("period_s" in item) == ("frequency_hz" in item):
             raise SceneError(f"base_motion.{axis}: give exactly one of 'period_s' and 'frequency_hz'")
-        f = 1.0 / _positive(f"base_motion.{axis}.period_s", item["period_s"]) if "period_s" in item else \
-            _positive(f"base_motion.{axis}.frequency_hz", item["frequency_hz"])
-        a = number(f"base_motion.{axis}.{unit}", item[unit])
+        where = f"base_motion.{axis}"
+        f = 1.0 / _within(where, "period_s", item["period_s"]) if "period_s" in item else \
+            _within(where, "frequency_hz", item["frequency_hz"])
+        a = _within(where, unit, item[unit])
         amplitude.append(math.radians(a) if angle else a)
         omega.append(2.0 * math.pi * f)
-        phase.append(math.radians(number(f"base_motion.{axis}.phase_deg", item.get("phase_deg", 0.0))))
-    offset = sum(math.radians(number(f"base_motion.{axis}.offset_deg", item.get("offset_deg", 0.0)))
+        phase.append(math.radians(_within(where, "phase_deg", item.get("phase_deg", 0.0))))
+    offset = sum(math.radians(_within(f"base_motion.{axis}", "offset_deg", item.get("offset_deg", 0.0)))
                  for item in specs) if angle else 0.0
     return (np.array(amplitude), np.array(omega), np.array(phase)), offset
 
@@ -342,7 +360,19 @@ def _velocity(spec: dict) -> tuple:
     if not (isinstance(v, list) and len(v) == 3):
         raise SceneError(f"base_motion.velocity_m_s must be a list of 3 numbers (constant velocity of point a in G), "
                          f"got {shown(v)}")
-    return tuple(number(f"base_motion.velocity_m_s[{i}]", x) for i, x in enumerate(v))
+    velocity = tuple(number(f"base_motion.velocity_m_s[{i}]", x) for i, x in enumerate(v))
+    low, high = KEY_RANGES["velocity_m_s"]
+    for i, x in enumerate(velocity):
+        if not low <= x <= high:
+            raise SceneError(f"base_motion.velocity_m_s[{i}] = {x:g} is outside [{low:g}, {high:g}]")
+    return velocity
+
+
+def _components(where: str, value) -> int:
+    """A sea state's sinusoids per degree of freedom: the kernel allocates and sums that many per step."""
+    components = integer(where, value, 1)
+    over_limit(where, components, MAX_SEA_STATE_COMPONENTS, " sinusoids")
+    return components
 
 
 def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
@@ -365,7 +395,7 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
         return Sinusoids(angle_terms, translation_terms, offsets, _velocity(spec))
     if kind == "sea_state":
         _check_keys("base_motion", spec, {"type", "velocity_m_s", "components", "seed"} | axes)
-        components = integer("base_motion.components", spec.get("components", SEA_STATE_DEFAULTS["components"]), 1)
+        components = _components("base_motion.components", spec.get("components", SEA_STATE_DEFAULTS["components"]))
         seed = integer("base_motion.seed", spec.get("seed", SEA_STATE_DEFAULTS["seed"]), 0)
         angle_terms, translation_terms, offsets = {}, {}, {}
         for index, name in enumerate(["pitch", "yaw", "roll", "surge", "sway", "heave"]):
@@ -380,16 +410,20 @@ def make_base_motion(spec: dict | None, scene_dir: pathlib.Path) -> BaseMotion:
             for key in (unit, "peak_period_s"):
                 if key not in item:
                     raise SceneError(f"base_motion.{name}: missing '{key}'")
-            # every value the kernel would refuse (sea_state_components), refused here by its key
+            # every value the kernel would refuse (sea_state_components), refused here by its key, and
+            # every value out of KEY_RANGES (where the spectrum is no longer finite)
             amplitude = non_negative(f"base_motion.{name}.{unit}", item[unit])
             gamma = number(f"base_motion.{name}.gamma", item.get("gamma", DEFAULT_GAMMA))
             if gamma < 1.0:
                 raise SceneError(f"base_motion.{name}.gamma = {gamma:g} (JONSWAP peak enhancement) must be >= 1 "
                                  "(1 = Pierson-Moskowitz)")
-            terms = sea_state_components(math.radians(amplitude) if angle else amplitude,
-                                         _positive(f"base_motion.{name}.peak_period_s", item["peak_period_s"]),
-                                         gamma, integer(f"base_motion.{name}.components",
-                                                        item.get("components", components), 1), seed, index)
+            amplitude, gamma = _within(f"base_motion.{name}", unit, amplitude), _within(f"base_motion.{name}", "gamma",
+                                                                                       gamma)
+            peak_period = _within(f"base_motion.{name}", "peak_period_s",
+                                  _positive(f"base_motion.{name}.peak_period_s", item["peak_period_s"]))
+            terms = sea_state_components(math.radians(amplitude) if angle else amplitude, peak_period,
+                                         gamma, _components(f"base_motion.{name}.components",
+                                                            item.get("components", components)), seed, index)
             if angle:
                 angle_terms[ANGLE_AXES[name]] = terms
             else:

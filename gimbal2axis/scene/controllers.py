@@ -31,7 +31,7 @@ import numpy as np
 
 from . import geometry
 from .. import native
-from ..errors import SceneError, check_keys, did_you_mean, number, shown
+from ..errors import SceneError, StopSignal, check_keys, did_you_mean, excerpt, number, shown
 from .references import Reference
 from .setpoints import plan_set_points
 from ..target import MovingTarget, pointing
@@ -143,7 +143,7 @@ class _ReferenceMixin:
                 self.refs.append(Reference(f"controller.{axis}.reference", sub))
             else:
                 raise SceneError(f"[controller.{axis}] needs a reference: 'target' or a table "
-                                 f"{{type = 'constant'|'step'|'ramp'|'sine', ...}}, got {sub!r}")
+                                 f"{{type = 'constant'|'step'|'ramp'|'sine', ...}}, got {shown(sub)}")
 
     def _references(self, t, alpha, base_attitude, base_rates=None, h=None):
         """Set points (r1, r2) and, with base_rates and h, their rates: for 'target' the exact
@@ -317,12 +317,22 @@ def user_exception(label: str, call: str, exc: BaseException, path: pathlib.Path
     at time t: its class and message, and where in the user's file it was raised."""
     import traceback
 
-    text = str(exc)
+    text = exception_text(exc)
     when = "" if t is None else f" at t = {t:.6g} s"
-    message = f"{label}: {call} raised {type(exc).__name__}{': ' + text if text else ''}{when}{raised_where(exc, path)}"
+    message = (f"{label}: {call} raised {excerpt(type(exc).__name__)}{': ' + text if text else ''}{when}"
+               f"{raised_where(exc, path)}")
     # the traceback from the user's code on: its first frame is the call here, the runner's own
     tb = exc.__traceback__.tb_next if exc.__traceback__ is not None and exc.__traceback__.tb_next else exc.__traceback__
     return ControllerError(message, "".join(traceback.format_exception(type(exc), exc, tb)))
+
+
+def exception_text(exc: BaseException) -> str:
+    """The user's exception message as an excerpt (one line, cut: a megabyte of text is not quoted
+    whole); what went wrong when its __str__ itself raises."""
+    try:
+        return excerpt(str(exc))
+    except Exception as failure:
+        return f"(its message: str() raised {type(failure).__name__})"
 
 
 def raised_where(exc: BaseException, path: pathlib.Path | None) -> str:
@@ -337,6 +347,14 @@ def raised_where(exc: BaseException, path: pathlib.Path | None) -> str:
     if mine:   # the file as the scene names it
         return f" ({path}:{mine[-1].lineno}, in {mine[-1].name})"
     return f" ({frames[-1].filename}:{frames[-1].lineno}, in {frames[-1].name})" if frames else ""
+
+
+def _fits_float(value: int) -> bool:
+    try:
+        float(value)
+        return True
+    except OverflowError:
+        return False
 
 
 def _is_real(value) -> bool:
@@ -354,16 +372,38 @@ def scalar_voltages(label: str, t: float, u) -> tuple[float, float]:
     elif kind is np.ndarray and u.shape == (2,) and u.dtype.kind in "fiu":
         u1, u2 = u.tolist()
     else:
-        what = f"an array of shape {u.shape}" if isinstance(u, np.ndarray) else repr(u)
+        what = f"an array of shape {u.shape}" if isinstance(u, np.ndarray) else shown(u)
         raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {what}; it must return (u_R1, u_R2), "
                               "two finite numbers in V")
     if not (type(u1) is float or _is_real(u1)) or not (type(u2) is float or _is_real(u2)):
-        raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {u!r}; the voltages must be numbers "
+        raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {shown(u)}; the voltages must be numbers "
                               "(not strings, booleans or None)")
-    u1, u2 = float(u1), float(u2)
+    u1, u2 = _as_float(label, t, "step() returned voltages", u1), _as_float(label, t, "step() returned voltages", u2)
     if not (isfinite(u1) and isfinite(u2)):
         raise ControllerError(f"{label}: step() at t = {t:.6g} s returned ({u1}, {u2}): the voltages must be finite")
     return u1, u2
+
+
+def _as_float(label: str, t: float, what: str, value) -> float:
+    """float(value) of a real number the user's code gave; a ControllerError naming it when it is
+    beyond a float's range (an int such as 10**400)."""
+    try:
+        return float(value)
+    except OverflowError:
+        raise ControllerError(f"{label}: {what.replace('()', f'() at t = {t:.6g} s', 1)} {shown(value)}, a number "
+                              "beyond a float's range (about 1.8e308)") from None
+
+
+def user_reference(label: str, t: float, reference) -> tuple[float, float]:
+    """A scalar controller's `self.reference` as two floats for the record: a pair of real numbers
+    (NaN: none); anything else is refused, naming the class, the time and the value."""
+    if isinstance(reference, (tuple, list, np.ndarray)) and len(reference) == 2 and all(
+            _is_real(r) or (type(r) is np.ndarray and r.shape == () and r.dtype.kind in "fiu") for r in reference):
+        pair = tuple(_as_float(label, t, "step() set self.reference to", r) for r in reference)
+        if not (math.isinf(pair[0]) or math.isinf(pair[1])):
+            return pair
+    raise ControllerError(f"{label}: step() at t = {t:.6g} s set self.reference to {shown(reference)}; it must be "
+                          "(alpha_ref, beta_ref), two finite numbers in rad (or NaN for none)")
 
 
 def batch_voltages(label: str, t: float, u, cases: int):
@@ -391,16 +431,18 @@ def batch_voltages(label: str, t: float, u, cases: int):
             if array.shape == (cases, 2) and array.dtype.kind in "fiu":
                 return array.astype(float)
             what = f"shape {array.shape} of {array.dtype.name}"
-    except (TypeError, ValueError):
+            if array.dtype == object and any(isinstance(x, int) and not _fits_float(x) for x in array.flat):
+                what += " (an integer beyond a float's range, about 1.8e308)"
+    except (TypeError, ValueError, OverflowError):
         pass
-    raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {what or repr(u)}; a batch controller (batch = True) "
+    raise ControllerError(f"{label}: step() at t = {t:.6g} s returned {what or shown(u)}; a batch controller (batch = True) "
                           f"must return the voltages as numbers, an array of shape ({cases}, 2) or (u_R1, u_R2), "
                           f"two arrays of shape ({cases},)")
 
 
-def batch_reference(label: str, user, cases: int):
+def batch_reference(label: str, user, cases: int, t: float | None = None):
     """A batch class's `reference` as an (N, 2) float array (NaN if it sets none): a pair
-    (alpha_ref, beta_ref) of (N,) arrays or scalars."""
+    (alpha_ref, beta_ref) of (N,) arrays or scalars; `t` the step's time, for the message."""
     reference = getattr(user, "reference", None)
     if reference is None:
         return np.full((cases, 2), math.nan)
@@ -410,14 +452,15 @@ def batch_reference(label: str, user, cases: int):
             return pair.T
         if pair.shape == (2,):
             return np.broadcast_to(pair, (cases, 2))
-    except ValueError:   # an array and a number: below
+    except (ValueError, TypeError, OverflowError):   # an array and a number: below
         pass
     try:
         first, second = reference
         return np.column_stack([np.broadcast_to(np.asarray(c, dtype=float), (cases,)) for c in (first, second)])
-    except (TypeError, ValueError):
-        raise ControllerError(f"{label}: self.reference must be (alpha_ref, beta_ref), two arrays of shape ({cases},) or "
-                         f"numbers; got {reference!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        when = "" if t is None else f" (set by step() at t = {t:.6g} s)"
+        raise ControllerError(f"{label}: self.reference{when} must be (alpha_ref, beta_ref), two arrays of shape "
+                              f"({cases},) or numbers; got {shown(reference)}") from None
 
 
 class UserController(Controller):
@@ -466,7 +509,9 @@ class UserController(Controller):
         context = ControllerContext(step_size, self.u_limit, self.target, self.delay_steps, scene_name)
         try:
             self.user.reset(context)
-        except Exception as exc:
+        except StopSignal:
+            raise
+        except BaseException as exc:   # sys.exit, a KeyboardInterrupt of its own: the code's failure
             raise user_exception(self.label, "reset()", exc, self.path, 0.0) from None
 
     def __call__(self, t, h, alpha, beta, gyro, base_attitude, base_rates, step=None):
@@ -475,10 +520,18 @@ class UserController(Controller):
         else:
             try:
                 u = self.user.step(t, Measurements(alpha, beta, gyro, base_attitude, base_rates))
-            except Exception as exc:
+            except StopSignal:
+                raise
+            except BaseException as exc:
                 raise user_exception(self.label, "step()", exc, self.path, t) from None
             u1, u2 = scalar_voltages(self.label, t, u)
-            self.reference = getattr(self.user, "reference", (math.nan, math.nan))
+            try:   # a property of the user's: its code too
+                reference = getattr(self.user, "reference", (math.nan, math.nan))
+            except StopSignal:
+                raise
+            except BaseException as exc:
+                raise user_exception(self.label, "reference", exc, self.path, t) from None
+            self.reference = user_reference(self.label, t, reference)
         self.asked = (u1, u2)
         return self.clamp(u1, 0), self.clamp(u2, 1)
 
@@ -487,30 +540,34 @@ class UserController(Controller):
                          np.array([base_attitude], dtype=float), np.array([base_rates], dtype=float))
         try:
             u = self.user.step(t, m)
-        except Exception as exc:
+        except StopSignal:
+            raise
+        except BaseException as exc:   # sys.exit, a KeyboardInterrupt of its own: the code's failure
             raise user_exception(self.label, "step()", exc, self.path, t) from None
         u1, u2 = batch_voltages(self.label, t, u, 1)[0].tolist()
         if not (math.isfinite(u1) and math.isfinite(u2)):
             raise ControllerError(f"{self.label}: step() at t = {t:.6g} s returned ({u1}, {u2}): the voltages must be "
                                   "finite")
-        self.reference = tuple(batch_reference(self.label, self.user, 1)[0].tolist())
+        self.reference = tuple(batch_reference(self.label, self.user, 1, t)[0].tolist())
         return u1, u2
 
 
 def class_label(cls, path: pathlib.Path) -> str:
     """How messages name a user controller class: the class and the user's file."""
-    return f"{cls.__qualname__} ({path})"
+    return f"{excerpt(cls.__qualname__)} ({path})"
 
 
 def build_user(cls, label: str, path: pathlib.Path, options: dict):
     """The user's object, cls(**options); an exception in its __init__ is the controller's."""
     try:
         return cls(**options)
-    except Exception as exc:
+    except StopSignal:
+        raise
+    except BaseException as exc:
         if isinstance(exc, TypeError) and exc.__traceback__ is not None and exc.__traceback__.tb_next is None:
             # raised by the call itself, not inside __init__: the options do not fit its signature
-            raise SceneError(f"[controller] {label}: the options ({', '.join(options) or 'none'}) do not fit its "
-                             f"__init__: {exc}") from None
+            raise SceneError(f"[controller] {label}: the options ({excerpt(', '.join(map(str, options))) or 'none'}) "
+                             f"do not fit its __init__: {exception_text(exc)}") from None
         raise user_exception(label, "__init__()", exc, path) from None
 
 
@@ -527,13 +584,13 @@ def controller_file(spec: dict, base_dir: pathlib.Path | None) -> pathlib.Path:
                          "and class = '<name of a class defined in it>'")
     path = pathlib.Path(name)
     if path.suffix != ".py":
-        raise SceneError(f"[controller] {key} = {name!r} is not a .py file: a user controller is a Python file, "
+        raise SceneError(f"[controller] {key} = {shown(name)} is not a .py file: a user controller is a Python file, "
                          "given as a path relative to the scene (file = \"my_controller.py\"); modules are not "
                          "imported")
     if base_dir is not None and not path.is_absolute():
         path = base_dir / path
     if not path.is_file():
-        raise SceneError(f"[controller] {key} = {name!r}: controller file {path} not found (a path relative to the "
+        raise SceneError(f"[controller] {key} = {shown(name)}: controller file {path} not found (a path relative to the "
                          "scene file)")
     return path
 
@@ -551,7 +608,9 @@ def load_user_class(spec: dict, base_dir: pathlib.Path | None):
         module = importlib.util.module_from_spec(loader_spec)
         try:
             loader_spec.loader.exec_module(module)
-        except Exception as exc:  # the user's file failed to load: say where
+        except StopSignal:
+            raise
+        except BaseException as exc:  # the user's file failed to load (or called sys.exit): say where
             raise user_exception(f"[controller] {path}", "loading", exc, path) from None
         sys.modules[module_name] = module
     cls = vars(module).get(class_name)

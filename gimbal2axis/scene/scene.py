@@ -56,8 +56,10 @@ from .controllers import make_controller
 from .. import target as moving_targets
 from ..target import spec as target_spec_table
 from ..errors import (SceneError, SceneWarning, boolean, check_keys, did_you_mean, excerpt, is_number_text, number,
-                      positive, read_toml, shown)
+                      positive, shown)
 from ..fmu import FIDELITY, FMU, enumeration_items
+from ..limits import (read_toml, MAX_DELAY_STEPS, MAX_DESCRIPTION_CHARS, MAX_PLOT_PANELS, MAX_PLOT_SIGNALS, MAX_TITLE_CHARS,
+                      over_limit, steps_of, too_long)
 from .sensors import Sensors
 from .setpoints import target_direction
 
@@ -71,6 +73,10 @@ ANGLE_STATES = ("alpha", "beta", "alpha_m", "beta_m", "theta_b1", "theta_b2")
 # beyond half a turn is the same pose as one within it, so a value beyond pi rad is degrees without the
 # suffix, not a pose.
 HALF_TURN_ANGLES = ("alpha", "beta")
+
+# The angle between two directions is at most pi rad: a line-of-sight bound above holds for any run (and
+# a plot's log axis drawn up to 1e300 overflows its tick labels).
+LARGEST_LOS_ERROR_MRAD = 1000.0 * math.pi
 
 # [imbalance]: a centre-of-mass offset in millimetres -> the FMU's vector parameter (metres, frame of
 # its body; docs/physics.md section 1).
@@ -244,9 +250,11 @@ def load_scene(path: pathlib.Path | str) -> Scene:
         title = raw.get("name", path.stem)
         if not isinstance(title, str) or not title.strip():
             raise SceneError(f"'name' (the title of the plot) must be a non-empty string, got {shown(title)}")
+        too_long("'name' (the title of the plot)", len(title), MAX_TITLE_CHARS)
         description = raw.get("description", "")
         if not isinstance(description, str):
             raise SceneError(f"'description' must be a string, got {shown(description)}")
+        too_long("'description'", len(description), MAX_DESCRIPTION_CHARS)
         step = positive("step_size", raw["step_size"])
         target = raw.get("target")
         if target is not None and target_spec_table.kind_of(_table(raw, "target")) != "direction":
@@ -286,6 +294,9 @@ def _validate(scene: Scene) -> None:
     # again here: with_changes (a sweep, --stop-time) brings values load_scene has not seen
     for key in ("stop_time", "step_size", "output_interval"):
         positive(key, getattr(scene, key))
+    steps_of("stop_time", scene.stop_time, scene.step_size)
+    # the steps between two recorded rows: a stride the streamed record counts in 64-bit integers
+    steps_of("output_interval", scene.output_interval, scene.step_size)
     if scene.n_steps < 1:
         raise SceneError(f"stop_time = {scene.stop_time:g} s is shorter than one step (step_size = "
                          f"{scene.step_size:g} s): the run would have no step")
@@ -319,6 +330,8 @@ def _validate(scene: Scene) -> None:
     if not isinstance(delay, int) or isinstance(delay, bool) or delay < 0:
         raise SceneError("[controller] delay_steps must be an integer >= 0 (1 = a one-sample delay: the voltage "
                          "computed at t_k is applied over [t_k+1, t_k+2])")
+    # the master keeps the commands of the last delay_steps steps in memory
+    over_limit("[controller] delay_steps", delay, MAX_DELAY_STEPS, " steps")
     found = _check_controller(scene.controller_spec)
     if not scene.base_motion_spec and scene.fidelity.get("base.fixed") is not True:
         setting = "= false" if "base.fixed" in scene.fidelity else "is not set (the FMU's default is false)"
@@ -337,6 +350,9 @@ def _validate(scene: Scene) -> None:
     check_keys("requirements", scene.requirements, {"los_rms_max_mrad", "los_final_max_mrad", "from_s"})
     for key, value in scene.requirements.items():
         positive(f"requirements.{key}", value) if key != "from_s" else number("requirements.from_s", value)
+        if key != "from_s" and value > LARGEST_LOS_ERROR_MRAD:
+            raise SceneError(f"requirements.{key} = {value:g} mrad can never fail: a line-of-sight error is at most "
+                             f"half a turn ({LARGEST_LOS_ERROR_MRAD:.1f} mrad)")
     if scene.requirements.get("from_s", 0.0) < 0:
         raise SceneError(f"requirements.from_s = {scene.requirements['from_s']:g} s must be >= 0 (the bounds hold "
                          "from then to the end of the run)")
@@ -345,9 +361,11 @@ def _validate(scene: Scene) -> None:
     check_keys("test", scene.test, {"stop_time"})
     if "stop_time" in scene.test:
         positive("test.stop_time", scene.test["stop_time"])
+    over_limit("[plot]: the number of panels", len(scene.plot), MAX_PLOT_PANELS)
     for panel, names in scene.plot.items():
         if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
             raise SceneError(f"[plot] {excerpt(panel)} must be a list of signal names, got {shown(names)}")
+        over_limit(f"[plot] {excerpt(panel)}: the number of signals", len(names), MAX_PLOT_SIGNALS)
     settings = scene.analysis
     if settings.bands and scene.target_spec is None:
         raise SceneError("[analysis.bands] of the line-of-sight error need a [target]")

@@ -15,7 +15,8 @@ class Progress:
     """`update(status)` per finished case ("ok" or else failed); `restart_clock()` where the
     cases start running (the rate counts from there); `close()` at the end."""
 
-    def __init__(self, total: int, enabled: bool = True, stream=sys.stderr):
+    def __init__(self, total: int, enabled: bool = True, stream=None):
+        stream = sys.stderr if stream is None else stream   # the stderr of now, not of the first import
         self.counts = {"ok": 0, "failed": 0}
         # smoothing=0: the rate is the average since the start; miniters=1: no tqdm guess of how
         # often to look at the clock

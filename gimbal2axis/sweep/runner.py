@@ -13,7 +13,7 @@ import threading
 import time
 from dataclasses import dataclass
 
-from ..errors import SceneError
+from ..errors import Interrupted, SceneError, StopSignal
 from ..fmu import FMU
 from ..fmu.worker_cache import fmu_digest
 from ..scene.scene import check_against_fmu, load_scene
@@ -21,15 +21,52 @@ from ..scene.scene import check_against_fmu, load_scene
 from . import store, table
 from .names import check_cases_accepted, resolve_names
 from .progress import Progress
-from .spec import SweepError, apply_case, case_key, load_sweep, scene_hash
+from .spec import SweepError, apply_case, case_key, check_cases_window, load_sweep, scene_hash
 from .worker import run_case, run_cases
 
+MAX_LOCAL_WORKERS = 256     # processes of a local cluster: beyond, --workers is a typo, not a machine
 SCHEDULER_TIMEOUT_S = 5.0   # a scheduler that does not answer by then is not coming
 
 
-class Stopped(KeyboardInterrupt):
+class Stopped(StopSignal, KeyboardInterrupt):
     """SIGTERM, ending the sweep as Ctrl-C does (the cases finished so far are kept); its message
-    names the signal, and gimbal2axis sweep's exit status tells the two apart."""
+    names the signal, and gimbal2axis sweep's exit status tells the two apart. A StopSignal: the
+    wrappers of a user controller's code let it pass (errors.StopSignal)."""
+
+
+def stop_signal(signum: int) -> StopSignal:
+    """The exception that the signal `signum` (SIGINT or SIGTERM) ends a sweep or a tuning with."""
+    return Stopped("terminated (SIGTERM)") if signum == signal.SIGTERM else Interrupted()
+
+
+class CaseSignals:
+    """While cases run in this process (a serial sweep or tuning; in the main thread): Ctrl-C and
+    SIGTERM raise their StopSignal (stop_signal) at once, which a user controller's wrappers let pass,
+    whereas any other BaseException its code raises (sys.exit, a KeyboardInterrupt of its own) is its
+    case's failure. Each signal is also recorded: check() raises it again after a case whose code
+    swallowed it, so that only the signals end the sweep, and always do."""
+
+    def __init__(self):
+        self.received: int | None = None
+        self.previous: dict = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.previous = {sig: signal.signal(sig, self._handle) for sig in (signal.SIGINT, signal.SIGTERM)}
+        return self
+
+    def _handle(self, signum, frame):
+        self.received = signum
+        raise stop_signal(signum)
+
+    def check(self) -> None:
+        if self.received is not None:
+            raise stop_signal(self.received)
+
+    def __exit__(self, *exc):
+        for sig, handler in self.previous.items():
+            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
+        return False
 
 
 @dataclass
@@ -82,6 +119,10 @@ def prepare(scene_path, sweep_path, fmu: FMU):
             case.scene, case.error = None, f"invalid case: {type(exc).__name__}: {exc}"
         cases.append(case)
     check_cases_accepted(scene, sweep, fmu, resolved, cases, candidates)
+    try:
+        check_cases_window(sweep.metrics_from_s, [case.scene for case in cases])
+    except SweepError as exc:
+        raise SweepError(f"{sweep.path}: {exc}") from None
     return scene, sweep, cases
 
 
@@ -104,10 +145,13 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
     from distributed import Client, LocalCluster
 
     if scheduler:
+        from .scheduler_check import check_scheduler
+
+        check_scheduler(scheduler, SCHEDULER_TIMEOUT_S)
         try:
             client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
-        except ValueError as exc:
-            raise SweepError(f"--scheduler {scheduler}: {exc}") from None
+        except (ValueError, MemoryError) as exc:   # MemoryError: a service whose answer reads as a huge message
+            raise SweepError(f"--scheduler {scheduler}: {type(exc).__name__}: {exc}") from None
         except (OSError, TimeoutError):
             raise SweepError(f"no Dask scheduler answered at {scheduler} within {SCHEDULER_TIMEOUT_S:g} s; start one "
                              f"(dask scheduler; dask worker ADDRESS --nthreads 1), or leave out --scheduler for a "
@@ -119,6 +163,8 @@ def make_client(scheduler: str | None = None, workers: int = 2, processes: bool 
             raise
         return client, None
     # The local workers are processes of this Python: they import the installed gimbal2axis.
+    if not 1 <= workers <= MAX_LOCAL_WORKERS:
+        raise SweepError(f"--workers {workers}: a local cluster has 1 to {MAX_LOCAL_WORKERS} workers")
     cluster = None
     try:
         with _StopRequests():   # a half-started cluster cannot be closed in order
@@ -216,7 +262,7 @@ class _StopRequests:
         if self.pending:
             signum = self.pending.pop(0)
             self.pending.clear()
-            raise Stopped("terminated (SIGTERM)") if signum == signal.SIGTERM else KeyboardInterrupt()
+            raise stop_signal(signum)
 
     def __exit__(self, *exc):
         for sig, handler in self.previous.items():
@@ -373,7 +419,8 @@ class Recorder:
 
 def run_planned(plan: Plan, options: SweepOptions, recorder: Recorder, dask: DaskRun) -> None:
     """Runs the cases of `plan.todo`, serially or on Dask, each result to `recorder` as it comes;
-    a case refused before running is recorded as failed with the reason."""
+    a case refused before running is recorded as failed with the reason. Serially, only Ctrl-C and
+    SIGTERM (CaseSignals) end the sweep early: whatever a case's code raises is that case's row."""
     runnable = []
     for case in plan.todo:
         if case.scene is None:
@@ -382,15 +429,17 @@ def run_planned(plan: Plan, options: SweepOptions, recorder: Recorder, dask: Das
         else:
             runnable.append(case)
     if options.serial:
-        for chunk in _serial_chunks(runnable):
-            if len(chunk) == 1:
-                results = [run_case(chunk[0].scene, chunk[0].case_id, plan.fmu_bytes, plan.fmu_sha,
-                                    plan.sweep.metrics_from_s)]
-            else:   # cases of a batch user controller: together, as a Dask task runs them
-                results = run_cases([(c.scene, c.case_id) for c in chunk], plan.fmu_bytes, plan.fmu_sha,
-                                    plan.sweep.metrics_from_s)
-            for case, result in zip(chunk, results):
-                recorder.record(case, result)
+        with CaseSignals() as signals:
+            for chunk in _serial_chunks(runnable):
+                if len(chunk) == 1:
+                    results = [run_case(chunk[0].scene, chunk[0].case_id, plan.fmu_bytes, plan.fmu_sha,
+                                        plan.sweep.metrics_from_s)]
+                else:   # cases of a batch user controller: together, as a Dask task runs them
+                    results = run_cases([(c.scene, c.case_id) for c in chunk], plan.fmu_bytes, plan.fmu_sha,
+                                        plan.sweep.metrics_from_s)
+                signals.check()   # a signal the case's code swallowed: its row is not a result
+                for case, result in zip(chunk, results):
+                    recorder.record(case, result)
     elif runnable:
         dask.run(plan, runnable, recorder)
 

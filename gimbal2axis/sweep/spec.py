@@ -55,7 +55,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SceneError, did_you_mean, excerpt, positive, read_toml, shown
+from ..errors import SceneError, did_you_mean, excerpt, positive, shown
+from ..limits import read_toml
+from ..limits import MAX_DESCRIPTION_CHARS, MAX_SWEEP_CASES, over_limit, too_long
 from ..scene.scene import Scene
 
 TOP_KEYS = {"name", "description", "cases", "seed", "samples", "stop_time", "metrics_from_s", "grid", "random"}
@@ -63,6 +65,8 @@ FLAT_SECTIONS = {"parameters", "fidelity", "initial"}
 NESTED_SECTIONS = {"controller": "controller_spec", "base_motion": "base_motion_spec", "sensors": "sensors_spec",
                    "target": "target_spec"}
 DISTRIBUTIONS = {"uniform", "loguniform", "normal", "integers", "choice"}
+# The values of a grid parameter a warning lists at most (a linspace may have a million).
+WARNING_VALUES = 8
 # A swept target.* on a scene without [target] starts from load_scene's defaults of a [target].
 NO_TARGET = {"azimuth_deg": 0.0, "elevation_deg": 0.0, "start_on_target": False}
 
@@ -109,17 +113,16 @@ class Sweep:
     def expand(self) -> list[dict]:
         """The cases: one dict {parameter name: value} per case, in a fixed order."""
         names = list(self.grid)
-        points = [dict(zip(names, combo)) for combo in itertools.product(*(self.grid[n] for n in names))]
+        # lazily, up to the `cases` limit: the full product may be far larger than what is run
+        points = (dict(zip(names, combo)) for combo in itertools.product(*(self.grid[n] for n in names)))
         if self.random:
             samples = self.samples_per_point
             draws = {name: draw(name, spec, samples, self.seed) for name, spec in self.random.items()}
-            cases = [dict(point, **{name: values[j] for name, values in draws.items()})
-                     for point in points for j in range(samples)]
+            cases = (dict(point, **{name: values[j] for name, values in draws.items()})
+                     for point in points for j in range(samples))
         else:
             cases = points
-        if self.cases_limit is not None:
-            cases = cases[:self.cases_limit]
-        return cases
+        return list(itertools.islice(cases, self.cases_limit))
 
     def drive_warning(self) -> str | None:
         """A sweep over a motor's drive (voltage or current) with the controller's gains as they are:
@@ -159,11 +162,14 @@ class Sweep:
         missing = []
         for name, values in self.grid.items():
             seen = {repr(c[name]) for c in kept_cases}
-            absent = [f"{v:g}" if isinstance(v, float) else str(v) for v in values if repr(v) not in seen]
+            absent = [f"{v:g}" if isinstance(v, float) else excerpt(str(v)) for v in values if repr(v) not in seen]
             if absent:
-                missing.append(f"{name} = {', '.join(absent)}")
+                more = f" and {len(absent) - WARNING_VALUES:,} more" if len(absent) > WARNING_VALUES else ""
+                missing.append(f"{excerpt(name)} = {', '.join(absent[:WARNING_VALUES])}{more}")
         if missing:
             text += f"; never run: {'; '.join(missing)}"
+        if full > MAX_SWEEP_CASES:
+            return text + f". A sweep runs at most {MAX_SWEEP_CASES:,} cases: split the grid to run them all."
         return text + f". Raise 'cases' to {full} (or leave it out) to run them all."
 
 
@@ -186,6 +192,7 @@ def _grid_values(name: str, spec) -> list:
             _finite_numbers(f"[grid] '{excerpt(name)}': {kind}", [a, b])
             if not (isinstance(n, int) and not isinstance(n, bool) and n >= 1):
                 raise SweepError(f"[grid] '{excerpt(name)}': {kind} = [start, stop, count], count a positive integer")
+            over_limit(f"[grid] '{excerpt(name)}': {kind} count", n, MAX_SWEEP_CASES, " values", SweepError)
             if kind == "geomspace" and not (a > 0 and b > 0):
                 raise SweepError(f"[grid] '{excerpt(name)}': geomspace needs positive bounds")
             return [float(v) for v in getattr(np, kind)(float(a), float(b), n)]
@@ -215,6 +222,11 @@ def _check_distribution(name: str, spec) -> dict:
         raise SweepError(f"[random] '{excerpt(name)}': loguniform needs positive bounds")
     if kind == "integers" and not all(isinstance(v, int) and not isinstance(v, bool) for v in args):
         raise SweepError(f"[random] '{excerpt(name)}': integers needs integer bounds")
+    if kind in ("uniform", "loguniform", "integers") and not args[0] <= args[1]:
+        raise SweepError(f"[random] '{excerpt(name)}': {kind} = [{args[0]:g}, {args[1]:g}] needs low <= high")
+    if kind == "uniform" and not math.isfinite(args[1] - args[0]):   # numpy draws low + width * u
+        raise SweepError(f"[random] '{excerpt(name)}': uniform = [{args[0]:g}, {args[1]:g}] are "
+                         f"{args[1] - args[0]:g} apart: their width must be a finite number")
     return spec
 
 
@@ -261,6 +273,8 @@ def load_sweep(path: pathlib.Path | str) -> Sweep:
         samples = raw.get("samples")
         if samples is not None and not (isinstance(samples, int) and not isinstance(samples, bool) and samples >= 1):
             raise SweepError("'samples' must be a positive integer")
+        if samples is not None:   # every random parameter draws `samples` values up front
+            over_limit("'samples'", samples, MAX_SWEEP_CASES, " draws per grid point", SweepError)
         seed = raw.get("seed", 0)
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise SweepError("'seed' must be a non-negative integer")
@@ -270,14 +284,30 @@ def load_sweep(path: pathlib.Path | str) -> Sweep:
                 raise SweepError(f"'{key}' must be a finite number >= 0, got {shown(value)}")
         if raw.get("stop_time", 1.0) == 0:
             raise SweepError("'stop_time' must be positive: every case ends there")
+        check_metrics_window(raw.get("metrics_from_s"), raw.get("stop_time"))
         name = raw.get("name", path.stem)
         if not isinstance(name, str) or not name.replace("_", "").replace("-", "").isalnum():
             raise SweepError("'name' must be a string of letters, digits, '_' and '-' (it names the result files)")
+        description = raw.get("description", "")
+        if not isinstance(description, str):
+            raise SweepError(f"'description' must be a string, got {shown(description)}")
+        too_long("'description'", len(description), MAX_DESCRIPTION_CHARS, error=SweepError)
+        sweep = Sweep(path=path, name=name, description=description, cases_limit=cases, seed=seed, samples=samples,
+                      stop_time=raw.get("stop_time"), metrics_from_s=raw.get("metrics_from_s"), grid=grid,
+                      random=random, raw=raw)
+        _check_size(sweep)
     except SweepError as exc:
         raise SweepError(f"{path}: {exc}") from None
-    return Sweep(path=path, name=name, description=str(raw.get("description", "")), cases_limit=cases, seed=seed,
-                 samples=samples, stop_time=raw.get("stop_time"), metrics_from_s=raw.get("metrics_from_s"),
-                 grid=grid, random=random, raw=raw)
+    return sweep
+
+
+def _check_size(sweep: Sweep) -> None:
+    """Refuses a sweep that would run more than MAX_SWEEP_CASES cases, or draw more values than that."""
+    if sweep.cases_limit is not None:
+        over_limit("'cases'", sweep.cases_limit, MAX_SWEEP_CASES, " cases", SweepError)
+    elif sweep.full_size > MAX_SWEEP_CASES:
+        raise SweepError(f"grid points x samples = {sweep.full_size:,} cases is over the limit of {MAX_SWEEP_CASES:,} "
+                         "cases; set 'cases' to run the first of them")
 
 
 def _flatten_names(table: dict, prefix: str = "") -> dict:
@@ -327,6 +357,23 @@ def _set_nested(table, path: list, value, name: str):
     elif not isinstance(node, dict):
         raise SceneError(f"'{excerpt(name)}': {'.'.join(map(str, path[:-1]))} is not a table")
     node[last] = value
+
+
+def check_metrics_window(from_s: float | None, stop_time: float | None, whose: str = "stop_time",
+                         error: type = SweepError) -> None:
+    """Refuses a metrics window [from_s, end] that starts at or after the stop time of the runs
+    (`whose` says which stop time): its metrics would be those of another window. A sweep's and a
+    tuning's own stop_time, and that of each case (the scene's, or a swept one)."""
+    if from_s is not None and stop_time is not None and not from_s < stop_time:
+        raise error(f"'metrics_from_s' = {from_s:g} must be below {whose} = {stop_time:g}: the metrics are over "
+                    f"[metrics_from_s, stop time]")
+
+
+def check_cases_window(from_s: float | None, scenes, error: type = SweepError) -> None:
+    """check_metrics_window for the stop time of each case's scene (None: a case refused already)."""
+    for index, scene in enumerate(scenes):
+        if scene is not None:
+            check_metrics_window(from_s, scene.stop_time, f"the stop time of case {index}", error)
 
 
 def apply_case(scene: Scene, resolved: dict, case: dict, stop_time: float | None = None) -> Scene:

@@ -14,6 +14,10 @@ and a reader of its table).
   (rows of two different sweeps in one table would have the other sweep's parameters missing); the
   first sweep claims a table by writing it, empty, before its first case, which also proves that the
   output folder and its files can be written.
+- A temporary file left by a writer that was killed (SIGKILL, out of memory) is removed by the next
+  save or claim in that folder once it is provably nobody's: a temporary of the table's Parquet or CSV
+  found while holding the table's lock (only lock holders write those), or any temporary whose name
+  says it was made by a process of this host that no longer runs (`.<file>.<pid>@<host>.<token>.tmp`).
 """
 from __future__ import annotations
 
@@ -21,7 +25,9 @@ import contextlib
 import json
 import os
 import pathlib
+import re
 import secrets
+import socket
 import sys
 from dataclasses import dataclass
 
@@ -29,6 +35,13 @@ from . import table
 from .spec import SweepError
 
 PARAMETERS_KEY = b"gimbal2axis.sweep.parameters"   # Parquet schema metadata: the swept parameters, a JSON list
+# This machine in the names of the temporary files it writes: a pid says whether the writer still runs
+# only on the host that gave it (an output folder may be shared by several machines).
+HOST = re.sub(r"[^A-Za-z0-9-]", "-", socket.gethostname())[:40] or "host"
+# What follows `.<file>.` in the name of a temporary file of publish (or of an earlier version, without @host).
+TEMPORARY_TAIL = re.compile(r"\d+(@[A-Za-z0-9-]+)?\.[0-9a-f]{12}\.tmp")
+# The end of the name of any temporary file of publish: its writer's pid and host.
+WRITER = re.compile(r"\.(?P<pid>\d+)@(?P<host>[A-Za-z0-9-]+)\.[0-9a-f]{12}\.tmp$")
 
 
 @dataclass(frozen=True)
@@ -108,12 +121,57 @@ def _new_file(folder: pathlib.Path, prefix: str, suffix: str) -> pathlib.Path:
     """Creates an empty file of a name no other process uses (O_EXCL), with the permissions of any new
     file (0666 less the umask; tempfile.mkstemp would make it 0600, and the table private)."""
     while True:
-        path = folder / f"{prefix}{os.getpid()}.{secrets.token_hex(6)}{suffix}"
+        path = folder / f"{prefix}{os.getpid()}@{HOST}.{secrets.token_hex(6)}{suffix}"
         try:
             os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
             return path
         except FileExistsError:
             continue
+
+
+def remove_stale_temporaries(files: TableFiles) -> list[pathlib.Path]:
+    """Removes the temporary files in the table's folder that no writer can still be writing (see the
+    module's doc): those of the table's Parquet and CSV (call under the table's lock), and those of a
+    process of this host that has ended. Returns the paths removed."""
+    try:
+        names = os.listdir(files.folder)
+    except OSError:
+        return []
+    removed = []
+    for name in names:
+        if name.endswith(".tmp") and _stale(name, files):
+            path = files.folder / name
+            try:
+                path.unlink()
+            except FileNotFoundError:
+                continue
+            except OSError:   # not ours to remove (another user's folder entry): left as it is
+                continue
+            removed.append(path)
+    return removed
+
+
+def _stale(name: str, files: TableFiles) -> bool:
+    for written_under_lock in (files.parquet, files.csv):
+        prefix = f".{written_under_lock.name}."
+        if name.startswith(prefix) and TEMPORARY_TAIL.fullmatch(name[len(prefix):]):
+            return True
+    writer = WRITER.search(name)
+    return (name.startswith(".") and writer is not None and writer.group("host") == HOST
+            and _process_ended(int(writer.group("pid"))))
+
+
+def _process_ended(pid: int) -> bool:
+    """Whether no process of this id runs on this host (a pid that was reused counts as running)."""
+    if sys.platform == "win32" or pid <= 0:   # os.kill would end a process there, not probe it
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except (OSError, OverflowError):   # PermissionError: it runs, as another user
+        return False
+    return False
 
 
 def check_folder(files: TableFiles, option: str = "--out") -> None:
@@ -178,6 +236,7 @@ def claim(files: TableFiles, parameters: list[str]) -> list[dict]:
     that a sweep over other parameters started meanwhile is refused, not mixed in."""
     check_folder(files)
     with locked(files):
+        remove_stale_temporaries(files)
         stored = read(files)
         if stored.parameters is None:
             write(files, [], parameters)
@@ -193,6 +252,7 @@ def save(files: TableFiles, rows: list[dict], parameters: list[str]) -> list[dic
     """Merges `rows` (this sweep's, replacing those of the same case_id) into the table as it is on
     disk now, under the lock, and writes it; returns the table's rows."""
     with locked(files):
+        remove_stale_temporaries(files)
         stored = read(files)
         merged = table.merge(stored.rows, rows)
         recorded = list(parameters)

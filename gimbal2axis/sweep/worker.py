@@ -71,13 +71,27 @@ def band_columns(result, from_s: float) -> dict:
     return {f"los_band_{name}_rms_mrad": value * 1e3 for name, value in result.band_rms(from_s).items()}
 
 
+def failure_message(exc: BaseException) -> str:
+    """A failed case's message for an exception that is not a SceneError: its class and text, and
+    for a BaseException that is not an Exception (sys.exit, KeyboardInterrupt, GeneratorExit, one of
+    the user's own, raised by a user's code outside the controller's wrappers) where it was raised."""
+    from ..errors import excerpt
+    from ..scene.controllers import raised_where
+
+    text = excerpt(str(exc))
+    where = "" if isinstance(exc, Exception) else raised_where(exc, None)
+    return f"{type(exc).__name__}{': ' + text if text else ''}{where}"
+
+
 def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float | None = None,
              extra_metrics=None) -> dict:
     """Runs one case (the scene with its values already put in) on this worker's FMU instance and
     returns its row: metrics and status 'ok', or status 'failed' with the error and the FMU's log.
-    Never raises for a failing case: failures are results too. `extra_metrics(result, fmu)`, when
-    given, adds its columns to the row of a run that went through (the tuner's objectives)."""
-    from ..errors import SceneError
+    Never raises for a failing case: failures are results too, also a BaseException of the case's
+    code (sys.exit, KeyboardInterrupt); only a StopSignal (Ctrl-C or SIGTERM of this process, see
+    runner.CaseSignals) goes through. `extra_metrics(result, fmu)`, when given, adds its columns to
+    the row of a run that went through (the tuner's objectives)."""
+    from ..errors import SceneError, StopSignal
     from ..master.master import run
 
     row = {"case_id": case_id, "status": "failed", "message": "", "fmu_log": "", "wall_time_s": math.nan,
@@ -105,8 +119,10 @@ def run_case(scene, case_id: str, fmu_bytes: bytes, digest: str, from_s: float |
         row["wall_time_s"] = time.perf_counter() - wall0
         if loaded is not None:
             row["fmu_log"] = "\n".join(map(str, loaded.log))
-    except Exception as exc:   # anything else: report it, and do not trust the instance any more
-        row["message"] = f"{type(exc).__name__}: {exc}"
+    except StopSignal:
+        raise
+    except BaseException as exc:   # anything else: report it, and do not trust the instance any more
+        row["message"] = failure_message(exc)
         row["wall_time_s"] = time.perf_counter() - wall0
         if loaded is not None:
             row["fmu_log"] = "\n".join(map(str, loaded.log))
@@ -127,7 +143,7 @@ def run_batch(cases: list, fmu_bytes: bytes, digest: str, from_s: float | None =
     """The (scene, case_id) pairs of one lockstep batch (gimbal2axis.master.lockstep.batch_key equal) run
     together on this worker's pool of instances; the rows as run_case gives them, with the batch's
     wall and CPU time shared out evenly and `batch_size`. Never raises for a failing case."""
-    from ..errors import SceneError
+    from ..errors import SceneError, StopSignal
     from ..master.lockstep import run_lockstep
 
     wall0, cpu0 = time.perf_counter(), time.thread_time()
@@ -142,8 +158,10 @@ def run_batch(cases: list, fmu_bytes: bytes, digest: str, from_s: float | None =
         except Exception:   # an instance would not reset: once more on fresh ones
             loaded.discard_pool()
             outcomes = run_lockstep(scenes, loaded.fmu, loaded.instances(len(scenes)))
-    except Exception as exc:   # the batch as a whole could not run: every case fails with the reason
-        message = str(exc) if isinstance(exc, SceneError) else f"{type(exc).__name__}: {exc}"
+    except StopSignal:
+        raise
+    except BaseException as exc:   # the batch as a whole could not run: every case fails with the reason
+        message = str(exc) if isinstance(exc, SceneError) else failure_message(exc)
         outcomes = [SceneError(message)] * len(cases)
         if loaded is not None and not isinstance(exc, SceneError):
             loaded.discard_pool()

@@ -69,6 +69,12 @@ class PointingCommand:
     about the line of sight y2, cross-elevation about z2)."""
 
     def __init__(self, u, u_dot, u_ddot, attitude, rates, accelerations):
+        # On the azimuth axis (the keyhole: rho2 = 0) the rates divide by zero and are inf or NaN, which
+        # the keyhole policy of the callers handles; numpy's warnings about it would only be noise.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self._solve(u, u_dot, u_ddot, attitude, rates, accelerations)
+
+    def _solve(self, u, u_dot, u_ddot, attitude, rates, accelerations):
         attitude, rates, accelerations = (np.asarray(a, dtype=float) for a in (attitude, rates, accelerations))
         w, w_dot = carrier_rate_and_acceleration(attitude, rates, accelerations)
         # v = C u with C = 0TG and C' = -[w x] C

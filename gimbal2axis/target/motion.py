@@ -29,6 +29,15 @@ from ..errors import SceneError, excerpt
 from .kinematics import unit_and_derivatives
 
 DIFFERENCE_STEP_S = 0.05
+# The farthest a target or a carrier is taken from the ellipsoid or from the carrier's start [m]:
+# beyond a geostationary orbit (3.6e7 m); a larger number is a typo, not a target.
+FARTHEST_M = 1e8
+# The fastest target or carrier [m/s]: beyond an orbital speed (7.8e3 m/s).
+FASTEST_M_S = 1e4
+# The range of each coordinate of a track (and of the [target] keys of the same name, spec.py).
+COORDINATE_RANGES = {"latitude_deg": (-90.0, 90.0), "longitude_deg": (-180.0, 360.0),
+                     "altitude_m": (-FARTHEST_M, FARTHEST_M), "north_m": (-FARTHEST_M, FARTHEST_M),
+                     "east_m": (-FARTHEST_M, FARTHEST_M), "down_m": (-FARTHEST_M, FARTHEST_M)}
 
 
 def enu_to_g(east, north, up, course):
@@ -47,30 +56,17 @@ class Track:
     `time` column [s] and either latitude_deg, longitude_deg, altitude_m (geodetic, WGS 84) or
     north_m, east_m, down_m (from `origin`, the carrier's start: pymap3d.ned2geodetic). Each
     coordinate is a C2 cubic spline through the samples (scipy's CubicSpline, not-a-knot ends, as
-    the recorded ship motions). Checked like them: a header with a time column, numbers in every
-    cell, at least 4 rows, time strictly increasing; refusals name the file, line and column."""
+    the recorded ship motions). Read by their reader (native/csv_table.py), so checked like them: a
+    header with a time column and no name twice, numbers in every cell, at least 4 rows, time
+    strictly increasing, a UTF-8 byte-order mark skipped; refusals name the file, line and column.
+    Each coordinate within COORDINATE_RANGES."""
 
     GEODETIC = ("latitude_deg", "longitude_deg", "altitude_m")
     LOCAL = ("north_m", "east_m", "down_m")
 
     def __init__(self, where: str, path: pathlib.Path, origin=None):
         self.path = path
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise SceneError(f"{where}: recorded track {path}: cannot read it: {getattr(exc, 'strerror', exc)}") \
-                from None
-        lines = [(number, line.strip()) for number, line in enumerate(text.splitlines(), start=1)
-                 if line.strip() and not line.lstrip().startswith("#")]
-        if lines and ";" in lines[0][1] and "time" in lines[0][1]:
-            raise SceneError(f"{where}: {path}: line {lines[0][0]} (the header) is separated by semicolons; the "
-                             "file must be comma-separated with '.' as the decimal point")
-        if not lines or "time" not in [c.strip() for c in lines[0][1].split(",")]:
-            raise SceneError(f"{where}: {path} is not a recorded track: its header (the first line that is not a "
-                             "comment) has no 'time' column (expected a header such as 'time,latitude_deg,"
-                             "longitude_deg,altitude_m', then rows of numbers)")
-        header_line, header = lines[0]
-        names = [c.strip() for c in header.split(",")]
+        names, table = self._read(where, path)
         for kind in (self.GEODETIC, self.LOCAL):
             if set(kind) <= set(names):
                 self.columns = kind
@@ -82,42 +78,13 @@ class Track:
         if extra:
             raise SceneError(f"{where}: {path}: unknown column(s) {excerpt(', '.join(extra))} (a track has time and "
                              f"{', '.join(self.columns)})")
-        rows = []
-        for row_number, (line_number, line) in enumerate(lines[1:], start=1):
-            cells = [c.strip() for c in line.split(",")]
-            if len(cells) != len(names):
-                raise SceneError(f"{where}: {path}: line {line_number} (data row {row_number}) has {len(cells)} "
-                                 f"cells, the header {len(names)}")
-            values = []
-            for name, cell in zip(names, cells):
-                try:
-                    value = float(cell)
-                except ValueError:
-                    what = "is empty" if not cell else f"is not a number: '{excerpt(cell)}'"
-                    raise SceneError(f"{where}: {path}: line {line_number} (data row {row_number}), column "
-                                     f"'{name}' {what}") from None
-                if not math.isfinite(value):
-                    raise SceneError(f"{where}: {path}: line {line_number} (data row {row_number}), column "
-                                     f"'{name}' is '{excerpt(cell)}', not a finite number")
-                values.append(value)
-            rows.append(values)
-        if len(rows) < 4:
-            raise SceneError(f"{where}: {path}: {len(rows)} data row(s); a track needs at least 4 (a cubic spline)")
-        table = np.array(rows)
         t = table[:, names.index("time")]
-        steps = np.flatnonzero(np.diff(t) <= 0)
-        if steps.size:
-            row = int(steps[0]) + 2
-            raise SceneError(f"{where}: {path}: line {lines[row][0]} (data row {row}): time {t[row - 1]:g} s does "
-                             f"not increase (the row before: {t[row - 2]:g} s)")
+        for name in self.columns:
+            self._check_range(where, path, name, table[:, names.index(name)])
         self.time = t
         self.t_start, self.t_end = float(t[0]), float(t[-1])
         coordinates = [table[:, names.index(c)] for c in self.columns]
         if self.columns == self.GEODETIC:
-            if np.any(np.abs(coordinates[0]) > 90.0):
-                row = int(np.flatnonzero(np.abs(coordinates[0]) > 90.0)[0]) + 1
-                raise SceneError(f"{where}: {path}: line {lines[row][0]} (data row {row}): latitude_deg "
-                                 f"{coordinates[0][row - 1]:g} is outside [-90, 90]")
             # a track across the antimeridian stays continuous for the spline
             coordinates[1] = np.degrees(np.unwrap(np.radians(coordinates[1])))
         elif origin is not None:
@@ -129,6 +96,38 @@ class Track:
         from scipy.interpolate import CubicSpline   # here: a scene without a track imports no scipy
 
         self.splines = [CubicSpline(t, c, bc_type="not-a-knot") for c in coordinates]
+
+    @staticmethod
+    def _read(where: str, path: pathlib.Path):
+        """(column names, values) of the file, read by the kernel's reader of recorded tables (the
+        ship-motion recordings' own)."""
+        from ..limits import MAX_RECORDING_BYTES, TooLarge, read_bounded
+        from ..native.csv_table import TableRefused, read_table
+
+        try:
+            text = read_bounded(path, MAX_RECORDING_BYTES, "a recorded track")
+        except OSError as exc:
+            raise SceneError(f"{where}: recorded track {path}: cannot read it: {exc.strerror or exc}") from None
+        except TooLarge as exc:
+            raise SceneError(f"{where}: recorded track {exc}") from None
+        try:
+            return read_table(text)
+        except TableRefused as exc:
+            reason = str(exc)
+            if reason.startswith(("not a recorded motion", "the file is empty")):   # the reader's words for a recording
+                raise SceneError(f"{where}: {path} is not a recorded track: its header (the first line that is not a "
+                                 "comment) has no 'time' column (expected a header such as 'time,latitude_deg,"
+                                 "longitude_deg,altitude_m', then rows of numbers)") from None
+            raise SceneError(f"{where}: {path}: {reason}") from None
+
+    @staticmethod
+    def _check_range(where: str, path: pathlib.Path, name: str, values: np.ndarray) -> None:
+        low, high = COORDINATE_RANGES[name]
+        outside = np.flatnonzero((values < low) | (values > high))
+        if outside.size:
+            row = int(outside[0]) + 1
+            raise SceneError(f"{where}: {path}: data row {row}: {name} {values[row - 1]:g} is outside "
+                             f"[{low:g}, {high:g}]")
 
     def check_covers(self, where: str, stop_time: float) -> None:
         # the differences reach DIFFERENCE_STEP_S beyond the run's ends
@@ -186,7 +185,16 @@ class MovingTarget:
 
     def kinematics(self, t):
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        return unit_and_derivatives(*self.relative(t))
+        with np.errstate(all="ignore"):   # a range of 0 or a position that is not finite: refused below
+            kinematics = unit_and_derivatives(*self.relative(t))
+        r = kinematics[3]
+        bad = np.flatnonzero(~(np.isfinite(r) & (r > 0.0)))
+        if bad.size:
+            at = float(t[bad[0]])
+            raise SceneError(f"target: at t = {at:g} s the {self.kind} target is "
+                             + ("at the gimbal (range 0)" if r[bad[0]] == 0.0 else f"at range {r[bad[0]]:g} m")
+                             + ": the line of sight has no direction")
+        return kinematics
 
     def direction(self, t):
         return self.kinematics(t)[0]

@@ -26,8 +26,11 @@ from __future__ import annotations
 import math
 import pathlib
 
-from ..errors import SceneError, boolean, check_keys, did_you_mean, non_negative, number, positive, shown
-from .motion import Carrier, EarthPoint, Flyby, RecordedTarget, Track
+import numpy as np
+
+from ..errors import SceneError, boolean, check_keys, did_you_mean, positive, shown, within
+from .motion import COORDINATE_RANGES, DIFFERENCE_STEP_S, FARTHEST_M, FASTEST_M_S, Carrier, EarthPoint, Flyby, \
+    RecordedTarget, Track
 
 MOVING_KINDS = ("earth_point", "flyby", "track")
 KINDS = ("direction",) + MOVING_KINDS
@@ -40,6 +43,17 @@ KIND_KEYS = {
 CARRIER_KEYS = {"latitude_deg", "longitude_deg", "altitude_m", "course_deg", "speed_m_s", "track"}
 DEFAULT_BEAM_WIDTH_MRAD = 1.0
 DEFAULT_KEYHOLE_DEG = 10.0
+# The latest closest approach of a flyby from the run's start [s] (about 30 years): a larger number is a typo.
+LATEST_S = 1e9
+# Every number of [target] and [target.carrier] by key: (low, high), both included (docs/targets.md).
+KEY_RANGES = {**COORDINATE_RANGES, "course_deg": (-360.0, 360.0), "heading_deg": (-360.0, 360.0),
+              "speed_m_s": (0.0, FASTEST_M_S), "closest_approach_m": (-FARTHEST_M, FARTHEST_M),
+              "closest_approach_s": (-LATEST_S, LATEST_S), "beam_width_mrad": (0.0, 2000.0 * math.pi)}
+
+
+def within_range(where: str, key: str, value) -> float:
+    """The finite number `value` of `key` (in table `where`) within KEY_RANGES[key]."""
+    return within(f"{where}.{key}", value, *KEY_RANGES[key])
 
 
 def kind_of(table: dict) -> str:
@@ -54,8 +68,9 @@ def parse(table: dict) -> dict:
     kind = kind_of(table)
     check_keys("target", table, COMMON_KEYS | KIND_KEYS[kind])
     spec = {"type": kind, "start_on_target": boolean("target.start_on_target", table.get("start_on_target", False)),
-            "beam_width_mrad": positive("target.beam_width_mrad", table.get("beam_width_mrad",
-                                                                              DEFAULT_BEAM_WIDTH_MRAD)),
+            "beam_width_mrad": within_range("target", "beam_width_mrad",
+                                            positive("target.beam_width_mrad", table.get("beam_width_mrad",
+                                                                                         DEFAULT_BEAM_WIDTH_MRAD))),
             "keyhole_deg": positive("target.keyhole_deg", table.get("keyhole_deg", DEFAULT_KEYHOLE_DEG))}
     if spec["keyhole_deg"] >= 90.0:
         raise SceneError(f"target.keyhole_deg = {spec['keyhole_deg']:g} must be below 90 (degrees from the azimuth "
@@ -64,21 +79,22 @@ def parse(table: dict) -> dict:
     if not isinstance(carrier, dict):
         raise SceneError(f"target.carrier must be a table ([target.carrier]), got {shown(carrier)}")
     check_keys("target.carrier", carrier, CARRIER_KEYS)
-    spec["carrier"] = {key: number(f"target.carrier.{key}", value) for key, value in carrier.items() if key != "track"}
+    spec["carrier"] = {key: within_range("target.carrier", key, value) for key, value in carrier.items()
+                       if key != "track"}
     if "track" in carrier:
         if not isinstance(carrier["track"], str):
             raise SceneError(f"target.carrier.track must be a file name, got {shown(carrier['track'])}")
         spec["carrier"]["track"] = carrier["track"]
     if "speed_m_s" in carrier:
-        non_negative("target.carrier.speed_m_s", carrier["speed_m_s"])
         if "track" in carrier:
             raise SceneError("target.carrier has both speed_m_s and track: the carrier sails at a speed or follows "
                              "its recorded track, not both")
-    if abs(spec["carrier"].get("latitude_deg", 0.0)) > 90.0:
-        raise SceneError(f"target.carrier.latitude_deg = {spec['carrier']['latitude_deg']:g} is outside [-90, 90]")
+    if abs(spec["carrier"].get("latitude_deg", 0.0)) == 90.0 and spec["carrier"].get("speed_m_s", 0.0) > 0.0:
+        raise SceneError(f"target.carrier.latitude_deg = {spec['carrier']['latitude_deg']:g}: a carrier at a pole has "
+                         "no course to sail (target.carrier.speed_m_s must be 0 there)")
     for key in KIND_KEYS[kind] - {"file"}:
         if key in table:
-            spec[key] = number(f"target.{key}", table[key])
+            spec[key] = within_range("target", key, table[key])
     if kind == "earth_point":
         geodetic = {"latitude_deg", "longitude_deg"} & set(table)
         local = {"north_m", "east_m", "down_m"} & set(table)
@@ -93,8 +109,6 @@ def parse(table: dict) -> dict:
                              "north_m, east_m, down_m from the carrier's start")
         if local and "altitude_m" in table:
             raise SceneError("target: altitude_m is for a geodetic point; a local one gives down_m")
-        if geodetic and abs(spec["latitude_deg"]) > 90.0:
-            raise SceneError(f"target.latitude_deg = {spec['latitude_deg']:g} is outside [-90, 90]")
         if geodetic and not {"latitude_deg", "longitude_deg"} <= set(carrier) and "track" not in carrier:
             raise SceneError("target: a geodetic point needs the carrier's position: [target.carrier] latitude_deg "
                              "and longitude_deg (or track)")
@@ -141,8 +155,41 @@ def build(spec: dict, base_dir: pathlib.Path):
 
 
 def check_run(target, stop_time: float) -> None:
-    """Refuses recorded tracks that do not cover the run (with the margin the rates need)."""
+    """Refuses recorded tracks that do not cover the run (with the margin the rates need), a carrier
+    that sails onto a pole during the run and a target where the gimbal is at the start."""
     if getattr(target, "track", None) is not None:
         target.track.check_covers("target.file", stop_time)
     if target.carrier.track is not None:
         target.carrier.track.check_covers("target.carrier.track", stop_time)
+    check_off_the_poles(target.carrier, stop_time)
+    check_apart(target)
+
+
+# The nearest a target may be to the gimbal at the start [m]: nearer, its direction is rounding noise.
+NEAREST_M = 1e-3
+
+
+def check_off_the_poles(carrier: Carrier, stop_time: float) -> None:
+    """Refuses a carrier whose rhumb line reaches a pole within the run (and the differences' margin):
+    there its course, the frame G, is undefined (pymap3d gives latitudes beyond 90 degrees)."""
+    if carrier.track is not None or carrier.speed == 0.0:
+        return
+    with np.errstate(all="ignore"):
+        latitude = carrier.geodetic(np.array([-DIFFERENCE_STEP_S, stop_time + DIFFERENCE_STEP_S]))[0]
+    if not np.all(np.abs(latitude) < 90.0):
+        raise SceneError(f"target.carrier: sailing course_deg = {math.degrees(carrier.course):g} at speed_m_s = "
+                         f"{carrier.speed:g} from latitude_deg = {carrier.latitude_deg!r}, it reaches a pole before "
+                         f"the run ends ({stop_time:g} s), where a course has no meaning")
+
+
+def check_apart(target) -> None:
+    """Refuses a target at the gimbal at the start (range below NEAREST_M): the line of sight has no
+    direction there."""
+    with np.errstate(all="ignore"):
+        p = target.relative(np.array([0.0]))[0]
+    distance = float(np.sqrt(np.sum(p * p)))
+    if not distance >= NEAREST_M:
+        keys = {"earth_point": "latitude_deg, longitude_deg, altitude_m or north_m, east_m, down_m",
+                "track": "file", "flyby": "closest_approach_m, altitude_m"}.get(target.kind, "type")
+        raise SceneError(f"target: the target ({keys}) is {distance:g} m from the gimbal at t = 0 s: the line of "
+                         f"sight has no direction; a target is at least {NEAREST_M:g} m away")

@@ -28,8 +28,8 @@ from ..fmu.worker_cache import fmu_digest
 from ..scene.scene import check_against_fmu, load_scene
 from ..sweep import store
 from ..sweep.names import check_cases_accepted, resolve_names
-from ..sweep.runner import Case, make_client, close_client, cases_per_task, _worker_count
-from ..sweep.spec import Sweep, apply_case, canonical, scene_hash
+from ..sweep.runner import Case, CaseSignals, make_client, close_client, cases_per_task, _worker_count
+from ..sweep.spec import Sweep, apply_case, canonical, check_metrics_window, scene_hash
 from . import objective as judge
 from .spec import TuneError, Tuning, load_tuning
 from .worker import run_tune_cases
@@ -114,10 +114,17 @@ def plan(scene_path, tuning_path, fmu_path, out_dir, tuning: Tuning | None = Non
             values.update(scenario)
             case = Case(0, "", dict(probe_values, **values))
             try:
-                check_against_fmu(apply_case(scene, resolved, values, tuning.stop_time), fmu)
+                scenario_scene = apply_case(scene, resolved, values, tuning.stop_time)
+                check_against_fmu(scenario_scene, fmu)
             except (SceneError, TypeError, ValueError, KeyError) as exc:
                 case.error = f"invalid case: {exc}"
                 check_cases_accepted(scene, sweep, fmu, resolved, [case], candidates)
+            else:
+                try:
+                    check_metrics_window(tuning.metrics_from_s, scenario_scene.stop_time, "the stop time of its runs",
+                                         TuneError)
+                except TuneError as exc:
+                    raise TuneError(f"{tuning.path}: {exc}") from None
         if not scene.target_spec:
             raise TuneError(f"{tuning.path}: scene {scene.name} has no [target]: there is no line-of-sight error to "
                             f"minimize")
@@ -238,10 +245,12 @@ class Evaluator:
         if not cases:
             return
         if self.options.serial:
-            for key, values, labels, scene in cases:
-                row, = run_tune_cases([(scene, key)], problem.fmu_bytes, problem.fmu_sha, tuning.metrics_from_s,
-                                      tuning.bands)
-                self._record(key, values, labels, row, role)
+            with CaseSignals() as signals:   # only Ctrl-C and SIGTERM stop the tuning, not the controller's code
+                for key, values, labels, scene in cases:
+                    row, = run_tune_cases([(scene, key)], problem.fmu_bytes, problem.fmu_sha, tuning.metrics_from_s,
+                                          tuning.bands)
+                    signals.check()
+                    self._record(key, values, labels, row, role)
             return
         self._run_dask(cases, role)
 

@@ -19,6 +19,7 @@ import html
 import json
 import math
 import pathlib
+import urllib.parse
 
 import numpy as np
 
@@ -204,7 +205,7 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
             f"<p>Objective: {html.escape(tuning.objective.describe())}; {len(problem.scenarios)} runs per candidate "
             f"(robustness set), sampler {tuning.sampler}, seed {tuning.seed}; {len(trials)} candidates, "
             f"{result.evaluations_run} evaluations run now, {result.evaluations_reused} from the table.</p>",
-            "<h2>Convergence</h2>", f"<img src='{figures['convergence'].name}' width='800'>",
+            "<h2>Convergence</h2>", _image(figures['convergence'], 800),
             "<h2>Best candidates</h2>",
             _table(["trial"] + names + ["objective_mrad", "worst_i_frac_peak", "worst_i_peak_A", "worst_u_sat_s",
                                         "gm_az_db", "pm_az_deg", "gm_el_db", "pm_el_deg"], top)]
@@ -214,7 +215,7 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
     page += ["<h2>Compared on the scene's own sea</h2>",
              "<p>" + "<br>".join(f"{html.escape(label)}: {html.escape(describe_candidate(c))}"
                                  for label, c in candidates.items()) + "</p>",
-             f"<img src='{figures['time_psd'].name}' width='1000'>",
+             _image(figures['time_psd'], 1000),
              "<h3>Pointing error budget per axis [mrad] (slope in mrad/s)</h3>",
              _table(["candidate", "axis", "bias", "drift_slope_per_s", "drift_rms", "sea", "loop", "high", "total", "rms"],
                     [dict(candidate=label, axis=axis, **values) for label, by_axis in budget_rows.items()
@@ -222,7 +223,7 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
              f"<p>Bands: sea [0, {budgets.SEA_HZ:g}) Hz, loop [{budgets.SEA_HZ:g}, {budgets.HIGH_HZ:g}) Hz, high "
              f"[{budgets.HIGH_HZ:g} Hz, Nyquist]; total = root-sum-square of the bias and the bands.</p>"]
     if "loops" in figures:
-        page += ["<h2>Sensitivity and complementary sensitivity</h2>", f"<img src='{figures['loops'].name}' width='1000'>"]
+        page += ["<h2>Sensitivity and complementary sensitivity</h2>", _image(figures['loops'], 1000)]
     if held:
         page += [f"<h2>Held out: {len(problem.holdout)} runs the tuning did not see</h2>",
                  _table(["candidate", "objective_mrad", "feasible", "worst_i_frac_peak"],
@@ -241,6 +242,12 @@ def _save(fig, path: pathlib.Path) -> pathlib.Path:
     store.publish(path, lambda p: fig.savefig(p, dpi=100, format="png"))
     plt.close(fig)
     return path
+
+
+def _image(path: pathlib.Path, width: int) -> str:
+    """An <img> of the figure file `path` beside the page: its name (the scene's file name is part of
+    it) URL-quoted, then escaped for the attribute, so that it is a link to that file and never markup."""
+    return f"<img src='{html.escape(urllib.parse.quote(path.name), quote=True)}' width='{width}'>"
 
 
 def _table(columns: list, rows: list) -> str:

@@ -49,10 +49,14 @@ from __future__ import annotations
 
 import math
 import pathlib
+import sys
 from dataclasses import dataclass, field
 
-from ..errors import did_you_mean, excerpt, read_toml, shown
-from ..sweep.spec import DISTRIBUTIONS, SweepError, _check_distribution, draw, parse_name
+from ..errors import did_you_mean, excerpt, shown
+from ..limits import read_toml
+from ..limits import (MAX_DESCRIPTION_CHARS, MAX_SCENARIOS, MAX_TUNE_BATCH, MAX_TUNE_PARAMETERS, MAX_TUNE_TRIALS,
+                      over_limit, too_long)
+from ..sweep.spec import DISTRIBUTIONS, SweepError, _check_distribution, check_metrics_window, draw, parse_name
 
 TOP_KEYS = {"name", "description", "seed", "stop_time", "metrics_from_s", "parameters", "objective", "constraints",
             "robustness", "holdout", "optimizer"}
@@ -70,6 +74,10 @@ CONSTRAINT_KEYS = {"peak_current_fraction", "voltage_saturation_max_s", "gain_ma
 ROBUSTNESS_KEYS = {"seeds", "sea_states", "draws", "draw", "seed"}
 OPTIMIZER_KEYS = {"sampler", "trials", "batch"}
 SAMPLERS = ("cmaes", "tpe", "random")
+
+
+# Optuna's samplers seed numpy's legacy RandomState, which takes 32 bits.
+MAX_SAMPLER_SEED = 2 ** 32 - 1
 
 
 class TuneError(SweepError):
@@ -248,6 +256,9 @@ def _parameter(name: str, spec) -> Parameter:
     low, high = (_number(f"{where}: bounds", b) for b in bounds)
     if not low < high:
         raise TuneError(f"{where}: bounds = [{low:g}, {high:g}]: low must be below high")
+    if not math.isfinite(high - low):   # the samplers draw and scale by the width
+        raise TuneError(f"{where}: bounds = [{low:g}, {high:g}] are {high - low:g} apart: their width must be a "
+                        f"finite number (at most {sys.float_info.max:.3g})")
     scale = spec.get("scale", "linear")
     if scale not in SCALES:
         raise TuneError(f"{where}: 'scale' must be \"linear\" or \"log\", got {shown(scale)}"
@@ -352,6 +363,7 @@ def _scenario_set(section: str, raw, default_seed: int) -> ScenarioSet:
             if isinstance(value, (dict, list)):
                 raise TuneError(f"[{section}] sea_states: '{excerpt(name)}' must be a value, got {shown(value)}")
     draws = _integer(f"[{section}] draws", table.get("draws", 0), 0)
+    over_limit(f"[{section}] draws", draws, MAX_SCENARIOS, " draws", TuneError)
     spec = _flatten(_table(f"[{section}.draw]", table.get("draw", {})))
     try:
         spec = {name: _check_distribution(name, value) for name, value in spec.items()}
@@ -364,6 +376,10 @@ def _scenario_set(section: str, raw, default_seed: int) -> ScenarioSet:
     if spec and not draws:
         raise TuneError(f"[{section}.draw] is given but draws = 0: say how many draws (draws = N)")
     seed = _integer(f"[{section}] seed", table.get("seed", default_seed), 0)
+    members = len(seas) * max(len(seeds), 1) * max(draws, 1)
+    if members > MAX_SCENARIOS:   # every candidate runs on each
+        raise TuneError(f"[{section}]: {len(seas)} sea states x {max(len(seeds), 1)} seeds x {max(draws, 1)} draws = "
+                        f"{members:,} runs per candidate, over the limit of {MAX_SCENARIOS:,}")
     return ScenarioSet(seas, tuple(seeds), draws, spec, seed)
 
 
@@ -377,19 +393,21 @@ def load_tuning(path) -> Tuning:
         if not isinstance(name, str) or not name.replace("_", "").replace("-", "").isalnum():
             raise TuneError("'name' must be a string of letters, digits, '_' and '-' (it names the result files)")
         seed = _integer("'seed'", raw.get("seed", 0), 0)
+        over_limit("'seed'", seed, MAX_SAMPLER_SEED, " (the seeds Optuna's samplers take)", TuneError)
         stop_time = raw.get("stop_time")
         if stop_time is not None:
             stop_time = _number("'stop_time'", stop_time, positive=True)
         from_s = raw.get("metrics_from_s")
         if from_s is not None:
             from_s = _number("'metrics_from_s'", from_s, minimum=0.0)
-            if stop_time is not None and from_s >= stop_time:
-                raise TuneError(f"'metrics_from_s' = {from_s:g} must be below stop_time = {stop_time:g}")
+            check_metrics_window(from_s, stop_time, error=TuneError)
         if "parameters" not in raw:
             raise TuneError("nothing to tune: give a [parameters] table of name = { bounds = [low, high] }")
         parameters = [_parameter(n, s) for n, s in _flatten(_table("[parameters]", raw["parameters"])).items()]
         if not parameters:
             raise TuneError("[parameters] is empty: nothing to tune")
+        over_limit("[parameters]: the number of tuned parameters", len(parameters), MAX_TUNE_PARAMETERS, "",
+                   TuneError)
         objective = _objective(raw.get("objective", {}))
         constraints = _constraints(raw.get("constraints", {}))
         robustness = _scenario_set("robustness", raw.get("robustness", {}), seed)
@@ -406,10 +424,16 @@ def load_tuning(path) -> Tuning:
             raise TuneError(f"[optimizer] sampler must be one of {', '.join(SAMPLERS)}, got {shown(sampler)}"
                             f"{did_you_mean(sampler, SAMPLERS)}")
         trials = _integer("[optimizer] trials", optimizer.get("trials", 60), 1)
+        over_limit("[optimizer] trials", trials, MAX_TUNE_TRIALS, " candidates", TuneError)
         default_batch = 4 + int(3 * math.log(len(parameters)))   # CMA-ES's default population
         batch = _integer("[optimizer] batch", optimizer.get("batch", default_batch), 1)
+        over_limit("[optimizer] batch", batch, MAX_TUNE_BATCH, " candidates", TuneError)
+        description = raw.get("description", "")
+        if not isinstance(description, str):
+            raise TuneError(f"'description' must be a string, got {shown(description)}")
+        too_long("'description'", len(description), MAX_DESCRIPTION_CHARS, error=TuneError)
     except TuneError as exc:
         raise TuneError(f"{path}: {exc}") from None
-    return Tuning(path=path, name=name, description=str(raw.get("description", "")), seed=seed, stop_time=stop_time,
+    return Tuning(path=path, name=name, description=description, seed=seed, stop_time=stop_time,
                   metrics_from_s=from_s, parameters=parameters, objective=objective, constraints=constraints,
                   robustness=robustness, holdout=holdout, sampler=sampler, trials=trials, batch=batch, raw=raw)

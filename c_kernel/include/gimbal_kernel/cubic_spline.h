@@ -19,6 +19,11 @@ long gimbal_cubic_spline_coefficient_count(long n);
  * 0; 1 when n < 4 (scipy's smaller cases are other curves); -1 when out of memory. */
 int gimbal_cubic_spline_fit(long n, const double* x, const double* y, double* coefficients);
 
+/* The first interval i (from x_i to x_{i+1}) on which the spline's value, first or second derivative
+ * could overflow a double, evaluated anywhere in it or up to its length beyond either end (as the
+ * end intervals are when extrapolated); -1 when none could: then every evaluation there is finite. */
+long gimbal_cubic_spline_first_overflow(long n, const double* x, const double* coefficients);
+
 /* The spline's value (derivative 0), first or second derivative at t. Outside [x_0, x_{n-1}] the end
  * intervals' cubics continue (as scipy extrapolates). */
 double gimbal_cubic_spline_evaluate(long n, const double* x, const double* coefficients, double t, int derivative);
