@@ -14,7 +14,7 @@ import pytest
 from gimbal2axis import SceneError, load_scene, run
 from gimbal2axis.scene import geometry
 from gimbal2axis.system.engines import run_fmpy_ssp, run_libcosim, run_libcosim_ssp
-from gimbal2axis.system.from_scene import ship_system
+from gimbal2axis.system.from_scene import GIMBAL as GIMBAL_UNIT, ship_system
 from gimbal2axis.system.osp import write_osp
 from gimbal2axis.system.ssp import write_ssp
 
@@ -51,7 +51,7 @@ def los_error(scene, alpha, beta):
 def test_libcosim_runs_the_osp_structure_as_the_scene_runner(scene, system, reference, tmp_path):
     structure = write_osp(system, tmp_path / "osp")
     steps = int(round(STOP / scene.step_size))
-    got = run_libcosim(structure, "gimbal", GIMBAL, steps)
+    got = run_libcosim(structure, GIMBAL_UNIT, GIMBAL, steps)
     assert np.allclose(got["time"], np.arange(1, steps + 1) * scene.step_size, rtol=0, atol=1e-12)
     # the same computation; libcosim's clock (integer nanoseconds) passes steps a few ulps off h
     for name in ("alpha", "beta"):
@@ -79,7 +79,8 @@ def test_libcosim_refuses_a_group_the_model_description_does_not_have(system, tm
     from libcosimpy.CosimExecution import CosimExecution
 
     structure = write_osp(system, tmp_path / "osp")
-    text = structure.read_text().replace('simulator="gimbal" name="gimbal_angles"', 'simulator="gimbal" name="angles"')
+    text = structure.read_text().replace(f'simulator="{GIMBAL_UNIT}" name="gimbal_angles"',
+                                         f'simulator="{GIMBAL_UNIT}" name="angles"')
     structure.write_text(text)
     with pytest.raises(AssertionError):
         CosimExecution.from_osp_config_file(str(structure))
@@ -129,7 +130,7 @@ def test_libcosim_runs_the_ssp_archive_on_the_step_it_states_as_the_scene_runner
     """A second SSP engine: libcosim's own SSP loader, given no step (it takes the archive's)."""
     archive = write_ssp(system, tmp_path / "ship.ssp")
     steps = int(round(STOP / scene.step_size))
-    got = run_libcosim_ssp(archive, "gimbal", GIMBAL, steps)
+    got = run_libcosim_ssp(archive, GIMBAL_UNIT, GIMBAL, steps)
     assert np.allclose(got["time"], np.arange(1, steps + 1) * scene.step_size, rtol=0, atol=1e-12)
     # the same computation as the OSP structure's (test above)
     for name in ("alpha", "beta"):
@@ -142,7 +143,7 @@ def test_libcosim_takes_its_step_from_the_archive(system, tmp_path):
     """The step libcosim's SSP loader runs is the archive's: the same system stated with 2 ms steps is
     stepped at 2 ms. (Without the annotation libcosimpy 0.0.6 has no algorithm and crashes the process.)"""
     archive = write_ssp(dataclasses.replace(system, step=2e-3), tmp_path / "two_ms.ssp")
-    got = run_libcosim_ssp(archive, "gimbal", ["alpha"], 5)
+    got = run_libcosim_ssp(archive, GIMBAL_UNIT, ["alpha"], 5)
     assert np.allclose(got["time"], np.arange(1, 6) * 2e-3, rtol=0, atol=1e-12)
 
 
@@ -152,8 +153,8 @@ def test_fmpy_runs_the_ssp_archive_with_the_start_transient_of_its_zero_connecti
     from fmpy.ssp.ssd import read_ssd
     read_ssd(str(archive), validate=True)   # against the SSP 1.0 schema
     with zipfile.ZipFile(archive) as contents:
-        assert {"SystemStructure.ssd", "resources/gimbal.ssv", "resources/Gimbal2Axis.fmu"} <= set(contents.namelist())
-    got = run_fmpy_ssp(archive, "gimbal", GIMBAL, scene.step_size, STOP)
+        assert {"SystemStructure.ssd", f"resources/{GIMBAL_UNIT}.ssv", "resources/Gimbal2Axis.fmu"} <= set(contents.namelist())
+    got = run_fmpy_ssp(archive, GIMBAL_UNIT, GIMBAL, scene.step_size, STOP)
     steps = len(reference["alpha"])
     got = {name: values[:steps] for name, values in got.items()}
     error = los_error(scene, got["alpha"], got["beta"])
@@ -182,8 +183,8 @@ def test_names_with_xml_characters_make_valid_structures(scene, build_dir, tmp_p
     ssd = ET.fromstring(zipfile.ZipFile(write_ssp(named, tmp_path / "awkward.ssp")).read("SystemStructure.ssd"))
     assert ssd.get("name") == awkward
     assert [element.get("name") for element in ssd.iter() if element.tag.endswith("}System")] == [awkward]
-    parameters = ET.fromstring(zipfile.ZipFile(tmp_path / "awkward.ssp").read("resources/gimbal.ssv"))
-    assert parameters.get("name") == f"{awkward}.gimbal"
+    parameters = ET.fromstring(zipfile.ZipFile(tmp_path / "awkward.ssp").read(f"resources/{GIMBAL_UNIT}.ssv"))
+    assert parameters.get("name") == f"{awkward}.{GIMBAL_UNIT}"
     osp = ET.parse(write_osp(named, tmp_path / "osp")).getroot()
     assert {element.get("name") for element in osp.iter() if element.tag.endswith("}Simulator")} == \
         {component.name for component in named.components}

@@ -37,7 +37,8 @@ fundamental / fundamental of the sampled base.<axis>_dot); "los" is sqrt(|G1|^2 
 
 The same loop broken at one motor's computed voltage gives the loop gain a voltage injection measures
 (Excitation("injection", ...)): loop_gain, injection_sensitivity, injection_response, loop_gain_rows /
-loop_gain_lines, and the classical margins of a sampled L (stability_margins, predicted_margins).
+loop_gain_lines, and the classical margins of a sampled L (stability_margins, predicted_margins), with the
+lower gain margin of a conditionally stable loop.
 """
 from __future__ import annotations
 
@@ -487,15 +488,26 @@ def loop_gain_lines(loop: IsolationLoop, axis: str, f_min: float, f_max: float, 
 
 @dataclasses.dataclass(frozen=True)
 class StabilityMargins:
-    """Classical margins of a negative-feedback loop gain L (NaN where there is no such crossing)."""
+    """Classical margins of a negative-feedback loop gain L (NaN where there is no such crossing).
+
+    A loop whose plant is open-loop unstable (a top-heavy payload's elevation) is conditionally stable: L
+    also passes -180 deg where |L| > 1, and there the gain may not DROP by more than the lower gain margin
+    (negative dB) before the loop goes unstable. The stable range of a gain factor k on L is
+    10^(lower/20) < k < 10^(upper/20)."""
     crossover_hz: float        # |L| = 1
     phase_margin_deg: float    # 180 deg + the phase of L there, in (-180, 180]
-    phase_crossover_hz: float  # phase of L = -180 deg (L crosses the negative real axis)
-    gain_margin_db: float      # -20 log10 |L| there: how much more gain makes the loop marginal
+    phase_crossover_hz: float  # phase of L = -180 deg with |L| <= 1, of the upper gain margin
+    gain_margin_db: float      # -20 log10 |L| there (>= 0): how much more gain makes the loop marginal
+    lower_phase_crossover_hz: float = math.nan   # phase of L = -180 deg with |L| > 1, of the lower gain margin
+    lower_gain_margin_db: float = math.nan       # -20 log10 |L| there (< 0): how much less gain makes it marginal
 
     def describe(self) -> str:
-        return (f"crossover {self.crossover_hz:.4g} Hz, phase margin {self.phase_margin_deg:.3g} deg; "
+        text = (f"crossover {self.crossover_hz:.4g} Hz, phase margin {self.phase_margin_deg:.3g} deg; "
                 f"-180 deg at {self.phase_crossover_hz:.4g} Hz, gain margin {self.gain_margin_db:.3g} dB")
+        if math.isfinite(self.lower_gain_margin_db):
+            text += (f"; -180 deg at {self.lower_phase_crossover_hz:.4g} Hz, "
+                     f"lower gain margin {self.lower_gain_margin_db:.3g} dB")
+        return text
 
 
 def stability_margins(frequencies, L) -> StabilityMargins:
@@ -504,21 +516,34 @@ def stability_margins(frequencies, L) -> StabilityMargins:
     Crossings are located between grid points by linear interpolation in log frequency (of log |L| for
     the gain crossover, of the phase of -L for the phase crossover; the phase at the gain crossover is
     interpolated on the unwrapped phase). Of several crossings the worst is reported: the gain crossover
-    with the smallest |phase margin| and the phase crossover with the smallest |gain margin| in dB (a
-    resonance may cross twice). A -180 deg crossing is one where the phase of -L passes 0 (L on the
-    negative real axis), not a jump of the wrapped phase at +-180 deg of -L.
+    with the smallest |phase margin|; of the phase crossovers with |L| <= 1 the smallest gain margin in
+    dB (the upper margin), of those with |L| > 1 the largest, i.e. nearest 0 dB (the lower margin, of a
+    conditionally stable loop; a resonance may cross twice). A -180 deg crossing is one where the phase of
+    -L passes 0 (L on the negative real axis), not a jump of the wrapped phase at +-180 deg of -L.
 
     Not python-control's `stability_margins(frd(L, 2 pi f), returnall=True)`, although it finds the
     same crossings (to 1e-5 on the textbook loops of tests/test_loop_gain.py, control 0.10.2): on the
     40,000-point grids used here it took 3.9 s of CPU per call against 2.8 ms for this one (measured
-    2026-11-25), and `predicted_margins` calls it per axis and per scene."""
+    2026-11-25), and `predicted_margins` calls it per axis and per scene. Without returnall, python-control
+    returns one gain margin, the one nearest 0 dB, which for a conditionally stable loop may be the lower."""
     f = np.asarray(frequencies, float)
     L = np.asarray(L, complex)
     if f.ndim != 1 or f.shape != L.shape or len(f) < 2 or np.any(np.diff(f) <= 0) or np.any(f <= 0):
         raise SceneError("stability_margins needs increasing positive frequencies and one L value each")
     x = np.log(f)
     magnitude = np.log(np.maximum(np.abs(L), 1e-300))
-    phase = np.unwrap(np.angle(L))
+    crossover_hz, phase_margin = _gain_crossover(x, magnitude, np.unwrap(np.angle(L)))
+    crossings = _phase_crossovers(x, magnitude, L)
+    upper = [(gain_db, hz) for hz, gain_db in crossings if gain_db >= 0.0]
+    lower = [(gain_db, hz) for hz, gain_db in crossings if gain_db < 0.0]
+    gain_margin, phase_crossover_hz = min(upper) if upper else (math.nan, math.nan)
+    lower_margin, lower_hz = max(lower) if lower else (math.nan, math.nan)
+    return StabilityMargins(float(crossover_hz), float(phase_margin), float(phase_crossover_hz), float(gain_margin),
+                            float(lower_hz), float(lower_margin))
+
+
+def _gain_crossover(x, magnitude, phase) -> tuple:
+    """(frequency, phase margin) of the |L| = 1 crossing with the smallest |phase margin|, or NaNs."""
     crossings = []
     for k in np.flatnonzero(np.sign(magnitude[:-1]) * np.sign(magnitude[1:]) <= 0):
         if magnitude[k] == magnitude[k + 1]:
@@ -527,18 +552,21 @@ def stability_margins(frequencies, L) -> StabilityMargins:
         angle = phase[k] + s * (phase[k + 1] - phase[k])
         margin = (math.degrees(angle) + 180.0 + 180.0) % 360.0 - 180.0   # (-180, 180]: wrapped 180 + phase
         crossings.append((abs(margin), math.exp(x[k] + s * (x[k + 1] - x[k])), margin))
+    return min(crossings)[1:] if crossings else (math.nan, math.nan)
+
+
+def _phase_crossovers(x, magnitude, L) -> list:
+    """[(frequency, -20 log10 |L| in dB), ...] of every crossing of L over the negative real axis."""
     negative_phase = np.angle(-L)           # 0 where L is on the negative real axis
-    phase_crossings = []
+    crossings = []
     for k in np.flatnonzero(np.sign(negative_phase[:-1]) * np.sign(negative_phase[1:]) <= 0):
         a, b = negative_phase[k], negative_phase[k + 1]
         if abs(a - b) > math.pi or a == b:   # a wrap at +-180 deg of -L: L crossing the positive real axis
             continue
         s = a / (a - b)
         gain_db = -20.0 / math.log(10.0) * (magnitude[k] + s * (magnitude[k + 1] - magnitude[k]))
-        phase_crossings.append((abs(gain_db), math.exp(x[k] + s * (x[k + 1] - x[k])), gain_db))
-    crossover_hz, phase_margin = min(crossings)[1:] if crossings else (math.nan, math.nan)
-    phase_crossover_hz, gain_margin = min(phase_crossings)[1:] if phase_crossings else (math.nan, math.nan)
-    return StabilityMargins(float(crossover_hz), float(phase_margin), float(phase_crossover_hz), float(gain_margin))
+        crossings.append((math.exp(x[k] + s * (x[k + 1] - x[k])), gain_db))
+    return crossings
 
 
 def predicted_margins(loop: IsolationLoop, axis: str, f_min: float = 0.01, f_max: float | None = None,

@@ -17,7 +17,8 @@ lines, and its values at the simulated frequencies are rows of curve "linear mod
 (gimbal2axis.analysis.linearization); isolation and loop-gain, the sampled-data closed loop of the scene's
 PID controller (gimbal2axis.analysis.isolation_prediction; for another controller, or a loop that does not
 settle, the command says so and measures without it). loop-gain also prints the predicted crossover,
-phase and gain margins.
+phase and gain margins, and the lower gain margin of a conditionally stable loop (an open-loop unstable
+plant: the top-heavy payload's elevation), where the gain may not drop by more.
 
 Every simulated point is checked: harmonics and drift of its output over the window, and against the
 linear prediction (the "no backlash, no dry friction" points) and its operating point (open loop: the

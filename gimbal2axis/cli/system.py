@@ -38,9 +38,9 @@ def _write(args) -> int:
     out = pathlib.Path(args.out)
     try:
         structure = write_osp(system, out / "osp")
-    except ValueError as exc:   # what libcosim cannot set
+        archive = write_ssp(system, out / f"{scene.name}.ssp")
+    except ValueError as exc:   # what libcosim cannot set; a component name an SSP importer would misread
         raise SceneError(str(exc)) from None
-    archive = write_ssp(system, out / f"{scene.name}.ssp")
     print(f"wrote {structure} (with the FMUs and their OSP model descriptions) and {archive}")
     return 0
 

@@ -10,8 +10,13 @@ Conventions (docs/jitter.md):
 - The mean over the whole window is removed once, not per segment: a per-segment detrend would
   throw away the power at periods longer than a segment (a sea's 10-s swell under 2-s segments);
   kept, it lands in the lowest bins. So the PSD and its cumulative RMS account for the signal's
-  variance (Parseval: sum(PSD) * df = variance, up to the estimate's statistics and the window's
-  half-segment ends), and the mean (a static pointing offset) is reported separately.
+  variance, and the mean (a static pointing offset) is reported separately. Exactly (Parseval, per
+  segment), sum(PSD) * df is the mean square of the samples weighted by welch_sample_weights: the
+  segments' squared Hann windows summed, which taper over the first and last half segment and, at
+  50 % overlap, swing between 1/2 and 1 of their peak once per step inside. For a stationary signal
+  that is its variance up to the estimate's statistics (within 1 % on noise: tests/test_cumulative_rms.py);
+  a window whose power is not evenly spread (a transient at its start, a sea of few long periods)
+  gets a top of the cumulative RMS some per cent off the window's standard deviation (docs/jitter.md).
 - Integrals are sums over bins times the bin width df (a bin holds the power around its centre);
   a bin belongs to the band [f_lo, f_hi) when its centre frequency does, and a band reaching the
   Nyquist frequency also holds the Nyquist bin, so bands that tile [0, Nyquist] tile the spectrum.
@@ -83,9 +88,23 @@ def psd(x, sample_rate: float, resolution_hz: float) -> Spectrum:
 
 
 def cumulative_rms(density: np.ndarray, resolution: float) -> np.ndarray:
-    """sqrt of the running integral of the PSD from 0 Hz up to each bin (inclusive): at the top it is
-    the standard deviation."""
+    """sqrt of the running integral of the PSD from 0 Hz up to each bin (inclusive): at the top, the RMS
+    about the mean of the samples weighted by welch_sample_weights (for a stationary signal, its
+    standard deviation; module docstring)."""
     return np.sqrt(np.cumsum(np.asarray(density, dtype=float)) * resolution)
+
+
+def welch_sample_weights(samples: int, segment: int) -> np.ndarray:
+    """The weight of each sample in psd's integral: the squared windows of the segments Welch averages
+    (WINDOW, OVERLAP), summed. sum(PSD) * df = sum(weights (x - mean)^2) / sum(weights); samples after
+    the last whole segment weigh 0."""
+    segment = min(segment, samples)
+    window = hann_window(segment) ** 2
+    step = segment - int(segment * OVERLAP)
+    weights = np.zeros(samples)
+    for start in range(0, segment_count(samples, segment) * step, step):
+        weights[start:start + segment] += window
+    return weights
 
 
 def band_mask(frequency: np.ndarray, f_lo: float, f_hi: float) -> np.ndarray:

@@ -126,10 +126,13 @@ class Scene:
         if self.target_spec is None or "type" not in self.target_spec:
             return None
         cache = self.__dict__.setdefault("_moving_target", {})
-        key = repr(sorted(self.target_spec.items(), key=str))
+        # the gimbal moves with the base motion and its lever arm d_ab (target.motion.GimbalMotion)
+        key = repr((sorted(self.target_spec.items(), key=str), self.base_motion_spec,
+                    target_spec_table.lever_arm(self.parameters), self.step_size))
         if key not in cache:
             cache.clear()
-            cache[key] = target_spec_table.build(self.target_spec, self.path.parent)
+            cache[key] = target_spec_table.build(self.target_spec, self.path.parent, self.base_motion(),
+                                                 self.parameters, self.step_size)
         return cache[key]
 
     @property

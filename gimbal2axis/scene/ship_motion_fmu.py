@@ -77,7 +77,7 @@ def target_table(scene, stop_time: float, step: float) -> bytes:
     for track in (getattr(target, "track", None), getattr(target.carrier, "track", None)):
         if isinstance(track, Track):
             track.check_covers("[target]", float(times[-1]))
-    p, p_dot, p_ddot = target.relative(times)
+    p, p_dot, p_ddot = target.relative(times, known=True)   # what the controller knows (its INS)
     columns = np.vstack([times, p, p_dot, p_ddot]).T
     lines = ["time," + ",".join(TARGET_COLUMNS)] + [",".join(repr(float(x)) for x in row) for row in columns]
     return ("\n".join(lines) + "\n").encode("ascii")

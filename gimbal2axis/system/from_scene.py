@@ -19,15 +19,24 @@ from ..scene.controller_fmu import controller_fmu_parameters
 from ..scene.ship_motion_fmu import TARGET_TABLE, ship_motion_fmu_parameters, target_table
 from .structure import Component, Connection, System
 
-FMUS = {"ship": "Gimbal2Axis-ShipMotion.fmu", "gimbal": "Gimbal2Axis.fmu", "controller": "Gimbal2Axis-Controller.fmu"}
+
+def component_name(role: str) -> str:
+    """A component's name in the system: its role and `_unit`, a word no variable of the three FMUs
+    has in its name, so no importer takes a segment of a bound name for the component
+    (structure.naming_conflicts says why that matters; write_ssp checks it)."""
+    return f"{role}_unit"
+
+
+SHIP, GIMBAL, CONTROLLER = (component_name(role) for role in ("ship_motion", "gimbal", "controller"))
+FMUS = {SHIP: "Gimbal2Axis-ShipMotion.fmu", GIMBAL: "Gimbal2Axis.fmu", CONTROLLER: "Gimbal2Axis-Controller.fmu"}
 CARRIER_GROUPS = ["carrier_attitude", "carrier_attitude_rate", "carrier_attitude_acceleration", "carrier_velocity",
                   "carrier_acceleration"]
-GROUPS = [("ship", g, "gimbal", g) for g in CARRIER_GROUPS] + \
-    [("ship", g, "controller", g) for g in ("carrier_attitude", "carrier_attitude_rate",
+GROUPS = [(SHIP, g, GIMBAL, g) for g in CARRIER_GROUPS] + \
+    [(SHIP, g, CONTROLLER, g) for g in ("carrier_attitude", "carrier_attitude_rate",
                                              "carrier_attitude_acceleration", "target_position", "target_velocity",
                                              "target_acceleration")] + \
-    [("gimbal", g, "controller", g) for g in ("gimbal_angles", "gimbal_rates", "line_of_sight_rate")] + \
-    [("controller", f"motor{j}_voltage", "gimbal", f"motor{j}_voltage") for j in (1, 2)]
+    [(GIMBAL, g, CONTROLLER, g) for g in ("gimbal_angles", "gimbal_rates", "line_of_sight_rate")] + \
+    [(CONTROLLER, f"motor{j}_voltage", GIMBAL, f"motor{j}_voltage") for j in (1, 2)]
 
 
 def _description(fmu_path: pathlib.Path, fmu: FMU) -> pathlib.Path | None:
@@ -38,7 +47,7 @@ def _description(fmu_path: pathlib.Path, fmu: FMU) -> pathlib.Path | None:
 
 # The gimbal's current commands act only with motor<j>.drive = current; the controller FMU commands
 # voltages, so a system of these FMUs drives the motors by voltage and leaves them at their start.
-VOLTAGE_DRIVE_UNUSED = {("gimbal", "i_R1_cmd"), ("gimbal", "i_R2_cmd")}
+VOLTAGE_DRIVE_UNUSED = {(GIMBAL, "i_R1_cmd"), (GIMBAL, "i_R2_cmd")}
 
 
 def _connections(fmus: dict) -> list[Connection]:
@@ -47,11 +56,11 @@ def _connections(fmus: dict) -> list[Connection]:
     outputs = {name: [v.name for v in fmu.model_description.modelVariables if v.causality == "output"]
                for name, fmu in fmus.items()}
     connections = []
-    for target in ("gimbal", "controller"):
+    for target in (GIMBAL, CONTROLLER):
         for variable in fmus[target].model_description.modelVariables:
             if variable.causality != "input" or (target, variable.name) in VOLTAGE_DRIVE_UNUSED:
                 continue
-            source = next((s for s in ("ship", "gimbal", "controller") if s != target and variable.name in outputs[s]),
+            source = next((s for s in (SHIP, GIMBAL, CONTROLLER) if s != target and variable.name in outputs[s]),
                           None)
             if source is None:
                 raise SceneError(f"the system has no output for the {target}'s input {variable.name}")
@@ -70,7 +79,7 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
         raise SceneError(f"missing FMU(s): {', '.join(missing)} (build them: cmake --build build)")
     fmus = {name: FMU(path) for name, path in paths.items()}
     try:
-        gimbal = fmus["gimbal"]
+        gimbal = fmus[GIMBAL]
         current = [drive.motor for drive in scene_drives(scene, gimbal) if drive.kind == "current"]
         if current:
             # (and libcosim, the engine of the OSP structure, sets no FMI 2.0 Enumeration such as motor<j>.drive)
@@ -81,14 +90,14 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
         base = motion.sample(np.array([0.0, 1e-6]))
         gimbal_values = start_values(scene, gimbal, base[0], base[1])
         u_limit = tuple(float(parameter_value(scene, gimbal, f"motor{j}.U_L")) for j in (1, 2))
-        values = {"ship": ship_motion_fmu_parameters(scene), "gimbal": gimbal_values,
-                  "controller": controller_fmu_parameters(scene, u_limit)}
+        values = {SHIP: ship_motion_fmu_parameters(scene), GIMBAL: gimbal_values,
+                  CONTROLLER: controller_fmu_parameters(scene, u_limit)}
         resources = {name: {} for name in FMUS}
         if scene.moving_target is not None:
             # the target's position from the gimbal, tabulated for the run, in the ship-motion FMU's
             # resources: its target outputs feed the controller's target inputs
-            values["ship"]["target"] = 1
-            resources["ship"][TARGET_TABLE] = target_table(scene, scene.stop_time if stop_time is None else stop_time,
+            values[SHIP]["target"] = 1
+            resources[SHIP][TARGET_TABLE] = target_table(scene, scene.stop_time if stop_time is None else stop_time,
                                                            scene.step_size)
         components = [Component(name, paths[name], values[name], _description(paths[name], fmus[name]),
                                 resources[name]) for name in FMUS]

@@ -1,7 +1,10 @@
 """A system as an SSP archive (System Structure and Parameterization 1.0, a zip read by FMPy,
 libcosim and OMSimulator): SystemStructure.ssd (the components, their connectors, the connections,
 the communication step), resources/<FMU>.fmu, and each component's start values as an SSP parameter
-set, resources/<component>.ssv (names of the component's variables), bound on the component.
+set, resources/<component>.ssv (names of the component's variables, as SSP 1.0 names a set bound on a
+component), bound on the component; every bound variable is declared as a connector of the component
+too. The component names are checked against every variable's name first (structure.naming_conflicts):
+an importer that strips a component's name from a bound name would otherwise lose values.
 
 SSP 1.0 has no attribute for the communication step: the importers read it from their own
 annotations, which the SSD carries both of. OMSimulator's (`org.openmodelica`, on the system) also
@@ -18,7 +21,7 @@ from xml.sax.saxutils import quoteattr
 
 from fmpy import read_model_description
 
-from .structure import System, write_fmu
+from .structure import System, check_component_names, write_fmu
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -30,12 +33,18 @@ TYPES = {"Real": "<ssc:Real/>", "Integer": "<ssc:Integer/>", "Boolean": "<ssc:Bo
          "Enumeration": "<ssc:Integer/>"}
 
 
+# SSD connector kinds of the FMU causalities a connection or a binding uses
+KINDS = {"input": "input", "output": "output", "parameter": "parameter", "calculatedParameter": "calculatedParameter"}
+
+
 def _connectors(fmu: pathlib.Path, used: set) -> str:
-    """The FMU's inputs and outputs that a connection uses, as SSD connectors."""
+    """The FMU's variables that a connection or a binding uses, as SSD connectors. A bound variable is a
+    connector too: OMSimulator's Python SSP API looks a bound name up among the component's connectors
+    by its whole name before it falls back on splitting it into segments (docs/systems.md)."""
     rows = []
     for variable in read_model_description(str(fmu)).modelVariables:
-        if variable.name in used and variable.causality in ("input", "output"):
-            rows.append(f'          <ssd:Connector name={quoteattr(variable.name)} kind="{variable.causality}">'
+        if variable.name in used and variable.causality in KINDS:
+            rows.append(f'          <ssd:Connector name={quoteattr(variable.name)} kind="{KINDS[variable.causality]}">'
                         f'{TYPES[variable.type]}</ssd:Connector>')
     return "\n".join(rows)
 
@@ -55,6 +64,33 @@ def parameter_set(name: str, start_values: dict) -> str:
     rows = [_parameter(variable, value) for variable, value in start_values.items()]
     return (f'<?xml version="1.0" encoding="UTF-8"?>\n<ssv:ParameterSet xmlns:ssv="{SSV}" version="1.0" '
             f'name={quoteattr(name)}>\n  <ssv:Parameters>\n' + "\n".join(rows) + "\n  </ssv:Parameters>\n</ssv:ParameterSet>\n")
+
+
+def read_parameter_set(text: bytes | str) -> dict:
+    """An SSV parameter set's values by name (float, int or bool): what parameter_set wrote."""
+    import xml.etree.ElementTree as ET
+
+    values = {}
+    for parameter in ET.fromstring(text).iter(f"{{{SSV}}}Parameter"):
+        for element in parameter:
+            kind, value = element.tag.split("}")[-1], element.get("value")
+            parse = {"Real": float, "Integer": int}.get(kind, lambda text: text in ("true", "1"))
+            values[parameter.get("name")] = parse(value)
+    return values
+
+
+def archive_parameters(archive: pathlib.Path) -> dict:
+    """{component: {variable: value}} of the parameter sets an archive binds on its components."""
+    import xml.etree.ElementTree as ET
+
+    with zipfile.ZipFile(archive) as contents:
+        root = ET.fromstring(contents.read("SystemStructure.ssd"))
+        bound = {}
+        for component in root.iter(f"{{{SSD}}}Component"):
+            values = bound.setdefault(component.get("name"), {})
+            for binding in component.iter(f"{{{SSD}}}ParameterBinding"):
+                values.update(read_parameter_set(contents.read(binding.get("source"))))
+    return bound
 
 
 def parameter_file(component_name: str) -> str:
@@ -83,7 +119,7 @@ def _default_experiment(system: System) -> str:
 
 def _component(system: System, component) -> str:
     used = {c.output for c in system.connections if c.source == component.name} | \
-           {c.input for c in system.connections if c.target == component.name}
+           {c.input for c in system.connections if c.target == component.name} | set(component.start_values)
     bindings = ""
     if component.start_values:
         bindings = ('        <ssd:ParameterBindings>\n'
@@ -108,6 +144,9 @@ def system_structure(system: System) -> str:
 
 
 def write_ssp(system: System, path: pathlib.Path) -> pathlib.Path:
+    """Writes the archive at `path`; its path. A component name an importer would confuse with a
+    segment of a bound name is refused (ValueError) before anything is written."""
+    check_component_names(system)
     path.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.writestr("SystemStructure.ssd", system_structure(system))

@@ -3,6 +3,7 @@ description if it has one) and connections from an output to an input, on one co
 from __future__ import annotations
 
 import pathlib
+import re
 import shutil
 import zipfile
 from dataclasses import dataclass, field
@@ -54,3 +55,48 @@ def write_fmu(component: Component, path: pathlib.Path) -> None:
                 copy.writestr(item, original.read(item))
         for name, data in component.resources.items():
             copy.writestr(f"resources/{name}", data)
+
+
+# The segments of OMSimulator's own path to a component (model.root.<component>): its Python SSP API
+# drops from a bound name every segment that is also one of these.
+OMSIMULATOR_PATH_SEGMENTS = ("model", "root")
+
+
+def name_segments(variable: str) -> set:
+    """The identifiers a variable's name is made of: `target.position[1]` has target, position and 1."""
+    return {segment for segment in re.split(r"[^A-Za-z0-9_]+", variable) if segment}
+
+
+def naming_conflicts(system: System) -> list[str]:
+    """Why a component's name would make an importer lose a bound value, one line each (none: the names
+    are safe). OMSimulator's SSP import strips a bound name's first segment when it equals the component's
+    name (`controller.kind` set on a component `controller` becomes `kind`), its Python SSP API drops every
+    segment equal to the component's name or to model or root, and FMPy picks a component's values by
+    `name.startswith(component)`: so no component's name is a segment of any variable of the system's FMUs,
+    nor model or root, nor the start of another component's name."""
+    from fmpy import read_model_description
+
+    segments = {}
+    for component in system.components:
+        for variable in read_model_description(str(component.fmu)).modelVariables:
+            for segment in name_segments(variable.name):
+                segments.setdefault(segment, f"{component.name}'s {variable.name}")
+    conflicts = []
+    for component in system.components:
+        if component.name in OMSIMULATOR_PATH_SEGMENTS:
+            conflicts.append(f"component {component.name!r} is a segment of OMSimulator's own path "
+                             f"model.root.<component>")
+        elif component.name in segments:
+            conflicts.append(f"component {component.name!r} is a segment of the variable {segments[component.name]}")
+        conflicts += [f"component {component.name!r} starts the name of component {other.name!r}"
+                      for other in system.components
+                      if other is not component and other.name.startswith(component.name)]
+    return conflicts
+
+
+def check_component_names(system: System) -> None:
+    """Refuses (ValueError) component names an importer would confuse with a variable's name."""
+    conflicts = naming_conflicts(system)
+    if conflicts:
+        raise ValueError(f"{system.name}: {conflicts[0]}: an SSP importer would lose bound values "
+                         f"({len(conflicts)} conflict(s))")

@@ -13,8 +13,9 @@ from .motion import MovingTarget
 def pointing(target: MovingTarget, times, attitude, rates, accelerations=None) -> PointingCommand:
     """The PointingCommand toward `target` at `times` for the base attitude, rates and accelerations
     ((n, 3) each, rows as the base inputs; accelerations None: zero, which leaves the angles and
-    their rates exact and only the accelerations without the carrier's angular acceleration)."""
-    u, u_dot, u_ddot, _, _ = target.kinematics(times)
+    their rates exact and only the accelerations without the carrier's angular acceleration). The
+    controller's command: the target seen from where its INS places the gimbal (known=True)."""
+    u, u_dot, u_ddot, _, _ = target.kinematics(times, known=True)
     attitude = np.asarray(attitude, dtype=float).reshape(-1, 3).T
     rates = np.asarray(rates, dtype=float).reshape(-1, 3).T
     accelerations = np.zeros_like(rates) if accelerations is None else \

@@ -18,6 +18,11 @@ from __future__ import annotations
 import numpy as np
 
 
+# The keyhole's hold [rad]: a target direction nearer the azimuth axis than this (a thousandth of
+# the gyros' microradian) has an azimuth of rounding noise, held instead (PointingCommand).
+KEYHOLE_HOLD_RAD = 1e-9
+
+
 def unit_and_derivatives(p, p_dot, p_ddot):
     """u = p/|p|, u' and u'' from p, p' and p'' ((3, n) each), and the range |p| and its rate.
     p = r u gives p' = r' u + r u', p'' = r'' u + 2 r' u' + r u''."""
@@ -55,6 +60,20 @@ def inertial_to_base(vector, attitude):
     x, y = c * x + s * y, -s * x + c * y
     c, s = np.cos(gamma), np.sin(gamma)
     x, z = c * x - s * z, s * x + c * z
+    return np.array([x, y, z])
+
+
+def base_to_inertial(vector, attitude):
+    """GT0 vector = Rx(delta) Rz(psi) Ry(gamma) vector, (3, n): a vector of frame 0 in G (the inverse of
+    inertial_to_base)."""
+    x, y, z = vector
+    delta, psi, gamma = attitude
+    c, s = np.cos(gamma), np.sin(gamma)
+    x, z = c * x + s * z, -s * x + c * z
+    c, s = np.cos(psi), np.sin(psi)
+    x, y = c * x - s * y, s * x + c * y
+    c, s = np.cos(delta), np.sin(delta)
+    y, z = c * y - s * z, s * y + c * z
     return np.array([x, y, z])
 
 
@@ -104,3 +123,22 @@ class PointingCommand:
         r1 = np.array([ca * rate_0[0] + sa * rate_0[1], -sa * rate_0[0] + ca * rate_0[1], rate_0[2]])
         self.los_rate = np.array([r1[0], cb * r1[1] + sb * r1[2], -sb * r1[1] + cb * r1[2]])
         self.direction_in_base = v
+        self._hold_azimuth(~(rho > KEYHOLE_HOLD_RAD))
+
+    def _hold_azimuth(self, on_axis):
+        """The keyhole policy where the target is on the azimuth axis (within KEYHOLE_HOLD_RAD): the
+        azimuth holds the command of the sample before (of the first sample off the axis, at the
+        start; 0 if none), the elevation is the exact +-90 deg, and their rates and accelerations are
+        0 (the line of sight's inertial rate stays): there the inverse kinematics divides by zero (docs/physics.md, section 9.3)."""
+        if not np.any(on_axis):
+            return
+        index = np.where(on_axis, -1, np.arange(on_axis.size))
+        index = np.maximum.accumulate(index)
+        off_axis = np.flatnonzero(~on_axis)
+        index[index < 0] = off_axis[0] if off_axis.size else -1
+        held = np.where(index >= 0, self.alpha[np.maximum(index, 0)], 0.0)
+        self.alpha = np.where(on_axis, held, self.alpha)
+        for name in ("alpha_dot", "alpha_ddot", "beta_dot", "beta_ddot"):
+            setattr(self, name, np.where(on_axis, 0.0, getattr(self, name)))
+        # the line of sight's own rate u x u' stays (what the gyro reads as the target passes), unless not finite
+        self.los_rate = np.where(on_axis & ~np.isfinite(self.los_rate), 0.0, self.los_rate)

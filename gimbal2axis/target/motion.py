@@ -17,6 +17,12 @@ error of the rate is (step^2 / 6) p''' and the rounding of the acceleration abou
 
 The flyby is flat: an aircraft on a straight line in the carrier's local level frame at its start,
 exact derivatives (closed form).
+
+[target.carrier] places the gimbal on the carrier at rest; the sea moves it from there (GimbalMotion:
+the base motion's translation and the lever arm d_ab turned by the attitude). The truth (the record's
+target signals and los_error) is the target seen from where the gimbal is; the controller's command
+sees it from where its INS says the gimbal is (`relative(t, known=True)`: the INS position error of
+[target] ins_position_error_m added). docs/targets.md, "Frames".
 """
 from __future__ import annotations
 
@@ -26,7 +32,7 @@ import pathlib
 import numpy as np
 
 from ..errors import SceneError, excerpt
-from .kinematics import unit_and_derivatives
+from .kinematics import base_to_inertial, carrier_rate_and_acceleration, unit_and_derivatives
 
 DIFFERENCE_STEP_S = 0.05
 # The farthest a target or a carrier is taken from the ellipsoid or from the carrier's start [m]:
@@ -172,21 +178,68 @@ class Carrier:
         return np.array([np.zeros_like(t), self.speed * t, np.zeros_like(t)])
 
 
+class GimbalMotion:
+    """Where the gimbal (point b, where its axes cross) is from where [target.carrier] places it, in G
+    with its velocity and acceleration (exact, from the base motion's): the base motion's translation
+    of point a from its start less its constant velocity (the carrier's sailing, which the carrier's
+    rhumb line or track gives already), plus the lever arm d_ab (frame 0) turned by the carrier's
+    attitude less the same arm on the level carrier, (GT0 - I) d_ab (docs/physics.md (2.18))."""
+
+    def __init__(self, motion, lever_arm, step_size: float):
+        self.motion, self.step = motion, float(step_size)
+        self.lever_arm = np.asarray(lever_arm, dtype=float).reshape(3, 1)
+        self.drift = np.asarray(getattr(motion, "velocity", np.zeros(3)), dtype=float).reshape(3, 1)
+
+    def _base(self, t):
+        """The base inputs (n, 15) and point a's position (n, 3) at t: on the run's grid t_k = k h the
+        rows of the grid (the bits the run sets, whole or chunk by chunk), elsewhere sampled at t."""
+        if len(t) > 1:
+            first = int(round(t[0] / self.step))
+            if np.array_equal(t, np.arange(first, first + len(t)) * self.step):
+                return (self.motion.sample_rows(first, len(t), self.step),
+                        self.motion.position_rows(first, len(t), self.step))
+        return self.motion.sample(t), self.motion.position(t)
+
+    def displacement(self, t):
+        base, position = self._base(np.atleast_1d(np.asarray(t, dtype=float)))
+        attitude = base[:, 0:3].T
+        w, w_dot = carrier_rate_and_acceleration(attitude, base[:, 3:6].T, base[:, 6:9].T)
+        d = np.broadcast_to(self.lever_arm, w.shape)
+        w_d = np.cross(w, d, axis=0)
+        arm = base_to_inertial(d, attitude) - d
+        arm_dot = base_to_inertial(w_d, attitude)
+        arm_ddot = base_to_inertial(np.cross(w_dot, d, axis=0) + np.cross(w, w_d, axis=0), attitude)
+        p = position.T - self.drift * t + arm
+        return p, base[:, 9:12].T - self.drift + arm_dot, base[:, 12:15].T + arm_ddot
+
+
 class MovingTarget:
     """Base of the moving targets: `relative(t)` -> p, p', p'' ((3, n) in G, metres) of the target
-    from the gimbal; `direction(t)` the unit vector; `kinematics(t)` u, u', u'', range, range rate."""
+    from the gimbal; `direction(t)` the unit vector; `kinematics(t)` u, u', u'', range, range rate.
+    `known=True`: from where the controller's INS places the gimbal (ins_error, in G)."""
     kind = "?"
+    gimbal: GimbalMotion | None = None   # None: the gimbal stays where [target.carrier] places it
+    ins_error = np.zeros((3, 1))
 
     def __init__(self, carrier: Carrier):
         self.carrier = carrier
 
-    def relative(self, t):
+    def relative_to_carrier(self, t):
+        """p, p', p'' of the target from where [target.carrier] places the gimbal (the carrier at rest)."""
         raise NotImplementedError
 
-    def kinematics(self, t):
+    def relative(self, t, known: bool = False):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        p, p_dot, p_ddot = self.relative_to_carrier(t)
+        if self.gimbal is not None:
+            d, d_dot, d_ddot = self.gimbal.displacement(t)
+            p, p_dot, p_ddot = p - d, p_dot - d_dot, p_ddot - d_ddot
+        return (p - self.ins_error if known else p), p_dot, p_ddot
+
+    def kinematics(self, t, known: bool = False):
         t = np.atleast_1d(np.asarray(t, dtype=float))
         with np.errstate(all="ignore"):   # a range of 0 or a position that is not finite: refused below
-            kinematics = unit_and_derivatives(*self.relative(t))
+            kinematics = unit_and_derivatives(*self.relative(t, known))
         r = kinematics[3]
         bad = np.flatnonzero(~(np.isfinite(r) & (r > 0.0)))
         if bad.size:
@@ -216,7 +269,7 @@ class GeodeticTarget(MovingTarget):
         east, north, up = pymap3d.geodetic2enu(lat, lon, alt, lat0, lon0, alt0)
         return enu_to_g(np.asarray(east), np.asarray(north), np.asarray(up), self.carrier.course)
 
-    def relative(self, t):
+    def relative_to_carrier(self, t):
         step = DIFFERENCE_STEP_S
         p, ahead, behind = (self._offset(t + shift) for shift in (0.0, step, -step))
         return p, (ahead - behind) / (2.0 * step), (ahead - 2.0 * p + behind) / (step * step)
@@ -270,8 +323,7 @@ class Flyby(MovingTarget):
         self.closest_point = carrier.flat_position(closest_approach_s) + right * closest_approach_m
         self.closest_point[2] = height_m
 
-    def relative(self, t):
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+    def relative_to_carrier(self, t):
         aircraft = self.closest_point[:, None] + self.velocity[:, None] * (t - self.t_ca)
         p = aircraft - self.carrier.flat_position(t)
         carrier_velocity = np.array([0.0, self.carrier.speed, 0.0])

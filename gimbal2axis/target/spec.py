@@ -9,6 +9,7 @@
     beam_width_mrad = 2.0           # on target: the error within half of it
     keyhole_deg = 10.0              # near the keyhole: the target within this of the azimuth axis
     start_on_target = true
+    ins_position_error_m = [0.0, 0.0, 0.0]   # east, north, up: where the controller's INS is wrong
 
     [target.carrier]                # the carrier's gimbal on the Earth
     latitude_deg = 59.85
@@ -30,11 +31,11 @@ import numpy as np
 
 from ..errors import SceneError, boolean, check_keys, did_you_mean, positive, shown, within
 from .motion import COORDINATE_RANGES, DIFFERENCE_STEP_S, FARTHEST_M, FASTEST_M_S, Carrier, EarthPoint, Flyby, \
-    RecordedTarget, Track
+    GimbalMotion, RecordedTarget, Track, enu_to_g
 
 MOVING_KINDS = ("earth_point", "flyby", "track")
 KINDS = ("direction",) + MOVING_KINDS
-COMMON_KEYS = {"type", "start_on_target", "beam_width_mrad", "keyhole_deg", "carrier"}
+COMMON_KEYS = {"type", "start_on_target", "beam_width_mrad", "keyhole_deg", "carrier", "ins_position_error_m"}
 KIND_KEYS = {
     "earth_point": {"latitude_deg", "longitude_deg", "altitude_m", "north_m", "east_m", "down_m"},
     "flyby": {"altitude_m", "speed_m_s", "heading_deg", "closest_approach_m", "closest_approach_s"},
@@ -43,6 +44,12 @@ KIND_KEYS = {
 CARRIER_KEYS = {"latitude_deg", "longitude_deg", "altitude_m", "course_deg", "speed_m_s", "track"}
 DEFAULT_BEAM_WIDTH_MRAD = 1.0
 DEFAULT_KEYHOLE_DEG = 10.0
+# The FMU's default lever arm base.d_ab[1..3] [m] (model_core/include/gimbal/real_variables.def), for
+# a scene that does not set it; tests/test_target_lever_arm.py holds them equal.
+DEFAULT_LEVER_ARM_M = (0.0, 0.0, 0.25)
+LEVER_ARM_PARAMETERS = ("base.d_ab[1]", "base.d_ab[2]", "base.d_ab[3]")
+# The largest INS position error a scene may give [m] per component: larger is no navigation system.
+LARGEST_INS_ERROR_M = 1e4
 # The latest closest approach of a flyby from the run's start [s] (about 30 years): a larger number is a typo.
 LATEST_S = 1e9
 # Every number of [target] and [target.carrier] by key: (low, high), both included (docs/targets.md).
@@ -75,6 +82,8 @@ def parse(table: dict) -> dict:
     if spec["keyhole_deg"] >= 90.0:
         raise SceneError(f"target.keyhole_deg = {spec['keyhole_deg']:g} must be below 90 (degrees from the azimuth "
                          "axis)")
+    if "ins_position_error_m" in table:
+        spec["ins_position_error_m"] = ins_error(table["ins_position_error_m"])
     carrier = table.get("carrier", {})
     if not isinstance(carrier, dict):
         raise SceneError(f"target.carrier must be a table ([target.carrier]), got {shown(carrier)}")
@@ -131,8 +140,37 @@ def parse(table: dict) -> dict:
     return spec
 
 
-def build(spec: dict, base_dir: pathlib.Path):
-    """The motion.MovingTarget of a parsed spec; files relative to base_dir (the scene's folder)."""
+def ins_error(value) -> list:
+    """[target] ins_position_error_m: three numbers (east, north, up) [m], each within +-LARGEST_INS_ERROR_M."""
+    if not isinstance(value, list) or len(value) != 3:
+        raise SceneError(f"target.ins_position_error_m must be three numbers [east, north, up] in metres, got "
+                         f"{shown(value)}")
+    return [within(f"target.ins_position_error_m[{i}]", x, -LARGEST_INS_ERROR_M, LARGEST_INS_ERROR_M)
+            for i, x in enumerate(value)]
+
+
+def lever_arm(parameters: dict) -> tuple:
+    """The lever arm d_ab [m] (frame 0) from the carrier's point a to the gimbal: the scene's
+    [parameters] base.d_ab[1..3], else the FMU's defaults."""
+    return tuple(float(parameters.get(name, default)) for name, default in zip(LEVER_ARM_PARAMETERS,
+                                                                               DEFAULT_LEVER_ARM_M))
+
+
+def build(spec: dict, base_dir: pathlib.Path, base_motion=None, parameters: dict | None = None,
+          step_size: float = 1e-3):
+    """The motion.MovingTarget of a parsed spec; files relative to base_dir (the scene's folder). With
+    the scene's base_motion (and its [parameters], for the lever arm d_ab; step_size, its grid), the
+    gimbal moves with the carrier (motion.GimbalMotion); without, it stays where the carrier is."""
+    target = _build(spec, base_dir)
+    if base_motion is not None:
+        target.gimbal = GimbalMotion(base_motion, lever_arm(parameters or {}), step_size)
+    error = spec.get("ins_position_error_m")
+    if error is not None:
+        target.ins_error = enu_to_g(*error, target.carrier.course).reshape(3, 1)
+    return target
+
+
+def _build(spec: dict, base_dir: pathlib.Path):
     c = spec["carrier"]
     origin = (c.get("latitude_deg", 0.0), c.get("longitude_deg", 0.0), c.get("altitude_m", 0.0))
     carrier_track = None

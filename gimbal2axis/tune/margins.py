@@ -5,8 +5,11 @@ linearized at the scene's operating point without backlash and dry friction, exa
 step, the controller's exact transfer functions, the delay), broken at one motor's computed voltage with
 the other axis's loop closed (loop_gain). It is built once per plant (the values of the tuned parameters
 that are not controller gains; for a tuning of gains alone, once) and the candidate's gains are put in.
-The margins and S, T are python-control's (control.frd, control.stability_margins, control.feedback)
-on L sampled on a log grid up to the Nyquist frequency.
+The phase margin and S, T are python-control's (control.frd, control.stability_margins, control.feedback)
+on L sampled on a log grid up to the Nyquist frequency; the gain margins are those of the -180 deg
+crossings of the same samples (isolation_prediction.stability_margins): the upper one, and the lower
+one of a conditionally stable loop (an open-loop unstable plant: a top-heavy payload's elevation), where
+python-control's single gain margin would be whichever is nearer 0 dB.
 """
 from __future__ import annotations
 
@@ -56,14 +59,14 @@ class LoopModels:
         return dataclasses.replace(base, axes=axes)
 
     def margins(self, candidate: dict) -> dict:
-        """{gm_<az|el>_db, pm_<az|el>_deg, crossover_<az|el>_hz, ms_<az|el>, linear_stable}: NaN margins and
-        linear_stable False for a loop with a closed-loop pole on or outside the unit circle."""
+        """{gm_<az|el>_db, lower_gm_<az|el>_db, pm_<az|el>_deg, crossover_<az|el>_hz, ms_<az|el>, linear_stable}:
+        NaN margins and linear_stable False for a loop with a closed-loop pole on or outside the unit circle."""
         from ..analysis import isolation_prediction as ip
 
         row = {"linear_stable": False}
         for axis in AXES.values():
-            row.update({f"gm_{axis}_db": math.nan, f"pm_{axis}_deg": math.nan, f"crossover_{axis}_hz": math.nan,
-                        f"ms_{axis}": math.nan})
+            row.update({f"gm_{axis}_db": math.nan, f"lower_gm_{axis}_db": math.nan, f"pm_{axis}_deg": math.nan,
+                        f"crossover_{axis}_hz": math.nan, f"ms_{axis}": math.nan})
         try:
             loop = self.loop(candidate)
         except SceneError as exc:
@@ -76,15 +79,18 @@ class LoopModels:
         row["linear_stable"] = True
         for motor, axis in AXES.items():
             response = frequency_response(loop, motor)
-            row.update({f"gm_{axis}_db": response["gm_db"], f"pm_{axis}_deg": response["pm_deg"],
+            row.update({f"gm_{axis}_db": response["gm_db"], f"lower_gm_{axis}_db": response["lower_gm_db"],
+                        f"pm_{axis}_deg": response["pm_deg"],
                         f"crossover_{axis}_hz": response["crossover_hz"], f"ms_{axis}": response["ms"]})
         return row
 
 
 def frequency_response(loop, motor: str, points: int = POINTS) -> dict:
     """L, S = 1 / (1 + L), T = L / (1 + L) of the loop broken at `motor` ('1' azimuth, '2' elevation) on a log
-    grid (Hz) up to Nyquist, with python-control's margins: gain margin [dB], phase margin [deg], the
-    gain crossover [Hz] and the peak sensitivity Ms = max |S|."""
+    grid (Hz) up to Nyquist, with the margins: gain margin [dB] (+inf without a -180 deg crossing where
+    |L| <= 1) and the lower gain margin [dB] of a conditionally stable loop (-inf without a crossing where
+    |L| > 1), each with its frequency [Hz]; python-control's phase margin [deg] and gain crossover [Hz];
+    the peak sensitivity Ms = max |S|."""
     import control
 
     from ..analysis import isolation_prediction as ip
@@ -95,13 +101,21 @@ def frequency_response(loop, motor: str, points: int = POINTS) -> dict:
     open_loop = control.frd(L, w)
     S = control.feedback(control.frd(np.ones_like(L), w), open_loop)
     T = control.feedback(open_loop, 1)
-    gm, pm, _sm, _wpc, wgc, _wms = control.stability_margins(open_loop)
+    _gm, pm, _sm, _wpc, wgc, _wms = control.stability_margins(open_loop)
+    crossings = ip.stability_margins(f, L)
     s_values = np.squeeze(_data(S))
     return {"f_hz": f, "L": L, "S": s_values, "T": np.squeeze(_data(T)),
-            "gm_db": 20 * math.log10(gm) if np.isfinite(gm) and gm > 0 else math.inf,
+            "gm_db": _or(crossings.gain_margin_db, math.inf), "gm_hz": crossings.phase_crossover_hz,
+            "lower_gm_db": _or(crossings.lower_gain_margin_db, -math.inf),
+            "lower_gm_hz": crossings.lower_phase_crossover_hz,
             "pm_deg": float(pm) if np.isfinite(pm) else math.inf,
             "crossover_hz": float(wgc) / (2 * math.pi) if np.isfinite(wgc) else math.nan,
             "ms": float(np.max(np.abs(s_values)))}
+
+
+def _or(margin_db: float, without: float) -> float:
+    """A margin, or `without` (+-inf: the gain may go that far) when the loop has no such crossing."""
+    return margin_db if math.isfinite(margin_db) else without
 
 
 def _data(response) -> np.ndarray:

@@ -8,6 +8,8 @@ number the optimizer minimizes.
                    saturation        (max u_sat_s - limit) / max(limit, 0.1 s)
                    gain margin       (min_db - min(gm_az, gm_el)) / max(|min_db|, 1 dB)
                    phase margin      (min_deg - min(pm_az, pm_el)) / max(|min_deg|, 1 deg)
+                   lower gain margin (min_db + max(lower_gm_az, lower_gm_el)) / max(min_db, 1 dB): the
+                                     lower margin (< 0 dB, -inf without one) of a conditionally stable loop
                    (a linear closed loop that is unstable violates each margin by 1)
                    requirements      1 when a run misses the scene's requirements
                    time on target    (min_fraction - min on_target_fraction) / min_fraction (moving targets)
@@ -87,6 +89,9 @@ def judge(tuning, rows: list, margins: dict) -> Judgement:
         pm = min(margins.get("pm_az_deg", math.nan), margins.get("pm_el_deg", math.nan))
         violations["phase_margin"] = 1.0 if not stable or not math.isfinite(pm) and not pm == math.inf else \
             (limit - pm) / max(abs(limit), 1.0)
+    if constraints.lower_gain_margin_min_db is not None:
+        violations["lower_gain_margin"] = _lower_margin_violation(constraints.lower_gain_margin_min_db, margins,
+                                                                  stable)
     if constraints.on_target_min_fraction is not None:   # the least on-target share of the set counts
         limit = constraints.on_target_min_fraction
         shares = [r["on_target_fraction"] for r in ok if r.get("on_target_fraction") is not None]
@@ -102,6 +107,14 @@ def judge(tuning, rows: list, margins: dict) -> Judgement:
         value = math.log10(objective) + PENALTY * excess
     feasible = not failed and math.isfinite(objective) and excess == 0.0
     return Judgement(objective, value, violations, feasible, failed, worst, per_run)
+
+
+def _lower_margin_violation(drop_db: float, margins: dict, stable: bool) -> float:
+    """The axis whose lower gain margin is nearest 0 dB counts; an axis without one (-inf) meets any limit."""
+    lower = [margins.get(f"lower_gm_{axis}_db", math.nan) for axis in ("az", "el")]
+    if not stable or any(math.isnan(value) for value in lower):
+        return 1.0
+    return (drop_db + max(lower)) / max(drop_db, 1.0)
 
 
 def trial_row(problem, number: int, batch: int, candidate: dict, verdict: Judgement, margins: dict) -> dict:

@@ -9,7 +9,7 @@ and <out>/<tuning>__<scene>_summary.json.
     PSD, and the pointing error budget per axis (budget.py: bias, drift, jitter in the sea, loop and high
     bands);
   - the loops: |S| and |T| per axis for the best and the scene's own gains, with the margins
-    (margins.py, python-control);
+    (margins.py: the lower gain margin too, of a conditionally stable loop);
   - the held-out check: the best and the others on the tuning file's [holdout] set, which the tuning never
     ran, objective per member and aggregated as the tuning aggregates.
 """
@@ -162,7 +162,7 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
                 continue
             for col, axis in enumerate(("az", "el")):
                 r = by_axis[axis]
-                margins = f"GM {r['gm_db']:.3g} dB, PM {r['pm_deg']:.3g} deg, Ms {r['ms']:.3g}"
+                margins = f"GM {r['gm_db']:.3g} dB{_lower_margin(r)}, PM {r['pm_deg']:.3g} deg, Ms {r['ms']:.3g}"
                 axes[col].loglog(r["f_hz"], np.abs(r["S"]), color=f"C{k}", label=f"{label} |S| ({margins})")
                 axes[col].loglog(r["f_hz"], np.abs(r["T"]), color=f"C{k}", ls="--", label=f"{label} |T|")
         for col, axis in enumerate(("azimuth (motor 1)", "elevation (motor 2)")):
@@ -186,7 +186,8 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
         "nominal_los_rms_mrad": {label: float(np.sqrt(np.mean(run.signals["los_error"][run.metrics_window(
             _from_s(problem, run))] ** 2))) * 1e3 for label, run in runs.items()},
         "budget_mrad": budget_rows,
-        "margins": {label: ({axis: {k: r[k] for k in ("gm_db", "pm_deg", "crossover_hz", "ms")}
+        "margins": {label: ({axis: {k: r[k] for k in ("gm_db", "gm_hz", "lower_gm_db", "lower_gm_hz", "pm_deg",
+                                                     "crossover_hz", "ms")}
                              for axis, r in by_axis.items()} if not isinstance(by_axis, str) else by_axis)
                     for label, by_axis in loops.items()},
         "holdout": {label: {"objective_mrad": row["objective_mrad"], "per_run_mrad": row["per_scenario"],
@@ -208,7 +209,8 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
             "<h2>Convergence</h2>", _image(figures['convergence'], 800),
             "<h2>Best candidates</h2>",
             _table(["trial"] + names + ["objective_mrad", "worst_i_frac_peak", "worst_i_peak_A", "worst_u_sat_s",
-                                        "gm_az_db", "pm_az_deg", "gm_el_db", "pm_el_deg"], top)]
+                                        "gm_az_db", "lower_gm_az_db", "pm_az_deg", "gm_el_db", "lower_gm_el_db",
+                                        "pm_el_deg"], top)]
     if not result.best:
         page.append("<p><b>No candidate met the constraints</b>; the least violating: "
                     f"{html.escape(describe_candidate({n: (result.least_violating or {}).get(n, math.nan) for n in names}))}</p>")
@@ -234,6 +236,13 @@ def write_report(result: TuneResult, evaluator, compare: dict | None = None) -> 
     path = folder / f"{stem}_report.html"
     store.publish(path, lambda p: pathlib.Path(p).write_text("".join(page), encoding="utf-8"))
     return path
+
+
+def _lower_margin(response: dict) -> str:
+    """The lower gain margin of a conditionally stable loop, for the legend ('' without one)."""
+    if not math.isfinite(response["lower_gm_db"]):
+        return ""
+    return f" (lower {response['lower_gm_db']:.3g} dB at {response['lower_gm_hz']:.3g} Hz)"
 
 
 def _save(fig, path: pathlib.Path) -> pathlib.Path:

@@ -25,6 +25,8 @@ A tuning file (TOML):
   voltage_saturation_max_s = 0.0   # time a controller asks for |u| >= motor.U_L, per run
   gain_margin_min_db = 6.0     # classical margins of the linearized loop (nominal plant, candidate's gains),
   phase_margin_min_deg = 35.0  #   each motor's loop broken with the other closed
+  lower_gain_margin_min_db = 20.0   # a conditionally stable loop (open-loop unstable plant): the gain may drop
+                               #   by this many dB before it goes unstable (lower gain margin <= -20 dB)
   requirements = true          # the scene's [requirements] met on every run
   on_target_min_fraction = 0.9 # a moving target: the share of the window with the error within half the beam
 
@@ -70,7 +72,7 @@ METRICS = ("los_rms", "band_rms", "weighted", "tracking_rms")
 AGGREGATES = ("mean", "max", "rms")
 AXES = ("both", "xel", "el")
 CONSTRAINT_KEYS = {"peak_current_fraction", "voltage_saturation_max_s", "gain_margin_min_db", "phase_margin_min_deg",
-                   "requirements", "on_target_min_fraction"}
+                   "lower_gain_margin_min_db", "requirements", "on_target_min_fraction"}
 ROBUSTNESS_KEYS = {"seeds", "sea_states", "draws", "draw", "seed"}
 OPTIMIZER_KEYS = {"sampler", "trials", "batch"}
 SAMPLERS = ("cmaes", "tpe", "random")
@@ -138,12 +140,14 @@ class Constraints:
     voltage_saturation_max_s: float | None = None
     gain_margin_min_db: float | None = None
     phase_margin_min_deg: float | None = None
+    lower_gain_margin_min_db: float | None = None   # the size of the allowed drop, >= 0 dB
     requirements: bool = False
     on_target_min_fraction: float | None = None
 
     @property
     def needs_margins(self) -> bool:
-        return self.gain_margin_min_db is not None or self.phase_margin_min_deg is not None
+        return any(limit is not None for limit in (self.gain_margin_min_db, self.phase_margin_min_deg,
+                                                   self.lower_gain_margin_min_db))
 
 
 @dataclass(frozen=True)
@@ -334,6 +338,12 @@ def _constraints(raw) -> Constraints:
     for key in ("gain_margin_min_db", "phase_margin_min_deg"):
         if key in table:
             values[key] = _number(f"[constraints] {key}", table[key])
+    if "lower_gain_margin_min_db" in table:   # a size: the lower margin itself is negative
+        drop = _number("[constraints] lower_gain_margin_min_db", table["lower_gain_margin_min_db"])
+        if drop < 0:
+            raise TuneError(f"[constraints] lower_gain_margin_min_db is the gain drop the loop must tolerate, in dB, "
+                            f"at least 0 (20 asks for a lower gain margin of -20 dB or less), got {drop:g}")
+        values["lower_gain_margin_min_db"] = drop
     if "on_target_min_fraction" in table:
         fraction = _number("[constraints] on_target_min_fraction", table["on_target_min_fraction"], positive=True)
         if fraction > 1.0:
