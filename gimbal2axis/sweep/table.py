@@ -83,7 +83,7 @@ def read_parquet(file):
     in between, as a sweep saving its table does, reads as corrupt; an open file stays one version."""
     import pyarrow.parquet as pq
 
-    return pq.ParquetFile(file).read()
+    return pq.ParquetFile(file).read(use_threads=False)   # no Arrow thread left busy when a refusal exits at once
 
 
 def merge(existing: list[dict], new: list[dict]) -> list[dict]:
