@@ -1,7 +1,7 @@
 # FMU states handed over by careless or hostile importers (tests/test_fmu_states.cpp), and the host's
 # floating-point environment and repeated loading (tests/test_host_environment.cpp): both drive the
 # built FMU through dlopen.
-add_executable(test_fmu_states test_fmu_states.cpp ${PROJECT_SOURCE_DIR}/fmu_src/fmu_state.c)
+add_executable(test_fmu_states test_fmu_states.cpp ${PROJECT_SOURCE_DIR}/fmu_src/fmi_layer/fmu_state.c)
 target_include_directories(test_fmu_states PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_SOURCE_DIR}/fmu_src)
 target_link_libraries(test_fmu_states PRIVATE ${CMAKE_DL_LIBS})
 add_dependencies(test_fmu_states fmu)

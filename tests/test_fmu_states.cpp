@@ -20,7 +20,7 @@
 #include "fmu_loader.hpp"
 
 extern "C" {
-#include "fmu_state.h"
+#include "fmi_layer/fmu_state.h"
 }
 
 namespace {

@@ -2,7 +2,9 @@
 includes only itself and the C standard library (no FMI, no C++ core, no Python); the Python package's
 C glue (gimbal2axis/native/module.c, the extension's module) may include the kernel; the FMI wrappers
 (fmu_src/) the kernel and model_core's C interface (the .h and .def files at model_core/include/gimbal/
-itself, not the layers behind it); model_core only itself. tests/test_package_layout.py keeps the
+itself, not the layers behind it); model_core only itself, but for the FMU's model table
+(model_core/src/simulation/fmu_model_table.cpp), the core's one file that knows the FMI layer: it may
+include fmu_src/'s headers, and is compiled into the FMU's binaries only, never into a core library. tests/test_package_layout.py keeps the
 Python imports' direction; the direction between model_core's own layer folders is another test's.
 
 Two things decide what code can include, and both are read:
@@ -39,6 +41,9 @@ MAY_USE = {
     "model_core": {"model_core", C_INTERFACE, C_LIBRARY, OUTSIDE, GENERATED},
 }
 C_INTERFACE_FOLDER = pathlib.Path("model_core/include/gimbal")
+# The FMI faces' table of the gimbal, filled over the core: the one file of model_core that may include
+# fmu_src/ (the FMI layer), compiled by fmu_src/'s targets only.
+FMU_MODEL_TABLE = pathlib.Path("model_core/src/simulation/fmu_model_table.cpp")
 C_STANDARD_HEADERS = {f"{name}.h" for name in (
     "assert complex ctype errno fenv float inttypes iso646 limits locale math setjmp signal stdalign stdarg "
     "stdatomic stdbool stddef stdint stdio stdlib stdnoreturn string tgmath threads time uchar wchar wctype").split()}
@@ -69,6 +74,10 @@ def classify(path: pathlib.Path, build_dir: pathlib.Path) -> str:
     return f"{relative.parts[0]}/"
 
 
+def is_fmu_model_table(path: pathlib.Path) -> bool:
+    return path.resolve() == (REPO / FMU_MODEL_TABLE).resolve()
+
+
 def folder_of(path: pathlib.Path) -> str | None:
     relative = path.resolve().relative_to(REPO)
     return next((name for name, folder in FOLDERS.items() if relative.parts[0] == folder), None)
@@ -97,6 +106,7 @@ def include_violations(files: dict[pathlib.Path, str], search_paths: dict[str, l
     wrong = []
     for path, text in files.items():
         owner = folder_of(path)
+        allowed = MAY_USE[owner] | ({"fmu_src"} if is_fmu_model_table(path) else set())
         for match in INCLUDE_LINE.finditer(text):
             quoted, name = match.group(1) == '"', match.group(2).strip()
             found = resolve(path, name, quoted, search_paths.get(owner, []))
@@ -107,10 +117,10 @@ def include_violations(files: dict[pathlib.Path, str], search_paths: dict[str, l
             else:   # not reachable now: whose it would be, were the folder holding it made an include directory
                 elsewhere = resolve(path, name, False, every_directory)
                 what = classify(elsewhere, build_dir) if elsewhere is not None else OUTSIDE
-            if what not in MAY_USE[owner]:
+            if what not in allowed:
                 line = text.count("\n", 0, match.start()) + 1
                 wrong.append(f"{path.relative_to(REPO)}:{line}: includes {name} ({what}); {owner} may use only "
-                             f"{', '.join(sorted(MAY_USE[owner]))}")
+                             f"{', '.join(sorted(allowed))}")
     return wrong
 
 
@@ -155,7 +165,10 @@ def include_directory_violations(targets: dict[str, dict], build_dir: pathlib.Pa
                              f"{owner} may use only {', '.join(sorted(MAY_USE[owner]))}")
         for source in target["sources"]:
             what = classify(source, build_dir)
-            if what not in MAY_USE[owner]:
+            if owner == "model_core" and is_fmu_model_table(source):
+                wrong.append(f"{name} ({target['folder']}/) compiles {source}: the FMU's model table, which only "
+                             "the FMU's binaries may compile")
+            elif what not in MAY_USE[owner] and not (owner == "fmu_src" and is_fmu_model_table(source)):
                 wrong.append(f"{name} ({target['folder']}/) compiles {source} ({what})")
     return wrong
 
@@ -210,6 +223,14 @@ def test_every_include_directory_goes_the_allowed_way(every_target, build_dir):
     assert wrong == [], "include directories against the direction:\n" + "\n".join(wrong)
 
 
+def test_the_fmu_model_table_is_compiled_into_the_fmus_binaries_only(build_targets):
+    """The core's one file that knows the FMI layer is compiled by the gimbal FMU's binaries (FMI 2.0
+    and 3.0), by no core library (a core library compiling it is refused above, naming it)."""
+    compiling = {name: target["folder"] for name, target in build_targets.items()
+                 if any(is_fmu_model_table(source) for source in target["sources"])}
+    assert len(compiling) >= 2 and all(folder.split("/")[0] == "fmu_src" for folder in compiling.values()), compiling
+
+
 def test_the_extension_and_the_cmake_libraries_compile_the_same_kernel(build_targets, python_extension):
     """One kernel: every source of c_kernel/src/ in the CMake libraries and in the Python extension."""
     everything = sorted((REPO / "c_kernel" / "src").glob("*.c"))
@@ -230,7 +251,9 @@ def test_the_extension_and_the_cmake_libraries_compile_the_same_kernel(build_tar
     ("fmu_src/ship_motion/ship_motion.c", '#include "../../model_core/src/integrators/tableaus.hpp"'),
     ("model_core/src/simulation/c_api.cpp", '#include "gimbal_kernel/controllers.h"'),   # the kernel
     ("model_core/include/gimbal/gimbal_c_api.h", '#include "../../../fmu_src/fmi_layer/fmi_instance.h"'),   # the wrappers
-    ("model_core/src/simulation/c_api.cpp", "#include <fmu_state.h>"),
+    ("model_core/src/simulation/c_api.cpp", "#include <fmi_layer/fmu_state.h>"),
+    ("model_core/src/simulation/c_api.cpp", '#include "fmi_layer/fmu_model.h"'),   # only the FMU's table may
+    ("model_core/src/simulation/fmu_model_table.cpp", '#include "gimbal_kernel/controllers.h"'),   # the kernel
     ("gimbal2axis/native/module.c", '#include "../../fmu_src/fmi_layer/fmi_instance.h"'),   # the package's glue, the wrappers
     ("gimbal2axis/native/module.c", '#include "gimbal/gimbal_c_api.h"'),         # and the core
 ])

@@ -37,12 +37,21 @@ def layer_of(path: pathlib.Path, core: pathlib.Path = CORE) -> str:
     raise ValueError(f"{path} is not under {core}/include/gimbal or {core}/src")
 
 
-def resolve(included: str, includer: pathlib.Path, core: pathlib.Path = CORE) -> pathlib.Path:
+# The FMU's model table (simulation/fmu_model_table.cpp, compiled into the FMU only) includes the FMI
+# layer's headers and the build's GUID header besides the core's: those are no layer of the core
+# (tests/test_include_directions.py keeps which it may include).
+FMU_MODEL_TABLE_OUTSIDE = re.compile(r"^(fmi_layer/[\w.]+\.h|gimbal_guid\.h)$")
+
+
+def resolve(included: str, includer: pathlib.Path, core: pathlib.Path = CORE) -> pathlib.Path | None:
     """The file an `#include "included"` in `includer` names: beside the includer first (as the
-    compiler looks), then on the core's include path."""
+    compiler looks), then on the core's include path; None for the FMU model table's headers of the FMI
+    layer."""
     for candidate in (includer.parent / included, core / "include" / included):
         if candidate.is_file():
             return candidate.resolve()
+    if includer.name == "fmu_model_table.cpp" and FMU_MODEL_TABLE_OUTSIDE.match(included):
+        return None
     raise FileNotFoundError(f"{includer}: #include \"{included}\" names no file of {core}")
 
 
@@ -57,6 +66,8 @@ def upward_includes(core: pathlib.Path = CORE) -> list[str]:
         own = layer_of(source, core)
         for match in INCLUDE.finditer(text):
             target = resolve(match.group(1), source, core)
+            if target is None:
+                continue
             theirs = layer_of(target, core)
             if RANK[theirs] > RANK[own]:
                 line = text.count("\n", 0, match.start()) + 1

@@ -27,7 +27,7 @@ def test_listed_sources_are_shipped_without_sundials(fmu_path):
     names = set(zipfile.ZipFile(fmu_path).namelist())
     # The core's sources keep their layer folder below sources/ (simulation/gimbal_instance.cpp, ...).
     basenames = {os.path.basename(f) for f in files}
-    assert {"fmi2_functions.c", "gimbal_model.c", "fmi_instance.c", "fmu_state.c", "gimbal_instance.cpp", "one_step_integrator.cpp"} <= basenames
+    assert {"fmi2_functions.c", "fmu_model_table.cpp", "fmi_instance.c", "fmu_state.c", "gimbal_instance.cpp", "one_step_integrator.cpp"} <= basenames
     assert [f for f in files if f"sources/{f}" not in names] == []
     assert SUNDIALS_SOURCES.isdisjoint(basenames)
     assert not any(n.startswith("sources/") and os.path.basename(n) in SUNDIALS_SOURCES for n in names)

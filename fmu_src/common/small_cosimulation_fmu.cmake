@@ -33,8 +33,10 @@ endfunction()
 # only the version's functions exported (`exports`: the version script), libgcc inside, on Linux the
 # C runtime's libm and libc its only shared libraries.
 function(link_small_fmu_binary target exports)
+  # model_core/include: the status type the FMI layer shares with the core (gimbal/gimbal_status.h).
   target_include_directories(${target} PRIVATE ${FMI2_INCLUDE_DIR} ${PROJECT_BINARY_DIR}/generated
-                             ${PROJECT_SOURCE_DIR}/fmu_src ${PROJECT_SOURCE_DIR}/fmu_src/common)
+                             ${PROJECT_SOURCE_DIR}/fmu_src ${PROJECT_SOURCE_DIR}/fmu_src/common
+                             ${PROJECT_SOURCE_DIR}/model_core/include)
   # No contraction into fused multiply-adds: the outputs are the bits the scene runner computes.
   target_compile_options(${target} PRIVATE -Wall -Wextra -ffp-contract=off)
   set_target_properties(${target} PROPERTIES PREFIX "" C_VISIBILITY_PRESET hidden)
@@ -72,7 +74,7 @@ function(add_small_cosimulation_fmu_binary identifier)
   configure_file(${ARG_GUID_HEADER} ${PROJECT_BINARY_DIR}/generated/${_header} @ONLY)
 
   set(_layer ${PROJECT_SOURCE_DIR}/fmu_src/fmi_layer)
-  set(_shared ${_layer}/fmu_model.c ${_layer}/fmi_instance.c ${PROJECT_SOURCE_DIR}/fmu_src/fmu_state.c)
+  set(_shared ${_layer}/fmu_model.c ${_layer}/fmi_instance.c ${_layer}/fmu_state.c)
   add_library(${identifier} SHARED ${ARG_SOURCES} ${_layer}/fmi2_functions.c ${_layer}/fmi2_face.c ${_shared})
   add_library(${identifier}_fmi3 SHARED ${ARG_SOURCES} ${_layer}/fmi3_functions.c ${_layer}/fmi3_face.c
               ${_layer}/fmi3_not_offered.c ${_shared})
@@ -136,7 +138,8 @@ function(package_small_cosimulation_fmu name)
   small_fmu_source_files(${_binary} _source_files)
   get_target_property(_model_folder ${ARG_MODEL_IDENTIFIER} SOURCE_DIR)
   set(_roots ${_model_folder} ${PROJECT_SOURCE_DIR}/fmu_src ${PROJECT_BINARY_DIR}/generated
-             ${PROJECT_SOURCE_DIR}/c_kernel/include ${PROJECT_SOURCE_DIR}/c_kernel/src)
+             ${PROJECT_SOURCE_DIR}/c_kernel/include ${PROJECT_SOURCE_DIR}/c_kernel/src
+             ${PROJECT_SOURCE_DIR}/model_core/include)
   set(_source_names "")
   set(_source_entries "")
   foreach(_file IN LISTS _source_files)
@@ -153,7 +156,8 @@ function(package_small_cosimulation_fmu name)
   string(JOIN "," _root_list ${_roots})
   set(_sources_stamp ${PROJECT_BINARY_DIR}/${name}_sources.stamp)
   file(GLOB_RECURSE _source_inputs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/fmu_src/*.c ${PROJECT_SOURCE_DIR}/fmu_src/*.h
-       ${PROJECT_SOURCE_DIR}/c_kernel/src/*.c ${PROJECT_SOURCE_DIR}/c_kernel/include/*.h)
+       ${PROJECT_SOURCE_DIR}/c_kernel/src/*.c ${PROJECT_SOURCE_DIR}/c_kernel/include/*.h
+       ${PROJECT_SOURCE_DIR}/model_core/include/gimbal/gimbal_status.h)
   add_custom_command(
     OUTPUT ${_sources_stamp}
     COMMAND ${CMAKE_COMMAND} -DCXX=${CMAKE_CXX_COMPILER} -DC=${CMAKE_C_COMPILER} -DSOURCES=${_source_list}

@@ -7,7 +7,7 @@
 #include "fmi2Functions.h"
 #include "fmi_layer/fmi_instance.h"
 
-_Static_assert((int)fmi2OK == (int)FMI_OK && (int)fmi2Warning == (int)FMI_WARNING &&
+FMI_STATIC_ASSERT((int)fmi2OK == (int)FMI_OK && (int)fmi2Warning == (int)FMI_WARNING &&
                    (int)fmi2Discard == (int)FMI_DISCARD && (int)fmi2Error == (int)FMI_ERROR &&
                    (int)fmi2Fatal == (int)FMI_FATAL,
                "fmi2Status is the layer's status");

@@ -8,7 +8,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "host_fp_environment.h"
+#include "fmi_layer/host_fp_environment.h"
 
 static const FmuModel* const kModel = &kFmuModel;
 

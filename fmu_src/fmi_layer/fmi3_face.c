@@ -1,7 +1,7 @@
 /* The FMI 3.0 face of the FMI instance layer (fmi3_face.h). */
 #include "fmi_layer/fmi3_face.h"
 
-#include "host_fp_environment.h"
+#include "fmi_layer/host_fp_environment.h"
 
 static const char* state_name(int state) {
     switch (state) {

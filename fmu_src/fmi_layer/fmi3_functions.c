@@ -16,7 +16,7 @@
 #include "common/fmi3_value_references.h"
 #include "fmi_layer/fmi3_face.h"
 #include "fmi_layer/fmu_model.h"
-#include "host_fp_environment.h"
+#include "fmi_layer/host_fp_environment.h"
 
 _Static_assert(sizeof(fmi3ValueReference) == sizeof(unsigned), "value references are the layer's unsigned");
 _Static_assert(sizeof(fmi3Int32) == sizeof(int), "an Int32 is the model's int");

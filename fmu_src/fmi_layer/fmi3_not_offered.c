@@ -5,7 +5,7 @@
  * the function and the reason, after the state check; nothing here computes, but every entry takes
  * the FMU's floating-point environment as every other does. */
 #include "fmi_layer/fmi3_face.h"
-#include "host_fp_environment.h"
+#include "fmi_layer/host_fp_environment.h"
 
 #define OWN_INSTANCE ((FmiInstance*)instance)
 

@@ -17,7 +17,8 @@
 #include <stdint.h>
 
 #include "common/communication_point.h"
-#include "fmu_state.h"
+#include "gimbal/gimbal_status.h"
+#include "fmi_layer/fmu_state.h"
 
 /* gnu_printf on mingw-w64 too: the messages use C99's %zu, which its vsnprintf formats. */
 #if defined(__MINGW32__)
@@ -28,8 +29,22 @@
 #define FMI_PRINTF_FORMAT(format_index, first_argument)
 #endif
 
-/* fmi2Status and fmi3Status share these values (the faces assert it). */
-typedef enum { FMI_OK = 0, FMI_WARNING = 1, FMI_DISCARD = 2, FMI_ERROR = 3, FMI_FATAL = 4 } FmiStatus;
+/* A check at compile time in C (C99 with the compilers' _Static_assert) and in C++ (the gimbal's model
+ * table, model_core/src/simulation/fmu_model_table.cpp, includes the layer's headers). */
+#ifdef __cplusplus
+#define FMI_STATIC_ASSERT(condition, message) static_assert(condition, message)
+#else
+#define FMI_STATIC_ASSERT(condition, message) _Static_assert(condition, message)
+#endif
+
+/* The core's status (gimbal/gimbal_status.h): one type from the host's call to the core's answer.
+ * fmi2Status and fmi3Status share its values (the faces assert it). */
+typedef GimbalStatus FmiStatus;
+#define FMI_OK GIMBAL_OK
+#define FMI_WARNING GIMBAL_WARNING
+#define FMI_DISCARD GIMBAL_DISCARD
+#define FMI_ERROR GIMBAL_ERROR
+#define FMI_FATAL GIMBAL_FATAL
 
 /* A variable's role, as the model's variable table gives it: what the settable rule reads. */
 typedef enum { FMI_PARAMETER = 0, FMI_INPUT = 1, FMI_OUTPUT = 2, FMI_LOCAL = 3 } FmiCausality;

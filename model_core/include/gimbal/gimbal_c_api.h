@@ -1,13 +1,18 @@
-/* C interface of the dynamics core, used by the FMI wrapper in fmu_src/.
- * The core knows variables, physics and integration; the wrapper knows the FMI state machine.
+/* C interface of the dynamics core: its variable tables (read by the FMU's model table and the model
+ * description generator) and the core's lifetime, values, steps and equations, used by the probe
+ * library (probe_api.h) and the core's tests. The FMU reaches the core through its model table instead
+ * (model_core/src/simulation/fmu_model_table.cpp, the FMI faces' table over the core itself).
+ * The core knows variables, physics and integration; the FMI layer knows the FMI state machine.
  * No function lets a C++ exception out: each returns GIMBAL_ERROR (with a logged reason) instead.
- * The core speaks no interface's language: its messages name no FMI function, and the wrapper that
- * calls it prefixes the function it serves (fmu_src/gimbal_fmu/gimbal_model.c, core_log).
+ * The core speaks no interface's language: its messages name no FMI function; a caller that serves
+ * one prefixes it (the FMU's: fmi_log_from_model).
  * Every GimbalCore* argument must come from gimbal_core_create; NULL is refused. */
 #ifndef GIMBAL_C_API_H
 #define GIMBAL_C_API_H
 
 #include <stddef.h>
+
+#include "gimbal/gimbal_status.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -15,7 +20,6 @@ extern "C" {
 
 typedef struct GimbalCore GimbalCore;
 
-typedef enum { GIMBAL_OK = 0, GIMBAL_WARNING = 1, GIMBAL_DISCARD = 2, GIMBAL_ERROR = 3 } GimbalStatus;
 typedef enum { GIMBAL_PARAMETER = 0, GIMBAL_INPUT = 1, GIMBAL_OUTPUT = 2, GIMBAL_LOCAL = 3 } GimbalCausality;
 typedef enum { GIMBAL_FIXED = 0, GIMBAL_TUNABLE = 1, GIMBAL_CONTINUOUS = 2 } GimbalVariability;
 /* APPROX: the rotor angles and rates, settable like EXACT, which gear<j>.start may put in mesh instead. */

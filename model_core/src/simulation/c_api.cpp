@@ -1,6 +1,7 @@
-// extern "C" face of the core. No C++ exception may cross into the host: every entry point runs its
-// body through guarded(), which turns any exception into a status and a logged message (as cppfmu's
-// entry points do).
+// extern "C" face of the core (gimbal_c_api.h), for the probe library and the core's tests; the FMU's
+// table over the core is fmu_model_table.cpp beside it. No C++ exception may cross into the host:
+// every entry point runs its body through guarded(), which turns any exception into a status and a
+// logged message (as cppfmu's entry points do).
 #include "gimbal/gimbal_c_api.h"
 
 #include <cstdio>
@@ -28,7 +29,7 @@ struct GimbalCore {
 
 namespace {
 
-// Messages name no interface function: the caller (fmu_src/) prefixes the one it serves.
+// Messages name no interface function: a caller that serves one prefixes it.
 template <class Body>
 GimbalStatus guarded(GimbalCore* core, Body&& body) noexcept {
     if (core == nullptr) return GIMBAL_ERROR;
@@ -173,14 +174,9 @@ GimbalStatus gimbal_core_do_step(GimbalCore* core, double current_time, double s
 GimbalStatus gimbal_core_do_step_until_mode_change(GimbalCore* core, double current_time, double step_size,
                                                    double* elapsed) {
     return guarded(core, [&] {
-        const double clock_at_start = core->instance.model_clock();
-        double end = current_time;
-        const GimbalStatus status = core->instance.do_step_until_mode_change(current_time, step_size, end);
-        if (elapsed != nullptr) {
-            const double clock_at_end = core->instance.model_clock();
-            // The clock moved by step_size itself when the step was not cut short.
-            *elapsed = clock_at_end == clock_at_start + step_size ? step_size : clock_at_end - clock_at_start;
-        }
+        double went = step_size;
+        const GimbalStatus status = core->instance.do_step_with_early_return(current_time, step_size, went);
+        if (elapsed != nullptr) *elapsed = went;
         return status;
     });
 }

@@ -22,6 +22,15 @@ GimbalStatus GimbalInstance::do_step_until_mode_change(double current_time, doub
     return advance_step(current_time, step_size, &reached, reached);
 }
 
+GimbalStatus GimbalInstance::do_step_with_early_return(double current_time, double step_size, double& elapsed) {
+    const double clock_at_start = run_.clock;
+    double end = current_time;
+    const GimbalStatus status = do_step_until_mode_change(current_time, step_size, end);
+    // The clock moved by step_size itself when the step was not cut short.
+    elapsed = run_.clock == clock_at_start + step_size ? step_size : run_.clock - clock_at_start;
+    return status;
+}
+
 GimbalStatus GimbalInstance::advance_step(double current_time, double step_size, double* early, double& reached) {
     if (!run_.integrator) return refuse(GIMBAL_ERROR, "the instance is not initialized");
     if (run_.continuous_time) return refuse(GIMBAL_ERROR, "the instance serves the continuous-time interface");

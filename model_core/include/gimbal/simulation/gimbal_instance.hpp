@@ -131,6 +131,10 @@ public:
     // is the time it ended at. The inputs are then left as the step carried them there (the carrier's
     // arc, a voltage ramp), so that the next step continues the same problem.
     GimbalStatus do_step_until_mode_change(double current_time, double step_size, double& reached);
+    // The same step, told how far it went on the model's own clock: `elapsed` is step_size when it did not
+    // end early, so that current_time + elapsed is the host's time where it ended (the C interface's and
+    // the FMU's early return).
+    GimbalStatus do_step_with_early_return(double current_time, double step_size, double& elapsed);
     // Work of one fmi2DoStep, in right-hand-side evaluations, beyond which the step is reported
     // (simulation/step_checks.hpp).
     static constexpr long kStepWorkBudget = gimbal::kStepWorkBudget;
