@@ -25,11 +25,11 @@ namespace gimbal {
 
 struct SnapshotContent;  // gimbal/simulation/snapshot.hpp
 
-// Which of the 17 continuous states (kContinuousStateCount, the FMU's order) a fidelity integrates,
+// Which of the 19 continuous states (kContinuousStateCount, the FMU's order) a fidelity integrates,
 // and where each lives in the state vector.
 struct IntegratedStates {
     int count = 0;
-    int state[kContinuousStateCount] = {};  // index among the 17 states
+    int state[kContinuousStateCount] = {};  // index among the 19 states
     int slot[kContinuousStateCount] = {};   // its slot in RunData::state
 };
 IntegratedStates integrated_states_of(const StateLayout& layout);

@@ -1,5 +1,5 @@
 // Publishing an instance's outputs (simulation/instance_outputs.cpp): the output variables at one
-// point of a run, and the 17 continuous states and their derivatives in full form whatever the
+// point of a run, and the 19 continuous states and their derivatives in full form whatever the
 // fidelity (a state a reduced model does not integrate is computed from the others).
 #pragma once
 
@@ -27,7 +27,7 @@ struct OutputPoint {
 void publish_outputs(const OutputPoint& point, double (&reals)[kRealVariableCount],
                      int (&integers)[kIntegerVariableCount]);
 
-// The 17 continuous states in full form, and their derivatives from the integrated ones'.
+// The 19 continuous states (kContinuousStateCount) in full form, and their derivatives from the integrated ones'.
 void full_state_vector(const ModelParameters& params, const Dynamics& dynamics, const double* state, double* states);
 void full_state_derivative(const ModelParameters& params, const Modes& modes, const Dynamics& dynamics,
                            const double* derivative, double* out);
