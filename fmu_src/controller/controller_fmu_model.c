@@ -151,15 +151,20 @@ static FmiStatus save(void* model, unsigned char* bytes) {
     return FMI_OK;
 }
 
-/* What in a snapshot this FMU could not have saved, or NULL. */
-static const char* snapshot_problem(const ControllerModel* m) {
-    if (m->sensors.gyro_noise != NULL || m->sensors.carrier_rate != NULL || m->sensors.gyro.error != NULL ||
-        m->controller.replayed != NULL || m->controller.set_points.values != NULL ||
-        m->controller.set_points.rates != NULL || m->controller.set_points.accelerations != NULL ||
-        m->controller.set_points.gyro_rates != NULL)
-        return "it refers to tables this FMU has none of";
-    if ((m->started & ~1) != 0 || m->step < 0 || (!m->started && m->step != 0)) return "its step count is not one a run reaches";
-    if (m->sensors.gyro.delay < 0 || m->sensors.gyro.delay > GIMBAL_GYRO_MAX_DELAY) return "its gyro delay is out of range";
+/* A snapshot's pointers: this FMU's sensors and controller hold no table (a snapshot that names one
+ * was not saved by it). */
+static int refers_to_tables(const ControllerModel* m) {
+    const void* const tables[] = {m->sensors.gyro_noise, m->sensors.carrier_rate, m->sensors.gyro.error,
+                                  m->controller.replayed, m->controller.set_points.values,
+                                  m->controller.set_points.rates, m->controller.set_points.accelerations,
+                                  m->controller.set_points.gyro_rates};
+    for (size_t k = 0; k < sizeof tables / sizeof tables[0]; ++k)
+        if (tables[k] != NULL) return 1;
+    return 0;
+}
+
+/* The variables' values outside what they may hold, or NULL. */
+static const char* variables_problem(const ControllerModel* m) {
     for (int i = 0; i < REAL_COUNT; ++i)
         if (!isfinite(m->real[i])) return "a Real variable is not finite";
     for (int i = 0; i < INTEGER_COUNT; ++i)
@@ -168,6 +173,14 @@ static const char* snapshot_problem(const ControllerModel* m) {
     for (int i = 0; i < BOOLEAN_COUNT; ++i)
         if ((m->boolean[i] & ~1) != 0) return "a Boolean parameter is neither 0 nor 1";
     return NULL;
+}
+
+/* What in a snapshot this FMU could not have saved, or NULL. */
+static const char* snapshot_problem(const ControllerModel* m) {
+    if (refers_to_tables(m)) return "it refers to tables this FMU has none of";
+    if ((m->started & ~1) != 0 || m->step < 0 || (!m->started && m->step != 0)) return "its step count is not one a run reaches";
+    if (m->sensors.gyro.delay < 0 || m->sensors.gyro.delay > GIMBAL_GYRO_MAX_DELAY) return "its gyro delay is out of range";
+    return variables_problem(m);
 }
 
 static FmiStatus check_snapshot(void* model, const unsigned char* bytes, int* initialized) {

@@ -55,25 +55,31 @@ static int write_units(FILE* out, int fmi3) {
 _Static_assert((int)SHIP_REAL_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY &&
                    (int)SHIP_INTEGER_COUNT <= (int)SMALL_FMI3_TYPE_CAPACITY,
                "FMI 3.0's value references leave room for the variables of each type");
+/* One Real: an output, or a parameter with its start value; 1 (said on stderr) when its unit is not
+ * one of the unit definitions. */
+static int write_real(FILE* out, int fmi3, int vr) {
+    const ShipRealVariable* v = &kShipRealVariables[vr];
+    const Unit* unit = find_unit(v->unit);
+    if (unit == NULL || (v->display_unit[0] != '\0' && strcmp(unit->display_unit, v->display_unit) != 0)) {
+        fprintf(stderr, "%s: unit '%s' or display unit '%s' is not defined\n", v->name, v->unit, v->display_unit);
+        return 1;
+    }
+    const int output = v->causality == SHIP_OUTPUT;
+    write_variable_start(out, fmi3, "Real", "Float64", v->name, (fmi3 ? SMALL_FMI3_FLOAT64_BASE : 0) + vr,
+                         output ? "output" : "parameter", output ? "continuous" : "fixed",
+                         output ? "calculated" : "exact", v->description);
+    fprintf(out, " unit=\"%s\"", v->unit);
+    if (v->display_unit[0] != '\0') fprintf(out, " displayUnit=\"%s\"", v->display_unit);
+    if (!output) fprintf(out, " start=\"%.17g\"", v->start);
+    if (v->min != -HUGE_VAL) fprintf(out, " min=\"%.17g\"", v->min);
+    write_variable_end(out, fmi3);
+    return 0;
+}
+
 static int write_variables(FILE* out, int fmi3) {
     write_independent_time(out, fmi3);
-    for (int vr = 0; vr < SHIP_REAL_COUNT; ++vr) {
-        const ShipRealVariable* v = &kShipRealVariables[vr];
-        const Unit* unit = find_unit(v->unit);
-        if (unit == NULL || (v->display_unit[0] != '\0' && strcmp(unit->display_unit, v->display_unit) != 0)) {
-            fprintf(stderr, "%s: unit '%s' or display unit '%s' is not defined\n", v->name, v->unit, v->display_unit);
-            return 1;
-        }
-        const int output = v->causality == SHIP_OUTPUT;
-        write_variable_start(out, fmi3, "Real", "Float64", v->name, (fmi3 ? SMALL_FMI3_FLOAT64_BASE : 0) + vr,
-                             output ? "output" : "parameter", output ? "continuous" : "fixed",
-                             output ? "calculated" : "exact", v->description);
-        fprintf(out, " unit=\"%s\"", v->unit);
-        if (v->display_unit[0] != '\0') fprintf(out, " displayUnit=\"%s\"", v->display_unit);
-        if (!output) fprintf(out, " start=\"%.17g\"", v->start);
-        if (v->min != -HUGE_VAL) fprintf(out, " min=\"%.17g\"", v->min);
-        write_variable_end(out, fmi3);
-    }
+    for (int vr = 0; vr < SHIP_REAL_COUNT; ++vr)
+        if (write_real(out, fmi3, vr) != 0) return 1;
     for (int vr = 0; vr < SHIP_INTEGER_COUNT; ++vr) {
         const ShipIntegerVariable* v = &kShipIntegerVariables[vr];
         write_variable_start(out, fmi3, "Integer", "Int32", v->name, (fmi3 ? SMALL_FMI3_INT32_BASE : 0) + vr,

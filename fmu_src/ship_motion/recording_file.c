@@ -20,16 +20,18 @@ static int has_drive_letter(const char* path) {
     return isalpha((unsigned char)path[0]) && path[1] == ':' && (path[2] == '/' || path[2] == '\\' || path[2] == '\0');
 }
 
-char* recording_resources_folder(const char* resource_location) {
+/* The path of a file: URI, its authority (empty or localhost) dropped; NULL for another host's. */
+static const char* uri_path(const char* resource_location) {
     if (resource_location == NULL || strncmp(resource_location, "file:", 5) != 0) return NULL;
     const char* path = resource_location + 5;
-    if (strncmp(path, "//", 2) == 0) { /* an authority: empty or localhost */
-        path += 2;
-        if (strncmp(path, "localhost", 9) == 0) path += 9;
-        if (*path != '/') return NULL; /* another host's file */
-    }
-    char* folder = malloc(strlen(path) + 1);
-    if (folder == NULL) return NULL;
+    if (strncmp(path, "//", 2) != 0) return path;
+    path += 2;
+    if (strncmp(path, "localhost", 9) == 0) path += 9;
+    return *path == '/' ? path : NULL;
+}
+
+/* `path` with its %XX escapes decoded into `folder` (as long as `path` at least); the decoded length. */
+static size_t percent_decoded(const char* path, char* folder) {
     size_t j = 0;
     for (size_t i = 0; path[i] != '\0'; ++i) {
         if (path[i] == '%' && hex_value(path[i + 1]) >= 0 && hex_value(path[i + 2]) >= 0) {
@@ -40,6 +42,15 @@ char* recording_resources_folder(const char* resource_location) {
         }
     }
     folder[j] = '\0';
+    return j;
+}
+
+char* recording_resources_folder(const char* resource_location) {
+    const char* path = uri_path(resource_location);
+    if (path == NULL) return NULL;
+    char* folder = malloc(strlen(path) + 1);
+    if (folder == NULL) return NULL;
+    size_t j = percent_decoded(path, folder);
     if (folder[0] == '/' && has_drive_letter(folder + 1)) memmove(folder, folder + 1, j--); /* /C:/x is C:/x */
     while (j > 1 && (folder[j - 1] == '/' || folder[j - 1] == '\\')) folder[--j] = '\0';
     return folder;

@@ -536,8 +536,8 @@ static FmiStatus save(void* model, unsigned char* bytes) {
     return FMI_OK;
 }
 
-/* What in a snapshot this FMU could not have saved, or NULL. */
-static const char* snapshot_problem(ShipSnapshot* snapshot) {
+/* A snapshot's flags and file names, or NULL. */
+static const char* state_problem(const ShipSnapshot* snapshot) {
     if ((snapshot->initialized & ~1) != 0 || (snapshot->prepared & ~1) != 0 || (snapshot->stop_time_defined & ~1) != 0)
         return "a flag is not a boolean";
     if (snapshot->initialized && !snapshot->prepared) return "it is initialized without a prepared motion";
@@ -545,6 +545,11 @@ static const char* snapshot_problem(ShipSnapshot* snapshot) {
         return "its recording_file is not a terminated string";
     if (memchr(snapshot->target_file, '\0', sizeof snapshot->target_file) == NULL)
         return "its target_file is not a terminated string";
+    return NULL;
+}
+
+/* A snapshot's parameters outside their bounds, or NULL. */
+static const char* parameters_problem(ShipSnapshot* snapshot) {
     for (unsigned vr = SHIP_REAL_OUTPUTS; vr < SHIP_REAL_COUNT; ++vr) {
         const double x = *ship_real_parameter(&snapshot->parameters, vr);
         const ShipRealVariable* variable = &kShipRealVariables[vr];
@@ -556,6 +561,11 @@ static const char* snapshot_problem(ShipSnapshot* snapshot) {
         if (x < kShipIntegerVariables[vr].min || x > kShipIntegerVariables[vr].max)
             return "an Integer parameter lies outside its bounds";
     }
+    return NULL;
+}
+
+/* A snapshot's times, grid row and outputs, or NULL. */
+static const char* progress_problem(const ShipSnapshot* snapshot) {
     if (!isfinite(snapshot->start_time) || !isfinite(snapshot->stop_time) || !isfinite(snapshot->step) ||
         snapshot->step < 0.0)
         return "its times or its step are not finite";
@@ -564,6 +574,14 @@ static const char* snapshot_problem(ShipSnapshot* snapshot) {
     for (int k = 0; k < SHIP_REAL_OUTPUTS; ++k)
         if (!isfinite(snapshot->outputs[k])) return "an output is not finite";
     return NULL;
+}
+
+/* What in a snapshot this FMU could not have saved, or NULL: the first problem, in this order. */
+static const char* snapshot_problem(ShipSnapshot* snapshot) {
+    const char* problem = state_problem(snapshot);
+    if (problem == NULL) problem = parameters_problem(snapshot);
+    if (problem == NULL) problem = progress_problem(snapshot);
+    return problem;
 }
 
 static FmiStatus check_snapshot(void* model, const unsigned char* bytes, int* initialized) {
