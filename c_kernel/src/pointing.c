@@ -41,22 +41,26 @@ static void carrier_rate(const double attitude[3], const double rates[3], const 
     w_dot[2] = d2 * cp * sg - d1 * p1 * sp * sg + d1 * g1 * cp * cg + p2 * cg - p1 * g1 * sg;
 }
 
-int gimbal_pointing_command(const double p[3], const double p_dot[3], const double p_ddot[3], const double attitude[3],
-                            const double rates[3], const double accelerations[3], GimbalPointing* command) {
-    /* u = p / r and its derivatives (kinematics.unit_and_derivatives): p = r u. */
-    const double r = sqrt(dot3(p, p));
-    if (!(r > 0.0) || !isfinite(r)) return GIMBAL_POINTING_AT_THE_GIMBAL;
-    double u[3], u_dot[3], u_ddot[3];
-    for (int i = 0; i < 3; ++i) u[i] = p[i] / r;
-    const double r_dot = dot3(u, p_dot);
-    for (int i = 0; i < 3; ++i) u_dot[i] = (p_dot[i] - u[i] * r_dot) / r;
+/* u = p / r and its derivatives (kinematics.unit_and_derivatives): p = r u. 0 when p is no direction. */
+static int unit_and_derivatives(const double p[3], const double p_dot[3], const double p_ddot[3], double* r,
+                                double* r_dot, double u[3], double u_dot[3], double u_ddot[3]) {
+    *r = sqrt(dot3(p, p));
+    if (!(*r > 0.0) || !isfinite(*r)) return 0;
+    for (int i = 0; i < 3; ++i) u[i] = p[i] / *r;
+    *r_dot = dot3(u, p_dot);
+    for (int i = 0; i < 3; ++i) u_dot[i] = (p_dot[i] - u[i] * *r_dot) / *r;
     const double r_ddot = dot3(u_dot, p_dot) + dot3(u, p_ddot);
-    for (int i = 0; i < 3; ++i) u_ddot[i] = (p_ddot[i] - u[i] * r_ddot - 2.0 * u_dot[i] * r_dot) / r;
+    for (int i = 0; i < 3; ++i) u_ddot[i] = (p_ddot[i] - u[i] * r_ddot - 2.0 * u_dot[i] * *r_dot) / *r;
+    return 1;
+}
 
-    /* v = C u with C = 0TG, C' = -[w x] C */
+/* v = C u in frame 0 and its derivatives, with C = 0TG, C' = -[w x] C. */
+static void in_base_frame(const double u[3], const double u_dot[3], const double u_ddot[3], const double attitude[3],
+                          const double rates[3], const double accelerations[3], double v[3], double v_dot[3],
+                          double v_ddot[3]) {
     double w[3], w_dot[3];
     carrier_rate(attitude, rates, accelerations, w, w_dot);
-    double v[3], c_u_dot[3], c_u_ddot[3], w_v[3], v_dot[3], v_ddot[3];
+    double c_u_dot[3], c_u_ddot[3], w_v[3];
     gimbal_inertial_to_base(u, attitude, v);
     gimbal_inertial_to_base(u_dot, attitude, c_u_dot);
     cross3(w, v, w_v);
@@ -67,27 +71,40 @@ int gimbal_pointing_command(const double p[3], const double p_dot[3], const doub
     cross3(w, v_dot, w_v_dot);
     cross3(w, c_u_dot, w_c_u_dot);
     for (int i = 0; i < 3; ++i) v_ddot[i] = c_u_ddot[i] - w_dot_v[i] - w_v_dot[i] - w_c_u_dot[i];
+}
 
+/* The angles alpha, beta of direction v and their first two derivatives; 0 when v is on the axis. */
+static int angles_of(const double v[3], const double v_dot[3], const double v_ddot[3], GimbalPointing* out) {
     const double x = v[0], y = v[1], z = v[2];
     const double x1 = v_dot[0], y1 = v_dot[1], z1 = v_dot[2];
     const double x2 = v_ddot[0], y2 = v_ddot[1], z2 = v_ddot[2];
     const double rho2 = x * x + y * y;
-    if (!(rho2 > 0.0)) return GIMBAL_POINTING_ON_THE_AXIS;
+    if (!(rho2 > 0.0)) return 0;
     const double rho = sqrt(rho2);
-    GimbalPointing out;
-    out.alpha = atan2(-x, y);
-    out.beta = atan2(z, rho);
+    out->alpha = atan2(-x, y);
+    out->beta = atan2(z, rho);
     const double n = x * y1 - x1 * y;
     const double rho2_dot = 2.0 * (x * x1 + y * y1);
-    out.alpha_dot = n / rho2;
-    out.alpha_ddot = (x * y2 - x2 * y) / rho2 - n * rho2_dot / (rho2 * rho2);
+    out->alpha_dot = n / rho2;
+    out->alpha_ddot = (x * y2 - x2 * y) / rho2 - n * rho2_dot / (rho2 * rho2);
     const double rho_dot = (x * x1 + y * y1) / rho;
     const double rho_ddot = (x1 * x1 + y1 * y1 + x * x2 + y * y2 - rho_dot * rho_dot) / rho;
     const double s2 = rho2 + z * z;
     const double s2_dot = rho2_dot + 2.0 * z * z1;
     const double m = rho * z1 - z * rho_dot;
-    out.beta_dot = m / s2;
-    out.beta_ddot = (rho * z2 - z * rho_ddot) / s2 - m * s2_dot / (s2 * s2);
+    out->beta_dot = m / s2;
+    out->beta_ddot = (rho * z2 - z * rho_ddot) / s2 - m * s2_dot / (s2 * s2);
+    return 1;
+}
+
+int gimbal_pointing_command(const double p[3], const double p_dot[3], const double p_ddot[3], const double attitude[3],
+                            const double rates[3], const double accelerations[3], GimbalPointing* command) {
+    double r, r_dot, u[3], u_dot[3], u_ddot[3];
+    if (!unit_and_derivatives(p, p_dot, p_ddot, &r, &r_dot, u, u_dot, u_ddot)) return GIMBAL_POINTING_AT_THE_GIMBAL;
+    double v[3], v_dot[3], v_ddot[3];
+    in_base_frame(u, u_dot, u_ddot, attitude, rates, accelerations, v, v_dot, v_ddot);
+    GimbalPointing out;
+    if (!angles_of(v, v_dot, v_ddot, &out)) return GIMBAL_POINTING_ON_THE_AXIS;
 
     /* the line of sight's inertial rate u x u' (in G), in frame 2 = Rx(beta)^T Rz(alpha)^T 0TG */
     double rate_g[3], rate_0[3];

@@ -50,8 +50,8 @@ static int is_allowed(const char* name) {
 
 static int compare_names(const void* a, const void* b) { return strcmp(*(const char* const*)a, *(const char* const*)b); }
 
-/* base_motion.Recorded's checks of the names, in its order, with its messages. */
-static int check_columns(const GimbalCsvTable* table, char* message, size_t size) {
+/* The angles' columns: one of radians or degrees, and no rate or acceleration without its angle. */
+static int check_angle_columns(const GimbalCsvTable* table, char* message, size_t size) {
     char name[64];
     for (int i = 0; i < 3; ++i) {
         const int angle = gimbal_csv_table_column(table, kAngles[i]) >= 0;
@@ -65,18 +65,13 @@ static int check_columns(const GimbalCsvTable* table, char* message, size_t size
                               name, kAngles[i], kAnglesInDegrees[i]);
         }
     }
-    const char** unknown = malloc(sizeof(char*) * (size_t)table->columns);
-    if (unknown == NULL) return GIMBAL_RECORDED_MOTION_OUT_OF_MEMORY;
-    int count = 0;
-    for (int k = 0; k < table->columns; ++k)
-        if (!is_allowed(table->names[k])) unknown[count++] = table->names[k];
-    if (count == 0) {
-        free(unknown);
-        return 0;
-    }
-    qsort(unknown, (size_t)count, sizeof(char*), compare_names);
-    /* What the user wrote is quoted in part (a header is any text: a message stays a line): the first
-     * kQuotedColumns names, each cut at kQuotedNameLength characters, then how many more. */
+    return 0;
+}
+
+/* The refusal of the `count` unknown column names (sorted). What the user wrote is quoted in part (a
+ * header is any text: a message stays a line): the first kQuotedColumns names, each cut at
+ * kQuotedNameLength characters, then how many more. */
+static int refuse_unknown_columns(const char** unknown, int count, char* message, size_t size) {
     enum { kQuotedColumns = 5, kQuotedNameLength = 40 };
     int written = snprintf(message, size, "unknown columns [");
     for (int k = 0; k < count && k < kQuotedColumns && written >= 0 && (size_t)written < size; ++k) {
@@ -87,8 +82,25 @@ static int check_columns(const GimbalCsvTable* table, char* message, size_t size
     if (count > kQuotedColumns && written >= 0 && (size_t)written < size)
         written += snprintf(message + written, size - (size_t)written, " and %d more", count - kQuotedColumns);
     if (written >= 0 && (size_t)written < size) snprintf(message + written, size - (size_t)written, "] (allowed: %s)", kAllowed);
-    free(unknown);
     return GIMBAL_RECORDED_MOTION_BAD_COLUMNS;
+}
+
+/* base_motion.Recorded's checks of the names, in its order, with its messages. */
+static int check_columns(const GimbalCsvTable* table, char* message, size_t size) {
+    const int angles = check_angle_columns(table, message, size);
+    if (angles != 0) return angles;
+    const char** unknown = malloc(sizeof(char*) * (size_t)table->columns);
+    if (unknown == NULL) return GIMBAL_RECORDED_MOTION_OUT_OF_MEMORY;
+    int count = 0;
+    for (int k = 0; k < table->columns; ++k)
+        if (!is_allowed(table->names[k])) unknown[count++] = table->names[k];
+    int status = 0;
+    if (count > 0) {
+        qsort(unknown, (size_t)count, sizeof(char*), compare_names);
+        status = refuse_unknown_columns(unknown, count, message, size);
+    }
+    free(unknown);
+    return status;
 }
 
 /* A spline through column `column` of the table (scaled by `scale`): its index (>= 0); -1 when out of

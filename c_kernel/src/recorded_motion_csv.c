@@ -54,36 +54,39 @@ static void strip(const char** start, size_t* length, int quotes_too) {
     while (*length > 0 && (is_blank((*start)[*length - 1]) || (quotes_too && (*start)[*length - 1] == '"'))) --*length;
 }
 
+/* How many continuation bytes a UTF-8 sequence led by `c` has (0: an ASCII byte), and the range of its
+ * second byte (no overlong forms, no surrogates, nothing above U+10FFFF); -1 when `c` leads none. */
+static int continuation_bytes(unsigned char c, unsigned char* low, unsigned char* high) {
+    *low = 0x80, *high = 0xBF;
+    if (c < 0x80) return 0;
+    if (c >= 0xC2 && c <= 0xDF) return 1;
+    if (c >= 0xE0 && c <= 0xEF) {
+        if (c == 0xE0) *low = 0xA0;
+        if (c == 0xED) *high = 0x9F;
+        return 2;
+    }
+    if (c >= 0xF0 && c <= 0xF4) {
+        if (c == 0xF0) *low = 0x90;
+        if (c == 0xF4) *high = 0x8F;
+        return 3;
+    }
+    return -1;
+}
+
 /* The offset of the first byte that is not part of well-formed UTF-8 (as Python's decoder judges:
  * no overlong forms, no surrogates, nothing above U+10FFFF), or -1. */
 static long first_non_utf8(const unsigned char* text, size_t length) {
     size_t i = 0;
     while (i < length) {
-        const unsigned char c = text[i];
-        size_t extra;
-        unsigned char low = 0x80, high = 0xBF; /* the range of the second byte */
-        if (c < 0x80) {
-            ++i;
-            continue;
-        } else if (c >= 0xC2 && c <= 0xDF) {
-            extra = 1;
-        } else if (c >= 0xE0 && c <= 0xEF) {
-            extra = 2;
-            if (c == 0xE0) low = 0xA0;
-            if (c == 0xED) high = 0x9F;
-        } else if (c >= 0xF0 && c <= 0xF4) {
-            extra = 3;
-            if (c == 0xF0) low = 0x90;
-            if (c == 0xF4) high = 0x8F;
-        } else {
-            return (long)i;
-        }
-        for (size_t k = 1; k <= extra; ++k) {
+        unsigned char low, high; /* the range of the second byte */
+        const int extra = continuation_bytes(text[i], &low, &high);
+        if (extra < 0) return (long)i;
+        for (size_t k = 1; k <= (size_t)extra; ++k) {
             if (i + k >= length) return (long)i;
             const unsigned char next = text[i + k];
             if (k == 1 ? (next < low || next > high) : (next < 0x80 || next > 0xBF)) return (long)i;
         }
-        i += extra + 1;
+        i += (size_t)extra + 1;
     }
     return -1;
 }
@@ -134,22 +137,32 @@ static int is_word(const char* cell, size_t length, const char* word) {
     return 1;
 }
 
+/* The digits of the cell from *i on, *i moved past them: how many. */
+static size_t skip_digits(const char* cell, size_t length, size_t* i) {
+    size_t digits = 0;
+    while (*i < length && isdigit((unsigned char)cell[*i])) ++*i, ++digits;
+    return digits;
+}
+
+/* A sign, when there is one at *i: skipped. */
+static void skip_sign(const char* cell, size_t length, size_t* i) {
+    if (*i < length && (cell[*i] == '+' || cell[*i] == '-')) ++*i;
+}
+
 /* Does the cell follow the number grammar? */
 static int is_decimal(const char* cell, size_t length) {
-    size_t i = 0, digits = 0;
-    if (i < length && (cell[i] == '+' || cell[i] == '-')) ++i;
-    while (i < length && isdigit((unsigned char)cell[i])) ++i, ++digits;
+    size_t i = 0;
+    skip_sign(cell, length, &i);
+    size_t digits = skip_digits(cell, length, &i);
     if (i < length && cell[i] == '.') {
         ++i;
-        while (i < length && isdigit((unsigned char)cell[i])) ++i, ++digits;
+        digits += skip_digits(cell, length, &i);
     }
     if (digits == 0) return 0;
     if (i < length && (cell[i] == 'e' || cell[i] == 'E')) {
         ++i;
-        if (i < length && (cell[i] == '+' || cell[i] == '-')) ++i;
-        size_t exponent_digits = 0;
-        while (i < length && isdigit((unsigned char)cell[i])) ++i, ++exponent_digits;
-        if (exponent_digits == 0) return 0;
+        skip_sign(cell, length, &i);
+        if (skip_digits(cell, length, &i) == 0) return 0;
     }
     return i == length;
 }

@@ -39,14 +39,23 @@ static double jonswap_shape(double omega, double peak_omega, double gamma) {
     return shape * pow(gamma, exp(exponent));
 }
 
-GimbalSeaStateStatus gimbal_sea_state_components(const uint32_t* entropy, long words, double significant_amplitude,
-                                                 double peak_period, double gamma, long components, double band_low,
-                                                 double band_high, double* amplitude, double* omega, double* phase) {
+/* The first argument of gimbal_sea_state_components it refuses, in the order of its checks, or OK. */
+static GimbalSeaStateStatus spectrum_refusal(double significant_amplitude, double peak_period, double gamma,
+                                             long components, double band_low, double band_high) {
     if (!isfinite(significant_amplitude) || significant_amplitude < 0.0) return GIMBAL_SEA_STATE_BAD_AMPLITUDE;
     if (!isfinite(peak_period) || !(peak_period > 0.0)) return GIMBAL_SEA_STATE_BAD_PERIOD;
     if (!isfinite(gamma) || !(gamma >= 1.0)) return GIMBAL_SEA_STATE_BAD_GAMMA;
     if (components < 1) return GIMBAL_SEA_STATE_BAD_COMPONENTS;
     if (!isfinite(band_high) || !(band_low > 0.0) || !(band_low < band_high)) return GIMBAL_SEA_STATE_BAD_BAND;
+    return GIMBAL_SEA_STATE_OK;
+}
+
+GimbalSeaStateStatus gimbal_sea_state_components(const uint32_t* entropy, long words, double significant_amplitude,
+                                                 double peak_period, double gamma, long components, double band_low,
+                                                 double band_high, double* amplitude, double* omega, double* phase) {
+    const GimbalSeaStateStatus refusal =
+        spectrum_refusal(significant_amplitude, peak_period, gamma, components, band_low, band_high);
+    if (refusal != GIMBAL_SEA_STATE_OK) return refusal;
 
     const double peak_omega = 2.0 * kPi / peak_period;
     /* np.linspace(start, stop, components + 1): edge i = i * step + start, the last edge stop itself. */
