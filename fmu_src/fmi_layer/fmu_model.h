@@ -118,7 +118,8 @@ typedef struct {
     int fmi2_fmu_state;
 } FmuModel;
 
-/* The table of the FMU the face is linked into (one per binary: each FMU's model file defines it). */
+/* The table of the FMU the face is linked into (one per binary: each FMU's model file defines it; the
+ * gimbal's is the core's, model_core/src/simulation/fmu_model_table.cpp, which includes this header). */
 extern const FmuModel kFmuModel;
 
 /* ---------------------------------------------------------------- what both faces do alike (fmu_model.c)
