@@ -9,6 +9,7 @@
 #include <exception>
 #include <new>
 
+#include "gimbal/simulation/entry_guard.hpp"
 #include "gimbal/simulation/gimbal_instance.hpp"
 #include "gimbal/simulation/linearization.hpp"
 
@@ -33,16 +34,7 @@ namespace {
 template <class Body>
 GimbalStatus guarded(GimbalCore* core, Body&& body) noexcept {
     if (core == nullptr) return GIMBAL_ERROR;
-    try {
-        return body();
-    } catch (const std::bad_alloc&) {
-        core->report("out of memory; the instance is left as it was before the call");
-    } catch (const std::exception& error) {
-        core->report(error.what());
-    } catch (...) {
-        core->report("internal error (an unknown C++ exception)");
-    }
-    return GIMBAL_ERROR;
+    return gimbal::guarded_entry([core](const char* what) { core->report(what); }, body);
 }
 // The continuous-time entries need an initialized instance of that interface.
 template <class Body>

@@ -10,8 +10,6 @@
 // Int64) or Boolean one by one; FMI 3.0's `time` and scalar event indicators follow the Booleans
 // (GIMBAL_FMI3_* of gimbal_c_api.h, which the model description generator numbers by too).
 #include <cmath>
-#include <exception>
-#include <new>
 #include <string>
 
 extern "C" {
@@ -19,6 +17,7 @@ extern "C" {
 #include "gimbal_guid.h"
 }
 #include "gimbal/gimbal_c_api.h"
+#include "gimbal/simulation/entry_guard.hpp"
 #include "gimbal/simulation/gimbal_instance.hpp"
 
 namespace {
@@ -56,19 +55,10 @@ void report(FmiInstance* instance, const char* what) noexcept {
     fmi_log_from_model(instance, GIMBAL_ERROR, "logStatusError", what);
 }
 
-// The body's status; any exception a logged GIMBAL_ERROR (as c_api.cpp's guarded()).
+// The body's status; any exception a GIMBAL_ERROR logged to the instance.
 template <class Body>
 GimbalStatus guarded(FmiInstance* instance, Body&& body) noexcept {
-    try {
-        return body();
-    } catch (const std::bad_alloc&) {
-        report(instance, "out of memory; the instance is left as it was before the call");
-    } catch (const std::exception& error) {
-        report(instance, error.what());
-    } catch (...) {
-        report(instance, "internal error (an unknown C++ exception)");
-    }
-    return GIMBAL_ERROR;
+    return gimbal::guarded_entry([instance](const char* what) { report(instance, what); }, body);
 }
 
 // Model Exchange's equations need an initialized instance (the faces have checked the interface).
