@@ -146,7 +146,25 @@ def draw_frames(path: pathlib.Path, azim: float = -20.0, elev: float = 18.0) -> 
     fig = plt.figure(figsize=(9.0, 6.4))
     ax = fig.add_axes([-0.08, -0.16, 1.16, 1.26], projection="3d")
     ax.set_axis_off()
+    _inertial_frame_and_carrier(ax, pose)
+    deck_z = _drives_and_yoke(ax, pose)
+    _payload(ax, pose)
+    _joint_frames_and_angles(ax, pose, deck_z, alpha, beta)
+    ax.set_xlim(-0.45, 0.45)
+    ax.set_ylim(-0.62, 0.68)
+    ax.set_zlim(-0.35, 0.70)
+    ax.set_box_aspect((0.9, 1.3, 1.05), zoom=1.0)
+    ax.view_init(elev=elev, azim=azim)
+    fig.text(0.02, 0.015,
+             "Carrier at pitch 7, yaw -15, roll -10 deg; gimbal at alpha = 35, beta = 25 deg; joint axes "
+             "dash-dotted.\nFrames 1 and 2 drawn at b, where the azimuth and elevation axes meet; the rotors "
+             "R1, R2 turn about these axes.",
+             fontsize=9, color="#333333")
+    fig.savefig(path, dpi=110, metadata=PNG_METADATA)
+    plt.close(fig)
 
+
+def _inertial_frame_and_carrier(ax, pose: Pose) -> None:
     # Inertial frame G, away from the carrier (its origin does not matter), and gravity.
     g_origin = np.array([0.0, -0.62, -0.10])
     frame3d(ax, g_origin, np.eye(3), 0.20, ["$x_G$", "$y_G$", "$z_G$ (up)"], offset=1.3)
@@ -167,6 +185,9 @@ def draw_frames(path: pathlib.Path, azim: float = -20.0, elev: float = 18.0) -> 
     ax.text(*(0.5 * (pose.a + pose.b) + pose.G0 @ np.array([0.0, -0.16, -0.03])), r"$d_{ab}$", color="#7d3c98",
             fontsize=12)
 
+
+def _drives_and_yoke(ax, pose: Pose) -> float:
+    """The joint axes, the two motors and body 1; the deck's height below b in frame-1 z."""
     # Azimuth axis (z_0 through b) and elevation axis (x_1 through b), dash-dotted.
     ax.plot(*zip(pose.in1((0, 0, -0.36)), pose.in1((0, 0, 0.46))), color="#1f4e99", lw=1.0, ls="-.")
     ax.plot(*zip(pose.in1((-0.40, 0, 0)), pose.in1((0.44, 0, 0))), color="#c0392b", lw=1.0, ls="-.")
@@ -188,7 +209,10 @@ def draw_frames(path: pathlib.Path, azim: float = -20.0, elev: float = 18.0) -> 
     add_faces(ax, cylinder_faces("x", 0.19, 0.28, 0.045, pose.in1), "#8e9aa6", alpha=0.9)
     callout(ax, pose.in1((0.28, 0.0, -0.045)), pose.b + np.array([0.0, 0.44, -0.28]),
             "motor 2 (on body 1):\nrotor $R2$, $\\beta_m$")
+    return deck_z
 
+
+def _payload(ax, pose: Pose) -> None:
     # Body 2: the payload, line of sight along y_2.
     add_faces(ax, box_faces((0.0, 0.03, 0.0), (0.10, 0.16, 0.07), pose.in2), "#5d8aa8", alpha=0.35)
     add_faces(ax, cylinder_faces("x", -0.02, 0.02, 0.05, lambda p: pose.in2(np.array([p[1], p[0], p[2]])),
@@ -198,6 +222,8 @@ def draw_frames(path: pathlib.Path, azim: float = -20.0, elev: float = 18.0) -> 
     callout(ax, pose.in2((-0.10, -0.05, 0.07)), pose.b + np.array([0.0, -0.48, 0.30]), "payload (body 2)",
             colour="#1b4f72", ha="right")
 
+
+def _joint_frames_and_angles(ax, pose: Pose, deck_z: float, alpha: float, beta: float) -> None:
     # Frames 1 and 2 drawn at b (only their orientation matters).
     ax.scatter(*pose.b, color="k", s=14, depthshade=False)
     ax.text(*pose.in1((0.0, -0.07, 0.04)), "$b$", fontsize=13)
@@ -216,19 +242,6 @@ def draw_frames(path: pathlib.Path, azim: float = -20.0, elev: float = 18.0) -> 
     ax.plot(*zip(pose.b, pose.b + 0.30 * y1_dir), color=AXIS_COLOURS["y"], lw=1.0, ls=":")
     arc3d(ax, pose.b, y1_dir, pose.G1[:, 2], beta, 0.36, "#111111", r"$\beta$")
 
-    ax.set_xlim(-0.45, 0.45)
-    ax.set_ylim(-0.62, 0.68)
-    ax.set_zlim(-0.35, 0.70)
-    ax.set_box_aspect((0.9, 1.3, 1.05), zoom=1.0)
-    ax.view_init(elev=elev, azim=azim)
-    fig.text(0.02, 0.015,
-             "Carrier at pitch 7, yaw -15, roll -10 deg; gimbal at alpha = 35, beta = 25 deg; joint axes "
-             "dash-dotted.\nFrames 1 and 2 drawn at b, where the azimuth and elevation axes meet; the rotors "
-             "R1, R2 turn about these axes.",
-             fontsize=9, color="#333333")
-    fig.savefig(path, dpi=110, metadata=PNG_METADATA)
-    plt.close(fig)
-
 
 # ---------------------------------------------------------------------------------------------------
 # 2-D drive-train schematic
@@ -246,7 +259,19 @@ def draw_drive_train(path: pathlib.Path) -> None:
     ax.set_aspect("equal")
     ax.axis("off")
     k = dict(color="#222222", lw=1.4)
+    right = _armature_circuit(ax, k)
+    _rotor_and_gear(ax, right)
+    _shaft(ax, k)
+    _backlash_and_load(ax)
+    ax.text(8.0, 5.6, "one drive axis:  $j = 1$: $q_m = \\alpha_m$, $q_l = \\alpha$;   "
+            "$j = 2$: $q_m = \\beta_m$, $q_l = \\beta$;   $\\theta_d = q_m/N - q_l$",
+            ha="center", fontsize=11)
+    fig.savefig(path, dpi=110, bbox_inches="tight", metadata=PNG_METADATA)
+    plt.close(fig)
 
+
+def _armature_circuit(ax, k: dict) -> float:
+    """The circuit's drawing; the x of its right side (the motor)."""
     # Armature circuit: source u, resistor R, inductor L, back-emf.
     left, right, bottom, top = 0.3, 3.9, 1.6, 4.4
     ax.plot([left, left], [bottom, 2.6], **k)
@@ -277,7 +302,10 @@ def draw_drive_train(path: pathlib.Path) -> None:
     ax.text(1.45, top - 0.7, "$i$,  $|i| \\leq i_L$", ha="center", color="#1f4e99", fontsize=11)
     ax.text(2.1, 0.85, "$|u| \\leq U_L$ (clamped)\n$L\\,di/dt = u - R\\,i - k_{emf}\\,\\dot q_m$",
             ha="center", fontsize=10, color="#333333")
+    return right
 
+
+def _rotor_and_gear(ax, right: float) -> None:
     # Rotor: shaft from the motor to the rotor inertia, torque k_torque i.
     ax.plot([right + 0.45, 5.0], [3.0, 3.0], color="#222222", lw=3)
     ax.add_patch(plt.Rectangle((5.0, 2.2), 1.1, 1.6, facecolor="#8e9aa6", edgecolor="#222222", lw=1.4))
@@ -293,6 +321,8 @@ def draw_drive_train(path: pathlib.Path) -> None:
     ax.text(7.15, 4.05, "gear $N$\n$\\theta_1 = q_m / N$", ha="center", va="bottom", fontsize=11)
     ax.plot([7.93, 8.6], [1.95, 1.95], color="#222222", lw=3)
 
+
+def _shaft(ax, k: dict) -> None:
     # Massless shaft E: spring k_s parallel to damper c_s.
     ax.plot([8.6, 8.6], [1.45, 2.45], **k)
     ax.plot([8.6, 8.9], [2.45, 2.45], **k)
@@ -309,6 +339,8 @@ def draw_drive_train(path: pathlib.Path) -> None:
     ax.text(9.3, 3.45, "shaft $E$: $T_E = k_s(\\theta_d-\\theta_b) + c_s(\\dot\\theta_d-\\dot\\theta_b)$",
             ha="center", fontsize=10)
 
+
+def _backlash_and_load(ax) -> None:
     # Backlash: a tooth on the shaft end theta_2 moving in a slot of the load, free travel +-eta.
     ax.plot([10.4, 10.75, 10.75, 11.7, 11.7], [1.95, 1.95, 2.85, 2.85, 2.15], color="#222222", lw=3)
     ax.add_patch(plt.Rectangle((11.55, 1.75), 0.3, 0.4, facecolor="#222222"))
@@ -327,12 +359,6 @@ def draw_drive_train(path: pathlib.Path) -> None:
     ax.text(13.8, 1.95, "load\nbody 1 / 2\n$q_l$", ha="center", va="center", fontsize=11)
     ax.text(13.8, 3.05, "$+T_E$ on the load\n$-T_E/N$ on the rotor", ha="center", va="bottom", fontsize=10)
     ax.text(13.8, 0.85, "friction\n$T_{as}, T_{av}$", ha="center", va="top", fontsize=9, color="#555555")
-
-    ax.text(8.0, 5.6, "one drive axis:  $j = 1$: $q_m = \\alpha_m$, $q_l = \\alpha$;   "
-            "$j = 2$: $q_m = \\beta_m$, $q_l = \\beta$;   $\\theta_d = q_m/N - q_l$",
-            ha="center", fontsize=11)
-    fig.savefig(path, dpi=110, bbox_inches="tight", metadata=PNG_METADATA)
-    plt.close(fig)
 
 
 # ---------------------------------------------------------------------------------------------------

@@ -158,78 +158,92 @@ class Converter:
         while i < len(lines):
             self.line = i + 1
             line = lines[i]
-            stripped = line.strip()
-            if not stripped:
+            if not line.strip():
                 i += 1
                 continue
-            if line.startswith("```"):
-                end = i + 1
-                while end < len(lines) and lines[end].rstrip() != "```":
-                    end += 1
-                if end == len(lines):
-                    self.fail("unclosed code block")
-                body = "\n".join(lines[i + 1:end])
-                out.append(f"<pre><code>{html.escape(body, quote=False)}</code></pre>")
-                i = end + 1
-                continue
-            if line != line.lstrip():
-                self.fail("an indented block (nested list, indented code) is not supported: unindent it")
-            if re.match(r"^(>|\* |\+ |<[a-zA-Z!/]|={3,}$|-{3,}$|#{5,})", line):
-                self.fail(f"unsupported Markdown construct: {line[:30]!r}")
-            heading = HEADING.match(line)
-            if heading:
-                out.append(self.heading(len(heading.group(1)), heading.group(2).strip()))
+            block, i = self.block(lines, i)
+            out.append(block)
+        self.check_fragments()
+        return "\n".join(out)
+
+    def block(self, lines: list[str], i: int) -> tuple[str, int]:
+        """The HTML of the block that starts at line i, and the line after it."""
+        line = lines[i]
+        if line.startswith("```"):
+            return self.code_block(lines, i)
+        if line != line.lstrip():
+            self.fail("an indented block (nested list, indented code) is not supported: unindent it")
+        if re.match(r"^(>|\* |\+ |<[a-zA-Z!/]|={3,}$|-{3,}$|#{5,})", line):
+            self.fail(f"unsupported Markdown construct: {line[:30]!r}")
+        heading = HEADING.match(line)
+        if heading:
+            return self.heading(len(heading.group(1)), heading.group(2).strip()), i + 1
+        if line.startswith("|"):
+            end = i
+            while end < len(lines) and lines[end].startswith("|"):
+                end += 1
+            return self.table(lines[i:end]), end
+        if LIST_ITEM.match(line):
+            return self.list_block(lines, i)
+        return self.paragraph(lines, i)
+
+    def code_block(self, lines: list[str], i: int) -> tuple[str, int]:
+        end = i + 1
+        while end < len(lines) and lines[end].rstrip() != "```":
+            end += 1
+        if end == len(lines):
+            self.fail("unclosed code block")
+        body = "\n".join(lines[i + 1:end])
+        return f"<pre><code>{html.escape(body, quote=False)}</code></pre>", end + 1
+
+    def list_block(self, lines: list[str], i: int) -> tuple[str, int]:
+        """A list of items of one kind (- or 1.), blank lines between them allowed."""
+        ordered = LIST_ITEM.match(lines[i]).group(1) != "-"
+        tag = "ol" if ordered else "ul"
+        items = []
+        while i < len(lines):
+            self.line = i + 1
+            item = LIST_ITEM.match(lines[i])
+            if not item or (item.group(1) != "-") != ordered:
+                break
+            text, i = self.list_item(lines, i, item.group(2))
+            items.append(f"<li>{self.inline(text)}</li>")
+            while i < len(lines) and not lines[i].strip() and i + 1 < len(lines) and \
+                    LIST_ITEM.match(lines[i + 1]) and (LIST_ITEM.match(lines[i + 1]).group(1) != "-") == ordered:
                 i += 1
-                continue
-            if line.startswith("|"):
-                end = i
-                while end < len(lines) and lines[end].startswith("|"):
-                    end += 1
-                out.append(self.table(lines[i:end]))
-                i = end
-                continue
-            item = LIST_ITEM.match(line)
-            if item:
-                ordered = item.group(1) != "-"
-                tag = "ol" if ordered else "ul"
-                items = []
-                while i < len(lines):
-                    self.line = i + 1
-                    item = LIST_ITEM.match(lines[i])
-                    if not item or (item.group(1) != "-") != ordered:
-                        break
-                    body = [item.group(2)]
-                    i += 1
-                    while i < len(lines) and lines[i].startswith("  ") and lines[i].strip():
-                        if LIST_ITEM.match(lines[i].strip()) or lines[i].strip().startswith("```"):
-                            self.line = i + 1
-                            self.fail("nested lists and code blocks inside list items are not supported")
-                        body.append(lines[i].strip())
-                        i += 1
-                    items.append(f"<li>{self.inline(' '.join(body))}</li>")
-                    while i < len(lines) and not lines[i].strip() and i + 1 < len(lines) and \
-                            LIST_ITEM.match(lines[i + 1]) and (LIST_ITEM.match(lines[i + 1]).group(1) != "-") == ordered:
-                        i += 1
-                out.append(f"<{tag}>\n" + "\n".join(items) + f"\n</{tag}>")
-                continue
-            # A paragraph: up to a blank line or the start of another block.
-            body = []
-            while i < len(lines) and lines[i].strip() and not re.match(r"^(```|#{1,4} |\||- |\d+\. )", lines[i]):
-                if lines[i] != lines[i].lstrip():
-                    self.line = i + 1
-                    self.fail("an indented line inside a paragraph")
-                body.append(lines[i])
-                i += 1
-            rendered = self.inline(" ".join(body))
-            if re.fullmatch(r'<img [^>]*>', rendered):
-                out.append(f"<figure>{rendered}</figure>")
-            else:
-                out.append(f"<p>{rendered}</p>")
+        return f"<{tag}>\n" + "\n".join(items) + f"\n</{tag}>", i
+
+    def list_item(self, lines: list[str], i: int, first: str) -> tuple[str, int]:
+        """The text of the item at line i (its continuation lines indented), and the line after it."""
+        body = [first]
+        i += 1
+        while i < len(lines) and lines[i].startswith("  ") and lines[i].strip():
+            if LIST_ITEM.match(lines[i].strip()) or lines[i].strip().startswith("```"):
+                self.line = i + 1
+                self.fail("nested lists and code blocks inside list items are not supported")
+            body.append(lines[i].strip())
+            i += 1
+        return " ".join(body), i
+
+    def paragraph(self, lines: list[str], i: int) -> tuple[str, int]:
+        """A paragraph: up to a blank line or the start of another block; an image alone is a figure."""
+        body = []
+        while i < len(lines) and lines[i].strip() and not re.match(r"^(```|#{1,4} |\||- |\d+\. )", lines[i]):
+            if lines[i] != lines[i].lstrip():
+                self.line = i + 1
+                self.fail("an indented line inside a paragraph")
+            body.append(lines[i])
+            i += 1
+        rendered = self.inline(" ".join(body))
+        if re.fullmatch(r'<img [^>]*>', rendered):
+            return f"<figure>{rendered}</figure>", i
+        return f"<p>{rendered}</p>", i
+
+    def check_fragments(self) -> None:
         for fragment, line in self.fragments:
             if fragment not in self.ids:
                 self.line = line
                 self.fail(f"link to #{fragment}, which is no heading of the page")
-        return "\n".join(out)
 
 
 def convert_file(source: pathlib.Path, output: pathlib.Path, title: str, subtitle: str = "") -> list[pathlib.Path]:

@@ -150,7 +150,7 @@ def test_a_sweep_of_a_scene_with_bands_has_a_column_per_band(tmp_path, fmu_path)
 
 def test_the_sea_estimate_is_put_on_the_dwell_scale_by_the_pointing_geometry(tmp_path, ship_run):
     from gimbal2axis.analysis.frequency_response import read_sea_estimate
-    from gimbal2axis.cli.freqresp import dwell_scale
+    from gimbal2axis.analysis.carrier_projection import dwell_scale
 
     # on the ship's target (azimuth 30 deg, elevation 5 deg) a roll about y0 lies sin 30 deg along the
     # elevation axis and cos 30 deg sin 5 deg along the cross-elevation one

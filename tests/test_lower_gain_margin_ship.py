@@ -50,7 +50,7 @@ def test_the_elevation_loop_has_a_lower_gain_margin_at_the_stability_edge(ship_l
 
 def test_freqresp_loop_gain_prints_the_lower_margin(ship_scene, fmu_path, elevation):
     """`freqresp loop-gain --axis 2`'s printed prediction names the lower gain margin and its frequency."""
-    from gimbal2axis.cli.freqresp import linear_prediction
+    from gimbal2axis.analysis.linear_prediction import linear_prediction
 
     _, _, summary = linear_prediction(ship_scene, fmu_path, Excitation("injection", "2", 0.2),
                                       ["loop_gain"], 0.1, 100.0)

@@ -284,13 +284,9 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
     U = fundamental(u, t, f)
     if excitation.kind == "voltage":
         U = zoh_fundamental(U, f, h)
-    limited = np.zeros(n_measure, bool)
-    for j in (1, 2):
-        if f"motor{j}.limited" in sig:
-            limited |= np.asarray(sig[f"motor{j}.limited"])[window] != 0
     common = dict(frequency_hz=f, requested_hz=frequency, input=excitation.input_signal,
                   input_amplitude=abs(U), samples_per_period=1.0 / (f * h), settle_s=n_settle * h,
-                  measure_periods=dwell.measure_periods, current_limited_fraction=float(limited.mean()),
+                  measure_periods=dwell.measure_periods, current_limited_fraction=_limited_fraction(sig, window),
                   alpha_mean_deg=math.degrees(float(np.mean(sig["alpha"][window]))),
                   beta_mean_deg=math.degrees(float(np.mean(sig["beta"][window]))))
     rows = _injection_rows(common, sig, window, t, f, excitation.axis, U) if excitation.kind == "injection" else []
@@ -301,18 +297,32 @@ def measure_point(scene, fmu, frequency: float, excitation: Excitation, dwell: D
         gains[name] = Y / U
         rows.append(_gain_row(common, name, Y / U, y, Y, t, f))
     if excitation.kind == "base" and all(name in gains for name in LOS_OUTPUTS):
-        g = math.sqrt(sum(abs(gains[name]) ** 2 for name in LOS_OUTPUTS))
-        parts = [r for r in rows if r["output"] in LOS_OUTPUTS]
-        total_var = sum(r["output_variance"] for r in parts)
-        # the variance-weighted mean of the components' fractions: the explained power over the total, in [0, 1]
-        explained = sum(r["coherence"] * r["output_variance"] for r in parts)
-        rows.append(dict(common, output="los", gain=g, gain_db=20 * math.log10(g) if g > 0 else -math.inf,
-                         phase_deg=math.nan,
-                         coherence=explained / total_var if total_var > 0 else math.nan,
-                         output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var,
-                         harmonic_amplitude=math.hypot(*(r["harmonic_amplitude"] for r in parts)),
-                         drift_amplitude=math.hypot(*(r["drift_amplitude"] for r in parts))))
+        rows.append(_los_row(common, rows, gains, U))
     return rows
+
+
+def _limited_fraction(sig: dict, window: slice) -> float:
+    """The share of the window's steps in which a motor's current was at its limit."""
+    limited = np.zeros(window.stop - window.start, bool)
+    for j in (1, 2):
+        if f"motor{j}.limited" in sig:
+            limited |= np.asarray(sig[f"motor{j}.limited"])[window] != 0
+    return float(limited.mean())
+
+
+def _los_row(common: dict, rows: list[dict], gains: dict, U: complex) -> dict:
+    """The combined line-of-sight row 'los' of a base excitation: sqrt(|G_1|^2 + |G_3|^2), no phase."""
+    g = math.sqrt(sum(abs(gains[name]) ** 2 for name in LOS_OUTPUTS))
+    parts = [r for r in rows if r["output"] in LOS_OUTPUTS]
+    total_var = sum(r["output_variance"] for r in parts)
+    # the variance-weighted mean of the components' fractions: the explained power over the total, in [0, 1]
+    explained = sum(r["coherence"] * r["output_variance"] for r in parts)
+    return dict(common, output="los", gain=g, gain_db=20 * math.log10(g) if g > 0 else -math.inf,
+                phase_deg=math.nan,
+                coherence=explained / total_var if total_var > 0 else math.nan,
+                output_amplitude=g * abs(U), output_mean=math.nan, output_variance=total_var,
+                harmonic_amplitude=math.hypot(*(r["harmonic_amplitude"] for r in parts)),
+                drift_amplitude=math.hypot(*(r["drift_amplitude"] for r in parts)))
 
 
 def _controller_for(run_scene, fmu, excitation: Excitation, f: float, n: int):
@@ -478,19 +488,22 @@ def marks_summary(rows: list[dict]) -> str | None:
             by_curve.setdefault(row["curve"], []).append(row)
     if not any(r["marks"] for points in by_curve.values() for r in points):
         return None
-    parts = []
-    for curve, points in by_curve.items():
-        marked = [r for r in points if r["marks"]]
-        counts: dict = {}
-        for row in marked:
-            for reason in row["marks"].split("; "):
-                key = next(k for k in ("harmonics", "drift", "vs linear", "operating point", reason)
-                           if reason.startswith(k))
-                counts[key] = counts.get(key, 0) + 1
-        why = ", ".join(f"{key} {count}" for key, count in counts.items())
-        parts.append(f"{curve or 'simulated'} {len(marked)} of {len(points)}" + (f" ({why})" if why else ""))
+    parts = [_curve_marks(curve, points) for curve, points in by_curve.items()]
     return (f"not a frequency response to {100 * LINEARITY_TOLERANCE:g} % and {PHASE_TOLERANCE_DEG:g} deg "
             f"(CSV column marks, grey in the plot; docs/frequency_response.md): " + "; ".join(parts))
+
+
+def _curve_marks(curve: str, points: list[dict]) -> str:
+    """'<curve> <marked> of <points> (<reason> <count>, ...)'."""
+    marked = [r for r in points if r["marks"]]
+    counts: dict = {}
+    for row in marked:
+        for reason in row["marks"].split("; "):
+            key = next(k for k in ("harmonics", "drift", "vs linear", "operating point", reason)
+                       if reason.startswith(k))
+            counts[key] = counts.get(key, 0) + 1
+    why = ", ".join(f"{key} {count}" for key, count in counts.items())
+    return f"{curve or 'simulated'} {len(marked)} of {len(points)}" + (f" ({why})" if why else "")
 
 
 def _injection_rows(common: dict, sig: dict, window: slice, t: np.ndarray, f: float, axis: str, D: complex) -> list:
@@ -684,66 +697,13 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
     fig, (ax_g, ax_p, ax_c) = plt.subplots(3, 1, figsize=(9, 10), sharex=True)
     if lines:
         rows = [r for r in rows if r.get("curve") != LINEAR_CURVE]
-    groups = curves(rows)
-    finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
-    for _, _, G, *_ in lines or []:
-        finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
-    for _, _, gain, *_ in sea or []:   # the sea's bins set the gain axis too: none is put on a floor it did not need
-        finite_gains += [20 * math.log10(g) for g in gain if np.isfinite(g) and g > 0]
-    top = max(finite_gains) if finite_gains else 0.0
-    floor = max(min(finite_gains) if finite_gains else top, top - GAIN_RANGE_DB) if finite_gains else -GAIN_RANGE_DB
+    floor = _gain_floor(rows, lines or [], sea or [])
     for index, line in enumerate(lines or []):
-        label, f, G = line[:3]
-        has_phase = line[3] if len(line) > 3 else True
-        style = ["-", "--", ":"][index % 3]
-        gain = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
-        shown = gain >= floor
-        ax_g.semilogx(f[shown], gain[shown], style, color="k", lw=0.9,
-                      label=label + ("" if has_phase else " (gain only)")
-                      + ("" if shown.all() else f" ({(~shown).sum()} points below {floor:.0f} dB not drawn)"))
-        if has_phase:
-            ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(G))), style, color="k", lw=0.9)
-    markers, styles = "osD^vP*X", ["-", "--", ":", "-."]
-    for index, ((curve, output), cr) in enumerate(groups.items()):
-        marker, style = markers[index % len(markers)], styles[index % len(styles)]
-        size = max(7 - index, 3)
-        f = np.array([r["frequency_hz"] for r in cr])
-        g = np.array([r["gain_db"] for r in cr], float)
-        p = np.array([r["phase_deg"] for r in cr], float)
-        c = np.array([r["coherence"] for r in cr], float)
-        marked = np.array([bool(r.get("marks")) for r in cr])
-        label = f"{curve}: {output}" if curve else output
-        low = ~(np.isfinite(g) & (g >= floor))
-        if low.any():
-            label += f" ({low.sum()} below {floor:.0f} dB: on the floor)"
-        if marked.any():
-            label += f" ({marked.sum()} of {len(cr)} not a frequency response: grey)"
-        shown_g = np.where(low, floor, g)
-        line, = ax_g.semilogx(f, shown_g, style, marker=marker, ms=size, mfc="none", label=label)
-        if low.any():
-            ax_g.semilogx(f[low], np.full(low.sum(), floor), "v", color=line.get_color(), ms=9)
-        kw = dict(color=line.get_color(), linestyle=style, marker=marker, ms=size, mfc="none")
-        # a point that is not a frequency response (column marks) is filled grey over its hollow marker
-        grey = dict(linestyle="none", marker=marker, ms=size, color="0.55", mfc="0.75", zorder=3)
-        ax_g.semilogx(f[marked], shown_g[marked], **grey)
-        finite = np.isfinite(p)
-        if finite.any():
-            unwrapped = np.degrees(np.unwrap(np.radians(p[finite])))
-            ax_p.semilogx(f[finite], unwrapped, **kw)
-            ax_p.semilogx(f[finite][marked[finite]], unwrapped[marked[finite]], **grey)
-        ax_c.semilogx(f, c, **kw)
-        ax_c.semilogx(f[marked], c[marked], **grey)
-    for index, (label, f, gain, coherence, known) in enumerate(sea or []):
-        color = ["0.45", "0.7"][index % 2]
-        with np.errstate(divide="ignore"):
-            db = 20 * np.log10(gain)
-        low = ~(np.isfinite(db) & (db >= floor))
-        shown = np.where(low, floor, db)
-        # a bin whose gain the run does not know (low coherence) is dotted, one it knows solid
-        ax_g.semilogx(f, shown, ":", color=color, lw=0.6)
-        ax_g.semilogx(f, np.where(known, shown, np.nan), "-", marker=".", ms=4, color=color, lw=0.9,
-                      label=label + (f" ({low.sum()} bins below {floor:.0f} dB: on the floor)" if low.any() else ""))
-        ax_c.semilogx(f, coherence, "-", color=color, lw=0.8, label=f"{label.split(':')[0]}: magnitude-squared coherence")
+        _draw_line(ax_g, ax_p, index, line, floor)
+    for index, ((curve, output), points) in enumerate(curves(rows).items()):
+        _draw_curve((ax_g, ax_p, ax_c), index, f"{curve}: {output}" if curve else output, points, floor)
+    for index, overlay in enumerate(sea or []):
+        _draw_sea(ax_g, ax_c, index, overlay, floor)
     if sea:
         ax_c.legend(fontsize=7)
     ax_g.set_ylabel("gain [dB]")
@@ -757,3 +717,79 @@ def plot_bode(rows: list[dict], path, title: str = "", lines: list | None = None
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _gain_floor(rows: list[dict], lines: list, sea: list) -> float:
+    """The gain axis's floor [dB]: the lowest finite gain of the points, lines and sea estimate, at most
+    GAIN_RANGE_DB below the highest."""
+    finite_gains = [r["gain_db"] for r in rows if math.isfinite(r["gain_db"])]
+    for _, _, G, *_ in lines:
+        finite_gains += [20 * math.log10(abs(g)) for g in G if g != 0]
+    for _, _, gain, *_ in sea:   # the sea's bins set the gain axis too: none is put on a floor it did not need
+        finite_gains += [20 * math.log10(g) for g in gain if np.isfinite(g) and g > 0]
+    if not finite_gains:
+        return -GAIN_RANGE_DB
+    return max(min(finite_gains), max(finite_gains) - GAIN_RANGE_DB)
+
+
+def _draw_line(ax_g, ax_p, index: int, line: tuple, floor: float) -> None:
+    """A thin black Bode line of the linear model (linear_lines), its gain only above the floor."""
+    label, f, G = line[:3]
+    has_phase = line[3] if len(line) > 3 else True
+    style = ["-", "--", ":"][index % 3]
+    gain = 20 * np.log10(np.maximum(np.abs(G), 1e-300))
+    shown = gain >= floor
+    ax_g.semilogx(f[shown], gain[shown], style, color="k", lw=0.9,
+                  label=label + ("" if has_phase else " (gain only)")
+                  + ("" if shown.all() else f" ({(~shown).sum()} points below {floor:.0f} dB not drawn)"))
+    if has_phase:
+        ax_p.semilogx(f, np.degrees(np.unwrap(np.angle(G))), style, color="k", lw=0.9)
+
+
+def _draw_curve(axes: tuple, index: int, label: str, points: list[dict], floor: float) -> None:
+    """One simulated curve in the three panels: gain (below the floor on it, a downward triangle), phase
+    and coherence, each with its own marker and line style; the points that are not a frequency response
+    (column marks) filled grey over their hollow marker."""
+    ax_g, ax_p, ax_c = axes
+    markers, styles = "osD^vP*X", ["-", "--", ":", "-."]
+    marker, style = markers[index % len(markers)], styles[index % len(styles)]
+    size = max(7 - index, 3)
+    f = np.array([r["frequency_hz"] for r in points])
+    g = np.array([r["gain_db"] for r in points], float)
+    p = np.array([r["phase_deg"] for r in points], float)
+    c = np.array([r["coherence"] for r in points], float)
+    marked = np.array([bool(r.get("marks")) for r in points])
+    low = ~(np.isfinite(g) & (g >= floor))
+    if low.any():
+        label += f" ({low.sum()} below {floor:.0f} dB: on the floor)"
+    if marked.any():
+        label += f" ({marked.sum()} of {len(points)} not a frequency response: grey)"
+    shown_g = np.where(low, floor, g)
+    line, = ax_g.semilogx(f, shown_g, style, marker=marker, ms=size, mfc="none", label=label)
+    if low.any():
+        ax_g.semilogx(f[low], np.full(low.sum(), floor), "v", color=line.get_color(), ms=9)
+    kw = dict(color=line.get_color(), linestyle=style, marker=marker, ms=size, mfc="none")
+    grey = dict(linestyle="none", marker=marker, ms=size, color="0.55", mfc="0.75", zorder=3)
+    ax_g.semilogx(f[marked], shown_g[marked], **grey)
+    finite = np.isfinite(p)
+    if finite.any():
+        unwrapped = np.degrees(np.unwrap(np.radians(p[finite])))
+        ax_p.semilogx(f[finite], unwrapped, **kw)
+        ax_p.semilogx(f[finite][marked[finite]], unwrapped[marked[finite]], **grey)
+    ax_c.semilogx(f, c, **kw)
+    ax_c.semilogx(f[marked], c[marked], **grey)
+
+
+def _draw_sea(ax_g, ax_c, index: int, overlay: tuple, floor: float) -> None:
+    """A sea-state run's isolation estimate (read_sea_estimate): thin grey lines of its gain, dotted where
+    the run does not know it (low coherence), and its coherence."""
+    label, f, gain, coherence, known = overlay
+    color = ["0.45", "0.7"][index % 2]
+    with np.errstate(divide="ignore"):
+        db = 20 * np.log10(gain)
+    low = ~(np.isfinite(db) & (db >= floor))
+    shown = np.where(low, floor, db)
+    ax_g.semilogx(f, shown, ":", color=color, lw=0.6)
+    ax_g.semilogx(f, np.where(known, shown, np.nan), "-", marker=".", ms=4, color=color, lw=0.9,
+                  label=label + (f" ({low.sum()} bins below {floor:.0f} dB: on the floor)" if low.any() else ""))
+    ax_c.semilogx(f, coherence, "-", color=color, lw=0.8, label=f"{label.split(':')[0]}: magnitude-squared coherence")

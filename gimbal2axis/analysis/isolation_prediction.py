@@ -240,15 +240,23 @@ def build_loop(scene, fmu, fidelity: dict | None) -> IsolationLoop:
                          cos_beta=max(math.cos(beta0), 0.2), h=scene.step_size, delay=scene.delay_steps)
     radius = float(np.max(np.abs(closed_loop_poles(loop))))
     if radius >= 1.0:
-        # in the backlash gap or stuck by friction the voltage does not reach the load: a pole at 1
-        decoupled = [f"{name} = {value}" for name, value in model.modes.items()
-                     if (name.endswith(".contact") and value == 0 and values.get(f"{name.split('.')[0]}.model", 2) == 2)
-                     or (name.endswith(".friction") and value != "none" and not str(value).startswith("slipping"))]
+        decoupled = _decoupled_modes(model.modes, values)
         why = (f"; at the operating point {', '.join(decoupled)}: linearize without backlash and dry friction "
                f"(LINEAR_FIDELITY)" if decoupled else "")
         raise SceneError(f"{scene.name}: the linear closed loop is unstable (a pole at |z| = {radius:.6g} >= 1): "
                          f"it has no steady-state response, hence no isolation ratio{why}")
     return loop
+
+
+def _decoupled_modes(modes: dict, values: dict) -> list[str]:
+    """'name = value' of the modes in which the voltage does not reach the load (in the backlash gap of a
+    gear with backlash, stuck by friction): each puts a pole at 1."""
+    def decoupled(name, value):
+        if name.endswith(".contact"):
+            return value == 0 and values.get(f"{name.split('.')[0]}.model", 2) == 2
+        return name.endswith(".friction") and value != "none" and not str(value).startswith("slipping")
+
+    return [f"{name} = {value}" for name, value in modes.items() if decoupled(name, value)]
 
 
 def closed_loop_poles(loop: IsolationLoop) -> np.ndarray:

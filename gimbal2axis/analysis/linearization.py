@@ -109,20 +109,7 @@ class Probe:
         values = dict(values or {})
         settings = (_Setting * max(len(values), 1))()
         for k, (name, value) in enumerate(values.items()):
-            if name not in self.variables:
-                raise SceneError(f"linearize: '{name}' is not a variable of the gimbal model"
-                                 f"{did_you_mean(name, self.variables)}")
-            type_, vr, causality = self.variables[name]
-            if snapshot is not None and causality != INPUT_CAUSALITY:
-                raise SceneError(f"linearize: '{name}' is not an input: at a running instance's operating point "
-                                 f"only inputs can be changed")
-            value = float(value)
-            if not math.isfinite(value):
-                raise SceneError(f"linearize: '{name}' = {value} is not finite")
-            if type_ != REAL and not value.is_integer():
-                raise SceneError(f"linearize: '{name}' is {'an Integer' if type_ == INTEGER else 'a Boolean'}: "
-                                 f"{value:g} is not a whole number")
-            settings[k] = _Setting(type_, vr, value)
+            settings[k] = self._setting(name, value, at_snapshot=snapshot is not None)
         buffer = None
         if snapshot is not None:
             if len(snapshot) != self.snapshot_size:
@@ -135,6 +122,27 @@ class Probe:
                                                   ctypes.byref(model), message, len(message))
         if status != 0:
             raise SceneError(f"linearize: {message.value.decode(errors='replace')}")
+        return self._linear_model(model, values)
+
+    def _setting(self, name: str, value, at_snapshot: bool) -> "_Setting":
+        """The probe's setting of variable `name` to `value`, checked."""
+        if name not in self.variables:
+            raise SceneError(f"linearize: '{name}' is not a variable of the gimbal model"
+                             f"{did_you_mean(name, self.variables)}")
+        type_, vr, causality = self.variables[name]
+        if at_snapshot and causality != INPUT_CAUSALITY:
+            raise SceneError(f"linearize: '{name}' is not an input: at a running instance's operating point "
+                             f"only inputs can be changed")
+        value = float(value)
+        if not math.isfinite(value):
+            raise SceneError(f"linearize: '{name}' = {value} is not finite")
+        if type_ != REAL and not value.is_integer():
+            raise SceneError(f"linearize: '{name}' is {'an Integer' if type_ == INTEGER else 'a Boolean'}: "
+                             f"{value:g} is not a whole number")
+        return _Setting(type_, vr, value)
+
+    def _linear_model(self, model, values: dict) -> "LinearModel":
+        """The LinearModel of the probe's result struct, linearized at `values`."""
         n = model.state_count
         max_states, input_count, output_count = self.dimensions
         A = np.ctypeslib.as_array(model.A).reshape(max_states, max_states)[:n, :n].copy()

@@ -40,6 +40,7 @@ linear prediction (docs/frequency_response.md).
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import pathlib
 import sys
@@ -119,11 +120,6 @@ def check_frequencies(frequencies, scene, dwell) -> None:
     fr.check_resolvable([max(frequencies)], scene.step_size, dwell, what="--fmax")
 
 
-def unit_of(mode: str, drive: str = "voltage") -> str:
-    """The unit of --amplitude: a motor's current command's in current drive."""
-    return "deg/s" if mode == "isolation" else ("V" if drive == "voltage" else "A")
-
-
 def motor_drive(scene, fmu_file, axis: str) -> str:
     """"voltage" or "current": the drive of motor `axis` in the scene (scene/drives.py); "voltage" for an
     axis that is not a motor's (refused later, with its own message)."""
@@ -134,141 +130,6 @@ def motor_drive(scene, fmu_file, axis: str) -> str:
         return "voltage"
     with FMU(fmu_file) as fmu:
         return scene_drives(scene, fmu)[int(axis) - 1].kind
-
-
-def linear_prediction(scene, fmu_path, excitation, outputs, f_min, f_max):
-    """The linear model's Bode lines, a function giving its rows at the simulated points and a line of
-    text to print (or None): open loop, the plant's G(jw) (analysis.linearization); isolation and loop
-    gain, the sampled-data closed loop of the scene's PID controller (analysis.isolation_prediction),
-    the loop gain with its predicted margins. All without backlash and dry friction."""
-    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
-    from ..fmu import FMU
-
-    with FMU(fmu_path) as fmu:
-        if excitation.kind == "voltage":
-            from ..analysis import linearization
-
-            model = linearization.linearize(fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY))
-            lines = fr.linear_lines(model, excitation.input_signal, outputs, f_min, f_max)
-            return lines, lambda rows: fr.linear_rows(model, rows), None
-        from ..analysis import isolation_prediction as isolation
-
-        loop = isolation.build_loop(scene, fmu, fr.LINEAR_FIDELITY)
-    def at_simulated(function):
-        return lambda rows: function(loop, excitation.axis, sorted({r["frequency_hz"] for r in rows}))
-    if excitation.kind == "injection":
-        margins = isolation.predicted_margins(loop, excitation.axis)
-        summary = f"linear model, loop gain at {fr.command_signal(excitation.axis, excitation.drive)}: {margins.describe()}"
-        return (isolation.loop_gain_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.loop_gain_rows),
-                summary)
-    return (isolation.isolation_lines(loop, excitation.axis, f_min, f_max), at_simulated(isolation.isolation_rows),
-            None)
-
-
-CARRIER_AXES = {"roll": (0.0, 1.0, 0.0), "pitch": (1.0, 0.0, 0.0), "yaw": (0.0, 0.0, 1.0)}   # in frame 0, level
-
-
-def dwell_scale(scene, axis: str) -> dict:
-    """{payload axis: |component of the dwell's carrier axis along it|} with the gimbal on the scene's
-    target on a level carrier: the dwell's ratio (LOS rate / carrier rate about one carrier axis) is the
-    per-payload-axis ratio times this, while the axes do not couple."""
-    import numpy as np
-
-    from ..scene import geometry
-
-    if scene.target is None:
-        raise SceneError("--sea-estimate needs a scene with a [target] (the gimbal's pointing sets the scale)")
-    alpha, beta = geometry.gimbal_angles_for(scene.target, 0.0, 0.0, 0.0)
-    carrier_axis = np.array(CARRIER_AXES[axis])
-    to_payload = (geometry.rz(alpha) @ geometry.rx(beta)).T   # frame 0 -> frame 2
-    components = to_payload @ carrier_axis
-    return {"elevation": abs(components[0]), "cross_elevation": abs(components[2])}
-
-
-def measured_margins(rows: list[dict]) -> list[str]:
-    """A line per simulated curve: the margins of its loop_gain points (interpolated between the dwell's
-    frequencies, so only as fine as its grid; a point of low coherence may place a crossing anywhere)."""
-    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
-    from ..analysis.isolation_prediction import stability_margins
-
-    lines = []
-    for (curve, output), points in fr.curves(rows).items():
-        if output != fr.LOOP_GAIN or curve == fr.LINEAR_CURVE or len(points) < 2:
-            continue
-        f = [r["frequency_hz"] for r in points]
-        L = [r["gain"] * complex(math.cos(math.radians(r["phase_deg"])), math.sin(math.radians(r["phase_deg"])))
-             for r in points]
-        lines.append(f"{curve}, from its {len(points)} points: {stability_margins(f, L).describe()}")
-    return lines
-
-
-NO_BACKLASH = "no backlash, no dry friction"   # the curve of the linear prediction's fidelity (with ", <amplitude>")
-
-
-def check_points(rows: list[dict], scene, fmu_file, excitation, with_prediction: bool) -> None:
-    """Marks the points that are not a frequency response (fr.mark_rows): harmonics and drift of every
-    simulated point; with the prediction, the "no backlash, no dry friction" points against it, and in
-    open loop every point's operating point (the window's gimbal angles) against the prediction's."""
-    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
-
-    if not with_prediction:
-        fr.mark_rows(rows)
-        return
-    predicted = {(r["output"], r["frequency_hz"]): complex(r["gain"]) if math.isnan(r["phase_deg"]) else
-                 r["gain"] * complex(math.cos(math.radians(r["phase_deg"])), math.sin(math.radians(r["phase_deg"])))
-                 for r in rows if r["curve"] == fr.LINEAR_CURVE}
-    changes = operating_point_changes(rows, scene, fmu_file, excitation) if excitation.kind == "voltage" else {}
-    fr.mark_rows(rows, lambda curve: curve.startswith(NO_BACKLASH),
-                 lambda output, f: predicted.get((output, f)),
-                 lambda row: changes.get((row["curve"], row["frequency_hz"], row["output"])))
-
-
-def operating_point_changes(rows: list[dict], scene, fmu_file, excitation) -> dict:
-    """{(curve, frequency, output): (G of the linear model at the window's mean alpha and beta over G at the
-    prediction's point, 'beta 5 -> -123 deg')} of every open-loop point: the prediction is made at the
-    scene's initial angles, and on a fixed base gravity moves an unbalanced payload away from them while the
-    dwell settles. Linearized without backlash and dry friction as the prediction (1 ms each)."""
-    from ..analysis import frequency_response as fr   # here, not at the top: --help does without numpy
-    from ..analysis import linearization
-    from ..fmu import FMU
-
-    changes = {}
-    with FMU(fmu_file) as fmu:
-        start = fr.linear_point(scene, fmu, excitation, fr.LINEAR_FIDELITY)
-        reference = linearization.linearize(start)
-        for row in rows:
-            if row["curve"] == fr.LINEAR_CURVE or row["output"] not in reference.outputs:
-                continue
-            # within half a turn (a start angle beyond it is refused as degrees): the same configuration, as an
-            # axis that walked round during the dwell (a torque-driven one, in current drive) left it
-            alpha, beta = (math.remainder(math.radians(row[key]), 2 * math.pi) for key in ("alpha_mean_deg",
-                                                                                          "beta_mean_deg"))
-            # the rotors follow their loads there (start_values), not the angles the scene may give them
-            initial = {k: v for k, v in scene.initial.items() if k not in ("alpha_m", "beta_m")}
-            moved_scene = scene.with_changes(initial={**initial, "alpha": alpha, "beta": beta})
-            moved = linearization.linearize(fr.linear_point(moved_scene, fmu, excitation, fr.LINEAR_FIDELITY))
-            f = [row["frequency_hz"]]
-            G0 = complex(reference.frequency_response(f, excitation.input_signal, row["output"])[0])
-            G = complex(moved.frequency_response(f, excitation.input_signal, row["output"])[0])
-            if G0 != 0:
-                changes[(row["curve"], row["frequency_hz"], row["output"])] = (
-                    G / G0, f"beta {math.degrees(start['beta']):.3g} -> {row['beta_mean_deg']:.3g} deg")
-    return changes
-
-
-def operating_point_hint(rows: list[dict]) -> str | None:
-    """Why open-loop points left the prediction's operating point, when some did (the payload falls)."""
-    moved = [r for r in rows if "operating point" in r.get("marks", "")]
-    if not moved:
-        return None
-    first = moved[0]
-    measured = [r for r in rows if "marks" in r]
-    return (f"{len(moved)} of {len(measured)} points were measured away from the linear prediction's operating "
-            f"point (e.g. {first['curve']}, {first['output']} at {first['frequency_hz']:.3g} Hz: "
-            f"{next(m for m in first['marks'].split('; ') if m.startswith('operating point'))}): on the fixed base "
-            f"and without a controller, gravity turns a payload whose centre of mass is off the elevation axis "
-            f"while the dwell settles; balance it (--set \"body2.d_bd[2]=0\" --set \"body2.d_bd[3]=0\") to "
-            f"measure the plant where it is linearized (docs/frequency_response.md)")
 
 
 def add_arguments(parser) -> None:
@@ -319,120 +180,111 @@ def execute(args) -> int:
 
 def measure_and_write(args) -> int:
     # here, not at the top: --help does without numpy and fmpy
+    from ..analysis import dwell_plan
     from ..analysis import frequency_response as fr
-    from ..scene import load_scene
+    from ..analysis.measured_margins import measured_margins
+    from ..analysis.point_checks import check_points, checks_summary, operating_point_hint
 
     check_arguments(args)
     fmu = fmu_path(args.fmu)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
-        scene = load_scene(scene_file(args.scene, DEFAULT_SCENE, "--scene SCENE.toml"))
-    scene = with_overrides(scene, args.set, fmu)
+    scene = with_overrides(_load_scene(args.scene), args.set, fmu)
     frequencies = fr.log_frequencies(args.fmin, args.fmax, args.points)
     dwell = fr.Dwell(args.settle_periods, args.settle_s, args.measure_periods)
     check_frequencies(frequencies, scene, dwell)
-    amplitudes = args.amplitude or [0.2 if args.mode == "loop-gain" else 1.0]
     drive = motor_drive(scene, fmu, args.axis or "1") if args.mode != "isolation" else "voltage"
-    if args.mode != "open-loop" and scene.moving_target is not None:
-        raise SceneError(f"{scene.name}: its [target] moves (type = \"{scene.target_spec.get('type', '?')}\"), and "
-                         f"freqresp {args.mode} measures the closed loop about one operating point: give the scene a "
-                         f"fixed [target] (type = \"direction\") or no target")
-    if args.mode == "open-loop":
-        axis = args.axis or "1"
-        if axis not in fr.MOTOR_AXES:
-            raise SceneError(f"--axis {shown(axis)}: open-loop drives motor 1 or 2")
-        excitations = [fr.Excitation("voltage", axis, a, args.offset, drive) for a in amplitudes]
-        scene = scene.with_changes(base_motion_spec={"type": "fixed"},
-                                   fidelity={**scene.fidelity, "base.fixed": True},
-                                   controller_spec={"type": "none"})
-        outputs = excitations[0].default_outputs()
-    elif args.mode == "loop-gain":
-        axis = args.axis or "1"
-        if axis not in fr.MOTOR_AXES:
-            raise SceneError(f"--axis {shown(axis)}: loop-gain injects at motor 1 or 2")
-        excitations = [fr.Excitation("injection", axis, a, drive=drive) for a in amplitudes]
-        outputs = None
-    else:
-        axis = args.axis or "roll"
-        if axis not in fr.BASE_AXES:
-            raise SceneError(f"--axis {shown(axis)}: isolation moves the carrier in roll, pitch or yaw")
-        excitations = [fr.Excitation("base", axis, math.radians(a)) for a in amplitudes]
-        outputs = None
-    excitation = excitations[0]
-    sea = None
-    if args.sea_estimate:
-        if excitation.kind != "base":
-            raise SceneError("--sea-estimate goes with freqresp isolation (a carrier rate as the input)")
-        try:
-            sea = fr.read_sea_estimate(args.sea_estimate, args.fmin, args.fmax, dwell_scale(scene, axis))
-        except ValueError as exc:   # a file that is not an isolation CSV: refused like a bad argument
-            raise SceneError(str(exc)) from None
-    variants = []
-    if not args.linear_only:
-        variants.append(("full model", None))
-    if not args.full_only:
-        variants.append((NO_BACKLASH, fr.LINEAR_FIDELITY))
-    lines, predict_rows = None, None
-    if not args.no_linear:
-        try:
-            lines, predict_rows, summary = linear_prediction(scene, fmu, excitation, outputs, args.fmin,
-                                                             args.fmax)
-            if summary:
-                print(summary)
-        except SceneError as exc:   # e.g. not a PID scene, or a loop that does not settle: measure anyway
-            print(f"{PROG}: warning: no linear prediction: {exc}", file=sys.stderr)
-    client = cluster = None
-    if not args.serial:
-        from ..sweep import make_client
-        from ..sweep.spec import SweepError
-        try:
-            client, cluster = make_client(args.scheduler, workers=args.workers)
-        except SweepError as exc:   # --scheduler, --workers refused: one line, as the scene's refusals
-            raise SceneError(str(exc)) from None
-    rows = []
-    wall = time.perf_counter()
-    try:
-        for each, amplitude in zip(excitations, amplitudes):
-            for label, fidelity in variants:
-                curve = label if len(amplitudes) == 1 else f"{label}, {amplitude:g} {unit_of(args.mode, excitation.drive)}"
-                rows += fr.sweep(scene, fmu, frequencies, each, dwell, outputs, fidelity, client, curve)
-    finally:
-        if client is not None:
-            from ..sweep import close_client
-            close_client(client, cluster)
+    dwell_plan.check_fixed_target(scene, args.mode)
+    plan = dwell_plan.plan_dwell(args.mode, scene, args.axis, args.amplitude, args.offset, drive)
+    sea = _sea_estimate(args, plan) if args.sea_estimate else None
+    variants = dwell_plan.variants(args.linear_only, args.full_only)
+    lines, predict_rows = (None, None) if args.no_linear else _prediction(args, plan, fmu)
+    with _dask_client(args) as client:
+        wall = time.perf_counter()   # the measurement's time, without the cluster's start
+        rows = dwell_plan.measure_curves(plan, fmu, frequencies, dwell, variants, client)
     if predict_rows is not None:
         rows += predict_rows(rows)
-    check_points(rows, scene, fmu, excitation, predict_rows is not None)
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{axis}"
-    csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
-    fr.write_csv(rows, csv_path)
-    amplitudes_text = ", ".join(f"{a:g}" for a in amplitudes)
-    if excitation.kind == "injection":
-        title = (f"{scene.name}: loop gain L = -U/A at {fr.command_signal(axis, excitation.drive)} (other axis closed) and sensitivity A/D, "
-                 f"injection {amplitudes_text} V")
-    else:
-        title = (f"{scene.name}: {excitation.input_signal} -> rates, amplitude{'s' if len(amplitudes) > 1 else ''} "
-                 f"{amplitudes_text} {unit_of(args.mode, excitation.drive)}" + (" (LOS rate / carrier rate)" if excitation.kind == "base" else ""))
-    plotted_rows, plotted_lines = rows, lines
-    if excitation.kind == "injection":   # the LOS rate per D (-90 dB) would squeeze L and S: it is in the CSV
-        shown_outputs = (fr.LOOP_GAIN, fr.SENSITIVITY)
-        plotted_rows = [r for r in rows if r["output"] in shown_outputs]
-        plotted_lines = lines and [line for line in lines if line[0].rsplit(": ", 1)[-1] in shown_outputs]
-    fr.plot_bode(plotted_rows, png_path, title, plotted_lines, sea)
-    if excitation.kind == "injection":
+    check_points(rows, plan.scene, fmu, plan.excitation, predict_rows is not None)
+    csv_path, png_path = _write(args, plan, rows, lines, sea)
+    if plan.excitation.kind == "injection":
         for line in measured_margins(rows):
             print(line)
-    print(fr.marks_summary(rows) or f"every point is a frequency response to {100 * fr.LINEARITY_TOLERANCE:g} % and "
-          f"{fr.PHASE_TOLERANCE_DEG:g} deg (no harmonics, no drift" + (", on the linear prediction)" if predict_rows
-                                                                      else ")"))
+    print(checks_summary(rows, predict_rows is not None))
     hint = operating_point_hint(rows)
     if hint:
         print(f"{PROG}: warning: {hint}", file=sys.stderr)
     simulated = len({r["frequency_hz"] for r in rows if r["curve"] != fr.LINEAR_CURVE})
-    runs = len(excitations) * len(variants)
+    runs = len(plan.excitations) * len(variants)
     print(f"{simulated} frequencies x {runs} simulated curve{'s' if runs != 1 else ''} ({len(rows)} CSV rows: "
           f"one per frequency, curve and output, the linear prediction's included) in "
           f"{time.perf_counter() - wall:.1f} s: {csv_path}, {png_path}")
     return 0
+
+
+def _load_scene(argument):
+    from ..scene import load_scene
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # a scene's advice (e.g. 'no controller') does not apply here
+        return load_scene(scene_file(argument, DEFAULT_SCENE, "--scene SCENE.toml"))
+
+
+def _sea_estimate(args, plan):
+    """The sea-state run's isolation estimate on the dwell's scale (--sea-estimate)."""
+    from ..analysis import frequency_response as fr
+    from ..analysis.carrier_projection import dwell_scale
+
+    if plan.excitation.kind != "base":
+        raise SceneError("--sea-estimate goes with freqresp isolation (a carrier rate as the input)")
+    try:
+        return fr.read_sea_estimate(args.sea_estimate, args.fmin, args.fmax, dwell_scale(plan.scene, plan.axis))
+    except ValueError as exc:   # a file that is not an isolation CSV: refused like a bad argument
+        raise SceneError(str(exc)) from None
+
+
+def _prediction(args, plan, fmu) -> tuple:
+    """(the linear prediction's lines, its rows at the simulated points), its summary printed; (None,
+    None) and a warning when there is none (e.g. not a PID scene, or a loop that does not settle)."""
+    from ..analysis.linear_prediction import linear_prediction
+
+    try:
+        lines, predict_rows, summary = linear_prediction(plan.scene, fmu, plan.excitation, plan.outputs,
+                                                         args.fmin, args.fmax)
+    except SceneError as exc:   # measured anyway
+        print(f"{PROG}: warning: no linear prediction: {exc}", file=sys.stderr)
+        return None, None
+    if summary:
+        print(summary)
+    return lines, predict_rows
+
+
+@contextlib.contextmanager
+def _dask_client(args):
+    """A Dask client on --scheduler or a local cluster of --workers, closed at the end; None with --serial."""
+    if args.serial:
+        yield None
+        return
+    from ..sweep import close_client, make_client
+    from ..sweep.spec import SweepError
+
+    try:
+        client, cluster = make_client(args.scheduler, workers=args.workers)
+    except SweepError as exc:   # --scheduler, --workers refused: one line, as the scene's refusals
+        raise SceneError(str(exc)) from None
+    try:
+        yield client
+    finally:
+        close_client(client, cluster)
+
+
+def _write(args, plan, rows: list, lines, sea) -> tuple:
+    """Writes <out>/<name>.csv and .png; their paths."""
+    from ..analysis import dwell_plan
+    from ..analysis import frequency_response as fr
+
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    name = args.name or f"frequency_response_{args.mode.replace('-', '_')}_{plan.axis}"
+    csv_path, png_path = out / f"{name}.csv", out / f"{name}.png"
+    fr.write_csv(rows, csv_path)
+    plotted_rows, plotted_lines = dwell_plan.plotted(plan, rows, lines)
+    fr.plot_bode(plotted_rows, png_path, dwell_plan.plot_title(plan, plan.scene.name), plotted_lines, sea)
+    return csv_path, png_path

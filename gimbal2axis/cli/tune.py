@@ -77,19 +77,25 @@ def add_arguments(parser) -> None:
                         help="no report page (nor its runs of the best and the scene's gains, nor the held-out check)")
 
 
-def execute(args) -> int:
-    if args.workers < 1:
-        args.command_parser.error("--workers must be >= 1")
-    if args.trials is not None and args.trials < 1:
-        args.command_parser.error("--trials must be >= 1")
+def check_options(args) -> None:
+    """What argparse cannot say: the ranges of the numeric options (refused as usage errors, status 2)."""
     from ..limits import MAX_TUNE_TRIALS
-    if args.trials is not None and args.trials > MAX_TUNE_TRIALS:
-        args.command_parser.error(f"--trials {args.trials} is over the limit of {MAX_TUNE_TRIALS:,} candidates")
-    if not args.save_every >= 0:
-        args.command_parser.error("--save-every must be >= 0 seconds")
+
+    refusals = [(args.workers < 1, "--workers must be >= 1"),
+                (args.trials is not None and args.trials < 1, "--trials must be >= 1"),
+                (args.trials is not None and args.trials > MAX_TUNE_TRIALS,
+                 f"--trials {args.trials} is over the limit of {MAX_TUNE_TRIALS:,} candidates"),
+                (not args.save_every >= 0, "--save-every must be >= 0 seconds")]
+    for refused, message in refusals:
+        if refused:
+            args.command_parser.error(message)
+
+
+def execute(args) -> int:
+    check_options(args)
     from ..sweep import SweepError
     from ..sweep.runner import Stopped
-    from ..tune.engine import TuneOptions, describe_candidate, plan, run_tuning
+    from ..tune.engine import TuneOptions, plan
 
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _stopped)
@@ -100,27 +106,8 @@ def execute(args) -> int:
     try:
         problem = plan(args.scene, args.tuning, fmu_path(args.fmu), args.out)
         if not args.quiet:
-            t = problem.tuning
-            print(f"tune {t.name} on scene {problem.scene.name}: {len(t.parameters)} parameters, "
-                  f"{options.trials or t.trials} candidates in batches of {min(t.batch, options.trials or t.trials)}, "
-                  f"each on {len(problem.scenarios)} runs ({t.sampler}, seed {t.seed}); "
-                  f"{'serially' if options.serial else options.scheduler or f'{options.workers} local workers'}",
-                  file=sys.stderr)
-        from ..tune.engine import Evaluator
-        evaluator = Evaluator(problem, options)
-        interrupted = False
-        try:
-            result = run_tuning(problem, options, evaluator)
-            report_path = None
-            if not args.no_report:
-                from ..tune.report import write_report
-                evaluator.progress = None
-                report_path = write_report(result, evaluator)
-        except KeyboardInterrupt:
-            interrupted = True
-            raise
-        finally:
-            evaluator.close(interrupted)
+            print(_plan_line(problem, options), file=sys.stderr)
+        result, report_path = _tune_and_report(problem, options, args.no_report)
     except (SceneError, SweepError) as exc:
         print(one_line(f"{PROG}: error: {' '.join(str(exc).split())}"), file=sys.stderr)
         return 2
@@ -132,24 +119,63 @@ def execute(args) -> int:
     finally:
         if problem is not None:
             problem.fmu.close()
-    best = result.best or result.least_violating
     if not args.quiet:
-        print(f"{len(result.trials)} candidates, {result.evaluations_run} evaluations run, "
-              f"{result.evaluations_reused} taken from the table; {result.wall_time:.1f} s")
-        if best is not None:
-            names = problem.tuning.parameter_names
-            print(f"{'best' if result.best else 'least violating (no candidate met the constraints)'}: trial "
-                  f"{best['trial']}: {describe_candidate({n: best[n] for n in names})}; objective "
-                  f"{best['objective_mrad']:.5g} mrad; peak current {best['worst_i_frac_peak']:.3g} of the limit"
-                  + (f"; margins az {best['gm_az_db']:.3g} dB / {best['pm_az_deg']:.3g} deg, el {best['gm_el_db']:.3g}"
-                     f" dB / {best['pm_el_deg']:.3g} deg" if "gm_az_db" in best else ""))
-        if result.holdout:
-            h = result.holdout
-            print(f"held out ({h['runs']} runs): best {h['best_mrad']:.5g} mrad, scene's own {h['own_mrad']:.5g} mrad")
-        print(f"wrote {problem.evaluations.parquet}, {problem.trials_files.parquet} (and .csv)"
-              + (f", {report_path}" if report_path else ""))
+        _print_outcome(problem, result, report_path)
     if result.best is None:
         print(f"{PROG}: no candidate met the constraints; see {problem.trials_files.csv} (violation_* columns)",
               file=sys.stderr)
         return 1
     return 0
+
+
+def _plan_line(problem, options) -> str:
+    t = problem.tuning
+    return (f"tune {t.name} on scene {problem.scene.name}: {len(t.parameters)} parameters, "
+            f"{options.trials or t.trials} candidates in batches of {min(t.batch, options.trials or t.trials)}, "
+            f"each on {len(problem.scenarios)} runs ({t.sampler}, seed {t.seed}); "
+            f"{'serially' if options.serial else options.scheduler or f'{options.workers} local workers'}")
+
+
+def _tune_and_report(problem, options, no_report: bool):
+    """(the tuning's result, the report page's path or None); the evaluator closed however it ends."""
+    from ..tune.engine import Evaluator, run_tuning
+
+    evaluator = Evaluator(problem, options)
+    interrupted = False
+    try:
+        result = run_tuning(problem, options, evaluator)
+        report_path = None
+        if not no_report:
+            from ..tune.report import write_report
+            evaluator.progress = None
+            report_path = write_report(result, evaluator)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
+    finally:
+        evaluator.close(interrupted)
+    return result, report_path
+
+
+def _print_outcome(problem, result, report_path) -> None:
+    print(f"{len(result.trials)} candidates, {result.evaluations_run} evaluations run, "
+          f"{result.evaluations_reused} taken from the table; {result.wall_time:.1f} s")
+    best = result.best or result.least_violating
+    if best is not None:
+        print(_best_line(problem, result, best))
+    if result.holdout:
+        h = result.holdout
+        print(f"held out ({h['runs']} runs): best {h['best_mrad']:.5g} mrad, scene's own {h['own_mrad']:.5g} mrad")
+    print(f"wrote {problem.evaluations.parquet}, {problem.trials_files.parquet} (and .csv)"
+          + (f", {report_path}" if report_path else ""))
+
+
+def _best_line(problem, result, best: dict) -> str:
+    from ..tune.engine import describe_candidate
+
+    names = problem.tuning.parameter_names
+    margins = (f"; margins az {best['gm_az_db']:.3g} dB / {best['pm_az_deg']:.3g} deg, el {best['gm_el_db']:.3g}"
+               f" dB / {best['pm_el_deg']:.3g} deg" if "gm_az_db" in best else "")
+    return (f"{'best' if result.best else 'least violating (no candidate met the constraints)'}: trial "
+            f"{best['trial']}: {describe_candidate({n: best[n] for n in names})}; objective "
+            f"{best['objective_mrad']:.5g} mrad; peak current {best['worst_i_frac_peak']:.3g} of the limit" + margins)

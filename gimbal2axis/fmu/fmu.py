@@ -155,23 +155,10 @@ class FMU:
                                  f"is the truth; is the FMU older than the scene?)")
             if v.causality not in causalities:
                 raise SceneError(f"[{where}] '{name}' has causality '{v.causality}', expected {sorted(causalities)}")
-            if v.type == "Real":
-                ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-            elif v.type == "Integer":
-                ok = isinstance(value, int) and not isinstance(value, bool)
-            elif v.type == "Enumeration":
-                items = enumeration_items(v)
-                listed = ", ".join(f"{k} ({n})" for k, n in sorted(items.items()))
-                if not isinstance(value, int) or isinstance(value, bool):
-                    raise SceneError(f"[{where}] '{name}' is an Enumeration in the FMU, given by its integer value: "
-                                     f"{listed}; got {value!r}")
-                if value not in items:
-                    raise SceneError(f"[{where}] '{name}' = {value} is none of its values: {listed}")
-                ok = True
-            elif v.type == "Boolean":
-                ok = isinstance(value, bool)
-            else:
-                ok = False
+            if v.type == "Enumeration":
+                _check_enumeration(where, name, v, value)
+                continue
+            ok = _TYPE_CHECKS.get(v.type, lambda value: False)(value)
             if not ok:
                 raise SceneError(f"[{where}] '{name}' is {v.type} in the FMU; got {value!r}")
 
@@ -271,3 +258,22 @@ def simulate(fmu: FMU, stop_time: float, step_size: float, start_values: dict | 
     result = {"time": times}
     result.update({name: record[:, j] for j, name in enumerate(outputs)})
     return result
+
+
+# {FMI type: whether a scene's value fits it} (an Enumeration: _check_enumeration, by its items)
+_TYPE_CHECKS = {
+    "Real": lambda value: isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value),
+    "Integer": lambda value: isinstance(value, int) and not isinstance(value, bool),
+    "Boolean": lambda value: isinstance(value, bool),
+}
+
+
+def _check_enumeration(where: str, name: str, variable, value) -> None:
+    """An Enumeration is given by the integer of one of its items."""
+    items = enumeration_items(variable)
+    listed = ", ".join(f"{k} ({n})" for k, n in sorted(items.items()))
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise SceneError(f"[{where}] '{name}' is an Enumeration in the FMU, given by its integer value: "
+                         f"{listed}; got {value!r}")
+    if value not in items:
+        raise SceneError(f"[{where}] '{name}' = {value} is none of its values: {listed}")

@@ -85,22 +85,8 @@ def load_comparison(path: pathlib.Path | str) -> Comparison:
         if "scene" not in raw or "grades" not in raw:
             raise SceneError("needs scene = \"<scene file>\" and at least one [grades.<name>] table")
         scene = load_scene((path.parent / str(raw["scene"])).resolve())
-        stop_time = positive("stop_time", raw.get("stop_time", scene.stop_time))
-        if stop_time > scene.stop_time * (1 + 1e-12):
-            raise SceneError(f"stop_time {stop_time:g} is after the scene's ({scene.stop_time:g} s)")
-        steps = stop_time / scene.step_size
-        if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
-            raise SceneError(f"stop_time {stop_time:g} is not a whole number of the scene's steps ({scene.step_size:g} s)")
-        schemes = raw.get("schemes", list(SCHEMES))
-        if not isinstance(schemes, list) or not schemes or any(s not in SCHEMES for s in schemes):
-            raise SceneError(f"schemes must be a non-empty list of {', '.join(repr(s) for s in SCHEMES)}, got {schemes!r}")
-        common = raw.get("sensors", {})
-        if not isinstance(common, dict) or "gyro" in common or "stabilization" in common:
-            raise SceneError("[sensors] must be a table of the sensors shared by every case (without gyro, which "
-                             "the grades give, and stabilization, which schemes gives)")
-        grades = raw["grades"]
-        if not isinstance(grades, dict) or not grades:
-            raise SceneError("[grades] must hold at least one [grades.<name>] table")
+        stop_time = _stop_time(raw, scene)
+        schemes, common, grades = _schemes(raw), _common_sensors(raw), _grades(raw)
         analysis = raw.get("analysis")
         repeats = raw.get("repeats", 1)
         if isinstance(repeats, bool) or not isinstance(repeats, int) or not 1 <= repeats <= MAX_REPEATS:
@@ -112,6 +98,39 @@ def load_comparison(path: pathlib.Path | str) -> Comparison:
         raise SceneError(f"{path}: {exc}") from None
     return Comparison(path, str(raw.get("title", path.stem)), str(raw.get("description", "")), scene, stop_time, cases,
                       repeats)
+
+
+def _stop_time(raw: dict, scene) -> float:
+    """The runs' end: within the scene's, on one of its steps."""
+    stop_time = positive("stop_time", raw.get("stop_time", scene.stop_time))
+    if stop_time > scene.stop_time * (1 + 1e-12):
+        raise SceneError(f"stop_time {stop_time:g} is after the scene's ({scene.stop_time:g} s)")
+    steps = stop_time / scene.step_size
+    if abs(steps - round(steps)) > 1e-9 * max(steps, 1.0):
+        raise SceneError(f"stop_time {stop_time:g} is not a whole number of the scene's steps ({scene.step_size:g} s)")
+    return stop_time
+
+
+def _schemes(raw: dict) -> list:
+    schemes = raw.get("schemes", list(SCHEMES))
+    if not isinstance(schemes, list) or not schemes or any(s not in SCHEMES for s in schemes):
+        raise SceneError(f"schemes must be a non-empty list of {', '.join(repr(s) for s in SCHEMES)}, got {schemes!r}")
+    return schemes
+
+
+def _common_sensors(raw: dict) -> dict:
+    common = raw.get("sensors", {})
+    if not isinstance(common, dict) or "gyro" in common or "stabilization" in common:
+        raise SceneError("[sensors] must be a table of the sensors shared by every case (without gyro, which "
+                         "the grades give, and stabilization, which schemes gives)")
+    return common
+
+
+def _grades(raw: dict) -> dict:
+    grades = raw["grades"]
+    if not isinstance(grades, dict) or not grades:
+        raise SceneError("[grades] must hold at least one [grades.<name>] table")
+    return grades
 
 
 def repeat_scene(case: Case, repeat: int):

@@ -47,32 +47,46 @@ def _reference_keys(prefix: str) -> list[str]:
 
 def valid_names(scene, fmu) -> list[str]:
     """Names a sweep could use with this scene and FMU: the vocabulary of the suggestions."""
-    names = ["stop_time"]
-    parameters = fmu_parameters(fmu)
-    names += parameters
-    names += [f"parameters.{p}" for p in parameters if p not in FIDELITY]
-    names += [f"fidelity.{f}" for f in FIDELITY]
-    names += [f"initial.{s}" for s in fmu.states]
-    names += [f"initial.{s}_deg" for s in fmu.states if s in ANGLE_STATES]
+    names = ["stop_time"] + _fmu_names(fmu)
     for section, attr in NESTED_SECTIONS.items():
         names += _leaf_paths(getattr(scene, attr) or {}, section)
-    names += [f"controller.{k}" for k in sorted(controllers.CONTROLLER_KEYS - LIST_KEYS - {"options"})
-              if k not in controllers.AXES]
+    names += _controller_names() + _sensor_names()
+    names += [f"target.{k}" for k in sorted(TARGET_KEYS)]
+    names += _base_motion_names()
+    return list(dict.fromkeys(names))
+
+
+def _fmu_names(fmu) -> list[str]:
+    parameters = fmu_parameters(fmu)
+    return (parameters + [f"parameters.{p}" for p in parameters if p not in FIDELITY]
+            + [f"fidelity.{f}" for f in FIDELITY] + [f"initial.{s}" for s in fmu.states]
+            + [f"initial.{s}_deg" for s in fmu.states if s in ANGLE_STATES])
+
+
+def _controller_names() -> list[str]:
+    names = [f"controller.{k}" for k in sorted(controllers.CONTROLLER_KEYS - LIST_KEYS - {"options"})
+             if k not in controllers.AXES]
     names += [f"controller.K.{i}.{j}" for i in range(2) for j in range(4)]
     names += [f"controller.{k}.{i}" for k in ("ki", "voltage_V") for i in range(2)]
     names += _reference_keys("controller")
     for axis in controllers.AXES:
         names += [f"controller.{axis}.{k}" for k in sorted(controllers.PID_KEYS) if k != "reference"]
         names += _reference_keys(f"controller.{axis}")
-    names += [f"sensors.{k}" for k in sorted(sensors.KEYS - {"gyro", "encoder_offset_deg"})]
-    names += [f"sensors.encoder_offset_deg.{i}" for i in range(2)]
-    names += [f"sensors.gyro.{k}" for k in sorted(gyro.GYRO_KEYS)]
-    names += [f"target.{k}" for k in sorted(TARGET_KEYS)]
-    names += [f"base_motion.{k}" for k in sorted(BASE_MOTION_KEYS)]
+    return names
+
+
+def _sensor_names() -> list[str]:
+    return ([f"sensors.{k}" for k in sorted(sensors.KEYS - {"gyro", "encoder_offset_deg"})]
+            + [f"sensors.encoder_offset_deg.{i}" for i in range(2)]
+            + [f"sensors.gyro.{k}" for k in sorted(gyro.GYRO_KEYS)])
+
+
+def _base_motion_names() -> list[str]:
+    names = [f"base_motion.{k}" for k in sorted(BASE_MOTION_KEYS)]
     names += [f"base_motion.velocity_m_s.{i}" for i in range(3)]
     for axis in list(base_motion.ANGLE_AXES) + list(base_motion.TRANSLATION_AXES):
         names += [f"base_motion.{axis}.{k}" for k in sorted(BASE_AXIS_KEYS)]
-    return list(dict.fromkeys(names))
+    return names
 
 
 def suggestions(name: str, candidates: list[str], n: int = 3) -> list[str]:
@@ -113,28 +127,35 @@ def resolve_names(sweep, scene, fmu) -> tuple[dict, list[str]]:
                                 f"{fmu.path.name}" + did_you_mean(name, candidates))
                 continue
         resolved[name] = (section, path)
-        if variable is None:
-            continue
-        v = fmu.variables.get(variable)
-        if section == "initial":
-            if variable.endswith("_deg") and variable.removesuffix("_deg") in ANGLE_STATES:
-                variable = variable.removesuffix("_deg")   # the angle in degrees (load_scene converts it)
-            if variable not in fmu.states:
-                problems.append(f"'{excerpt(name)}': '{excerpt(variable)}' is not a state of the FMU (states: {', '.join(fmu.states)})"
-                                + did_you_mean(name, candidates))
-        elif v is None:
-            problems.append(f"'{excerpt(name)}': '{excerpt(variable)}' is not a variable of {fmu.path.name}"
-                            + did_you_mean(name, candidates))
-        elif v.causality not in PARAMETER_CAUSALITIES:
-            hint = f"; its start value is swept as 'initial.{variable}'" if variable in fmu.states else ""
-            what = f"'{excerpt(name)}'" if name == variable else f"'{excerpt(name)}': '{excerpt(variable)}'"
-            problems.append(f"{what} is not a parameter of the FMU (causality {v.causality}){hint}")
-        elif section == "fidelity" and variable not in FIDELITY:
-            problems.append(f"'{excerpt(name)}': '{excerpt(variable)}' is not a structural switch ({', '.join(FIDELITY)}); "
-                            f"sweep it as 'parameters.{variable}'")
+        problem = _variable_problem(name, section, variable, fmu, candidates) if variable is not None else None
+        if problem:
+            problems.append(problem)
     if problems:
         raise SweepError(f"{sweep.path}: " + "\n  ".join(["parameter names refused, no case was run:"] + problems))
     return resolved, candidates
+
+
+def _variable_problem(name: str, section: str, variable: str, fmu, candidates: list[str]) -> str | None:
+    """Why the FMU variable `variable` that `name` sets in `section` cannot be swept; None if it can."""
+    v = fmu.variables.get(variable)
+    if section == "initial":
+        if variable.endswith("_deg") and variable.removesuffix("_deg") in ANGLE_STATES:
+            variable = variable.removesuffix("_deg")   # the angle in degrees (load_scene converts it)
+        if variable not in fmu.states:
+            return (f"'{excerpt(name)}': '{excerpt(variable)}' is not a state of the FMU (states: {', '.join(fmu.states)})"
+                    + did_you_mean(name, candidates))
+        return None
+    if v is None:
+        return (f"'{excerpt(name)}': '{excerpt(variable)}' is not a variable of {fmu.path.name}"
+                + did_you_mean(name, candidates))
+    if v.causality not in PARAMETER_CAUSALITIES:
+        hint = f"; its start value is swept as 'initial.{variable}'" if variable in fmu.states else ""
+        what = f"'{excerpt(name)}'" if name == variable else f"'{excerpt(name)}': '{excerpt(variable)}'"
+        return f"{what} is not a parameter of the FMU (causality {v.causality}){hint}"
+    if section == "fidelity" and variable not in FIDELITY:
+        return (f"'{excerpt(name)}': '{excerpt(variable)}' is not a structural switch ({', '.join(FIDELITY)}); "
+                f"sweep it as 'parameters.{variable}'")
+    return None
 
 
 def _probe(scene, fmu, resolved, values: dict, stop_time):
@@ -156,27 +177,30 @@ def check_cases_accepted(scene, sweep, fmu, resolved: dict, cases: list, candida
     error = _probe(scene, fmu, resolved, {}, sweep.stop_time)
     if error is not None:
         raise SweepError(f"{where}: stop_time = {sweep.stop_time:g}: {error}")
-    problems = []
-    for name in sweep.parameters:
-        values = list(dict.fromkeys(repr(case.values[name]) for case in cases))[:3]
-        tried = {}
-        for case in cases:
-            key = repr(case.values[name])
-            if key in values and key not in tried:
-                try:
-                    tried[key] = _probe(scene, fmu, resolved, {name: case.values[name]}, sweep.stop_time)
-                except (TypeError, ValueError, KeyError) as exc:
-                    tried[key] = f"{type(exc).__name__}: {exc}"
-            if len(tried) == len(values):
-                break
-        if all(error is not None for error in tried.values()):
-            first = next(iter(tried.values()))
-            if name in candidates:
-                problems.append(f"'{excerpt(name)}' = {', '.join(excerpt(v) for v in values)} is refused: {first}")
-            else:
-                problems.append(f"'{excerpt(name)}' is not a name the scene accepts: {first}"
-                                + did_you_mean(name, candidates))
+    problems = [problem for name in sweep.parameters
+                if (problem := _refused_alone(scene, fmu, resolved, sweep.stop_time, name, cases, candidates))]
     if not problems:   # refused only in combination: show the first case as it is
         problems.append(f"case 0 ({', '.join(f'{excerpt(k)} = {shown(v)}' for k, v in cases[0].values.items())}): "
                         f"{cases[0].error.removeprefix('invalid case: ')}")
     raise SweepError(where + ":\n  " + "\n  ".join(problems))
+
+
+def _refused_alone(scene, fmu, resolved: dict, stop_time, name: str, cases: list, candidates: list[str]) -> str | None:
+    """Why the scene refuses `name` on its own, when it refuses each of its first 3 values; else None."""
+    values = list(dict.fromkeys(repr(case.values[name]) for case in cases))[:3]
+    tried = {}
+    for case in cases:
+        key = repr(case.values[name])
+        if key in values and key not in tried:
+            try:
+                tried[key] = _probe(scene, fmu, resolved, {name: case.values[name]}, stop_time)
+            except (TypeError, ValueError, KeyError) as exc:
+                tried[key] = f"{type(exc).__name__}: {exc}"
+        if len(tried) == len(values):
+            break
+    if not all(error is not None for error in tried.values()):
+        return None
+    first = next(iter(tried.values()))
+    if name in candidates:
+        return f"'{excerpt(name)}' = {', '.join(excerpt(v) for v in values)} is refused: {first}"
+    return f"'{excerpt(name)}' is not a name the scene accepts: {first}" + did_you_mean(name, candidates)

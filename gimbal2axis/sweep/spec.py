@@ -140,24 +140,36 @@ class Sweep:
         limit, full = self.cases_limit, self.full_size
         if limit is None or limit >= full:
             return None
+        text = self._what_the_limit_keeps()
+        missing = self._never_run()
+        if missing:
+            text += f"; never run: {'; '.join(missing)}"
+        if full > MAX_SWEEP_CASES:
+            return text + f". A sweep runs at most {MAX_SWEEP_CASES:,} cases: split the grid to run them all."
+        return text + f". Raise 'cases' to {full} (or leave it out) to run them all."
+
+    def _what_the_limit_keeps(self) -> str:
+        limit, full = self.cases_limit, self.full_size
         points, samples = self.grid_points, self.samples_per_point
         shape = " x ".join(str(len(v)) for v in self.grid.values())
         grid = f"{shape} = {points} grid points" if len(self.grid) > 1 else f"{points} grid points"
         order = "the cases go in order, the first grid parameter varying slowest, so the limit keeps"
         if not self.grid:
-            text = f"cases = {limit} runs the first {limit} of the {samples} samples"
-        elif samples == 1:
-            text = f"cases = {limit} runs {limit} of the {grid}: {order} the first {limit} and drops the last " \
+            return f"cases = {limit} runs the first {limit} of the {samples} samples"
+        if samples == 1:
+            return f"cases = {limit} runs {limit} of the {grid}: {order} the first {limit} and drops the last " \
                    f"{points - limit}"
-        else:
-            whole, part = divmod(limit, samples)
-            dropped = points - whole - (part > 0)
-            kept = [f"{'grid point 1' if whole == 1 else f'the first {whole} grid points'} with all {samples} "
-                    f"samples"] if whole else []
-            kept += [f"grid point {whole + 1} with {part} of its {samples} samples"] if part else []
-            text = (f"cases = {limit} runs {limit} of the {full} cases ({grid} x {samples} samples): {order} "
-                    + " and ".join(kept)
-                    + (f", and drops the last {dropped} grid point{'s' * (dropped != 1)}" if dropped else ""))
+        whole, part = divmod(limit, samples)
+        dropped = points - whole - (part > 0)
+        kept = [f"{'grid point 1' if whole == 1 else f'the first {whole} grid points'} with all {samples} "
+                f"samples"] if whole else []
+        kept += [f"grid point {whole + 1} with {part} of its {samples} samples"] if part else []
+        return (f"cases = {limit} runs {limit} of the {full} cases ({grid} x {samples} samples): {order} "
+                + " and ".join(kept)
+                + (f", and drops the last {dropped} grid point{'s' * (dropped != 1)}" if dropped else ""))
+
+    def _never_run(self) -> list:
+        """'name = values' of the grid values no kept case has."""
         kept_cases = self.expand()
         missing = []
         for name, values in self.grid.items():
@@ -166,11 +178,7 @@ class Sweep:
             if absent:
                 more = f" and {len(absent) - WARNING_VALUES:,} more" if len(absent) > WARNING_VALUES else ""
                 missing.append(f"{excerpt(name)} = {', '.join(absent[:WARNING_VALUES])}{more}")
-        if missing:
-            text += f"; never run: {'; '.join(missing)}"
-        if full > MAX_SWEEP_CASES:
-            return text + f". A sweep runs at most {MAX_SWEEP_CASES:,} cases: split the grid to run them all."
-        return text + f". Raise 'cases' to {full} (or leave it out) to run them all."
+        return missing
 
 
 def _plain(value):
@@ -188,16 +196,25 @@ def _grid_values(name: str, spec) -> list:
     if isinstance(spec, dict) and len(spec) == 1:
         (kind, args), = spec.items()
         if kind in ("linspace", "geomspace") and isinstance(args, list) and len(args) == 3:
-            a, b, n = args
-            _finite_numbers(f"[grid] '{excerpt(name)}': {kind}", [a, b])
-            if not (isinstance(n, int) and not isinstance(n, bool) and n >= 1):
-                raise SweepError(f"[grid] '{excerpt(name)}': {kind} = [start, stop, count], count a positive integer")
-            over_limit(f"[grid] '{excerpt(name)}': {kind} count", n, MAX_SWEEP_CASES, " values", SweepError)
-            if kind == "geomspace" and not (a > 0 and b > 0):
-                raise SweepError(f"[grid] '{excerpt(name)}': geomspace needs positive bounds")
-            return [float(v) for v in getattr(np, kind)(float(a), float(b), n)]
+            return _spaced_values(name, kind, *args)
     raise SweepError(f"[grid] '{excerpt(name)}': expected a list of values, {{ linspace = [a, b, n] }} or "
                      f"{{ geomspace = [a, b, n] }}, got {shown(spec)}")
+
+
+def _spaced_values(name: str, kind: str, a, b, n) -> list:
+    """The values of { linspace = [a, b, n] } or { geomspace = [a, b, n] }."""
+    _finite_numbers(f"[grid] '{excerpt(name)}': {kind}", [a, b])
+    if not _is_count(n):
+        raise SweepError(f"[grid] '{excerpt(name)}': {kind} = [start, stop, count], count a positive integer")
+    over_limit(f"[grid] '{excerpt(name)}': {kind} count", n, MAX_SWEEP_CASES, " values", SweepError)
+    if kind == "geomspace" and not (a > 0 and b > 0):
+        raise SweepError(f"[grid] '{excerpt(name)}': geomspace needs positive bounds")
+    return [float(v) for v in getattr(np, kind)(float(a), float(b), n)]
+
+
+def _is_count(value) -> bool:
+    """A positive integer (a bool is none)."""
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 1
 
 
 def _finite_numbers(where: str, values: list) -> None:
@@ -205,6 +222,23 @@ def _finite_numbers(where: str, values: list) -> None:
     for value in values:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise SweepError(f"{where}: {shown(value)} is not a finite number")
+
+
+# (the kinds it applies to, whether their [a, b] are wrong, what is said after "[random] 'name': "), in
+# this order, once the arguments are a list of the right length and, but for choice, finite numbers
+_DISTRIBUTION_REFUSALS = [
+    (("normal",), lambda args: args[1] < 0,
+     lambda kind, args: f"normal = [mean, std] needs std >= 0, got {args[1]:g}"),
+    (("loguniform",), lambda args: not (args[0] > 0 and args[1] > 0),
+     lambda kind, args: "loguniform needs positive bounds"),
+    (("integers",), lambda args: not all(isinstance(v, int) and not isinstance(v, bool) for v in args),
+     lambda kind, args: "integers needs integer bounds"),
+    (("uniform", "loguniform", "integers"), lambda args: not args[0] <= args[1],
+     lambda kind, args: f"{kind} = [{args[0]:g}, {args[1]:g}] needs low <= high"),
+    (("uniform",), lambda args: not math.isfinite(args[1] - args[0]),   # numpy draws low + width * u
+     lambda kind, args: f"uniform = [{args[0]:g}, {args[1]:g}] are {args[1] - args[0]:g} apart: their width must be a "
+                        f"finite number"),
+]
 
 
 def _check_distribution(name: str, spec) -> dict:
@@ -216,17 +250,9 @@ def _check_distribution(name: str, spec) -> dict:
         raise SweepError(f"[random] '{excerpt(name)}': {kind} needs " + ("a non-empty list" if kind == "choice" else "[a, b]"))
     if kind != "choice":
         _finite_numbers(f"[random] '{excerpt(name)}': {kind}", args)
-    if kind == "normal" and args[1] < 0:
-        raise SweepError(f"[random] '{excerpt(name)}': normal = [mean, std] needs std >= 0, got {args[1]:g}")
-    if kind == "loguniform" and not (args[0] > 0 and args[1] > 0):
-        raise SweepError(f"[random] '{excerpt(name)}': loguniform needs positive bounds")
-    if kind == "integers" and not all(isinstance(v, int) and not isinstance(v, bool) for v in args):
-        raise SweepError(f"[random] '{excerpt(name)}': integers needs integer bounds")
-    if kind in ("uniform", "loguniform", "integers") and not args[0] <= args[1]:
-        raise SweepError(f"[random] '{excerpt(name)}': {kind} = [{args[0]:g}, {args[1]:g}] needs low <= high")
-    if kind == "uniform" and not math.isfinite(args[1] - args[0]):   # numpy draws low + width * u
-        raise SweepError(f"[random] '{excerpt(name)}': uniform = [{args[0]:g}, {args[1]:g}] are "
-                         f"{args[1] - args[0]:g} apart: their width must be a finite number")
+    for kinds, wrong, message in _DISTRIBUTION_REFUSALS:
+        if kind in kinds and wrong(args):
+            raise SweepError(f"[random] '{excerpt(name)}': " + message(kind, args))
     return spec
 
 
@@ -251,47 +277,11 @@ def load_sweep(path: pathlib.Path | str) -> Sweep:
     path = pathlib.Path(path)
     raw = read_toml(path, SweepError)
     try:
-        unknown = set(raw) - TOP_KEYS
-        if unknown:
-            raise SweepError(f"unknown key(s) {[excerpt(key) for key in sorted(unknown)[:5]]}"
-                             f"{did_you_mean(sorted(unknown)[0], sorted(TOP_KEYS))}; allowed: {sorted(TOP_KEYS)}")
-        for key in ("grid", "random"):
-            if not isinstance(raw.get(key, {}), dict):
-                raise SweepError(f"'{key}' must be a table ([{key}])")
-        grid = {name: _grid_values(name, spec) for name, spec in _flatten_names(raw.get("grid", {})).items()}
-        random = {name: _check_distribution(name, spec) for name, spec in _flatten_names(raw.get("random", {})).items()}
-        both = set(grid) & set(random)
-        if both:
-            raise SweepError(f"parameter(s) {sorted(both)} both in [grid] and [random]")
-        if not grid and not random:
-            raise SweepError("nothing to sweep: give a [grid] and/or a [random] table")
-        for name in list(grid) + list(random):
-            parse_name(name)
-        cases = raw.get("cases")
-        if cases is not None and not (isinstance(cases, int) and not isinstance(cases, bool) and cases >= 1):
-            raise SweepError("'cases' must be a positive integer")
-        samples = raw.get("samples")
-        if samples is not None and not (isinstance(samples, int) and not isinstance(samples, bool) and samples >= 1):
-            raise SweepError("'samples' must be a positive integer")
-        if samples is not None:   # every random parameter draws `samples` values up front
-            over_limit("'samples'", samples, MAX_SWEEP_CASES, " draws per grid point", SweepError)
-        seed = raw.get("seed", 0)
-        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-            raise SweepError("'seed' must be a non-negative integer")
-        for key in ("stop_time", "metrics_from_s"):
-            value = raw.get(key, 0.0)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0 <= value < math.inf):
-                raise SweepError(f"'{key}' must be a finite number >= 0, got {shown(value)}")
-        if raw.get("stop_time", 1.0) == 0:
-            raise SweepError("'stop_time' must be positive: every case ends there")
-        check_metrics_window(raw.get("metrics_from_s"), raw.get("stop_time"))
-        name = raw.get("name", path.stem)
-        if not isinstance(name, str) or not name.replace("_", "").replace("-", "").isalnum():
-            raise SweepError("'name' must be a string of letters, digits, '_' and '-' (it names the result files)")
-        description = raw.get("description", "")
-        if not isinstance(description, str):
-            raise SweepError(f"'description' must be a string, got {shown(description)}")
-        too_long("'description'", len(description), MAX_DESCRIPTION_CHARS, error=SweepError)
+        _check_tables(raw)
+        grid, random = _parameters(raw)
+        cases, samples, seed = _counts(raw)
+        _check_times(raw)
+        name, description = _name_and_description(raw, path)
         sweep = Sweep(path=path, name=name, description=description, cases_limit=cases, seed=seed, samples=samples,
                       stop_time=raw.get("stop_time"), metrics_from_s=raw.get("metrics_from_s"), grid=grid,
                       random=random, raw=raw)
@@ -299,6 +289,67 @@ def load_sweep(path: pathlib.Path | str) -> Sweep:
     except SweepError as exc:
         raise SweepError(f"{path}: {exc}") from None
     return sweep
+
+
+def _check_tables(raw: dict) -> None:
+    unknown = set(raw) - TOP_KEYS
+    if unknown:
+        raise SweepError(f"unknown key(s) {[excerpt(key) for key in sorted(unknown)[:5]]}"
+                         f"{did_you_mean(sorted(unknown)[0], sorted(TOP_KEYS))}; allowed: {sorted(TOP_KEYS)}")
+    for key in ("grid", "random"):
+        if not isinstance(raw.get(key, {}), dict):
+            raise SweepError(f"'{key}' must be a table ([{key}])")
+
+
+def _parameters(raw: dict) -> tuple:
+    """({name: grid values}, {name: distribution}) of [grid] and [random]."""
+    grid = {name: _grid_values(name, spec) for name, spec in _flatten_names(raw.get("grid", {})).items()}
+    random = {name: _check_distribution(name, spec) for name, spec in _flatten_names(raw.get("random", {})).items()}
+    both = set(grid) & set(random)
+    if both:
+        raise SweepError(f"parameter(s) {sorted(both)} both in [grid] and [random]")
+    if not grid and not random:
+        raise SweepError("nothing to sweep: give a [grid] and/or a [random] table")
+    for name in list(grid) + list(random):
+        parse_name(name)
+    return grid, random
+
+
+def _counts(raw: dict) -> tuple:
+    """(cases, samples, seed)."""
+    cases = raw.get("cases")
+    if cases is not None and not _is_count(cases):
+        raise SweepError("'cases' must be a positive integer")
+    samples = raw.get("samples")
+    if samples is not None and not _is_count(samples):
+        raise SweepError("'samples' must be a positive integer")
+    if samples is not None:   # every random parameter draws `samples` values up front
+        over_limit("'samples'", samples, MAX_SWEEP_CASES, " draws per grid point", SweepError)
+    seed = raw.get("seed", 0)
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise SweepError("'seed' must be a non-negative integer")
+    return cases, samples, seed
+
+
+def _check_times(raw: dict) -> None:
+    for key in ("stop_time", "metrics_from_s"):
+        value = raw.get(key, 0.0)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0 <= value < math.inf):
+            raise SweepError(f"'{key}' must be a finite number >= 0, got {shown(value)}")
+    if raw.get("stop_time", 1.0) == 0:
+        raise SweepError("'stop_time' must be positive: every case ends there")
+    check_metrics_window(raw.get("metrics_from_s"), raw.get("stop_time"))
+
+
+def _name_and_description(raw: dict, path: pathlib.Path) -> tuple:
+    name = raw.get("name", path.stem)
+    if not isinstance(name, str) or not name.replace("_", "").replace("-", "").isalnum():
+        raise SweepError("'name' must be a string of letters, digits, '_' and '-' (it names the result files)")
+    description = raw.get("description", "")
+    if not isinstance(description, str):
+        raise SweepError(f"'description' must be a string, got {shown(description)}")
+    too_long("'description'", len(description), MAX_DESCRIPTION_CHARS, error=SweepError)
+    return name, description
 
 
 def _check_size(sweep: Sweep) -> None:

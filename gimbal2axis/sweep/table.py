@@ -54,11 +54,19 @@ def _arrow_column(values: list):
     present = [v for v in values if v is not None]
     if present and all(isinstance(v, bool) for v in present):
         return pa.array(values, type=pa.bool_())
-    if present and all(isinstance(v, int) and not isinstance(v, bool) for v in present):
+    if present and all(map(_is_integer, present)):
         return pa.array(values, type=pa.int64())
-    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in present):
+    if all(map(_is_number, present)):
         return pa.array([None if v is None else float(v) for v in values], type=pa.float64())
     return pa.array([None if v is None else str(v) for v in values], type=pa.string())
+
+
+def _is_integer(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def to_arrow(rows: list[dict], parameters: list[str]):
@@ -168,22 +176,34 @@ def summary_figure(rows: list[dict], parameters: list[str], title: str = "", gri
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    metrics = [m for m in METRICS + band_metrics(rows) if any(r.get("status") == "ok" and _finite(r.get(m)) for r in rows)]
     ok = [r for r in rows if r.get("status") == "ok"]
     failed = [r for r in rows if r.get("status") != "ok"]
+    metrics = _plotted_metrics(rows, ok)
     title = title or f"{len(rows)} cases: {len(ok)} ok, {len(failed)} failed"
-    pair = [p for p in (grid or []) if _numeric(rows, p) and not is_seed(p)
-            and len({r[p] for r in rows if r.get(p) is not None}) > 1]
-    if len(grid or []) == 2 and len(pair) == 2 and metrics:
+    pair = _heat_map_pair(rows, grid or [])
+    if pair and metrics:
         return _heat_maps(plt, rows, pair[0], pair[1], metrics, title)
     numeric = [p for p in parameters if _numeric(rows, p)] or ["case"]
     return _scatter_panels(plt, rows, ok, failed, numeric, metrics or ["wall_time_s"], title)
 
 
-def _scatter_panels(plt, rows, ok, failed, numeric, metrics, title):
-    import numpy as np
-    from matplotlib.ticker import FuncFormatter, MaxNLocator
+def _plotted_metrics(rows: list[dict], ok: list[dict]) -> list[str]:
+    """The metrics some ok case has a finite value of."""
+    return [m for m in METRICS + band_metrics(rows) if any(_finite(r.get(m)) for r in ok)]
 
+
+def _heat_map_pair(rows: list[dict], grid: list[str]) -> list[str] | None:
+    """The two grid parameters of a heat map: a grid of exactly two numeric parameters, no seed, each
+    with more than one value; else None."""
+    pair = [p for p in grid if _numeric(rows, p) and not is_seed(p) and len(_values_of(rows, p)) > 1]
+    return pair if len(grid) == 2 and len(pair) == 2 else None
+
+
+def _values_of(rows: list[dict], parameter: str) -> set:
+    return {r[parameter] for r in rows if r.get(parameter) is not None}
+
+
+def _scatter_panels(plt, rows, ok, failed, numeric, metrics, title):
     fig, axes = plt.subplots(len(metrics), len(numeric), figsize=(3.3 * len(numeric) + 0.9, 2.3 * len(metrics) + 1.0),
                              squeeze=False, sharex="col", layout="constrained")
     for j, p in enumerate(numeric):
@@ -192,26 +212,10 @@ def _scatter_panels(plt, rows, ok, failed, numeric, metrics, title):
         log_x = not seed and floats and _log_scale([float(r[p]) for r in rows if r.get(p) is not None], 10.0)
         for i, m in enumerate(metrics):
             ax = axes[i, j]
-            pairs = [(float(r[p]), float(r[m])) for r in ok if r.get(p) is not None and _finite(r.get(m))]
-            x = np.array([a for a, _ in pairs])
-            y = np.array([b for _, b in pairs])
-            ax.plot(x, y, ".", ms=3 if len(x) > 200 else 5, alpha=0.5 if len(x) > 200 else 0.9, color="tab:blue")
-            levels = np.unique(x)
-            if not seed and 1 < len(levels) <= 12 and len(x) > len(levels):   # a grid parameter
-                ax.plot(levels, [np.median(y[x == v]) for v in levels], "-o", color="k", ms=3, lw=1, label="median")
-            if m.startswith("los") and _log_scale(list(y)):
-                ax.set_yscale("log")
-            xf = [float(r[p]) for r in failed if r.get(p) is not None]
-            if xf:
-                ax.plot(xf, [0.0] * len(xf), "x", color="tab:red", transform=ax.get_xaxis_transform(), clip_on=False,
-                        label=f"failed ({len(failed)})")
+            _scatter_panel(ax, ok, failed, p, m, seed)
             if i == 0 and j == 0 and ax.get_legend_handles_labels()[0]:
                 ax.legend(fontsize=7, loc="upper right")
-            if log_x:
-                ax.set_xscale("log")
-            else:   # few ticks, no offset text: long values (seeds, 0.53308) would run together
-                ax.xaxis.set_major_locator(MaxNLocator(nbins=4, integer=seed))
-                ax.xaxis.set_major_formatter(FuncFormatter(lambda v, pos: f"{v:.6g}"))
+            _parameter_axis(ax, log_x, seed)
             if j == 0:
                 ax.set_ylabel(metric_label(m), fontsize=8)
             if i == len(metrics) - 1:
@@ -222,6 +226,44 @@ def _scatter_panels(plt, rows, ok, failed, numeric, metrics, title):
     return fig
 
 
+def _scatter_panel(ax, ok, failed, p, m, seed: bool) -> None:
+    """Metric m of the ok cases against parameter p, the median per value of a grid parameter, the
+    failed cases as red crosses on the axis."""
+    import numpy as np
+
+    pairs = [(float(r[p]), float(r[m])) for r in ok if r.get(p) is not None and _finite(r.get(m))]
+    x = np.array([a for a, _ in pairs])
+    y = np.array([b for _, b in pairs])
+    ax.plot(x, y, ".", ms=3 if len(x) > 200 else 5, alpha=0.5 if len(x) > 200 else 0.9, color="tab:blue")
+    if not seed:
+        _median_line(ax, x, y)
+    if m.startswith("los") and _log_scale(list(y)):
+        ax.set_yscale("log")
+    xf = [float(r[p]) for r in failed if r.get(p) is not None]
+    if xf:
+        ax.plot(xf, [0.0] * len(xf), "x", color="tab:red", transform=ax.get_xaxis_transform(), clip_on=False,
+                label=f"failed ({len(failed)})")
+
+
+def _median_line(ax, x, y) -> None:
+    """The median of y per value of x, when x looks like a grid parameter's (few values, repeated)."""
+    import numpy as np
+
+    levels = np.unique(x)
+    if 1 < len(levels) <= 12 and len(x) > len(levels):
+        ax.plot(levels, [np.median(y[x == v]) for v in levels], "-o", color="k", ms=3, lw=1, label="median")
+
+
+def _parameter_axis(ax, log_x: bool, seed: bool) -> None:
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
+
+    if log_x:
+        ax.set_xscale("log")
+    else:   # few ticks, no offset text: long values (seeds, 0.53308) would run together
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=4, integer=seed))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, pos: f"{v:.6g}"))
+
+
 def _heat_maps(plt, rows, px, py, metrics, title):
     import numpy as np
     from matplotlib import colormaps
@@ -229,9 +271,8 @@ def _heat_maps(plt, rows, px, py, metrics, title):
 
     cmap = colormaps["viridis"].with_extremes(bad="0.85")   # grey: no case of the grid point ran to the end
 
-    xs = sorted({r[px] for r in rows if r.get(px) is not None})
-    ys = sorted({r[py] for r in rows if r.get(py) is not None})
-    cells = {(x, y): [r for r in rows if r.get(px) == x and r.get(py) == y] for x in xs for y in ys}
+    xs, ys = sorted(_values_of(rows, px)), sorted(_values_of(rows, py))
+    cells = _grid_cells(rows, px, py, xs, ys)
     samples = max(len(c) for c in cells.values())
     cols = min(len(metrics), 3)
     nrows = -(-len(metrics) // cols)
@@ -240,32 +281,14 @@ def _heat_maps(plt, rows, px, py, metrics, title):
                              squeeze=False, layout="constrained")
     for k, m in enumerate(metrics):
         ax = axes[k // cols, k % cols]
-        z = np.full((len(ys), len(xs)), np.nan)
-        fails = np.zeros((len(ys), len(xs)), dtype=int)
-        for (x, y), members in cells.items():
-            i, j = ys.index(y), xs.index(x)
-            values = [float(r[m]) for r in members if r.get("status") == "ok" and _finite(r.get(m))]
-            fails[i, j] = sum(r.get("status") != "ok" for r in members)
-            if values:
-                z[i, j] = np.median(values)
+        z, fails = _cell_medians(cells, xs, ys, m)
         finite = z[np.isfinite(z)]
         norm = LogNorm(finite.min(), finite.max()) if m.startswith("los") and _log_scale(list(finite)) else None
         image = ax.imshow(np.ma.masked_invalid(z), origin="lower", aspect="auto", cmap=cmap, norm=norm,
                           interpolation="nearest")
         if len(xs) * len(ys) <= 80:   # the numbers too, while they fit in the cells
-            for i in range(len(ys)):
-                for j in range(len(xs)):
-                    text = f"{z[i, j]:.3g}" if np.isfinite(z[i, j]) else ""
-                    if fails[i, j]:
-                        text += ("\n" if text else "") + f"{fails[i, j]} failed"
-                    bright = np.isfinite(z[i, j]) and image.norm(z[i, j]) > 0.5   # viridis: yellow at the top
-                    color = "tab:red" if fails[i, j] else "k" if bright else "w"
-                    ax.text(j, i, text, ha="center", va="center", fontsize=7, color=color)
-        ax.set_xticks(range(len(xs)), [_tick(v) for v in xs], fontsize=7, rotation=45 if len(xs) > 6 else 0)
-        ax.set_yticks(range(len(ys)), [_tick(v) for v in ys], fontsize=7)
-        ax.set_xlabel(_wrap(px, 40), fontsize=8)
-        if k % cols == 0:   # the same parameter along every row: once, clear of the colour bars
-            ax.set_ylabel(_wrap(py, 30), fontsize=8)
+            _cell_texts(ax, image, z, fails)
+        _grid_axes(ax, px, xs, py if k % cols == 0 else None, ys)
         label = metric_label(m)
         bar = fig.colorbar(image, ax=ax)
         bar.set_label(label + (f", median of {samples}" if samples > 1 else ""), fontsize=8)
@@ -276,3 +299,48 @@ def _heat_maps(plt, rows, px, py, metrics, title):
     fig.get_layout_engine().set(wspace=0.08, hspace=0.06)
     fig.suptitle(title, fontsize=10)
     return fig
+
+
+def _grid_cells(rows: list[dict], px: str, py: str, xs: list, ys: list) -> dict:
+    """{(x, y): the cases of that grid point}."""
+    return {(x, y): [r for r in rows if r.get(px) == x and r.get(py) == y] for x in xs for y in ys}
+
+
+def _grid_axes(ax, px: str, xs: list, py: str | None, ys: list) -> None:
+    """Ticks at the grid values; the y label only where py is given (the first column: the same parameter
+    along every row, once, clear of the colour bars)."""
+    ax.set_xticks(range(len(xs)), [_tick(v) for v in xs], fontsize=7, rotation=45 if len(xs) > 6 else 0)
+    ax.set_yticks(range(len(ys)), [_tick(v) for v in ys], fontsize=7)
+    ax.set_xlabel(_wrap(px, 40), fontsize=8)
+    if py is not None:
+        ax.set_ylabel(_wrap(py, 30), fontsize=8)
+
+
+def _cell_medians(cells: dict, xs: list, ys: list, m: str):
+    """(the median of metric m over the ok cases of each grid point, NaN where none; failed cases per point),
+    both indexed [y, x]."""
+    import numpy as np
+
+    z = np.full((len(ys), len(xs)), np.nan)
+    fails = np.zeros((len(ys), len(xs)), dtype=int)
+    for (x, y), members in cells.items():
+        i, j = ys.index(y), xs.index(x)
+        values = [float(r[m]) for r in members if r.get("status") == "ok" and _finite(r.get(m))]
+        fails[i, j] = sum(r.get("status") != "ok" for r in members)
+        if values:
+            z[i, j] = np.median(values)
+    return z, fails
+
+
+def _cell_texts(ax, image, z, fails) -> None:
+    """Each cell's median and its failed cases written in it."""
+    import numpy as np
+
+    for i in range(z.shape[0]):
+        for j in range(z.shape[1]):
+            text = f"{z[i, j]:.3g}" if np.isfinite(z[i, j]) else ""
+            if fails[i, j]:
+                text += ("\n" if text else "") + f"{fails[i, j]} failed"
+            bright = np.isfinite(z[i, j]) and image.norm(z[i, j]) > 0.5   # viridis: yellow at the top
+            color = "tab:red" if fails[i, j] else "k" if bright else "w"
+            ax.text(j, i, text, ha="center", va="center", fontsize=7, color=color)

@@ -77,28 +77,11 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
     missing = [str(p) for p in paths.values() if not p.is_file()]
     if missing:
         raise SceneError(f"missing FMU(s): {', '.join(missing)} (build them: cmake --build build)")
+    stop_time = scene.stop_time if stop_time is None else stop_time
     fmus = {name: FMU(path) for name, path in paths.items()}
     try:
-        gimbal = fmus[GIMBAL]
-        current = [drive.motor for drive in scene_drives(scene, gimbal) if drive.kind == "current"]
-        if current:
-            # (and libcosim, the engine of the OSP structure, sets no FMI 2.0 Enumeration such as motor<j>.drive)
-            raise SceneError(f"{scene.name}: motor{current[0]}.drive = current, but the controller FMU commands "
-                             f"voltages (u_R1, u_R2): a system of these FMUs runs voltage-driven motors only; run "
-                             f"the scene with `gimbal2axis run`")
-        motion = scene.base_motion()
-        base = motion.sample(np.array([0.0, 1e-6]))
-        gimbal_values = start_values(scene, gimbal, base[0], base[1])
-        u_limit = tuple(float(parameter_value(scene, gimbal, f"motor{j}.U_L")) for j in (1, 2))
-        values = {SHIP: ship_motion_fmu_parameters(scene), GIMBAL: gimbal_values,
-                  CONTROLLER: controller_fmu_parameters(scene, u_limit)}
-        resources = {name: {} for name in FMUS}
-        if scene.moving_target is not None:
-            # the target's position from the gimbal, tabulated for the run, in the ship-motion FMU's
-            # resources: its target outputs feed the controller's target inputs
-            values[SHIP]["target"] = 1
-            resources[SHIP][TARGET_TABLE] = target_table(scene, scene.stop_time if stop_time is None else stop_time,
-                                                           scene.step_size)
+        _check_voltage_drives(scene, fmus[GIMBAL])
+        values, resources = _start_values(scene, fmus[GIMBAL], stop_time)
         components = [Component(name, paths[name], values[name], _description(paths[name], fmus[name]),
                                 resources[name]) for name in FMUS]
         connections = _connections(fmus)
@@ -106,5 +89,30 @@ def ship_system(scene, fmu_dir: pathlib.Path, stop_time: float | None = None) ->
         for fmu in fmus.values():
             fmu.close()
     described = all(c.osp_description is not None for c in components)
-    return System(scene.name, scene.step_size, scene.stop_time if stop_time is None else stop_time, components,
-                  connections, GROUPS if described else [])
+    return System(scene.name, scene.step_size, stop_time, components, connections, GROUPS if described else [])
+
+
+def _check_voltage_drives(scene, gimbal) -> None:
+    current = [drive.motor for drive in scene_drives(scene, gimbal) if drive.kind == "current"]
+    if current:
+        # (and libcosim, the engine of the OSP structure, sets no FMI 2.0 Enumeration such as motor<j>.drive)
+        raise SceneError(f"{scene.name}: motor{current[0]}.drive = current, but the controller FMU commands "
+                         f"voltages (u_R1, u_R2): a system of these FMUs runs voltage-driven motors only; run "
+                         f"the scene with `gimbal2axis run`")
+
+
+def _start_values(scene, gimbal, stop_time: float) -> tuple:
+    """({component: {variable: start value}}, {component: {resource file: bytes}})."""
+    motion = scene.base_motion()
+    base = motion.sample(np.array([0.0, 1e-6]))
+    gimbal_values = start_values(scene, gimbal, base[0], base[1])
+    u_limit = tuple(float(parameter_value(scene, gimbal, f"motor{j}.U_L")) for j in (1, 2))
+    values = {SHIP: ship_motion_fmu_parameters(scene), GIMBAL: gimbal_values,
+              CONTROLLER: controller_fmu_parameters(scene, u_limit)}
+    resources = {name: {} for name in FMUS}
+    if scene.moving_target is not None:
+        # the target's position from the gimbal, tabulated for the run, in the ship-motion FMU's
+        # resources: its target outputs feed the controller's target inputs
+        values[SHIP]["target"] = 1
+        resources[SHIP][TARGET_TABLE] = target_table(scene, stop_time, scene.step_size)
+    return values, resources

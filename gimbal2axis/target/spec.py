@@ -74,6 +74,18 @@ def parse(table: dict) -> dict:
     """The validated [target] table of a moving target (numbers checked by key), as Scene.target_spec."""
     kind = kind_of(table)
     check_keys("target", table, COMMON_KEYS | KIND_KEYS[kind])
+    spec = _common(table, kind)
+    carrier = table.get("carrier", {})
+    spec["carrier"] = _carrier(carrier)
+    for key in KIND_KEYS[kind] - {"file"}:
+        if key in table:
+            spec[key] = within_range("target", key, table[key])
+    _KIND_CHECKS[kind](table, carrier, spec)
+    return spec
+
+
+def _common(table: dict, kind: str) -> dict:
+    """The keys every kind of target takes."""
     spec = {"type": kind, "start_on_target": boolean("target.start_on_target", table.get("start_on_target", False)),
             "beam_width_mrad": within_range("target", "beam_width_mrad",
                                             positive("target.beam_width_mrad", table.get("beam_width_mrad",
@@ -84,60 +96,71 @@ def parse(table: dict) -> dict:
                          "axis)")
     if "ins_position_error_m" in table:
         spec["ins_position_error_m"] = ins_error(table["ins_position_error_m"])
-    carrier = table.get("carrier", {})
+    return spec
+
+
+def _carrier(carrier) -> dict:
+    """The validated [target.carrier] table."""
     if not isinstance(carrier, dict):
         raise SceneError(f"target.carrier must be a table ([target.carrier]), got {shown(carrier)}")
     check_keys("target.carrier", carrier, CARRIER_KEYS)
-    spec["carrier"] = {key: within_range("target.carrier", key, value) for key, value in carrier.items()
-                       if key != "track"}
+    spec = {key: within_range("target.carrier", key, value) for key, value in carrier.items() if key != "track"}
     if "track" in carrier:
         if not isinstance(carrier["track"], str):
             raise SceneError(f"target.carrier.track must be a file name, got {shown(carrier['track'])}")
-        spec["carrier"]["track"] = carrier["track"]
-    if "speed_m_s" in carrier:
-        if "track" in carrier:
-            raise SceneError("target.carrier has both speed_m_s and track: the carrier sails at a speed or follows "
-                             "its recorded track, not both")
-    if abs(spec["carrier"].get("latitude_deg", 0.0)) == 90.0 and spec["carrier"].get("speed_m_s", 0.0) > 0.0:
-        raise SceneError(f"target.carrier.latitude_deg = {spec['carrier']['latitude_deg']:g}: a carrier at a pole has "
+        spec["track"] = carrier["track"]
+    if "speed_m_s" in carrier and "track" in carrier:
+        raise SceneError("target.carrier has both speed_m_s and track: the carrier sails at a speed or follows "
+                         "its recorded track, not both")
+    if abs(spec.get("latitude_deg", 0.0)) == 90.0 and spec.get("speed_m_s", 0.0) > 0.0:
+        raise SceneError(f"target.carrier.latitude_deg = {spec['latitude_deg']:g}: a carrier at a pole has "
                          "no course to sail (target.carrier.speed_m_s must be 0 there)")
-    for key in KIND_KEYS[kind] - {"file"}:
-        if key in table:
-            spec[key] = within_range("target", key, table[key])
-    if kind == "earth_point":
-        geodetic = {"latitude_deg", "longitude_deg"} & set(table)
-        local = {"north_m", "east_m", "down_m"} & set(table)
-        if geodetic and local:
-            raise SceneError("target: give the point by latitude_deg, longitude_deg (and altitude_m) or by north_m, "
-                             "east_m, down_m from the carrier's start, not both")
-        if len(geodetic) == 1:
-            missing = ({"latitude_deg", "longitude_deg"} - geodetic).pop()
-            raise SceneError(f"target: {geodetic.pop()} without {missing}")
-        if not geodetic and not local:
-            raise SceneError("target type 'earth_point' needs latitude_deg, longitude_deg (and altitude_m), or "
-                             "north_m, east_m, down_m from the carrier's start")
-        if local and "altitude_m" in table:
-            raise SceneError("target: altitude_m is for a geodetic point; a local one gives down_m")
-        if geodetic and not {"latitude_deg", "longitude_deg"} <= set(carrier) and "track" not in carrier:
-            raise SceneError("target: a geodetic point needs the carrier's position: [target.carrier] latitude_deg "
-                             "and longitude_deg (or track)")
-    elif kind == "flyby":
-        for key in ("altitude_m", "speed_m_s", "heading_deg", "closest_approach_m", "closest_approach_s"):
-            if key not in table:
-                raise SceneError(f"target type 'flyby' needs {key}")
-        positive("target.speed_m_s", spec["speed_m_s"])
-        if "track" in carrier:
-            raise SceneError("target type 'flyby' is flat, on a carrier sailing at speed_m_s; a recorded carrier "
-                             "track goes with earth_point or track targets")
-        if spec["altitude_m"] - spec["carrier"].get("altitude_m", 0.0) == 0.0 and spec["closest_approach_m"] == 0.0:
-            raise SceneError("target: a flyby at the gimbal's own altitude with closest_approach_m = 0 passes "
-                             "through the gimbal")
-    else:
-        if not isinstance(table.get("file"), str):
-            raise SceneError(f"target type 'track' needs file = \"<track>.csv\" (relative to the scene file), got "
-                             f"{shown(table.get('file'))}")
-        spec["file"] = table["file"]
     return spec
+
+
+def _check_earth_point(table: dict, carrier: dict, spec: dict) -> None:
+    """A point given one way, geodetic or local, whole, and a geodetic one with the carrier's position."""
+    geodetic = {"latitude_deg", "longitude_deg"} & set(table)
+    local = {"north_m", "east_m", "down_m"} & set(table)
+    if geodetic and local:
+        raise SceneError("target: give the point by latitude_deg, longitude_deg (and altitude_m) or by north_m, "
+                         "east_m, down_m from the carrier's start, not both")
+    if len(geodetic) == 1:
+        missing = ({"latitude_deg", "longitude_deg"} - geodetic).pop()
+        raise SceneError(f"target: {geodetic.pop()} without {missing}")
+    if not geodetic and not local:
+        raise SceneError("target type 'earth_point' needs latitude_deg, longitude_deg (and altitude_m), or "
+                         "north_m, east_m, down_m from the carrier's start")
+    if local and "altitude_m" in table:
+        raise SceneError("target: altitude_m is for a geodetic point; a local one gives down_m")
+    if geodetic and not {"latitude_deg", "longitude_deg"} <= set(carrier) and "track" not in carrier:
+        raise SceneError("target: a geodetic point needs the carrier's position: [target.carrier] latitude_deg "
+                         "and longitude_deg (or track)")
+
+
+def _check_flyby(table: dict, carrier: dict, spec: dict) -> None:
+    """Every key given, a flat pass over a sailing carrier that does not go through the gimbal."""
+    for key in ("altitude_m", "speed_m_s", "heading_deg", "closest_approach_m", "closest_approach_s"):
+        if key not in table:
+            raise SceneError(f"target type 'flyby' needs {key}")
+    positive("target.speed_m_s", spec["speed_m_s"])
+    if "track" in carrier:
+        raise SceneError("target type 'flyby' is flat, on a carrier sailing at speed_m_s; a recorded carrier "
+                         "track goes with earth_point or track targets")
+    if spec["altitude_m"] - spec["carrier"].get("altitude_m", 0.0) == 0.0 and spec["closest_approach_m"] == 0.0:
+        raise SceneError("target: a flyby at the gimbal's own altitude with closest_approach_m = 0 passes "
+                         "through the gimbal")
+
+
+def _check_track(table: dict, carrier: dict, spec: dict) -> None:
+    """The recorded track's file name, into spec."""
+    if not isinstance(table.get("file"), str):
+        raise SceneError(f"target type 'track' needs file = \"<track>.csv\" (relative to the scene file), got "
+                         f"{shown(table.get('file'))}")
+    spec["file"] = table["file"]
+
+
+_KIND_CHECKS = {"earth_point": _check_earth_point, "flyby": _check_flyby, "track": _check_track}
 
 
 def ins_error(value) -> list:

@@ -104,41 +104,8 @@ def plan(scene_path, tuning_path, fmu_path, out_dir, tuning: Tuning | None = Non
         holdout = tuning.holdout.scenarios() if tuning.holdout else []
         names = list(dict.fromkeys(tuning.parameter_names + tuning.robustness.names +
                                    (tuning.holdout.names if tuning.holdout else [])))
-        probe_values = {p.name: midpoint(p) for p in tuning.parameters}
-        for scenario in scenarios + holdout:
-            probe_values.update({k: v for k, v in scenario.items() if k not in probe_values})
-        sweep = _pseudo_sweep(tuning, names, probe_values)
-        resolved, candidates = resolve_names(sweep, scene, fmu)
-        for scenario in scenarios + holdout:   # every scenario with the midpoint candidate, checked as a case
-            values = {p.name: midpoint(p) for p in tuning.parameters}
-            values.update(scenario)
-            case = Case(0, "", dict(probe_values, **values))
-            try:
-                scenario_scene = apply_case(scene, resolved, values, tuning.stop_time)
-                check_against_fmu(scenario_scene, fmu)
-            except (SceneError, TypeError, ValueError, KeyError) as exc:
-                case.error = f"invalid case: {exc}"
-                check_cases_accepted(scene, sweep, fmu, resolved, [case], candidates)
-            else:
-                try:
-                    check_metrics_window(tuning.metrics_from_s, scenario_scene.stop_time, "the stop time of its runs",
-                                         TuneError)
-                except TuneError as exc:
-                    raise TuneError(f"{tuning.path}: {exc}") from None
-        if not scene.target_spec:
-            raise TuneError(f"{tuning.path}: scene {scene.name} has no [target]: there is no line-of-sight error to "
-                            f"minimize")
-        if scene.moving_target is None:
-            fixed = "its target is a fixed direction, whose error is metric = \"los_rms\""
-            if any(term.metric == "tracking_rms" for term in tuning.objective.terms):
-                raise TuneError(f"{tuning.path}: [objective] metric = \"tracking_rms\" needs a moving target "
-                                f"([target] type = \"earth_point\", \"flyby\" or \"track\") in scene {scene.name}: {fixed}")
-            if tuning.constraints.on_target_min_fraction is not None:
-                raise TuneError(f"{tuning.path}: [constraints] on_target_min_fraction needs a moving target in scene "
-                                f"{scene.name}: {fixed}")
-        if tuning.constraints.requirements and not scene.requirements:
-            raise TuneError(f"{tuning.path}: [constraints] requirements = true, but scene {scene.name} has no "
-                            f"[requirements]")
+        resolved = _check_scenarios(tuning, scene, fmu, names, scenarios + holdout)
+        _check_objective_against_scene(tuning, scene)
         fmu_bytes = pathlib.Path(fmu_path).read_bytes()
         stem = f"{tuning.name}__{scene.name}"
         evaluations = store.TableFiles.of(out_dir, stem)
@@ -146,19 +113,70 @@ def plan(scene_path, tuning_path, fmu_path, out_dir, tuning: Tuning | None = Non
         problem = Problem(scene, tuning, fmu, fmu_bytes, fmu_digest(fmu_bytes), scene_hash(scene), resolved,
                           scenarios, holdout, evaluations, trials_files, names)
         if tuning.constraints.needs_margins:
-            from ..analysis.isolation_prediction import pid_gains
-            from .margins import LoopModels
-            try:
-                pid_gains(scene, fmu)
-            except SceneError as exc:
-                raise TuneError(f"{tuning.path}: [constraints] gain/phase margins: {exc}") from None
-            problem.loops = LoopModels(scene, fmu, problem.apply)
+            _add_loop_models(problem)
         store.claim(evaluations, names)
         store.claim(trials_files, tuning.parameter_names)
         return problem
     except BaseException:
         fmu.close()
         raise
+
+
+def _check_scenarios(tuning: Tuning, scene, fmu, names: list, scenarios: list) -> dict:
+    """The names resolved as a sweep's (resolve_names); every scenario (robustness and holdout) with the
+    midpoint candidate checked as a case, its metrics window against its stop time."""
+    probe_values = {p.name: midpoint(p) for p in tuning.parameters}
+    for scenario in scenarios:
+        probe_values.update({k: v for k, v in scenario.items() if k not in probe_values})
+    sweep = _pseudo_sweep(tuning, names, probe_values)
+    resolved, candidates = resolve_names(sweep, scene, fmu)
+    for scenario in scenarios:
+        values = {p.name: midpoint(p) for p in tuning.parameters}
+        values.update(scenario)
+        case = Case(0, "", dict(probe_values, **values))
+        try:
+            scenario_scene = apply_case(scene, resolved, values, tuning.stop_time)
+            check_against_fmu(scenario_scene, fmu)
+        except (SceneError, TypeError, ValueError, KeyError) as exc:
+            case.error = f"invalid case: {exc}"
+            check_cases_accepted(scene, sweep, fmu, resolved, [case], candidates)
+        else:
+            try:
+                check_metrics_window(tuning.metrics_from_s, scenario_scene.stop_time, "the stop time of its runs",
+                                     TuneError)
+            except TuneError as exc:
+                raise TuneError(f"{tuning.path}: {exc}") from None
+    return resolved
+
+
+def _check_objective_against_scene(tuning: Tuning, scene) -> None:
+    """What the objective and the constraints measure must be in the scene: a target, a moving one for
+    tracking and on-target shares, requirements."""
+    if not scene.target_spec:
+        raise TuneError(f"{tuning.path}: scene {scene.name} has no [target]: there is no line-of-sight error to "
+                        f"minimize")
+    if scene.moving_target is None:
+        fixed = "its target is a fixed direction, whose error is metric = \"los_rms\""
+        if any(term.metric == "tracking_rms" for term in tuning.objective.terms):
+            raise TuneError(f"{tuning.path}: [objective] metric = \"tracking_rms\" needs a moving target "
+                            f"([target] type = \"earth_point\", \"flyby\" or \"track\") in scene {scene.name}: {fixed}")
+        if tuning.constraints.on_target_min_fraction is not None:
+            raise TuneError(f"{tuning.path}: [constraints] on_target_min_fraction needs a moving target in scene "
+                            f"{scene.name}: {fixed}")
+    if tuning.constraints.requirements and not scene.requirements:
+        raise TuneError(f"{tuning.path}: [constraints] requirements = true, but scene {scene.name} has no "
+                        f"[requirements]")
+
+
+def _add_loop_models(problem: Problem) -> None:
+    """The linear loops of the margin constraints: a PID scene's only."""
+    from ..analysis.isolation_prediction import pid_gains
+    from .margins import LoopModels
+    try:
+        pid_gains(problem.scene, problem.fmu)
+    except SceneError as exc:
+        raise TuneError(f"{problem.tuning.path}: [constraints] gain/phase margins: {exc}") from None
+    problem.loops = LoopModels(problem.scene, problem.fmu, problem.apply)
 
 
 class Evaluator:
@@ -362,29 +380,12 @@ def run_tuning(problem: Problem, options: TuneOptions = TuneOptions(), evaluator
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", category=optuna.exceptions.ExperimentalWarning)
-            study = optuna.create_study(direction="minimize", sampler=make_sampler(tuning, batch))
-            start = {p.name: p.start for p in tuning.parameters if p.start is not None}
-            if len(start) == len(tuning.parameters):
-                # the start (e.g. the scene's own gains) is trial 0, run alone: the study knows its search
-                # space after it, so CMA-ES's first generation is drawn around x0, not at random
-                study.enqueue_trial(start)
+            study, from_start = _study(tuning, batch)
             number = batch_number = 0
             while number < total:
-                size = 1 if number == 0 and len(start) == len(tuning.parameters) else min(batch, total - number)
-                asked = [study.ask() for _ in range(size)]
-                candidates = [suggest(trial, tuning) for trial in asked]
-                requests = [r for trial, c in zip(asked, candidates) for r in requests_for(c, problem.scenarios,
-                                                                                         trial.number)]
-                rows = evaluator.rows(requests, "tuning")
-                evaluator.save()
-                for index, (trial, candidate) in enumerate(zip(asked, candidates)):
-                    own_rows = rows[index * len(problem.scenarios):(index + 1) * len(problem.scenarios)]
-                    margins = problem.loops.margins(candidate) if problem.loops is not None else {}
-                    verdict = judge.judge(tuning, own_rows, margins)
-                    study.tell(trial, verdict.value)
-                    trial_rows.append(judge.trial_row(problem, trial.number, batch_number, candidate, verdict,
-                                                      margins))
-                number += len(asked)
+                size = 1 if number == 0 and from_start else min(batch, total - number)
+                trial_rows += _run_batch(problem, evaluator, study, size, batch_number)
+                number += size
                 batch_number += 1
                 store.save(problem.trials_files, trial_rows, tuning.parameter_names)
     except KeyboardInterrupt:
@@ -401,6 +402,38 @@ def run_tuning(problem: Problem, options: TuneOptions = TuneOptions(), evaluator
     best, least = judge.pick_best(trial_rows)
     return TuneResult(problem, trial_rows, best, least, evaluator.ran, evaluator.reused,
                       time.perf_counter() - wall0)
+
+
+def _study(tuning: Tuning, batch: int):
+    """(the Optuna study, whether its first trial is the start point): with a start for every parameter
+    (e.g. the scene's own gains) that start is trial 0, run alone: the study knows its search space after
+    it, so CMA-ES's first generation is drawn around x0, not at random."""
+    import optuna
+
+    study = optuna.create_study(direction="minimize", sampler=make_sampler(tuning, batch))
+    start = {p.name: p.start for p in tuning.parameters if p.start is not None}
+    from_start = len(start) == len(tuning.parameters)
+    if from_start:
+        study.enqueue_trial(start)
+    return study, from_start
+
+
+def _run_batch(problem: Problem, evaluator: Evaluator, study, size: int, batch_number: int) -> list:
+    """Asks the study for `size` candidates, runs each on the robustness set, tells it their values; their
+    trial rows."""
+    tuning, runs = problem.tuning, len(problem.scenarios)
+    asked = [study.ask() for _ in range(size)]
+    candidates = [suggest(trial, tuning) for trial in asked]
+    requests = [r for trial, c in zip(asked, candidates) for r in requests_for(c, problem.scenarios, trial.number)]
+    rows = evaluator.rows(requests, "tuning")
+    evaluator.save()
+    trial_rows = []
+    for index, (trial, candidate) in enumerate(zip(asked, candidates)):
+        margins = problem.loops.margins(candidate) if problem.loops is not None else {}
+        verdict = judge.judge(tuning, rows[index * runs:(index + 1) * runs], margins)
+        study.tell(trial, verdict.value)
+        trial_rows.append(judge.trial_row(problem, trial.number, batch_number, candidate, verdict, margins))
+    return trial_rows
 
 
 def evaluate(problem: Problem, evaluator: Evaluator, candidate: dict, scenarios: list, role: str) -> dict:

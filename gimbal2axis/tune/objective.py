@@ -62,44 +62,12 @@ def aggregate(values: list, how: str) -> float:
 
 
 def judge(tuning, rows: list, margins: dict) -> Judgement:
-    constraints = tuning.constraints
     ok = [r for r in rows if r.get("status") == "ok"]
     failed = len(rows) - len(ok)
     per_run = [run_objective(tuning, r) if r.get("status") == "ok" else math.nan for r in rows]
     objective = aggregate(per_run, tuning.objective.aggregate) if not failed else math.nan
-    worst = {}
-    for column in ("i_frac_peak", "u_sat_s", "los_rms_mrad", "i_peak_A"):
-        values = [r[column] for r in ok if r.get(column) is not None and math.isfinite(r[column])]
-        worst[column] = max(values) if values else math.nan
-    violations = {}
-    if constraints.peak_current_fraction is not None:
-        limit = constraints.peak_current_fraction
-        violations["peak_current"] = (worst["i_frac_peak"] - limit) / limit
-    if constraints.voltage_saturation_max_s is not None:
-        limit = constraints.voltage_saturation_max_s
-        violations["voltage_saturation"] = (worst["u_sat_s"] - limit) / max(limit, 0.1)
-    stable = margins.get("linear_stable", True)
-    if constraints.gain_margin_min_db is not None:
-        limit = constraints.gain_margin_min_db
-        gm = min(margins.get("gm_az_db", math.nan), margins.get("gm_el_db", math.nan))
-        violations["gain_margin"] = 1.0 if not stable or not math.isfinite(gm) and not gm == math.inf else \
-            (limit - gm) / max(abs(limit), 1.0)
-    if constraints.phase_margin_min_deg is not None:
-        limit = constraints.phase_margin_min_deg
-        pm = min(margins.get("pm_az_deg", math.nan), margins.get("pm_el_deg", math.nan))
-        violations["phase_margin"] = 1.0 if not stable or not math.isfinite(pm) and not pm == math.inf else \
-            (limit - pm) / max(abs(limit), 1.0)
-    if constraints.lower_gain_margin_min_db is not None:
-        violations["lower_gain_margin"] = _lower_margin_violation(constraints.lower_gain_margin_min_db, margins,
-                                                                  stable)
-    if constraints.on_target_min_fraction is not None:   # the least on-target share of the set counts
-        limit = constraints.on_target_min_fraction
-        shares = [r["on_target_fraction"] for r in ok if r.get("on_target_fraction") is not None]
-        worst["on_target_fraction"] = min(shares) if shares else math.nan
-        violations["on_target"] = (limit - worst["on_target_fraction"]) / limit
-    if constraints.requirements:
-        violations["requirements"] = 1.0 if any(r.get("requirements_met") is False for r in ok) else 0.0
-    violations = {k: (v if math.isfinite(v) else -1.0 if v == -math.inf else 1.0) for k, v in violations.items()}
+    worst = _worst(ok, tuning.constraints)
+    violations = _violations(tuning.constraints, worst, margins, ok)
     excess = sum(max(v, 0.0) for v in violations.values())
     if failed or not math.isfinite(objective) or objective <= 0:
         value = FAILED_VALUE + PENALTY * excess
@@ -107,6 +75,55 @@ def judge(tuning, rows: list, margins: dict) -> Judgement:
         value = math.log10(objective) + PENALTY * excess
     feasible = not failed and math.isfinite(objective) and excess == 0.0
     return Judgement(objective, value, violations, feasible, failed, worst, per_run)
+
+
+def _worst(ok: list, constraints) -> dict:
+    """The worst of the ok runs per constrained column (NaN: none has it); the on-target share's least
+    with an on-target constraint."""
+    worst = {}
+    for column in ("i_frac_peak", "u_sat_s", "los_rms_mrad", "i_peak_A"):
+        values = [r[column] for r in ok if r.get(column) is not None and math.isfinite(r[column])]
+        worst[column] = max(values) if values else math.nan
+    if constraints.on_target_min_fraction is not None:   # the least on-target share of the set counts
+        shares = [r["on_target_fraction"] for r in ok if r.get("on_target_fraction") is not None]
+        worst["on_target_fraction"] = min(shares) if shares else math.nan
+    return worst
+
+
+def _margin_violation(limit: float, margins: dict, keys: tuple) -> float:
+    """The smaller margin of the two axes under `limit`, relative; 1 for an unstable loop or a margin that
+    is not a number (an infinite margin meets any limit)."""
+    value = min(margins.get(keys[0], math.nan), margins.get(keys[1], math.nan))
+    if not margins.get("linear_stable", True) or not math.isfinite(value) and not value == math.inf:
+        return 1.0
+    return (limit - value) / max(abs(limit), 1.0)
+
+
+# (constraint, violation name, its violation: > 0 by how much it is broken, relative to the limit), in
+# the order of the table's violation_* columns
+_VIOLATIONS = [
+    ("peak_current_fraction", "peak_current",
+     lambda limit, worst, margins: (worst["i_frac_peak"] - limit) / limit),
+    ("voltage_saturation_max_s", "voltage_saturation",
+     lambda limit, worst, margins: (worst["u_sat_s"] - limit) / max(limit, 0.1)),
+    ("gain_margin_min_db", "gain_margin",
+     lambda limit, worst, margins: _margin_violation(limit, margins, ("gm_az_db", "gm_el_db"))),
+    ("phase_margin_min_deg", "phase_margin",
+     lambda limit, worst, margins: _margin_violation(limit, margins, ("pm_az_deg", "pm_el_deg"))),
+    ("lower_gain_margin_min_db", "lower_gain_margin",
+     lambda limit, worst, margins: _lower_margin_violation(limit, margins, margins.get("linear_stable", True))),
+    ("on_target_min_fraction", "on_target",
+     lambda limit, worst, margins: (limit - worst["on_target_fraction"]) / limit),
+]
+
+
+def _violations(constraints, worst: dict, margins: dict, ok: list) -> dict:
+    """{constraint: violation} of every constraint the tuning has, a non-finite one made 1 (-inf: -1)."""
+    violations = {name: violation(getattr(constraints, limit), worst, margins)
+                  for limit, name, violation in _VIOLATIONS if getattr(constraints, limit) is not None}
+    if constraints.requirements:
+        violations["requirements"] = 1.0 if any(r.get("requirements_met") is False for r in ok) else 0.0
+    return {k: (v if math.isfinite(v) else -1.0 if v == -math.inf else 1.0) for k, v in violations.items()}
 
 
 def _lower_margin_violation(drop_db: float, margins: dict, stable: bool) -> float:

@@ -359,28 +359,11 @@ def _constraints(raw) -> Constraints:
 def _scenario_set(section: str, raw, default_seed: int) -> ScenarioSet:
     table = _table(f"[{section}]", raw)
     _unknown(f"[{section}]: ", table, ROBUSTNESS_KEYS)
-    seeds = table.get("seeds", [])
-    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds):
-        raise TuneError(f"[{section}] seeds must be a list of non-negative integers (base_motion.seed values), "
-                        f"got {shown(seeds)}")
-    seas = table.get("sea_states", [{}])
-    if not isinstance(seas, list) or not seas or not all(isinstance(s, dict) for s in seas):
-        raise TuneError(f"[{section}] sea_states must be a non-empty list of tables of scene overrides, got {shown(seas)}")
-    seas = tuple(_flatten(s) for s in seas)
-    for sea in seas:
-        for name, value in sea.items():
-            parse_name(name)
-            if isinstance(value, (dict, list)):
-                raise TuneError(f"[{section}] sea_states: '{excerpt(name)}' must be a value, got {shown(value)}")
+    seeds = _seeds(section, table.get("seeds", []))
+    seas = _sea_states(section, table.get("sea_states", [{}]))
     draws = _integer(f"[{section}] draws", table.get("draws", 0), 0)
     over_limit(f"[{section}] draws", draws, MAX_SCENARIOS, " draws", TuneError)
-    spec = _flatten(_table(f"[{section}.draw]", table.get("draw", {})))
-    try:
-        spec = {name: _check_distribution(name, value) for name, value in spec.items()}
-    except SweepError as exc:
-        raise TuneError(f"[{section}.draw] {str(exc).removeprefix('[random] ')}") from None
-    for name in spec:
-        parse_name(name)
+    spec = _draw_spec(section, table.get("draw", {}))
     if draws and not spec:
         raise TuneError(f"[{section}] draws = {draws} needs a [{section}.draw] table of distributions")
     if spec and not draws:
@@ -391,6 +374,38 @@ def _scenario_set(section: str, raw, default_seed: int) -> ScenarioSet:
         raise TuneError(f"[{section}]: {len(seas)} sea states x {max(len(seeds), 1)} seeds x {max(draws, 1)} draws = "
                         f"{members:,} runs per candidate, over the limit of {MAX_SCENARIOS:,}")
     return ScenarioSet(seas, tuple(seeds), draws, spec, seed)
+
+
+def _seeds(section: str, seeds) -> list:
+    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds):
+        raise TuneError(f"[{section}] seeds must be a list of non-negative integers (base_motion.seed values), "
+                        f"got {shown(seeds)}")
+    return seeds
+
+
+def _sea_states(section: str, seas) -> tuple:
+    """The sea states, each a flat table of scene overrides {name: value}."""
+    if not isinstance(seas, list) or not seas or not all(isinstance(s, dict) for s in seas):
+        raise TuneError(f"[{section}] sea_states must be a non-empty list of tables of scene overrides, got {shown(seas)}")
+    seas = tuple(_flatten(s) for s in seas)
+    for sea in seas:
+        for name, value in sea.items():
+            parse_name(name)
+            if isinstance(value, (dict, list)):
+                raise TuneError(f"[{section}] sea_states: '{excerpt(name)}' must be a value, got {shown(value)}")
+    return seas
+
+
+def _draw_spec(section: str, raw) -> dict:
+    """[<section>.draw]: {name: distribution} as a sweep's [random] takes them."""
+    spec = _flatten(_table(f"[{section}.draw]", raw))
+    try:
+        spec = {name: _check_distribution(name, value) for name, value in spec.items()}
+    except SweepError as exc:
+        raise TuneError(f"[{section}.draw] {str(exc).removeprefix('[random] ')}") from None
+    for name in spec:
+        parse_name(name)
+    return spec
 
 
 def load_tuning(path) -> Tuning:
@@ -404,40 +419,14 @@ def load_tuning(path) -> Tuning:
             raise TuneError("'name' must be a string of letters, digits, '_' and '-' (it names the result files)")
         seed = _integer("'seed'", raw.get("seed", 0), 0)
         over_limit("'seed'", seed, MAX_SAMPLER_SEED, " (the seeds Optuna's samplers take)", TuneError)
-        stop_time = raw.get("stop_time")
-        if stop_time is not None:
-            stop_time = _number("'stop_time'", stop_time, positive=True)
-        from_s = raw.get("metrics_from_s")
-        if from_s is not None:
-            from_s = _number("'metrics_from_s'", from_s, minimum=0.0)
-            check_metrics_window(from_s, stop_time, error=TuneError)
-        if "parameters" not in raw:
-            raise TuneError("nothing to tune: give a [parameters] table of name = { bounds = [low, high] }")
-        parameters = [_parameter(n, s) for n, s in _flatten(_table("[parameters]", raw["parameters"])).items()]
-        if not parameters:
-            raise TuneError("[parameters] is empty: nothing to tune")
-        over_limit("[parameters]: the number of tuned parameters", len(parameters), MAX_TUNE_PARAMETERS, "",
-                   TuneError)
+        stop_time, from_s = _times(raw)
+        parameters = _parameters(raw)
         objective = _objective(raw.get("objective", {}))
         constraints = _constraints(raw.get("constraints", {}))
         robustness = _scenario_set("robustness", raw.get("robustness", {}), seed)
         holdout = _scenario_set("holdout", raw["holdout"], seed + 1) if "holdout" in raw else None
-        tuned = {p.name for p in parameters}
-        for section, scenario_set in (("robustness", robustness), ("holdout", holdout)):
-            clash = tuned & set(scenario_set.names) if scenario_set else set()
-            if clash:
-                raise TuneError(f"[{section}] sets '{sorted(clash)[0]}', which is tuned in [parameters]")
-        optimizer = _table("[optimizer]", raw.get("optimizer", {}))
-        _unknown("[optimizer]: ", optimizer, OPTIMIZER_KEYS)
-        sampler = optimizer.get("sampler", "cmaes")
-        if sampler not in SAMPLERS:
-            raise TuneError(f"[optimizer] sampler must be one of {', '.join(SAMPLERS)}, got {shown(sampler)}"
-                            f"{did_you_mean(sampler, SAMPLERS)}")
-        trials = _integer("[optimizer] trials", optimizer.get("trials", 60), 1)
-        over_limit("[optimizer] trials", trials, MAX_TUNE_TRIALS, " candidates", TuneError)
-        default_batch = 4 + int(3 * math.log(len(parameters)))   # CMA-ES's default population
-        batch = _integer("[optimizer] batch", optimizer.get("batch", default_batch), 1)
-        over_limit("[optimizer] batch", batch, MAX_TUNE_BATCH, " candidates", TuneError)
+        _check_not_tuned(parameters, robustness, holdout)
+        sampler, trials, batch = _optimizer(raw.get("optimizer", {}), len(parameters))
         description = raw.get("description", "")
         if not isinstance(description, str):
             raise TuneError(f"'description' must be a string, got {shown(description)}")
@@ -447,3 +436,51 @@ def load_tuning(path) -> Tuning:
     return Tuning(path=path, name=name, description=description, seed=seed, stop_time=stop_time,
                   metrics_from_s=from_s, parameters=parameters, objective=objective, constraints=constraints,
                   robustness=robustness, holdout=holdout, sampler=sampler, trials=trials, batch=batch, raw=raw)
+
+
+def _times(raw: dict) -> tuple:
+    """(stop_time, metrics_from_s), each None when not given."""
+    stop_time = raw.get("stop_time")
+    if stop_time is not None:
+        stop_time = _number("'stop_time'", stop_time, positive=True)
+    from_s = raw.get("metrics_from_s")
+    if from_s is not None:
+        from_s = _number("'metrics_from_s'", from_s, minimum=0.0)
+        check_metrics_window(from_s, stop_time, error=TuneError)
+    return stop_time, from_s
+
+
+def _parameters(raw: dict) -> list:
+    if "parameters" not in raw:
+        raise TuneError("nothing to tune: give a [parameters] table of name = { bounds = [low, high] }")
+    parameters = [_parameter(n, s) for n, s in _flatten(_table("[parameters]", raw["parameters"])).items()]
+    if not parameters:
+        raise TuneError("[parameters] is empty: nothing to tune")
+    over_limit("[parameters]: the number of tuned parameters", len(parameters), MAX_TUNE_PARAMETERS, "",
+               TuneError)
+    return parameters
+
+
+def _check_not_tuned(parameters: list, robustness: ScenarioSet, holdout: ScenarioSet | None) -> None:
+    """A scenario must not set what is tuned: it would overwrite the candidate's value."""
+    tuned = {p.name for p in parameters}
+    for section, scenario_set in (("robustness", robustness), ("holdout", holdout)):
+        clash = tuned & set(scenario_set.names) if scenario_set else set()
+        if clash:
+            raise TuneError(f"[{section}] sets '{sorted(clash)[0]}', which is tuned in [parameters]")
+
+
+def _optimizer(raw, parameter_count: int) -> tuple:
+    """[optimizer]: (sampler, trials, batch)."""
+    optimizer = _table("[optimizer]", raw)
+    _unknown("[optimizer]: ", optimizer, OPTIMIZER_KEYS)
+    sampler = optimizer.get("sampler", "cmaes")
+    if sampler not in SAMPLERS:
+        raise TuneError(f"[optimizer] sampler must be one of {', '.join(SAMPLERS)}, got {shown(sampler)}"
+                        f"{did_you_mean(sampler, SAMPLERS)}")
+    trials = _integer("[optimizer] trials", optimizer.get("trials", 60), 1)
+    over_limit("[optimizer] trials", trials, MAX_TUNE_TRIALS, " candidates", TuneError)
+    default_batch = 4 + int(3 * math.log(parameter_count))   # CMA-ES's default population
+    batch = _integer("[optimizer] batch", optimizer.get("batch", default_batch), 1)
+    over_limit("[optimizer] batch", batch, MAX_TUNE_BATCH, " candidates", TuneError)
+    return sampler, trials, batch
