@@ -224,7 +224,7 @@ def model_exchange(folder: pathlib.Path) -> str:
             for run in results["runs"]]
     scenes = table(["scene", "interface", "rtol", "CPU [s]", "real-time factor", "max angle error [rad]", "events"],
                    rows, right_from=2)
-    return calls + "\n\n" + scenes
+    return measured(results.get("date")) + "\n\n" + calls + "\n\n" + scenes
 
 
 def scene_runner(folder: pathlib.Path) -> str:
@@ -247,15 +247,19 @@ def scene_runner(folder: pathlib.Path) -> str:
 
 
 def sweeps(folder: pathlib.Path) -> str:
-    rows = []
+    rows, dates = [], []
     for name in ("sweep_throughput.json", "sweep_throughput_10s.json"):
         results = load(name, folder)
+        dates.append(results.get("date"))
         rows.append([f"{results['cases']} cases of {results['simulated_s_per_case']:g} s", sig(results["serial"]["wall_s"]),
                      sig(results["dask"]["wall_s"]), f"{results['workers']}", sig(results["dask"]["cluster_startup_s"]),
                      sig(results["cases"] * results["simulated_s_per_case"] / results["dask"]["sum_of_case_cpu_s"]),
                      sig(results["load_average_1min"]), "yes" if results["dask_equals_serial"] else "**no**"])
-    return table(["", "serial, wall [s]", "Dask, wall [s]", "workers", "cluster start [s]",
-                  "simulated s per CPU s of the workers", "load average", "Dask equal to serial, bit for bit"], rows)
+    when = " and ".join(sorted({date for date in dates if date})) or None
+    return (measured(when, "best of the file's repetitions, wall times with case expansion and table writing")
+            + "\n\n" + table(["", "serial, wall [s]", "Dask, wall [s]", "workers", "cluster start [s]",
+                               "simulated s per CPU s of the workers", "load average",
+                               "Dask equal to serial, bit for bit"], rows))
 
 
 def batch_controller(folder: pathlib.Path) -> str:
@@ -288,7 +292,8 @@ def current_drive(folder: pathlib.Path) -> str:
     cost = table(["variant", "CPU [s]", "vs voltage", "steps", "right-hand sides", "Jacobians", "mode changes"], rows)
     errors = [[name, *(sci(e[key]) for key in ("alpha_rad", "beta_rad", "los_omega_rad_s", "i_R1_A", "i_R2_A"))]
               for name, e in results["errors"].items()]
-    return (f"{results['simulated_s']:g} s, median of {results['repeat']}; {results['scene']}.\n\n" + cost + "\n\n"
+    return (measured(results.get("date"), f"{results['simulated_s']:g} s, median of {results['repeat']}; "
+                                          f"{results['scene']}") + "\n\n" + cost + "\n\n"
             + "Largest differences at the 1 ms points:\n\n"
             + table(["compared", "alpha [rad]", "beta [rad]", "los.omega [rad/s]", "i_R1 [A]", "i_R2 [A]"], errors))
 
@@ -305,7 +310,7 @@ def tracking_scenes(folder: pathlib.Path) -> str:
         if "against_reference" in row:
             e = row["against_reference"]
             errors.append([name, *(sci(e[key]) for key in ("alpha_rad", "beta_rad", "los_error_mrad", "i_R1_A"))])
-    return (f"Median of {results['repeat']} runs ({results['machine']}).\n\n"
+    return (measured(results.get("date"), f"median of {results['repeat']} runs ({results['machine']})") + "\n\n"
             + table(["scene", "CPU [s]", "x real time", "vs voltage flyby", "steps", "right-hand sides", "events",
                      "LOS RMS [mrad]", "lost near the keyhole [s]"], rows)
             + "\n\nLargest differences from the reference (rtol 1e-10) over the run:\n\n"
