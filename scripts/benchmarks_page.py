@@ -269,7 +269,8 @@ def batch_controller(folder: pathlib.Path) -> str:
         rate, master = size["simulated_s_per_cpu_s"], size["master_us_per_case_step"]
         rows.append([count(size["cases"]), f"{sig(rate['one_at_a_time'])} ({sig(master['one_at_a_time'], 3)})",
                      f"{sig(rate['lockstep'])} ({sig(master['lockstep'], 3)})",
-                     f"{sig(rate['fmu_alone'], 3)} ({sig(size['fmu_us_per_case_step'])})"])
+                     f"{sig(rate['fmu_alone'], 3)} ({sig(size['fmu_us_per_case_step'])})",
+                     sci(size["max_relative_los_rms_difference_batch_vs_scalar"])])
     sweep = results.get("serial_sweep") or {}
     serial = "; ".join(f"`{name}` {sig(entry['cpu_s'])} s CPU for {entry['cases']} cases"
                        for name, entry in sweep.items())
@@ -277,7 +278,8 @@ def batch_controller(folder: pathlib.Path) -> str:
     return (measured(results["date"], f"load average {load_text}; cases of {results['sizes'][0]['stop_time_s']:g} s "
                                       f"of `{results['scene']}`") + "\n\n"
             + table(["N cases", "one at a time, scalar class: simulated s per CPU s (master us per case-step)",
-                     "lockstep, batch class: the same", "the FMU alone: simulated s per CPU s (us per step)"], rows)
+                     "lockstep, batch class: the same", "the FMU alone: simulated s per CPU s (us per step)",
+                     "batch against scalar: LOS RMS, relative"], rows)
             + (f"\n\nA whole serial sweep: {serial}." if serial else ""))
 
 
