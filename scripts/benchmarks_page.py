@@ -352,7 +352,10 @@ def cli_latency(folder: pathlib.Path) -> str:
     return (measured(results["date"], f"{results['cpus']} cores, Python {results['python']}; targets: `--help` "
                                       f"{targets['help_wall_s']:g} s ({'met' if targets['help_met'] else 'not met'}), "
                                       f"a run {targets['run_wall_s']:g} s ({'met' if targets['run_met'] else 'not met'})")
-            + "\n\n" + table(["command", "wall, median [s]", "best", "worst", "CPU, median [s]"], rows))
+            + "\n\n" + table(["command", "wall, median [s]", "best", "worst", "CPU, median [s]"], rows)
+            + "\n\nThe ship run's phases under cProfile (its overhead included), in seconds: "
+            + "; ".join(f"{label.strip()} {sig(seconds)}" for label, seconds in results["run_phases_profiled_s"].items())
+            + ".")
 
 
 def codebase_metrics(folder: pathlib.Path) -> str:
