@@ -22,7 +22,9 @@ disturb it. Steps:
 6. the stiff variants (L = 1e-7 H, k_s = 1e8 N.m/rad, c_s = 1e-6 N.m.s/rad) at default settings,
    against CVODE BDF at rtol 1e-11 and at its own defaults;
 7. single doSteps of the default and of the real-time method (1, 2, 4 substeps): median, p99, p99.9
-   and maximum in wall time and in right-hand sides.
+   and maximum in wall time and in right-hand sides;
+8. the core's pieces without FMI or an integrator (build/benchmarks/gimbal_bench_core): a right-hand
+   side, an event check, a Jacobian, the outputs.
 
 Writes benchmarks/results/results.json and benchmarks/results/work_precision.png, prints a summary.
 """
@@ -278,6 +280,7 @@ def main(argv=None) -> int:
         results["allocations_in_dostep"] = allocations_in_dostep(drv, fidelities, args.step)
         results["stiff_cases"] = stiff_cases(drv, args.stiff_duration, args.step, args.run_timeout)
         results["single_dosteps"] = single_dosteps(drv, args.duration, args.step)
+    results["core_costs"] = core_costs(args.build_dir.resolve() / "benchmarks" / "gimbal_bench_core", fidelities)
 
     results["elapsed_s"] = round(time.time() - t_start, 1)
     write_results(results, args.out, methods, fidelities, args.duration)
@@ -487,6 +490,21 @@ def allocations_in_dostep(drv: Driver, fidelities, step: float) -> dict:
     return alloc
 
 
+def core_costs(core_bench: pathlib.Path, fidelities) -> dict:
+    """Step 8: the core's pieces without FMI or an integrator (gimbal_bench_core): ns per right-hand
+    side, event check, Jacobian and outputs, per fidelity; {} when the driver was not built."""
+    if not core_bench.exists():
+        log(f"[core] {core_bench} is missing: the core's costs are not measured")
+        return {}
+    costs = {}
+    for fid in fidelities:
+        done = subprocess.run([str(core_bench), "--json", "--fidelity", fid], capture_output=True, text=True)
+        lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
+        costs[fid] = json.loads(lines[-1]) if lines else {"failure": done.stderr.strip()[-500:]}
+        log(f"[core] {fid}: " + ", ".join(f"{k} {v}" for k, v in costs[fid].items()))
+    return costs
+
+
 def write_results(results: dict, out: pathlib.Path, methods, fidelities, duration: float) -> None:
     """OUT/results.json and OUT/work_precision.png; the tables on stdout."""
     out.mkdir(parents=True, exist_ok=True)
@@ -615,7 +633,7 @@ def plot_targets(axes, fidelities) -> None:
 def summary(results: dict, methods, fidelities, duration: float) -> None:
     """The tables on stdout, one function per step."""
     for section in (summary_sweep, summary_at_target, summary_durations, summary_overhead, summary_allocations,
-                    summary_stiff, summary_single_dosteps):
+                    summary_stiff, summary_single_dosteps, summary_core):
         section(results, duration)
 
 
@@ -719,6 +737,15 @@ def summary_single_dosteps(results: dict, duration: float) -> None:
             + " ".join(f"{c:7.2f}" for c in cpu) + "            "
             + " ".join(f"{w:6.0f}" for w in work)
             + f"                      {wall[3] / wall[0]:.1f} / {cpu[2] / cpu[0]:.1f} / {work[2] / work[0]:.1f}")
+
+
+def summary_core(results: dict, duration: float) -> None:
+    log("\n=== the core without FMI or an integrator (gimbal_bench_core; targets: RHS <= 150 ns, event check "
+        "<= 50 ns) ===")
+    for fid, c in results.get("core_costs", {}).items():
+        log(f"{fid:8s} " + (f"FAILED {c['failure']}" if c.get("failure") else
+                            f"RHS {c['rhs_ns']:.0f} ns, event check {c['event_check_ns']:.0f} ns, Jacobian "
+                            f"{c['jacobian_ns']:.0f} ns, outputs {c['outputs_ns']:.0f} ns"))
 
 
 if __name__ == "__main__":

@@ -196,6 +196,14 @@ def speed_targets(folder: pathlib.Path) -> str:
             rtf = case["default"]["rtf"]
             rows.append([f"{case['case']}, default settings: >= 100x real time, no discarded step", f"{sig(rtf)}x",
                          met(rtf >= 100)])
+    core = results.get("core_costs", {})
+    if "rhs_ns" in core.get("full", {}):
+        rows.append(["a right-hand side, full fidelity (`gimbal_bench_core`) <= 150 ns", f"{sig(core['full']['rhs_ns'])} ns",
+                     met(core["full"]["rhs_ns"] <= 150)])
+    for fidelity, costs in core.items():
+        if "event_check_ns" in costs:
+            rows.append([f"event checks per step, {fidelity} fidelity <= 50 ns", f"{sig(costs['event_check_ns'])} ns",
+                         met(costs["event_check_ns"] <= 50)])
     overhead = max(run["ns_per_dostep"] for run in results["fmi_overhead"].values())
     rows.append(["FMI overhead: doStep at rest <= 100 ns", f"{sig(overhead)} ns", met(overhead <= 100)])
     allocations = sum(run["dostep_allocations"] for run in results["allocations_in_dostep"].values())
