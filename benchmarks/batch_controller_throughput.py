@@ -99,8 +99,9 @@ def sweep(fmu_path, count: int, stop_time: float) -> dict:
         tmp = pathlib.Path(tmp)
         (tmp / "sweep.toml").write_text(text)
         for class_name in ("GyroStabilizer", "GyroStabilizerBatch"):
-            scene = EXAMPLE.read_text().replace('module = "gyro_stabilizer.py"',
-                                                f'module = "{REPO / "examples" / "gyro_stabilizer.py"}"')
+            # the scene in another folder: its controller file by its absolute path
+            scene = EXAMPLE.read_text().replace('file = "gyro_stabilizer.py"',
+                                                f'file = "{REPO / "examples" / "gyro_stabilizer.py"}"')
             scene = scene.replace('class = "GyroStabilizer"', f'class = "{class_name}"')
             (tmp / "scene.toml").write_text(scene)
             t0, c0 = time.perf_counter(), time.process_time()

@@ -486,6 +486,44 @@ void usage() {
         "                           the median, 99th, 99.9th percentile and maximum of single doSteps");
 }
 
+// The options by the kind of value they take: a text, a number, an integer, or none (a flag's value).
+const std::map<std::string, std::string Options::*> kTextOptions = {
+    {"--fmu", &Options::fmu}, {"--model-description", &Options::model_description},
+    {"--fidelity", &Options::fidelity}, {"--trajectory", &Options::trajectory}};
+const std::map<std::string, double Options::*> kNumberOptions = {
+    {"--duration", &Options::duration}, {"--step", &Options::step}, {"--rtol", &Options::rtol},
+    {"--atol", &Options::atol}, {"--overhead-step", &Options::overhead_step}};
+const std::map<std::string, void (*)(Options&, double)> kIntegerOptions = {
+    {"--method", [](Options& o, double v) { o.method = static_cast<int>(v); }},
+    {"--seed", [](Options& o, double v) { o.seed = static_cast<uint64_t>(v); }},
+    {"--overhead-steps", [](Options& o, double v) { o.overhead_steps = static_cast<long>(v); }}};
+const std::map<std::string, std::pair<bool Options::*, bool>> kFlags = {
+    {"--json", {&Options::json, true}}, {"--fmi-overhead", {&Options::fmi_overhead, true}},
+    {"--no-trace", {&Options::trace_allocations, false}}, {"--time-dostep", {&Options::time_dostep, true}}};
+
+// --set NAME=VALUE: a Real parameter.
+void add_real_parameter(Options& o, const std::string& assignment) {
+    const auto equals = assignment.find('=');
+    if (equals == std::string::npos || equals == 0) die("--set expects NAME=VALUE, got " + assignment);
+    const std::string text = assignment.substr(equals + 1);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0') die("--set " + assignment + ": not a number");
+    o.real_parameters.emplace_back(assignment.substr(0, equals), v);
+}
+
+// The checks across options, and the model description's default place beside the shared object.
+void complete(Options& o) {
+    if (o.fmu.empty()) die("--fmu is required (see --help)");
+    if (o.fidelity != "full" && o.fidelity != "reduced") die("--fidelity must be 'full' or 'reduced'");
+    if (!(o.step > 0.0) || !(o.duration > 0.0)) die("--step and --duration must be > 0");
+    if (o.model_description.empty()) {
+        std::string dir = o.fmu.substr(0, o.fmu.find_last_of('/') == std::string::npos ? 0 : o.fmu.find_last_of('/'));
+        if (dir.empty()) dir = ".";
+        o.model_description = dir + "/../../modelDescription.xml";
+    }
+}
+
 Options parse(int argc, char** argv) {
     Options o;
     auto value = [&](int& i) -> std::string {
@@ -501,45 +539,17 @@ Options parse(int argc, char** argv) {
     };
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        if (a == "--fmu") o.fmu = value(i);
-        else if (a == "--model-description") o.model_description = value(i);
-        else if (a == "--duration") o.duration = number(i);
-        else if (a == "--step") o.step = number(i);
-        else if (a == "--rtol") o.rtol = number(i);
-        else if (a == "--atol") o.atol = number(i);
-        else if (a == "--method") o.method = static_cast<int>(number(i));
-        else if (a == "--fidelity") o.fidelity = value(i);
-        else if (a == "--set") {
-            const std::string assignment = value(i);
-            const auto equals = assignment.find('=');
-            if (equals == std::string::npos || equals == 0) die("--set expects NAME=VALUE, got " + assignment);
-            const std::string text = assignment.substr(equals + 1);
-            char* end = nullptr;
-            const double v = std::strtod(text.c_str(), &end);
-            if (end == text.c_str() || *end != '\0') die("--set " + assignment + ": not a number");
-            o.real_parameters.emplace_back(assignment.substr(0, equals), v);
-        }
-        else if (a == "--trajectory") o.trajectory = value(i);
-        else if (a == "--seed") o.seed = static_cast<uint64_t>(number(i));
-        else if (a == "--json") o.json = true;
-        else if (a == "--fmi-overhead") o.fmi_overhead = true;
-        else if (a == "--overhead-steps") o.overhead_steps = static_cast<long>(number(i));
-        else if (a == "--overhead-step") o.overhead_step = number(i);
-        else if (a == "--no-trace") o.trace_allocations = false;
-        else if (a == "--time-dostep") o.time_dostep = true;
+        if (const auto text = kTextOptions.find(a); text != kTextOptions.end()) o.*(text->second) = value(i);
+        else if (const auto real = kNumberOptions.find(a); real != kNumberOptions.end()) o.*(real->second) = number(i);
+        else if (const auto integer = kIntegerOptions.find(a); integer != kIntegerOptions.end()) integer->second(o, number(i));
+        else if (const auto flag = kFlags.find(a); flag != kFlags.end()) o.*(flag->second.first) = flag->second.second;
+        else if (a == "--set") add_real_parameter(o, value(i));
         else if (a == "--help" || a == "-h") {
             usage();
             std::exit(0);
         } else die("unknown option " + a + " (see --help)");
     }
-    if (o.fmu.empty()) die("--fmu is required (see --help)");
-    if (o.fidelity != "full" && o.fidelity != "reduced") die("--fidelity must be 'full' or 'reduced'");
-    if (!(o.step > 0.0) || !(o.duration > 0.0)) die("--step and --duration must be > 0");
-    if (o.model_description.empty()) {
-        std::string dir = o.fmu.substr(0, o.fmu.find_last_of('/') == std::string::npos ? 0 : o.fmu.find_last_of('/'));
-        if (dir.empty()) dir = ".";
-        o.model_description = dir + "/../../modelDescription.xml";
-    }
+    complete(o);
     return o;
 }
 
@@ -639,47 +649,50 @@ void collect_sites(Report& report) {
                                std::to_string(kMaxTraced) + " were; counts per site above are among those)");
 }
 
-void print_report(const Options& o, const Report& r) {
+// The report as one JSON line (scripts/benchmark.py reads it).
+void print_json(const Options& o, const Report& r) {
     const double rtf = r.cpu > 0 ? r.simulated / r.cpu : 0.0;
-    if (o.json) {
-        auto num = [](double v) {
-            char text[32];
-            if (std::isnan(v)) return std::string("null");
-            std::snprintf(text, sizeof text, "%.6g", v);
-            return std::string(text);
-        };
-        std::printf("{\"mode\": \"%s\", \"fidelity\": \"%s\", \"method\": %s, \"rtol\": %s, \"atol\": %s, "
-                    "\"step\": %.9g, \"duration\": %.9g, \"simulated\": %.9g, \"wall_s\": %.6g, \"cpu_s\": %.6g, "
-                    "\"dostep_wall_s\": %s, \"master_cpu_s\": %s, \"dostep_calls\": %ld, \"rtf\": %.6g, "
-                    "\"cpu_us_per_step\": %.6g, \"states\": %ld",
-                    r.mode.c_str(), o.fidelity.c_str(), o.method < 0 ? "null" : std::to_string(o.method).c_str(),
-                    num(o.rtol).c_str(), num(o.atol).c_str(),
-                    r.mode == "overhead" ? o.overhead_step : o.step, r.simulated, r.simulated, r.wall, r.cpu,
-                    num(r.dostep_wall).c_str(), num(r.master_cpu).c_str(), r.dostep_calls, rtf, r.dostep_calls ? 1e6 * r.cpu / r.dostep_calls : 0.0, r.states);
-        std::printf(", \"dostep_p50_s\": %s, \"dostep_p99_s\": %s, \"dostep_p999_s\": %s, "
-                    "\"dostep_max_s\": %s", num(r.dostep_p50).c_str(), num(r.dostep_p99).c_str(),
-                    num(r.dostep_p999).c_str(), num(r.dostep_max).c_str());
-        std::printf(", \"dostep_cpu_p50_s\": %s, \"dostep_cpu_p99_s\": %s, \"dostep_cpu_p999_s\": %s, "
-                    "\"dostep_cpu_max_s\": %s", num(r.dostep_cpu_p50).c_str(), num(r.dostep_cpu_p99).c_str(),
-                    num(r.dostep_cpu_p999).c_str(), num(r.dostep_cpu_max).c_str());
-        std::printf(", \"rhs_per_dostep_median\": %s, \"rhs_per_dostep_p999\": %s, \"rhs_per_dostep_max\": %s",
-                    num(r.rhs_per_dostep_median).c_str(), num(r.rhs_per_dostep_p999).c_str(),
-                    num(r.rhs_per_dostep_max).c_str());
-        for (int c = 0; c < 5; ++c) std::printf(", \"%s\": %ld", kCounterKeys[c], r.counters[c]);
-        std::printf(", \"instance_allocations\": %llu, \"instance_bytes\": %lld, \"first_step_allocations\": %llu, "
-                    "\"dostep_allocations\": %llu, \"dostep_alloc_bytes\": %llu",
-                    (unsigned long long)r.instance_allocations, (long long)r.instance_bytes,
-                    (unsigned long long)r.first_step_allocations, (unsigned long long)r.dostep_allocations,
-                    (unsigned long long)r.dostep_alloc_bytes);
-        if (r.mode == "overhead")
-            std::printf(", \"ns_per_dostep\": %.6g, \"wall_ns_per_dostep\": %.6g", 1e9 * r.cpu / r.dostep_calls,
-                        1e9 * r.wall / r.dostep_calls);
-        std::printf(", \"allocation_sites\": [");
-        for (size_t s = 0; s < r.sites.size(); ++s)
-            std::printf("%s\"%s\"", s ? ", " : "", json_escape(r.sites[s]).c_str());
-        std::printf("], \"failure\": \"%s\"}\n", json_escape(r.failure).c_str());
-        return;
-    }
+    auto num = [](double v) {
+        char text[32];
+        if (std::isnan(v)) return std::string("null");
+        std::snprintf(text, sizeof text, "%.6g", v);
+        return std::string(text);
+    };
+    std::printf("{\"mode\": \"%s\", \"fidelity\": \"%s\", \"method\": %s, \"rtol\": %s, \"atol\": %s, "
+                "\"step\": %.9g, \"duration\": %.9g, \"simulated\": %.9g, \"wall_s\": %.6g, \"cpu_s\": %.6g, "
+                "\"dostep_wall_s\": %s, \"master_cpu_s\": %s, \"dostep_calls\": %ld, \"rtf\": %.6g, "
+                "\"cpu_us_per_step\": %.6g, \"states\": %ld",
+                r.mode.c_str(), o.fidelity.c_str(), o.method < 0 ? "null" : std::to_string(o.method).c_str(),
+                num(o.rtol).c_str(), num(o.atol).c_str(),
+                r.mode == "overhead" ? o.overhead_step : o.step, r.simulated, r.simulated, r.wall, r.cpu,
+                num(r.dostep_wall).c_str(), num(r.master_cpu).c_str(), r.dostep_calls, rtf, r.dostep_calls ? 1e6 * r.cpu / r.dostep_calls : 0.0, r.states);
+    std::printf(", \"dostep_p50_s\": %s, \"dostep_p99_s\": %s, \"dostep_p999_s\": %s, "
+                "\"dostep_max_s\": %s", num(r.dostep_p50).c_str(), num(r.dostep_p99).c_str(),
+                num(r.dostep_p999).c_str(), num(r.dostep_max).c_str());
+    std::printf(", \"dostep_cpu_p50_s\": %s, \"dostep_cpu_p99_s\": %s, \"dostep_cpu_p999_s\": %s, "
+                "\"dostep_cpu_max_s\": %s", num(r.dostep_cpu_p50).c_str(), num(r.dostep_cpu_p99).c_str(),
+                num(r.dostep_cpu_p999).c_str(), num(r.dostep_cpu_max).c_str());
+    std::printf(", \"rhs_per_dostep_median\": %s, \"rhs_per_dostep_p999\": %s, \"rhs_per_dostep_max\": %s",
+                num(r.rhs_per_dostep_median).c_str(), num(r.rhs_per_dostep_p999).c_str(),
+                num(r.rhs_per_dostep_max).c_str());
+    for (int c = 0; c < 5; ++c) std::printf(", \"%s\": %ld", kCounterKeys[c], r.counters[c]);
+    std::printf(", \"instance_allocations\": %llu, \"instance_bytes\": %lld, \"first_step_allocations\": %llu, "
+                "\"dostep_allocations\": %llu, \"dostep_alloc_bytes\": %llu",
+                (unsigned long long)r.instance_allocations, (long long)r.instance_bytes,
+                (unsigned long long)r.first_step_allocations, (unsigned long long)r.dostep_allocations,
+                (unsigned long long)r.dostep_alloc_bytes);
+    if (r.mode == "overhead")
+        std::printf(", \"ns_per_dostep\": %.6g, \"wall_ns_per_dostep\": %.6g", 1e9 * r.cpu / r.dostep_calls,
+                    1e9 * r.wall / r.dostep_calls);
+    std::printf(", \"allocation_sites\": [");
+    for (size_t s = 0; s < r.sites.size(); ++s)
+        std::printf("%s\"%s\"", s ? ", " : "", json_escape(r.sites[s]).c_str());
+    std::printf("], \"failure\": \"%s\"}\n", json_escape(r.failure).c_str());
+}
+
+// The report as text, for a person.
+void print_text(const Options& o, const Report& r) {
+    const double rtf = r.cpu > 0 ? r.simulated / r.cpu : 0.0;
     std::printf("gimbal_bench: %s, fidelity %s, method %s, rtol %s, atol %s\n", r.mode.c_str(), o.fidelity.c_str(),
                 o.method < 0 ? "FMU default" : std::to_string(o.method).c_str(),
                 std::isnan(o.rtol) ? "default" : std::to_string(o.rtol).c_str(),
@@ -717,6 +730,13 @@ void print_report(const Options& o, const Report& r) {
     std::printf("  later doSteps      %llu allocations, %llu bytes\n", (unsigned long long)r.dostep_allocations,
                 (unsigned long long)r.dostep_alloc_bytes);
     for (const std::string& site : r.sites) std::printf("    %s\n", site.c_str());
+}
+
+void print_report(const Options& o, const Report& r) {
+    if (o.json)
+        print_json(o, r);
+    else
+        print_text(o, r);
 }
 
 struct Run {

@@ -117,22 +117,7 @@ def main() -> int:
 
     gimbal2axis = command()
     load_before = os.getloadavg()[0]
-    answers = {"gimbal2axis --help": timed(gimbal2axis + ["--help"], args.repeat),
-               "gimbal2axis --version": timed(gimbal2axis + ["--version"], args.repeat)}
-    for name in SUBCOMMANDS:
-        answers[f"gimbal2axis {name} --help"] = timed(gimbal2axis + [name, "--help"], args.repeat)
-    with tempfile.TemporaryDirectory(prefix="gimbal_cli_latency_") as tmp:
-        tmp = pathlib.Path(tmp)
-        run_label = f"gimbal2axis run {SHIP_SCENE.relative_to(REPO)} --quiet"
-        answers[run_label] = timed(gimbal2axis + ["run", str(SHIP_SCENE), "--quiet", "--out", str(tmp / "run")],
-                                   args.run_repeat)
-        run_imports = import_times("from gimbal2axis.cli.main import main\n"
-                                   f"main(['run', {str(SHIP_SCENE)!r}, '--quiet', '--out', {str(tmp / 'imports')!r}])",
-                                   args.top)
-        phases = run_phases(tmp)
-    help_imports = import_times("from gimbal2axis.cli.main import main\ntry:\n    main(['--help'])\n"
-                                "except SystemExit:\n    pass", args.top)
-
+    answers, run_label, help_imports, run_imports, phases = measure(gimbal2axis, args)
     helps = [label for label in answers if label.endswith("--help")]
     slowest_help = max(answers[label]["wall_median_s"] for label in helps)
     run_wall = answers[run_label]["wall_median_s"]
@@ -152,7 +137,34 @@ def main() -> int:
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(result, indent=2) + "\n")
+    report(result, load_before, slowest_help, run_wall)
+    print(f"wrote {out}")
+    return 0
 
+
+def measure(gimbal2axis: list[str], args):
+    """The timed answers of every command, the run's label among them, the imports of --help and of
+    the run, and the run's profiled phases."""
+    answers = {"gimbal2axis --help": timed(gimbal2axis + ["--help"], args.repeat),
+               "gimbal2axis --version": timed(gimbal2axis + ["--version"], args.repeat)}
+    for name in SUBCOMMANDS:
+        answers[f"gimbal2axis {name} --help"] = timed(gimbal2axis + [name, "--help"], args.repeat)
+    with tempfile.TemporaryDirectory(prefix="gimbal_cli_latency_") as tmp:
+        tmp = pathlib.Path(tmp)
+        run_label = f"gimbal2axis run {SHIP_SCENE.relative_to(REPO)} --quiet"
+        answers[run_label] = timed(gimbal2axis + ["run", str(SHIP_SCENE), "--quiet", "--out", str(tmp / "run")],
+                                   args.run_repeat)
+        run_imports = import_times("from gimbal2axis.cli.main import main\n"
+                                   f"main(['run', {str(SHIP_SCENE)!r}, '--quiet', '--out', {str(tmp / 'imports')!r}])",
+                                   args.top)
+        phases = run_phases(tmp)
+    help_imports = import_times("from gimbal2axis.cli.main import main\ntry:\n    main(['--help'])\n"
+                                "except SystemExit:\n    pass", args.top)
+    return answers, run_label, help_imports, run_imports, phases
+
+
+def report(result: dict, load_before: float, slowest_help: float, run_wall: float) -> None:
+    answers = result["answers"]
     width = max(len(label) for label in answers)
     print(f"{'command':<{width}}  wall median  wall best  CPU median   ({os.cpu_count()} CPUs, load "
           f"{load_before:.2f} before)")
@@ -162,14 +174,12 @@ def main() -> int:
     print(f"targets: every --help < {HELP_TARGET_S} s: {'met' if result['targets']['help_met'] else 'NOT met'} "
           f"(slowest {slowest_help:.3f} s); the ship run < {RUN_TARGET_S} s: "
           f"{'met' if result['targets']['run_met'] else 'NOT met'} ({run_wall:.3f} s)")
-    for title, found in (("--help", help_imports), ("run", run_imports)):
+    for title, found in (("--help", result["imports_of_help"]), ("run", result["imports_of_run"])):
         print(f"imports of {title}: {found['total_s']:.3f} s; top level by total: " + ", ".join(
             f"{row['module']} {row['cumulative_s']:.3f}" for row in found["top_level_by_cumulative_time"][:6]))
         print("  by own time: " + ", ".join(f"{row['module']} {row['own_s']:.3f}" for row in found["by_own_time"][:8]))
     print("the run's phases (cProfile, its overhead included): " + "; ".join(
-        f"{label.strip()} {seconds:.2f} s" for label, seconds in phases.items()))
-    print(f"wrote {out}")
-    return 0
+        f"{label.strip()} {seconds:.2f} s" for label, seconds in result["run_phases_profiled_s"].items()))
 
 
 if __name__ == "__main__":

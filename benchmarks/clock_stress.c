@@ -79,13 +79,8 @@ static void* symbol(void* library, const char* name) {
     return found;
 }
 
-int main(int argc, char** argv) {
-    if (argc != 9) {
-        fprintf(stderr, "usage: clock_stress fmi2|fmi3 BINARY TOKEN FIXED_BASE_VR kh|sum|kahan|ns START STEP STEPS\n");
-        return 2;
-    }
-    const int fmi3 = strcmp(argv[1], "fmi3") == 0;
-    const unsigned fixed_base_vr = (unsigned)strtoul(argv[4], NULL, 10);
+/* The clock of the command line's CLOCK START STEP. */
+static Clock parse_clock(char** argv) {
     Clock clock = {0};
     const char* kinds[] = {"kh", "sum", "kahan", "ns"};
     for (int i = 0; i < 4; ++i)
@@ -94,6 +89,79 @@ int main(int argc, char** argv) {
     clock.step = strtod(argv[7], NULL);
     clock.start_ns = llround(clock.start * 1e9);
     clock.step_ns = llround(clock.step * 1e9) > 0 ? llround(clock.step * 1e9) : 1;
+    return clock;
+}
+
+/* An initialized FMI 3.0 instance on a fixed base, or NULL. */
+static void* instantiate_fmi3(void* library, const char* token, unsigned fixed_base_vr, double start) {
+    fmi3InstanceEnvironment environment = NULL;
+    void* instance = ((fmi3InstantiateCoSimulationTYPE*)symbol(library, "fmi3InstantiateCoSimulation"))(
+        "stress", token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, environment, fmi3_logger, NULL);
+    const fmi3ValueReference vr = fixed_base_vr;
+    const fmi3Boolean yes = fmi3True;
+    if (instance == NULL ||
+        ((fmi3EnterInitializationModeTYPE*)symbol(library, "fmi3EnterInitializationMode"))(
+            instance, fmi3False, 0.0, start, fmi3False, 0.0) != fmi3OK ||
+        ((fmi3SetBooleanTYPE*)symbol(library, "fmi3SetBoolean"))(instance, &vr, 1, &yes, 1) != fmi3OK ||
+        ((fmi3ExitInitializationModeTYPE*)symbol(library, "fmi3ExitInitializationMode"))(instance) != fmi3OK)
+        return NULL;
+    return instance;
+}
+
+/* An initialized FMI 2.0 instance on a fixed base, or NULL. */
+static void* instantiate_fmi2(void* library, const char* token, unsigned fixed_base_vr, double start) {
+    static fmi2CallbackFunctions callbacks = {fmi2_logger, calloc, free, NULL, NULL};
+    void* instance = ((fmi2InstantiateTYPE*)symbol(library, "fmi2Instantiate"))("stress", fmi2CoSimulation, token, NULL,
+                                                                               &callbacks, fmi2False, fmi2False);
+    const fmi2ValueReference vr = fixed_base_vr;
+    const fmi2Boolean yes = fmi2True;
+    if (instance == NULL ||
+        ((fmi2SetupExperimentTYPE*)symbol(library, "fmi2SetupExperiment"))(instance, fmi2False, 0.0, start,
+                                                                           fmi2False, 0.0) != fmi2OK ||
+        ((fmi2SetBooleanTYPE*)symbol(library, "fmi2SetBoolean"))(instance, &vr, 1, &yes) != fmi2OK ||
+        ((fmi2EnterInitializationModeTYPE*)symbol(library, "fmi2EnterInitializationMode"))(instance) != fmi2OK ||
+        ((fmi2ExitInitializationModeTYPE*)symbol(library, "fmi2ExitInitializationMode"))(instance) != fmi2OK)
+        return NULL;
+    return instance;
+}
+
+/* Where a run ended: the steps taken, the last point and step passed, the FMU's time and status. */
+typedef struct {
+    long taken;
+    double point, step, reported;
+    int status;
+} Run;
+
+/* Up to `steps` doSteps on `clock`, printing the resident set size every 2^20 steps. */
+static Run run_steps(void* library, void* instance, int fmi3, Clock* clock, long steps) {
+    fmi2DoStepTYPE* fmi2_do_step = fmi3 ? NULL : (fmi2DoStepTYPE*)symbol(library, "fmi2DoStep");
+    fmi3DoStepTYPE* fmi3_do_step = fmi3 ? (fmi3DoStepTYPE*)symbol(library, "fmi3DoStep") : NULL;
+    Run run = {0, clock->start, clock->step, clock->start, 0};
+    for (long k = 0; k < steps; ++k) {
+        clock_point(clock, k, &run.point, &run.step);
+        if (fmi3) {
+            fmi3Boolean event, terminate, early;
+            run.status = fmi3_do_step(instance, run.point, run.step, fmi3True, &event, &terminate, &early, &run.reported);
+        } else {
+            run.status = fmi2_do_step(instance, run.point, run.step, fmi2True);
+        }
+        if (run.status > 1) break;
+        ++run.taken;
+        if ((k & ((1L << 20) - 1)) == 0) printf("%s%ld", k == 0 ? "" : ", ", resident_kib("VmRSS:"));
+    }
+    if (!fmi3 && run.status <= 1)
+        ((fmi2GetRealStatusTYPE*)symbol(library, "fmi2GetRealStatus"))(instance, fmi2LastSuccessfulTime, &run.reported);
+    return run;
+}
+
+int main(int argc, char** argv) {
+    if (argc != 9) {
+        fprintf(stderr, "usage: clock_stress fmi2|fmi3 BINARY TOKEN FIXED_BASE_VR kh|sum|kahan|ns START STEP STEPS\n");
+        return 2;
+    }
+    const int fmi3 = strcmp(argv[1], "fmi3") == 0;
+    const unsigned fixed_base_vr = (unsigned)strtoul(argv[4], NULL, 10);
+    Clock clock = parse_clock(argv);
     const long steps = strtol(argv[8], NULL, 10);
 
     void* library = dlopen(argv[2], RTLD_NOW | RTLD_LOCAL);
@@ -101,67 +169,25 @@ int main(int argc, char** argv) {
         fprintf(stderr, "clock_stress: dlopen(%s): %s\n", argv[2], dlerror());
         return 2;
     }
-    void* instance;
-    int status = 0;
-    if (fmi3) {
-        fmi3InstanceEnvironment environment = NULL;
-        instance = ((fmi3InstantiateCoSimulationTYPE*)symbol(library, "fmi3InstantiateCoSimulation"))(
-            "stress", argv[3], NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, environment, fmi3_logger, NULL);
-        const fmi3ValueReference vr = fixed_base_vr;
-        const fmi3Boolean yes = fmi3True;
-        if (instance == NULL ||
-            ((fmi3EnterInitializationModeTYPE*)symbol(library, "fmi3EnterInitializationMode"))(
-                instance, fmi3False, 0.0, clock.start, fmi3False, 0.0) != fmi3OK ||
-            ((fmi3SetBooleanTYPE*)symbol(library, "fmi3SetBoolean"))(instance, &vr, 1, &yes, 1) != fmi3OK ||
-            ((fmi3ExitInitializationModeTYPE*)symbol(library, "fmi3ExitInitializationMode"))(instance) != fmi3OK) {
-            fprintf(stderr, "clock_stress: initialization failed: %s\n", last_message);
-            return 2;
-        }
-    } else {
-        static fmi2CallbackFunctions callbacks = {fmi2_logger, calloc, free, NULL, NULL};
-        instance = ((fmi2InstantiateTYPE*)symbol(library, "fmi2Instantiate"))("stress", fmi2CoSimulation, argv[3], NULL,
-                                                                             &callbacks, fmi2False, fmi2False);
-        const fmi2ValueReference vr = fixed_base_vr;
-        const fmi2Boolean yes = fmi2True;
-        if (instance == NULL ||
-            ((fmi2SetupExperimentTYPE*)symbol(library, "fmi2SetupExperiment"))(instance, fmi2False, 0.0, clock.start,
-                                                                               fmi2False, 0.0) != fmi2OK ||
-            ((fmi2SetBooleanTYPE*)symbol(library, "fmi2SetBoolean"))(instance, &vr, 1, &yes) != fmi2OK ||
-            ((fmi2EnterInitializationModeTYPE*)symbol(library, "fmi2EnterInitializationMode"))(instance) != fmi2OK ||
-            ((fmi2ExitInitializationModeTYPE*)symbol(library, "fmi2ExitInitializationMode"))(instance) != fmi2OK) {
-            fprintf(stderr, "clock_stress: initialization failed: %s\n", last_message);
-            return 2;
-        }
+    void* instance = fmi3 ? instantiate_fmi3(library, argv[3], fixed_base_vr, clock.start)
+                          : instantiate_fmi2(library, argv[3], fixed_base_vr, clock.start);
+    if (instance == NULL) {
+        fprintf(stderr, "clock_stress: initialization failed: %s\n", last_message);
+        return 2;
     }
-    fmi2DoStepTYPE* fmi2_do_step = fmi3 ? NULL : (fmi2DoStepTYPE*)symbol(library, "fmi2DoStep");
-    fmi3DoStepTYPE* fmi3_do_step = fmi3 ? (fmi3DoStepTYPE*)symbol(library, "fmi3DoStep") : NULL;
 
     printf("{\"rss_kib\": [");
-    long taken = 0;
-    double point = clock.start, step = clock.step, reported = clock.start;
-    for (long k = 0; k < steps; ++k) {
-        clock_point(&clock, k, &point, &step);
-        if (fmi3) {
-            fmi3Boolean event, terminate, early;
-            status = fmi3_do_step(instance, point, step, fmi3True, &event, &terminate, &early, &reported);
-        } else {
-            status = fmi2_do_step(instance, point, step, fmi2True);
-        }
-        if (status > 1) break;
-        ++taken;
-        if ((k & ((1L << 20) - 1)) == 0) printf("%s%ld", k == 0 ? "" : ", ", resident_kib("VmRSS:"));
-    }
-    if (!fmi3 && status <= 1)
-        ((fmi2GetRealStatusTYPE*)symbol(library, "fmi2GetRealStatus"))(instance, fmi2LastSuccessfulTime, &reported);
+    const Run run = run_steps(library, instance, fmi3, &clock, steps);
     printf("], \"peak_rss_kib\": %ld, \"steps\": %ld, \"refused\": %s, \"point\": %.17g, \"step\": %.17g, "
            "\"reported_time\": %.17g, \"master_end\": %.17g, \"message\": \"",
-           resident_kib("VmHWM:"), taken, status > 1 ? "true" : "false", point, step, reported, point + step);
-    for (const char* c = last_message; status > 1 && *c; ++c)
+           resident_kib("VmHWM:"), run.taken, run.status > 1 ? "true" : "false", run.point, run.step, run.reported,
+           run.point + run.step);
+    for (const char* c = last_message; run.status > 1 && *c; ++c)
         printf(*c == '"' || *c == '\\' ? "\\%c" : "%c", *c);
     printf("\"}\n");
     if (fmi3)
         ((fmi3FreeInstanceTYPE*)symbol(library, "fmi3FreeInstance"))(instance);
     else
         ((fmi2FreeInstanceTYPE*)symbol(library, "fmi2FreeInstance"))(instance);
-    return status > 1 ? 1 : 0;
+    return run.status > 1 ? 1 : 0;
 }

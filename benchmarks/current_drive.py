@@ -23,6 +23,7 @@ Prints a table and writes benchmarks/results/current_drive.json.
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import pathlib
 import platform
@@ -145,16 +146,29 @@ def main() -> int:
                          "counters": runs[0]["counters"]}
         print(f"{name}: {statistics.median(cpus):.3f} s CPU, {runs[0]['counters']}", flush=True)
 
+    summary = summarize(results, args)
+    print_summary(summary)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "current_drive.json").write_text(json.dumps(summary, indent=1) + "\n")
+    print(f"\nwritten: {out / 'current_drive.json'}")
+    return 0
+
+
+def summarize(results: dict, args) -> dict:
+    """What current_drive.json holds: each variant's CPU time, its ratio to voltage drive, its counters,
+    and the largest differences between the variants' records."""
     def errors(a: str, b: str) -> dict:
         x, y = results[a]["record"], results[b]["record"]
         d = np.abs(x - y).max(axis=0)
-        return {"alpha_rad": d[0], "beta_rad": d[1], "los_omega_rad_s": max(d[2], d[3]), "i_R1_A": d[4],
-                "i_R2_A": d[5]}
+        return {"alpha_rad": float(d[0]), "beta_rad": float(d[1]), "los_omega_rad_s": float(max(d[2], d[3])),
+                "i_R1_A": float(d[4]), "i_R2_A": float(d[5])}
 
     voltage = results["voltage"]["cpu_s"]
     names = list(VARIANTS)
-    summary = {
+    return {
         "scene": "scenes/ship_stabilization.toml (base motion, full fidelity), own PID at 1 kHz",
+        "date": datetime.date.today().isoformat(),
         "simulated_s": args.seconds,
         "repeat": args.repeat,
         "machine": platform.processor() or platform.machine(),
@@ -171,7 +185,9 @@ def main() -> int:
             "quasi-static at rtol 1e-6 against PI at rtol 1e-10": errors(names[2], names[5]),
         },
     }
-    summary["errors"] = {k: {kk: float(vv) for kk, vv in v.items()} for k, v in summary["errors"].items()}
+
+
+def print_summary(summary: dict) -> None:
     print(f"\n{'variant':48s} {'CPU s':>8s} {'ratio':>6s} {'steps':>7s} {'rhs':>8s} {'jac':>6s} {'events':>6s}")
     for name, v in summary["variants"].items():
         c = v["counters"]
@@ -180,11 +196,6 @@ def main() -> int:
     print()
     for name, e in summary["errors"].items():
         print(f"{name}: " + ", ".join(f"{k} {v:.3g}" for k, v in e.items()))
-    out = pathlib.Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "current_drive.json").write_text(json.dumps(summary, indent=1) + "\n")
-    print(f"\nwritten: {out / 'current_drive.json'}")
-    return 0
 
 
 if __name__ == "__main__":

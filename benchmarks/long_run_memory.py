@@ -48,7 +48,7 @@ def scene_with_stop_time(scene: pathlib.Path, stop_time: float, folder: pathlib.
 def measure(scene: pathlib.Path, fmu: str, length: float, folder: pathlib.Path) -> dict:
     out = folder / f"out_{length:g}"
     command = [sys.executable, "-m", "gimbal2axis", "run", str(scene_with_stop_time(scene, length, folder)),
-               "--fmu", fmu, "--out", str(out), "--quiet"]
+               "--fmu", fmu, "--out", str(out)]   # not --quiet: its summary line is recorded
     # run from the temporary folder: `python -m` puts the current directory first on the path, and the
     # repository's root would shadow a PYTHONPATH that points at another version of the package
     child = subprocess.run([sys.executable, "-c", MEASURE, *command], capture_output=True, text=True, check=True,

@@ -15,6 +15,7 @@ Also runs build/benchmarks/gimbal_bench_me (the cost of one evaluation through t
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import pathlib
 import subprocess
@@ -85,7 +86,8 @@ def main() -> int:
         print("one evaluation through the interface:", evaluation)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "model_exchange.json").write_text(json.dumps({"runs": rows, "evaluation": evaluation}, indent=1) + "\n")
+    (out / "model_exchange.json").write_text(json.dumps({"date": datetime.date.today().isoformat(), "runs": rows,
+                                                         "evaluation": evaluation}, indent=1) + "\n")
     print(f"written {out / 'model_exchange.json'}")
     return 0
 

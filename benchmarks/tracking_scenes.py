@@ -19,6 +19,7 @@ Prints a table and writes benchmarks/results/tracking_scenes.json.
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import pathlib
 import platform
@@ -113,7 +114,8 @@ def main() -> int:
               f"los_error {d['los_error_mrad']:.2g} mrad, i_R1 {d['i_R1_A']:.2g} A")
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"machine": platform.processor() or platform.machine(), "repeat": args.repeat,
+    out.write_text(json.dumps({"date": datetime.date.today().isoformat(),
+                               "machine": platform.processor() or platform.machine(), "repeat": args.repeat,
                                "rows": rows}, indent=1) + "\n")
     print(f"wrote {out}")
     return 0

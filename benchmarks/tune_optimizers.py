@@ -151,14 +151,7 @@ def main() -> int:
                         help="the evaluations table (a rerun takes the evaluations it has from it)")
     args = parser.parse_args()
 
-    tuning = load_tuning(ROOT / "tunings" / "ship_pid.toml")
-    tuning.stop_time = args.stop_time
-    tuning.metrics_from_s = min(tuning.metrics_from_s, args.stop_time / 3)
-    tuning.robustness = ScenarioSet(tuning.robustness.sea_states[:1], tuning.robustness.seeds[:2])
-    tuning.holdout = ScenarioSet(tuning.holdout.sea_states, tuning.holdout.seeds[:2])
-    tuning.batch = args.batch
-    # every optimizer from scratch: no start point (pycma, DE and nevergrad start from the box alone too)
-    tuning.parameters = [dataclasses.replace(p, start=None) for p in tuning.parameters]
+    tuning = reduced_tuning(args)
     work = pathlib.Path(args.work)
     problem = engine.plan(ROOT / "scenes" / "ship_stabilization.toml", tuning.path, fmu_path(None), work, tuning=tuning)
     evaluator = engine.Evaluator(problem, engine.TuneOptions(serial=True, progress=False))
@@ -170,6 +163,48 @@ def main() -> int:
         "scipy-de": lambda seed: run_scipy_de(problem, evaluator, seed, args.budget, args.batch),
         "nevergrad": lambda seed: run_nevergrad(problem, evaluator, seed, args.budget, args.batch),
     }
+    histories, skipped, times = run_optimizers(args, runners)
+    overall = min(best_curve(h)[-1] for runs in histories.values() for h in runs)
+    targets = {f"{within:.0%}": overall * (1 + within) for within in WITHIN}
+    summary = {name: summarize(runs, targets, times[name], problem, evaluator) for name, runs in histories.items()}
+    result = {
+        "benchmark": "tune_optimizers", "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+        "problem": {"tuning": "tunings/ship_pid.toml (reduced)", "scene": "scenes/ship_stabilization.toml",
+                    "parameters": tuning.parameter_names, "stop_time_s": tuning.stop_time,
+                    "metrics_from_s": tuning.metrics_from_s, "runs_per_candidate": len(problem.scenarios),
+                    "holdout_runs": len(problem.holdout), "budget": args.budget, "repeats": args.repeats,
+                    "batch": args.batch, "objective": tuning.objective.describe(),
+                    "constraints": {k: v for k, v in vars(tuning.constraints).items() if v not in (None, False)}},
+        "targets_mrad": targets, "best_found_mrad": overall,
+        "optimizers": summary, "skipped": skipped,
+        "versions": _versions(), "machine": f"{platform.machine()}, {platform.python_version()}",
+    }
+    out = pathlib.Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(result, indent=1))
+    print_table(result, args.repeats)
+    print(f"wrote {out}")
+    evaluator.close()
+    problem.fmu.close()
+    return 0
+
+
+def reduced_tuning(args):
+    """tunings/ship_pid.toml made cheaper for the comparison: shorter runs, fewer sea states, no start."""
+    tuning = load_tuning(ROOT / "tunings" / "ship_pid.toml")
+    tuning.stop_time = args.stop_time
+    tuning.metrics_from_s = min(tuning.metrics_from_s, args.stop_time / 3)
+    tuning.robustness = ScenarioSet(tuning.robustness.sea_states[:1], tuning.robustness.seeds[:2])
+    tuning.holdout = ScenarioSet(tuning.holdout.sea_states, tuning.holdout.seeds[:2])
+    tuning.batch = args.batch
+    # every optimizer from scratch: no start point (pycma, DE and nevergrad start from the box alone too)
+    tuning.parameters = [dataclasses.replace(p, start=None) for p in tuning.parameters]
+    return tuning
+
+
+def run_optimizers(args, runners: dict):
+    """Each optimizer of --optimizers, --repeats seeds: its histories and wall times; the skipped ones
+    and why (one that cannot run here is reported, not fatal)."""
     histories, skipped, times = {}, {}, {}
     for name in args.optimizers.split(","):
         if name == "nevergrad":
@@ -194,51 +229,54 @@ def main() -> int:
             print(f"{name} seed {seed}: {len(history)} candidates, best feasible {curve[-1]:.5g} mrad "
                   f"({times[name][-1]:.1f} s)", file=sys.stderr)
     histories = {name: runs for name, runs in histories.items() if runs and name not in skipped}
-    overall = min(best_curve(h)[-1] for runs in histories.values() for h in runs)
-    targets = {f"{within:.0%}": overall * (1 + within) for within in WITHIN}
-    summary = {}
-    for name, runs in histories.items():
-        finals, held = [], []
-        reached = {label: [] for label in targets}
-        for history in runs:
-            curve = best_curve(history)
-            finals.append(curve[-1])
-            for label, target in targets.items():
-                reached[label].append(next((i + 1 for i, v in enumerate(curve) if v <= target), None))
-            feasible = [r for r in history if r.get("feasible")]
-            if feasible and problem.holdout:
-                best = min(feasible, key=lambda r: r["objective_mrad"])
-                candidate = {p: best[p] for p in tuning.parameter_names}
-                held.append(engine.evaluate(problem, evaluator, candidate, problem.holdout, "holdout")["objective_mrad"])
-        summary[name] = {
-            "best_mrad_median": statistics.median(finals), "best_mrad_min": min(finals), "best_mrad_max": max(finals),
-            "evaluations_to_target": reached,
-            "reached": {label: sum(h is not None for h in hits) for label, hits in reached.items()},
-            "evaluations_to_target_median": {label: statistics.median([h for h in hits if h is not None])
-                                             if any(h is not None for h in hits) else None
-                                             for label, hits in reached.items()},
-            "holdout_mrad_median": statistics.median(held) if held else None,
-            "holdout_mrad": held,
-            "feasible_fraction": sum(r.get("feasible", False) for h in runs for r in h) / sum(len(h) for h in runs),
-            "wall_time_s_median": statistics.median(times[name]),
-            "curves": [best_curve(h) for h in runs],
-        }
-    result = {
-        "benchmark": "tune_optimizers", "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-        "problem": {"tuning": "tunings/ship_pid.toml (reduced)", "scene": "scenes/ship_stabilization.toml",
-                    "parameters": tuning.parameter_names, "stop_time_s": tuning.stop_time,
-                    "metrics_from_s": tuning.metrics_from_s, "runs_per_candidate": len(problem.scenarios),
-                    "holdout_runs": len(problem.holdout), "budget": args.budget, "repeats": args.repeats,
-                    "batch": args.batch, "objective": tuning.objective.describe(),
-                    "constraints": {k: v for k, v in vars(tuning.constraints).items() if v not in (None, False)}},
-        "targets_mrad": targets, "best_found_mrad": overall,
-        "optimizers": summary, "skipped": skipped,
-        "versions": _versions(), "machine": f"{platform.machine()}, {platform.python_version()}",
+    return histories, skipped, times
+
+
+def summarize(runs: list, targets: dict, times: list, problem, evaluator) -> dict:
+    """One optimizer's figures over its seeds: best found, evaluations to each target, the held-out
+    objective of its best candidates, the feasible fraction, the wall time, the curves."""
+    curves = [best_curve(history) for history in runs]
+    finals = [curve[-1] for curve in curves]
+    reached = {label: [first_at_or_below(curve, target) for curve in curves] for label, target in targets.items()}
+    held = held_out(runs, problem, evaluator)
+    return {
+        "best_mrad_median": statistics.median(finals), "best_mrad_min": min(finals), "best_mrad_max": max(finals),
+        "evaluations_to_target": reached,
+        "reached": {label: sum(h is not None for h in hits) for label, hits in reached.items()},
+        "evaluations_to_target_median": {label: median_of_found(hits) for label, hits in reached.items()},
+        "holdout_mrad_median": statistics.median(held) if held else None,
+        "holdout_mrad": held,
+        "feasible_fraction": sum(r.get("feasible", False) for h in runs for r in h) / sum(len(h) for h in runs),
+        "wall_time_s_median": statistics.median(times),
+        "curves": curves,
     }
-    out = pathlib.Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(result, indent=1))
-    print(f"best found by any run: {overall:.5g} mrad; targets: " +
+
+
+def first_at_or_below(curve: list, target: float):
+    """The evaluations a best-so-far curve took to reach `target`, None if it did not."""
+    return next((i + 1 for i, v in enumerate(curve) if v <= target), None)
+
+
+def median_of_found(hits: list):
+    found = [h for h in hits if h is not None]
+    return statistics.median(found) if found else None
+
+
+def held_out(runs: list, problem, evaluator) -> list:
+    """The held-out objective of each run's best feasible candidate."""
+    held = []
+    for history in runs:
+        feasible = [r for r in history if r.get("feasible")]
+        if feasible and problem.holdout:
+            best = min(feasible, key=lambda r: r["objective_mrad"])
+            candidate = {p: best[p] for p in problem.tuning.parameter_names}
+            held.append(engine.evaluate(problem, evaluator, candidate, problem.holdout, "holdout")["objective_mrad"])
+    return held
+
+
+def print_table(result: dict, repeats: int) -> None:
+    targets, summary = result["targets_mrad"], result["optimizers"]
+    print(f"best found by any run: {result['best_found_mrad']:.5g} mrad; targets: " +
           ", ".join(f"+{label} = {t:.5g} mrad" for label, t in targets.items()))
     print(f"{'optimizer':<15} {'best median [min, max] mrad':<34}" + "".join(f"{'+' + label + ': n, evals':<16}"
                                                                              for label in targets)
@@ -247,16 +285,12 @@ def main() -> int:
         cells = ""
         for label in targets:
             median = s["evaluations_to_target_median"][label]
-            cells += f"{s['reached'][label]}/{args.repeats}, {'-' if median is None else f'{median:g}'}".ljust(16)
+            cells += f"{s['reached'][label]}/{repeats}, {'-' if median is None else f'{median:g}'}".ljust(16)
         held = "-" if s["holdout_mrad_median"] is None else f"{s['holdout_mrad_median']:.5g}"
         print(f"{name:<15} " + f"{s['best_mrad_median']:.5g} [{s['best_mrad_min']:.5g}, {s['best_mrad_max']:.5g}]".ljust(34)
               + cells + f"{held:<16} {s['feasible_fraction']:.2f}")
-    for name, why in skipped.items():
+    for name, why in result["skipped"].items():
         print(f"{name}: skipped, {why}")
-    print(f"wrote {out}")
-    evaluator.close()
-    problem.fmu.close()
-    return 0
 
 
 def _versions() -> dict:

@@ -59,18 +59,41 @@ def main() -> int:
     parser.add_argument("--figures", default=str(ROOT / "docs" / "figures" / "tuning"))
     args = parser.parse_args()
 
-    from gimbal2axis.scene.scene import load_scene
     from gimbal2axis.tune import engine
-    from gimbal2axis.tune.report import write_report
 
     out = pathlib.Path(args.out)
     grid, grid_figures = grid_best(out / "grid", args.workers)
-    scene = load_scene(SCENE)
-    grid_candidate = dict(grid)
-    for key in ("kp", "ki", "k_gyro"):
-        grid_candidate[f"controller.elevation.{key}"] = float(scene.controller_spec["elevation"][key])
+    grid_candidate = with_scene_elevation(grid)
     print(f"grid best (azimuth, of {grid_figures['cases']} cases): {engine.describe_candidate(grid)}; median LOS RMS "
           f"over its sea states {grid_figures['median_los_rms_mrad_of_best_point']:.5g} mrad (0.5-s runs)")
+    problem, result, report, walls = tune(args, out, grid_candidate)
+    summary = json.loads((out / f"{problem.evaluations.parquet.stem}_summary.json").read_text())
+    copy_figures(out, problem.evaluations.parquet.stem, pathlib.Path(args.figures))
+    results = record(args, problem, result, summary, report, walls, (grid_candidate, grid_figures))
+    path = pathlib.Path(args.results)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(results, indent=1))
+    print_summary(results, summary["best"], args.workers, len(problem.holdout))
+    print(f"wrote {path} and {report}")
+    return 0
+
+
+def with_scene_elevation(grid: dict) -> dict:
+    """The grid's best azimuth gains with the scene's own elevation gains: a whole candidate."""
+    from gimbal2axis.scene.scene import load_scene
+
+    scene = load_scene(SCENE)
+    candidate = dict(grid)
+    for key in ("kp", "ki", "k_gyro"):
+        candidate[f"controller.elevation.{key}"] = float(scene.controller_spec["elevation"][key])
+    return candidate
+
+
+def tune(args, out: pathlib.Path, grid_candidate: dict):
+    """The tuning run and its report (which compares the grid's best): the problem, the result, the
+    report's path, and the wall times of both."""
+    from gimbal2axis.tune import engine
+    from gimbal2axis.tune.report import write_report
 
     options = engine.TuneOptions(workers=args.workers, progress=False, trials=args.trials)
     problem = engine.plan(SCENE, TUNING, fmu_path(None), out)
@@ -85,17 +108,23 @@ def main() -> int:
     finally:
         evaluator.close()
         problem.fmu.close()
-    summary = json.loads((out / f"{problem.evaluations.parquet.stem}_summary.json").read_text())
-    best = summary["best"]
-    names = problem.tuning.parameter_names
-    held = summary["holdout"]
-    figures = pathlib.Path(args.figures)
+    return problem, result, report, (tuning_wall, report_wall)
+
+
+def copy_figures(out: pathlib.Path, stem: str, figures: pathlib.Path) -> None:
+    """The report's figures that docs/tuning.md shows, copied to docs/figures/tuning/."""
     figures.mkdir(parents=True, exist_ok=True)
     for suffix in ("convergence", "time_psd", "loops"):
-        source = out / f"{problem.evaluations.parquet.stem}_{suffix}.png"
+        source = out / f"{stem}_{suffix}.png"
         if source.is_file():
             shutil.copyfile(source, figures / f"ship_pid_{suffix}.png")
-    results = {
+
+
+def record(args, problem, result, summary: dict, report: pathlib.Path, walls: tuple, grid: tuple) -> dict:
+    """What tune_ship.json holds; `grid`: the grid's best candidate and the sweep's figures."""
+    best, held = summary["best"], summary["holdout"]
+    tuning_wall, report_wall = walls
+    return {
         "benchmark": "tune_ship", "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "machine": f"{platform.machine()}, {platform.python_version()}, workers {args.workers} (2 cores shared)",
         "tuning": {"file": "tunings/ship_pid.toml", "sampler": problem.tuning.sampler, "seed": problem.tuning.seed,
@@ -103,12 +132,12 @@ def main() -> int:
                    "evaluations_run": result.evaluations_run, "evaluations_reused": result.evaluations_reused,
                    "wall_time_s": tuning_wall, "report_and_holdout_wall_time_s": report_wall,
                    "feasible_candidates": sum(bool(r["feasible"]) for r in result.trials)},
-        "tuned": {n: best[n] for n in names},
+        "tuned": {n: best[n] for n in problem.tuning.parameter_names},
         "tuned_trial": best["trial"], "tuned_objective_mrad": best["objective_mrad"],
         "tuned_margins": {k: best.get(k) for k in ("gm_az_db", "pm_az_deg", "gm_el_db", "pm_el_deg", "ms_az", "ms_el")},
         "tuned_worst_i_peak_A": best["worst_i_peak_A"],
         "scene_own": summary["candidates"].get("scene's own"),
-        "grid_best": grid_candidate, "grid": grid_figures,
+        "grid_best": grid[0], "grid": grid[1],
         "holdout_runs": len(problem.holdout),
         "holdout_los_rms_mrad": {label: h["objective_mrad"] for label, h in held.items()},
         "holdout_per_run_mrad": {label: h["per_run_mrad"] for label, h in held.items()},
@@ -118,20 +147,20 @@ def main() -> int:
         "nominal_los_rms_mrad": summary["nominal_los_rms_mrad"], "report": str(report.relative_to(ROOT))
         if report.is_relative_to(ROOT) else str(report),
     }
-    path = pathlib.Path(args.results)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(results, indent=1))
+
+
+def print_summary(results: dict, best: dict, workers: int, holdout_runs: int) -> None:
+    from gimbal2axis.tune import engine
+
     t = results["tuning"]
     print(f"tuning: {t['candidates']} candidates x {t['runs_per_candidate']} runs: {t['evaluations_run']} evaluations "
-          f"run, {t['evaluations_reused']} from the table, {t['wall_time_s']:.1f} s wall on {args.workers} workers "
-          f"(report and held-out check {report_wall:.1f} s); {t['feasible_candidates']} feasible")
+          f"run, {t['evaluations_reused']} from the table, {t['wall_time_s']:.1f} s wall on {workers} workers "
+          f"(report and held-out check {t['report_and_holdout_wall_time_s']:.1f} s); {t['feasible_candidates']} feasible")
     print(f"tuned (trial {best['trial']}): {engine.describe_candidate(results['tuned'])}; objective "
           f"{best['objective_mrad']:.5g} mrad; peak current {best['worst_i_peak_A']:.3g} A; margins az "
           f"{best['gm_az_db']:.3g} dB / {best['pm_az_deg']:.3g} deg, el {best['gm_el_db']:.3g} dB / {best['pm_el_deg']:.3g} deg")
-    print(f"held out ({len(problem.holdout)} runs), mean LOS RMS: " + ", ".join(
+    print(f"held out ({holdout_runs} runs), mean LOS RMS: " + ", ".join(
         f"{label} {value:.5g} mrad" for label, value in results["holdout_los_rms_mrad"].items()))
-    print(f"wrote {path} and {report}")
-    return 0
 
 
 if __name__ == "__main__":

@@ -22,7 +22,9 @@ disturb it. Steps:
 6. the stiff variants (L = 1e-7 H, k_s = 1e8 N.m/rad, c_s = 1e-6 N.m.s/rad) at default settings,
    against CVODE BDF at rtol 1e-11 and at its own defaults;
 7. single doSteps of the default and of the real-time method (1, 2, 4 substeps): median, p99, p99.9
-   and maximum in wall time and in right-hand sides.
+   and maximum in wall time and in right-hand sides;
+8. the core's pieces without FMI or an integrator (build/benchmarks/gimbal_bench_core): a right-hand
+   side, an event check, a Jacobian, the outputs.
 
 Writes benchmarks/results/results.json and benchmarks/results/work_precision.png, prints a summary.
 """
@@ -108,33 +110,14 @@ class Driver:
                 self.default_method = int(block.split('start="', 1)[1].split('"', 1)[0])
         self.count = 0
 
-    def run(self, *, method=None, fidelity="full", rtol=None, atol=None, duration=10.0, step=1e-3,
-            trajectory=False, overhead=False, overhead_steps=None, trace=False, timeout=None,
-            parameters=None, time_dostep=False) -> dict:
-        cmd = [str(self.bench), "--fmu", str(self.so), "--json", "--fidelity", fidelity]
-        if time_dostep:
-            cmd.append("--time-dostep")
-        for name, value in (parameters or {}).items():
-            cmd += ["--set", f"{name}={value!r}"]
-        if not trace:
-            cmd.append("--no-trace")
-        if method is not None:
-            cmd += ["--method", str(method)]
-        if rtol is not None:
-            cmd += ["--rtol", repr(rtol)]
-        if atol is not None:
-            cmd += ["--atol", repr(atol)]
+    def run(self, *, timeout=None, trajectory=False, overhead=False, **settings) -> dict:
+        """One gimbal_bench run with `settings` (command's keywords); its JSON, with the trajectory as
+        `_trajectory` when asked for, or {"failure": ...}."""
         traj_path = None
-        if overhead:
-            cmd.append("--fmi-overhead")
-            if overhead_steps:
-                cmd += ["--overhead-steps", str(overhead_steps)]
-        else:
-            cmd += ["--duration", repr(duration), "--step", repr(step)]
-            if trajectory:
-                self.count += 1
-                traj_path = self.workdir / f"traj{self.count}.bin"
-                cmd += ["--trajectory", str(traj_path)]
+        if trajectory and not overhead:
+            self.count += 1
+            traj_path = self.workdir / f"traj{self.count}.bin"
+        cmd = self.command(overhead=overhead, trajectory=traj_path, **settings)
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout or self.timeout)
         except subprocess.TimeoutExpired:
@@ -151,6 +134,25 @@ class Driver:
             traj_path.unlink()
         return result
 
+    def command(self, *, method=None, fidelity="full", rtol=None, atol=None, duration=10.0, step=1e-3,
+                trajectory=None, overhead=False, overhead_steps=None, trace=False, parameters=None,
+                time_dostep=False) -> list[str]:
+        """gimbal_bench's command line: options only for what is given."""
+        cmd = [str(self.bench), "--fmu", str(self.so), "--json", "--fidelity", fidelity]
+        flags = {"--time-dostep": time_dostep, "--no-trace": not trace, "--fmi-overhead": overhead}
+        cmd += [flag for flag, wanted in flags.items() if wanted]
+        for name, value in (parameters or {}).items():
+            cmd += ["--set", f"{name}={value!r}"]
+        options = {"--method": method, "--rtol": rtol, "--atol": atol}
+        if overhead:
+            options["--overhead-steps"] = overhead_steps or None
+        else:
+            options.update({"--duration": duration, "--step": step, "--trajectory": trajectory})
+        for option, value in options.items():
+            if value is not None:
+                cmd += [option, str(value) if isinstance(value, (int, pathlib.Path)) else repr(value)]
+        return cmd
+
 
 def errors_against(run: dict, reference: np.ndarray, horizon: float | None = None) -> dict:
     """Max absolute errors at the communication points: alpha, beta [rad], los.omega [rad/s]; with a
@@ -166,7 +168,7 @@ def errors_against(run: dict, reference: np.ndarray, horizon: float | None = Non
     return errors
 
 
-def machine_info() -> dict:
+def machine_info(build_dir: pathlib.Path) -> dict:
     cpu = "?"
     try:
         for line in open("/proc/cpuinfo"):
@@ -176,7 +178,7 @@ def machine_info() -> dict:
     except OSError:
         pass
     compiler = "?"
-    cache = REPO / "build" / "CMakeCache.txt"
+    cache = build_dir / "CMakeCache.txt"
     try:
         cxx = "c++"
         for line in cache.read_text().splitlines():
@@ -255,7 +257,7 @@ def main(argv=None) -> int:
     t_start = time.time()
     rtols = [float(x) for x in args.rtols.split(",")]
     fidelities = [f for f in args.fidelities.split(",") if f]
-    results: dict = {"machine": machine_info(), "settings": {
+    results: dict = {"machine": machine_info(args.build_dir), "settings": {
         "scene": "ship_stabilization (benchmarks/bench_driver.cpp: sea state seed 1, PD + gyro, one-step delay)",
         "duration_s": args.duration, "step_s": args.step, "rtols": rtols, "atol_factor": args.atol_factor,
         "reference": "rtol 1e-12, atol 1e-14", "error": "max abs over communication points"}}
@@ -278,6 +280,7 @@ def main(argv=None) -> int:
         results["allocations_in_dostep"] = allocations_in_dostep(drv, fidelities, args.step)
         results["stiff_cases"] = stiff_cases(drv, args.stiff_duration, args.step, args.run_timeout)
         results["single_dosteps"] = single_dosteps(drv, args.duration, args.step)
+    results["core_costs"] = core_costs(args.build_dir.resolve() / "benchmarks" / "gimbal_bench_core", fidelities)
 
     results["elapsed_s"] = round(time.time() - t_start, 1)
     write_results(results, args.out, methods, fidelities, args.duration)
@@ -362,33 +365,44 @@ def work_precision_sweep(drv: Driver, methods, fidelities, rtols, args, referenc
             settings = ([(None, None, n) for n in REAL_TIME_SUBSTEPS] if m == REAL_TIME else
                         [(rtol, rtol * args.atol_factor, None) for rtol in rtols])
             for rtol, atol, substeps in settings:
-                parameters = {"solver.substeps": substeps} if substeps else None
-                run = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
-                              step=args.step, trajectory=True, parameters=parameters)
-                # Cheap runs are noisy: keep the fastest of up to three.
-                if not run.get("failure") and run["cpu_s"] < 0.5:
-                    for _ in range(2):
-                        again = drv.run(method=m, fidelity=fid, rtol=rtol, atol=atol, duration=args.duration,
-                                        step=args.step, parameters=parameters)
-                        if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
-                            for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
-                                run[key] = again[key]
-                if not run.get("failure"):
-                    fmu_cpu = run["cpu_s"] - (run.get("master_cpu_s") or 0.0)
-                    run["fmu_cpu_s"] = fmu_cpu
-                    run["fmu_rtf"] = run["simulated"] / fmu_cpu if fmu_cpu > 0 else None
-                point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol, "substeps": substeps,
-                         **errors_against(run, references[fid]), **strip(run)}
+                point = sweep_point(drv, fid, m, rtol, atol, substeps, args, references[fid])
                 sweep.append(point)
-                log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} {setting_label(point):>7s}: "
-                    + (f"FAILED {run['failure']}" if run.get("failure") else
-                       f"cpu {run['cpu_s']:.3f} s  rtf {run['rtf']:9.1f}  err beta {fmt(point['err_beta'])}  "
-                       f"alpha {fmt(point['err_alpha'])}  omega {fmt(point['err_omega'])}  "
-                       f"steps {run['solver_steps']}  rhs {run['rhs_evaluations']}  jac {run['jacobian_evaluations']}"))
-                if run.get("failure", "").startswith("timeout"):
+                if point.get("failure", "").startswith("timeout"):
                     log("  (tighter tolerances of this method skipped)")
                     break
     return sweep
+
+
+def sweep_point(drv: Driver, fid: str, m, rtol, atol, substeps, args, reference) -> dict:
+    """One point of the sweep: the fastest of up to three runs (cheap runs are noisy), its errors."""
+    parameters = {"solver.substeps": substeps} if substeps else None
+    settings = {"method": m, "fidelity": fid, "rtol": rtol, "atol": atol, "duration": args.duration,
+                "step": args.step, "parameters": parameters}
+    run = drv.run(trajectory=True, **settings)
+    keep_fastest(drv, run, settings, repeats=2)
+    if not run.get("failure"):
+        fmu_cpu = run["cpu_s"] - (run.get("master_cpu_s") or 0.0)
+        run["fmu_cpu_s"] = fmu_cpu
+        run["fmu_rtf"] = run["simulated"] / fmu_cpu if fmu_cpu > 0 else None
+    point = {"fidelity": fid, "method": m, "rtol": rtol, "atol": atol, "substeps": substeps,
+             **errors_against(run, reference), **strip(run)}
+    log(f"[sweep] {fid:7s} method {fmt(m, '')!s:4s} {setting_label(point):>7s}: "
+        + (f"FAILED {run['failure']}" if run.get("failure") else
+           f"cpu {run['cpu_s']:.3f} s  rtf {run['rtf']:9.1f}  err beta {fmt(point['err_beta'])}  "
+           f"alpha {fmt(point['err_alpha'])}  omega {fmt(point['err_omega'])}  "
+           f"steps {run['solver_steps']}  rhs {run['rhs_evaluations']}  jac {run['jacobian_evaluations']}"))
+    return point
+
+
+def keep_fastest(drv: Driver, run: dict, settings: dict, repeats: int) -> None:
+    """A run under 0.5 s of CPU is repeated up to `repeats` times; `run` takes the fastest's times."""
+    if run.get("failure") or run["cpu_s"] >= 0.5:
+        return
+    for _ in range(repeats):
+        again = drv.run(**settings)
+        if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
+            for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
+                run[key] = again[key]
 
 
 def setting_label(point: dict) -> str:
@@ -476,6 +490,21 @@ def allocations_in_dostep(drv: Driver, fidelities, step: float) -> dict:
     return alloc
 
 
+def core_costs(core_bench: pathlib.Path, fidelities) -> dict:
+    """Step 8: the core's pieces without FMI or an integrator (gimbal_bench_core): ns per right-hand
+    side, event check, Jacobian and outputs, per fidelity; {} when the driver was not built."""
+    if not core_bench.exists():
+        log(f"[core] {core_bench} is missing: the core's costs are not measured")
+        return {}
+    costs = {}
+    for fid in fidelities:
+        done = subprocess.run([str(core_bench), "--json", "--fidelity", fid], capture_output=True, text=True)
+        lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
+        costs[fid] = json.loads(lines[-1]) if lines else {"failure": done.stderr.strip()[-500:]}
+        log(f"[core] {fid}: " + ", ".join(f"{k} {v}" for k, v in costs[fid].items()))
+    return costs
+
+
 def write_results(results: dict, out: pathlib.Path, methods, fidelities, duration: float) -> None:
     """OUT/results.json and OUT/work_precision.png; the tables on stdout."""
     out.mkdir(parents=True, exist_ok=True)
@@ -527,12 +556,9 @@ def stiff_cases(drv: Driver, duration: float, step: float, timeout: float) -> li
         if not second.get("failure"):
             case["reference_spread"] = errors_against(second, ref["_trajectory"], SHORT_HORIZON)
         for label, method in (("default", None), ("cvode_default", 0)):
-            run = drv.run(method=method, duration=duration, step=step, trajectory=True, parameters=parameters)
-            if not run.get("failure") and run["cpu_s"] < 0.5:
-                again = drv.run(method=method, duration=duration, step=step, parameters=parameters)
-                if not again.get("failure") and again["cpu_s"] < run["cpu_s"]:
-                    for key in ("cpu_s", "wall_s", "rtf", "cpu_us_per_step", "master_cpu_s"):
-                        run[key] = again[key]
+            settings = {"method": method, "duration": duration, "step": step, "parameters": parameters}
+            run = drv.run(trajectory=True, **settings)
+            keep_fastest(drv, run, settings, repeats=1)
             case[label] = {**errors_against(run, ref["_trajectory"], SHORT_HORIZON), **strip(run)}
             if not run.get("failure") and run.get("events"):
                 # Where impacts set the cost: the work per mode change (nearly all are backlash impacts).
@@ -546,42 +572,25 @@ def stiff_cases(drv: Driver, duration: float, step: float, timeout: float) -> li
     return cases
 
 
+PLOT_COLORS = {None: "k", 0: "tab:blue", 1: "tab:orange", 2: "tab:green", 3: "tab:red", 4: "k", 5: "tab:purple",
+               6: "tab:brown", REAL_TIME: "tab:cyan"}
+PLOT_STYLES = {"full": ("-", "o"), "reduced": ("--", "s")}
+
+
 def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    colors = {None: "k", 0: "tab:blue", 1: "tab:orange", 2: "tab:green", 3: "tab:red", 4: "k", 5: "tab:purple",
-              6: "tab:brown", REAL_TIME: "tab:cyan"}
-    styles = {"full": ("-", "o"), "reduced": ("--", "s")}
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.8), sharey=True)
     for ax, key, label in ((axes[0], "err_beta", "max error of beta [rad]"),
                            (axes[1], "err_omega", "max error of los.omega [rad/s]")):
         for fid in fidelities:
             for m in methods:
-                pts = [p for p in results["sweep"] if p["fidelity"] == fid and p["method"] == m
-                       and p.get(key) is not None and not p.get("failure")]
-                if not pts:
-                    continue
-                x = [max(p[key], 1e-16) for p in pts]
-                y = [1e3 * p["cpu_s"] / p["simulated"] for p in pts]
-                ls, mk = styles.get(fid, ("-", "o"))
-                ax.loglog(x, y, ls=ls, marker=mk, color=colors.get(m, "gray"), ms=4,
-                          label=f"{METHOD_NAMES.get(m, m)}, {fid}")
-                for p, xi, yi in zip(pts, x, y):
-                    ax.annotate(setting_label(p), (xi, yi), fontsize=6, alpha=0.6,
-                                xytext=(2, 2), textcoords="offset points")
+                plot_method(ax, results["sweep"], key, fid, m)
         ax.set_xlabel(label)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].axvline(TARGET_BETA_ERROR, color="gray", lw=0.8, ls=":")
-    for fid, rtf in TARGET_RTF.items():
-        if fid in fidelities:
-            for ax in axes:
-                ax.axhline(1e3 / rtf, color="gray", lw=0.8, ls=styles[fid][0])
-                ax.text(0.01, 1e3 / rtf * 1.08, f"target {fid}: {rtf:.0f}x real time", fontsize=7, color="gray",
-                        transform=ax.get_yaxis_transform())
-    axes[0].text(TARGET_BETA_ERROR * 0.9, 0.5, "beta bound 1e-6 rad", rotation=90, fontsize=7, color="gray",
-                 ha="right", transform=axes[0].get_xaxis_transform())
+    plot_targets(axes, fidelities)
     axes[0].set_ylabel("CPU time per simulated ms [us]  (1000 / real-time factor)")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=4, frameon=False)
@@ -594,25 +603,70 @@ def plot(results: dict, path: pathlib.Path, methods, fidelities, duration: float
     plt.close(fig)
 
 
+def plot_method(ax, sweep: list, key: str, fid: str, m) -> None:
+    """One method's curve at one fidelity: CPU per simulated ms against the error `key`, labelled."""
+    pts = [p for p in sweep if p["fidelity"] == fid and p["method"] == m and p.get(key) is not None
+           and not p.get("failure")]
+    if not pts:
+        return
+    x = [max(p[key], 1e-16) for p in pts]
+    y = [1e3 * p["cpu_s"] / p["simulated"] for p in pts]
+    ls, mk = PLOT_STYLES.get(fid, ("-", "o"))
+    ax.loglog(x, y, ls=ls, marker=mk, color=PLOT_COLORS.get(m, "gray"), ms=4, label=f"{METHOD_NAMES.get(m, m)}, {fid}")
+    for p, xi, yi in zip(pts, x, y):
+        ax.annotate(setting_label(p), (xi, yi), fontsize=6, alpha=0.6, xytext=(2, 2), textcoords="offset points")
+
+
+def plot_targets(axes, fidelities) -> None:
+    """The real-time targets as horizontal lines, the beta bound as a vertical one."""
+    axes[0].axvline(TARGET_BETA_ERROR, color="gray", lw=0.8, ls=":")
+    for fid, rtf in TARGET_RTF.items():
+        if fid in fidelities:
+            for ax in axes:
+                ax.axhline(1e3 / rtf, color="gray", lw=0.8, ls=PLOT_STYLES[fid][0])
+                ax.text(0.01, 1e3 / rtf * 1.08, f"target {fid}: {rtf:.0f}x real time", fontsize=7, color="gray",
+                        transform=ax.get_yaxis_transform())
+    axes[0].text(TARGET_BETA_ERROR * 0.9, 0.5, "beta bound 1e-6 rad", rotation=90, fontsize=7, color="gray",
+                 ha="right", transform=axes[0].get_xaxis_transform())
+
+
 def summary(results: dict, methods, fidelities, duration: float) -> None:
+    """The tables on stdout, one function per step."""
+    for section in (summary_sweep, summary_at_target, summary_durations, summary_overhead, summary_allocations,
+                    summary_stiff, summary_single_dosteps, summary_core):
+        section(results, duration)
+
+
+def method_name(m) -> str:
+    return str(METHOD_NAMES.get(m, m))
+
+
+def summary_sweep(results: dict, duration: float) -> None:
     log("\n=== work precision (ship stabilization, %g s, 1 kHz; errors vs rtol 1e-12 reference) ===" % duration)
     log(f"{'fidelity':8s} {'method':38s} {'rtol':>7s} {'cpu [s]':>9s} {'RTF':>10s} {'err beta':>9s} "
         f"{'err alpha':>9s} {'err omega':>9s} {'steps':>8s} {'rhs':>9s} {'jac':>7s} {'events':>6s}")
     for p in results["sweep"]:
+        head = f"{p['fidelity']:8s} {method_name(p['method']):38s} {setting_label(p):>7s}"
         if p.get("failure"):
-            log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {setting_label(p):>7s}  FAILED: {p['failure'][:60]}")
+            log(f"{head}  FAILED: {p['failure'][:60]}")
             continue
-        log(f"{p['fidelity']:8s} {METHOD_NAMES.get(p['method'], p['method'])!s:38s} {setting_label(p):>7s} {p['cpu_s']:9.3f} "
-            f"{p['rtf']:10.1f} {fmt(p['err_beta']):>9s} {fmt(p['err_alpha']):>9s} {fmt(p['err_omega']):>9s} "
-            f"{p['solver_steps']:8d} {p['rhs_evaluations']:9d} {p['jacobian_evaluations']:7d} {p['events']:6d}")
+        log(f"{head} {p['cpu_s']:9.3f} {p['rtf']:10.1f} {fmt(p['err_beta']):>9s} {fmt(p['err_alpha']):>9s} "
+            f"{fmt(p['err_omega']):>9s} {p['solver_steps']:8d} {p['rhs_evaluations']:9d} {p['jacobian_evaluations']:7d} "
+            f"{p['events']:6d}")
+
+
+def summary_at_target(results: dict, duration: float) -> None:
     log(f"\n=== at max beta error <= {TARGET_BETA_ERROR:g} rad (cheapest tolerance of the sweep) ===")
     log(f"{'fidelity':8s} {'method':38s} {'rtol':>7s} {'us/step':>8s} {'RTF':>9s} {'RTF FMU':>9s} {'target':>7s}  met")
     for b in results["at_target_error"]:
-        log(f"{b['fidelity']:8s} {METHOD_NAMES.get(b['method'], b['method'])!s:38s} {fmt(b['rtol'], '.0e'):>7s} "
+        log(f"{b['fidelity']:8s} {method_name(b['method']):38s} {fmt(b['rtol'], '.0e'):>7s} "
             f"{fmt(b.get('cpu_us_per_step'), '.2f'):>8s} {fmt(b['rtf'], '.1f'):>9s} {fmt(b.get('fmu_rtf'), '.1f'):>9s} "
             f"{fmt(b['target_rtf'], '.0f'):>7s}  {'yes' if b['meets_target'] else 'NO'}"
             + (f"  (substeps {b['substeps']})" if b.get("substeps") else ""))
     log("(RTF = simulated / CPU time of the whole master loop; RTF FMU leaves out the master's own share)")
+
+
+def summary_durations(results: dict, duration: float) -> None:
     log("\n=== cost against simulated time (FMU default integrator, full fidelity) ===")
     for g in results["cost_vs_duration"]["runs"]:
         if g.get("failure"):
@@ -620,6 +674,9 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
         else:
             log(f"{g['simulated_s']:8g} s  cpu {g['cpu_s']:9.3f} s  {g['cpu_us_per_simulated_ms']:8.2f} us/ms  "
                 f"RTF {g['rtf']:9.1f}  steps {g['solver_steps']}")
+
+
+def summary_overhead(results: dict, duration: float) -> None:
     log(f"\n=== FMI overhead (model at rest, fixed base, 1 us steps; target < {TARGET_OVERHEAD_NS:.0f} ns) ===")
     for fid, o in results["fmi_overhead"].items():
         if o.get("failure"):
@@ -627,17 +684,21 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
         else:
             log(f"{fid:8s} {o['ns_per_dostep']:8.0f} ns per doStep; instance {o['instance_bytes']} bytes; "
                 f"{o['dostep_allocations']} allocations in {o['dostep_calls']} doSteps")
+
+
+def summary_allocations(results: dict, duration: float) -> None:
     log("\n=== heap allocations in doStep after the first (ship stabilization 2 s) ===")
     for fid, a in results["allocations_in_dostep"].items():
         log(f"{fid:8s} {a['dostep_allocations']} allocations ({a['dostep_alloc_bytes']} bytes) in {a['dostep_calls']} doSteps")
         for site in (a.get("allocation_sites") or [])[:6]:
-            lines = [l for l in re.split(r"\n|\s{4,}(?=#\d)", site) if l.strip()]
+            lines = [line for line in re.split(r"\n|\s{4,}(?=#\d)", site) if line.strip()]
             # The first frames that are neither the allocator nor the C++ library say who allocates.
-            own = [l.strip().split(" ", 2)[-1] for l in lines[1:]
-                   if not any(x in l for x in ("operator new", "std::", " N_VNew", " N_VClone", "malloc"))]
+            own = [line.strip().split(" ", 2)[-1] for line in lines[1:]
+                   if not any(x in line for x in ("operator new", "std::", " N_VNew", " N_VClone", "malloc"))]
             log("    " + lines[0] + " " + " <- ".join(own[:3]))
 
 
+def summary_stiff(results: dict, duration: float) -> None:
     log(f"\n=== stiff variants at default settings (target >= {TARGET_STIFF_RTF:.0f}x real time, no discard) ===")
     for c in results.get("stiff_cases", []):
         if c.get("failure"):
@@ -648,13 +709,19 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
             log(f"{c['case']:22s} {'references':13s} CVODE BDF rtol 1e-10 against 1e-11: beta {fmt(spread['err_beta'])}"
                 f" (first {SHORT_HORIZON:g} s: {fmt(spread['err_beta_short'])})")
         for label in ("default", "cvode_default"):
-            r = c[label]
-            log(f"{c['case']:22s} {label:13s} " + (f"FAILED {r['failure'][:60]}" if r.get("failure") else
-                f"RTF {r['rtf']:8.1f}  {r['cpu_us_per_step']:8.1f} us/step  err beta {fmt(r['err_beta'])} "
-                f"(first {SHORT_HORIZON:g} s: {fmt(r.get('err_beta_short'))})  alpha {fmt(r['err_alpha'])}  omega "
-                f"{fmt(r['err_omega'])}  mode changes {r.get('events')}: {r.get('steps_per_event', 0):.1f} steps, "
-                f"{r.get('us_per_event', 0):.1f} us each"))
+            log(f"{c['case']:22s} {label:13s} " + stiff_line(c[label]))
 
+
+def stiff_line(r: dict) -> str:
+    if r.get("failure"):
+        return f"FAILED {r['failure'][:60]}"
+    return (f"RTF {r['rtf']:8.1f}  {r['cpu_us_per_step']:8.1f} us/step  err beta {fmt(r['err_beta'])} "
+            f"(first {SHORT_HORIZON:g} s: {fmt(r.get('err_beta_short'))})  alpha {fmt(r['err_alpha'])}  omega "
+            f"{fmt(r['err_omega'])}  mode changes {r.get('events')}: {r.get('steps_per_event', 0):.1f} steps, "
+            f"{r.get('us_per_event', 0):.1f} us each")
+
+
+def summary_single_dosteps(results: dict, duration: float) -> None:
     log("\n=== single doSteps (wall and thread CPU time include the machine's interrupts; right-hand sides "
         "are the work) ===")
     log(f"{'':26s} {'median':>8s} {'p99':>8s} {'p99.9':>8s} {'max':>8s}  [us wall]   {'median':>7s} {'p99.9':>7s} "
@@ -670,6 +737,15 @@ def summary(results: dict, methods, fidelities, duration: float) -> None:
             + " ".join(f"{c:7.2f}" for c in cpu) + "            "
             + " ".join(f"{w:6.0f}" for w in work)
             + f"                      {wall[3] / wall[0]:.1f} / {cpu[2] / cpu[0]:.1f} / {work[2] / work[0]:.1f}")
+
+
+def summary_core(results: dict, duration: float) -> None:
+    log("\n=== the core without FMI or an integrator (gimbal_bench_core; targets: RHS <= 150 ns, event check "
+        "<= 50 ns) ===")
+    for fid, c in results.get("core_costs", {}).items():
+        log(f"{fid:8s} " + (f"FAILED {c['failure']}" if c.get("failure") else
+                            f"RHS {c['rhs_ns']:.0f} ns, event check {c['event_check_ns']:.0f} ns, Jacobian "
+                            f"{c['jacobian_ns']:.0f} ns, outputs {c['outputs_ns']:.0f} ns"))
 
 
 if __name__ == "__main__":
