@@ -38,26 +38,26 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
     GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
     "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider "${parallel[@]}" \
-    --deselect tests/test_reference_solution.py \
-    --ignore tests/test_report.py --ignore tests/test_readme_commands.py --ignore tests/test_example_notebook.py \
-    --ignore tests/test_rigid_body_symbolic.py --ignore tests/test_scene_input_checks.py \
-    --ignore tests/test_gyro_model.py --ignore tests/test_target_geometry.py \
-    --ignore tests/test_documentation.py --ignore tests/test_controller_api_page.py \
-    --ignore tests/test_package_layout.py --ignore tests/test_include_directions.py \
-    --ignore tests/test_model_core_layers.py --ignore tests/test_main_job_builds.py \
-    --ignore tests/test_build_locations.py --ignore tests/test_installed_package.py \
-    --ignore tests/test_cli_exit_statuses.py --ignore tests/test_cli_bench.py --ignore tests/test_progress.py \
-    --ignore tests/test_scene_messages.py --ignore tests/test_hostile_names.py --ignore tests/test_run_lock.py \
-    --ignore tests/test_frequency_response.py --ignore tests/test_freqresp_linearity.py \
-    --ignore tests/test_isolation_prediction.py --ignore tests/test_spectra.py --ignore tests/test_jitter.py \
-    --ignore tests/test_linearize_command.py --ignore tests/test_system_command.py \
-    --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
-    --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py \
-    --ignore tests/test_run_partial.py --ignore tests/test_long_run.py --ignore tests/test_tune.py \
-    --ignore tests/test_run_failure_paths.py --ignore tests/test_toml_fuzz.py --ignore tests/test_input_bounds.py \
-    --ignore tests/test_culprit_messages.py --ignore tests/test_target_inputs.py \
-    --ignore tests/test_sweep_failure_paths.py --ignore tests/test_html_escaping.py \
-    --ignore tests/test_lower_gain_margin.py --ignore tests/test_cumulative_rms.py
+    --deselect tests/model_core/model/test_reference_solution.py \
+    --ignore tests/package/report/test_report.py --ignore tests/docs/test_readme_commands.py --ignore tests/docs/test_example_notebook.py \
+    --ignore tests/model_core/multibody/test_rigid_body_symbolic.py --ignore tests/package/scene/test_scene_input_checks.py \
+    --ignore tests/package/scene/test_gyro_model.py --ignore tests/package/target/test_target_geometry.py \
+    --ignore tests/docs/test_documentation.py --ignore tests/docs/test_controller_api_page.py \
+    --ignore tests/layout/test_package_layout.py --ignore tests/layout/test_include_directions.py \
+    --ignore tests/layout/test_model_core_layers.py --ignore tests/layout/test_main_job_builds.py \
+    --ignore tests/layout/test_build_locations.py --ignore tests/layout/test_installed_package.py \
+    --ignore tests/package/cli/test_cli_exit_statuses.py --ignore tests/package/cli/test_cli_bench.py --ignore tests/package/cli/test_progress.py \
+    --ignore tests/package/scene/test_scene_messages.py --ignore tests/package/test_hostile_names.py --ignore tests/package/master/test_run_lock.py \
+    --ignore tests/package/analysis/test_frequency_response.py --ignore tests/package/analysis/test_freqresp_linearity.py \
+    --ignore tests/package/analysis/test_isolation_prediction.py --ignore tests/package/master/test_spectra.py --ignore tests/package/scene/test_jitter.py \
+    --ignore tests/package/cli/test_linearize_command.py --ignore tests/package/cli/test_system_command.py \
+    --ignore tests/package/sweep/test_sweep.py --ignore tests/package/sweep/test_sweep_messages.py \
+    --ignore tests/package/sweep/test_sweep_concurrency.py --ignore tests/package/sweep/test_sweep_cluster.py \
+    --ignore tests/package/master/test_run_partial.py --ignore tests/package/master/test_long_run.py --ignore tests/package/tune/test_tune.py \
+    --ignore tests/package/master/test_run_failure_paths.py --ignore tests/package/test_toml_fuzz.py --ignore tests/package/test_input_bounds.py \
+    --ignore tests/package/scene/test_culprit_messages.py --ignore tests/package/target/test_target_inputs.py \
+    --ignore tests/package/sweep/test_sweep_failure_paths.py --ignore tests/package/report/test_html_escaping.py \
+    --ignore tests/package/analysis/test_lower_gain_margin.py --ignore tests/package/master/test_cumulative_rms.py
   unset ASAN_OPTIONS UBSAN_OPTIONS
   echo "[test] sanitizer pass clean; now the release build"
 fi
