@@ -20,6 +20,8 @@ import zipfile
 
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 PHYSICS = REPO / "docs" / "physics.md"
 DEF_FILES = sorted((REPO / "model_core" / "include" / "gimbal").glob("*_variables.def"))

@@ -5,6 +5,8 @@ import shutil
 
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 NOTEBOOK = REPO / "examples" / "gimbal_notebook.ipynb"
 

@@ -18,8 +18,9 @@ README = REPO / "README.md"
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
 NOT_HERE = {"bash scripts/test.sh"}   # the command that runs this test
 
-pytestmark = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
-                                reason="documentation commands: the release pass runs them")
+pytestmark = [pytest.mark.python_bound,
+              pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
+                                 reason="documentation commands: the release pass runs them")]
 
 
 def blocks():

@@ -7,6 +7,8 @@ import subprocess
 
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 DECISION = REPO / "cmake" / "record_build_location.cmake"
 

@@ -23,6 +23,8 @@ from unittest import mock
 
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 
 # The folders whose direction is kept, by the names the rules use.

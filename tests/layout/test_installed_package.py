@@ -28,9 +28,10 @@ BAD_ARGUMENTS = {
     "bench": ["--repeat", "0"],
 }
 
-pytestmark = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
-                                reason="building and installing a wheel under the preloaded sanitizer runtime tests "
-                                       "nothing more")
+pytestmark = [pytest.mark.python_bound,
+              pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
+                                 reason="building and installing a wheel under the preloaded sanitizer runtime tests "
+                                        "nothing more")]
 
 
 @pytest.fixture(scope="module")

@@ -13,6 +13,8 @@ import pytest
 
 from gimbal2axis.system.from_scene import FMUS
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 
 

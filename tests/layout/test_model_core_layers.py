@@ -7,6 +7,8 @@ import re
 
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 CORE = ROOT / "model_core"
 ARCHITECTURE = ROOT / "docs" / "architecture.md"

@@ -8,6 +8,8 @@ import pathlib
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 PACKAGE = pathlib.Path(__file__).resolve().parents[2] / "gimbal2axis"
 ROOT = "gimbal2axis"
 

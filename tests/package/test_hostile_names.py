@@ -10,7 +10,8 @@ import pytest
 REPO = pathlib.Path(__file__).resolve().parents[2]
 COMMAND = [str(REPO / ".venv" / "bin" / "gimbal2axis")]
 
-pytestmark = pytest.mark.skipif(not pathlib.Path(COMMAND[0]).exists(), reason="the package's command is not installed")
+pytestmark = [pytest.mark.python_bound,
+              pytest.mark.skipif(not pathlib.Path(COMMAND[0]).exists(), reason="the package's command is not installed")]
 
 HOSTILE = 'R&D "<probe>"'
 

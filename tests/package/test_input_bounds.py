@@ -16,6 +16,8 @@ from gimbal2axis.limits import (MAX_ANALYSIS_BANDS, MAX_DELAY_STEPS, MAX_DESCRIP
                                 MAX_PLOT_SIGNALS, MAX_SCENARIOS, MAX_SEA_STATE_COMPONENTS, MAX_STEPS, MAX_SWEEP_CASES,
                                 MAX_TOML_BYTES, MAX_TOML_DEPTH, MAX_TUNE_BATCH, MAX_TUNE_PARAMETERS, MAX_TUNE_TRIALS)
 
+pytestmark = pytest.mark.memory_limit
+
 # A sea-state scene with a PID on a fixed target: each attack changes one line of it.
 SCENE = """name = "bounds"
 stop_time = 0.02

@@ -32,6 +32,8 @@ import traceback
 
 import pytest
 
+pytestmark = pytest.mark.memory_limit
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEED = int(os.environ.get("GIMBAL2AXIS_FUZZ_SEED", "44"))
 # GIMBAL2AXIS_FUZZ_SCALE multiplies the cases (a longer search than CI's, by hand)

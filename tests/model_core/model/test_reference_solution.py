@@ -1,10 +1,13 @@
 """A closed-loop scene on a moving base against an independent high-accuracy solution."""
 import numpy as np
+import pytest
 
 from gimbal2axis.fmu import simulate
 
 from support.expected_names import STATES
 from support.reference_model import ReferenceModel
+
+pytestmark = pytest.mark.python_bound
 
 STEP = 2e-3
 STOP = 0.4

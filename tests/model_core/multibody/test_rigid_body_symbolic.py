@@ -15,6 +15,8 @@ from scipy.integrate import solve_ivp
 
 from support.symbolic import lagrange_reference as ref
 
+pytestmark = pytest.mark.python_bound
+
 N_RANDOM_STATES = 100
 REL_TOL = 1e-10          # core vs reference
 SYM_TOL = 1e-14          # symmetry of the core's J, relative

@@ -14,6 +14,8 @@ import pytest
 from gimbal2axis.analysis import frequency_response as fr
 from gimbal2axis.master import spectra
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[3]
 SHIP = REPO / "scenes" / "ship_stabilization.toml"
 BALANCED = ["--set", "body2.d_bd[2]=0", "--set", "body2.d_bd[3]=0"]

@@ -11,6 +11,8 @@ import pytest
 from gimbal2axis import load_scene
 from gimbal2axis.analysis.frequency_response import Dwell, Excitation, fundamental, measure_point, zoh_fundamental
 
+pytestmark = [pytest.mark.python_bound, pytest.mark.dask_workers]
+
 REPO = pathlib.Path(__file__).resolve().parents[3]
 
 SCENE = """

@@ -12,6 +12,8 @@ from gimbal2axis.errors import SceneError
 from gimbal2axis.analysis.frequency_response import LINEAR_CURVE, LINEAR_FIDELITY, Dwell, Excitation, prediction_errors, sweep
 from gimbal2axis.analysis import isolation_prediction
 
+pytestmark = pytest.mark.python_bound
+
 FREQUENCIES_HZ = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 60.0, 100.0)
 RATE_AMPLITUDE = math.radians(0.1)     # rad/s: small enough to stay linear, large against the solver's tolerance
 DWELL = Dwell(settle_periods=3, settle_s=1.0, measure_periods=1)

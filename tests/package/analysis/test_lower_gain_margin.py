@@ -11,6 +11,8 @@ from scipy.optimize import brentq
 from gimbal2axis.analysis import isolation_prediction
 from gimbal2axis.tune import objective, spec
 
+pytestmark = pytest.mark.python_bound
+
 # L(s) = K (s + z) / (s (s - p) (s / b + 1)^2): an integrator, an unstable pole at +p, a lead zero, two lags
 P, Z, B, K = 1.0, 2.0, 20.0, 5.0
 

@@ -4,6 +4,8 @@ import pytest
 
 from gimbal2axis.cli.bench import cost_text
 
+pytestmark = pytest.mark.python_bound
+
 
 @pytest.mark.parametrize("cost, noise", [(-0.04, 0.0), (-0.04, 0.3), (0.2, 0.3), (0.0, 0.0)])
 def test_a_cost_within_the_noise_is_said_to_be_so(cost, noise):

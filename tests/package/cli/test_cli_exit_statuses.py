@@ -12,6 +12,8 @@ import pytest
 from gimbal2axis import __version__
 from gimbal2axis.cli import main as cli_main
 
+pytestmark = pytest.mark.python_bound
+
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 COMMAND = [sys.executable, "-m", "gimbal2axis"]
 SUBCOMMANDS = ["run", "sweep", "linearize", "freqresp", "system", "report", "bench", "tune"]

@@ -4,6 +4,9 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
+
+pytestmark = pytest.mark.python_bound
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 

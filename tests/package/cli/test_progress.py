@@ -3,8 +3,12 @@ through tqdm: into a pipe or a log whole lines and never a carriage return; on a
 redrawn in place, also on one that reports no size."""
 import io
 
+import pytest
+
 from gimbal2axis.progress import Progress as SceneProgress
 from gimbal2axis.sweep.progress import Progress as SweepProgress
+
+pytestmark = pytest.mark.python_bound
 
 
 class Terminal(io.StringIO):

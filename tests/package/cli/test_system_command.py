@@ -6,7 +6,11 @@ import subprocess
 import sys
 import zipfile
 
+import pytest
+
 from gimbal2axis.locations import FMU_ENVIRONMENT, fmu_directory
+
+pytestmark = pytest.mark.python_bound
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 SCENE = REPO / "scenes" / "ship_stabilization.toml"

@@ -18,6 +18,8 @@ REPO = pathlib.Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(REPO / "tests" / "c_kernel"))
 from test_compiled_loop import variant  # noqa: E402
 
+pytestmark = pytest.mark.python_bound
+
 # Chunks far shorter than the runs (and not a multiple of the sum of sines' 128-row blocks), so that
 # every prepared input crosses many chunk boundaries.
 SMALL_CHUNK = 173

@@ -20,6 +20,8 @@ import pytest
 
 from gimbal2axis.cli.main import main
 
+pytestmark = pytest.mark.python_bound
+
 RUN = [sys.executable, "-m", "gimbal2axis", "run"]
 
 # A cheap gimbal on a fixed base, open loop or a user controller: these tests need the run's length

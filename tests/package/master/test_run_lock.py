@@ -5,6 +5,10 @@ import pathlib
 import subprocess
 import sys
 
+import pytest
+
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[3]
 SCENE = REPO / "scenes" / "free_swing.toml"
 

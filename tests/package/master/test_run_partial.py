@@ -21,6 +21,8 @@ from gimbal2axis import FMU, load_scene, run
 from gimbal2axis.cli.failures import EXIT_FAILED_PARTIAL, EXIT_INTERRUPTED, EXIT_TERMINATED
 from gimbal2axis.master.units import split_label
 
+pytestmark = pytest.mark.python_bound
+
 RUN = [sys.executable, "-m", "gimbal2axis", "run"]
 
 # A cheap gimbal (rigid gears, motors without inductance, no dry friction) on a fixed base with an

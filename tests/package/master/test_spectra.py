@@ -10,6 +10,8 @@ from scipy import signal
 
 from gimbal2axis.master import spectra
 
+pytestmark = pytest.mark.python_bound
+
 FS = 1000.0
 
 

@@ -9,6 +9,8 @@ import urllib.parse
 
 import pytest
 
+pytestmark = pytest.mark.python_bound
+
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 HOSTILE = "a'><script>x"   # a file name: no '/' in it
 

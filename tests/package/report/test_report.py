@@ -11,6 +11,8 @@ from gimbal2axis import FMU, SceneError, load_scene, run
 from gimbal2axis.report import load_comparison, run_comparison, write_page
 from gimbal2axis.report.comparison import run_metrics, table_rows
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[3]
 EXAMPLE = REPO / "reports" / "gyro_grades_and_schemes.toml"
 

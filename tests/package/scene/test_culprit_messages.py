@@ -11,6 +11,8 @@ import pytest
 from gimbal2axis.cli.main import main
 from gimbal2axis.errors import EXCERPT_CHARS, LONGEST_MESSAGE_CHARS, excerpt, one_line, shown
 
+pytestmark = pytest.mark.python_bound
+
 # A cheap gimbal on a fixed base: these runs need the controller's failure, not the physics.
 SCENE = """stop_time = 0.05
 step_size = 0.001

@@ -15,6 +15,8 @@ from gimbal2axis import native
 from gimbal2axis.scene.gyro import GyroModel
 from gimbal2axis.scene.sensors import Sensors, carrier_rate
 
+pytestmark = pytest.mark.python_bound
+
 DEG_H = math.radians(1.0) / 3600.0
 
 

@@ -14,6 +14,8 @@ from gimbal2axis import FMU, SceneError, load_scene, run
 from gimbal2axis.master import run_scene_file
 from gimbal2axis.sweep import SweepOptions, run_sweep
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[3]
 SHIP = REPO / "scenes" / "ship_stabilization.toml"
 JITTER = REPO / "examples" / "ship_jitter.toml"

@@ -15,6 +15,8 @@ from gimbal2axis import FMU, SceneError, check_against_fmu, load_scene
 from gimbal2axis.errors import EXCERPT_CHARS, excerpt
 from test_scene_messages import QUIET   # a scene that draws no warning
 
+pytestmark = pytest.mark.python_bound
+
 GIMBAL2AXIS = [sys.executable, "-m", "gimbal2axis"]
 
 

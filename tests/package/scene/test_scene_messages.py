@@ -15,6 +15,8 @@ import pytest
 from gimbal2axis import FMU, SceneError, load_scene, run
 from gimbal2axis.errors import SceneWarning
 
+pytestmark = pytest.mark.python_bound
+
 REPO = pathlib.Path(__file__).resolve().parents[3]
 
 RUN_SCENE = [sys.executable, "-m", "gimbal2axis", "run"]   # the installed package's command

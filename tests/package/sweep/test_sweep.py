@@ -16,6 +16,8 @@ from gimbal2axis.sweep import SweepError, SweepOptions, load_sweep, prepare, run
 from gimbal2axis.sweep.table import read_rows  # noqa: E402
 from gimbal2axis.sweep.worker import metrics  # noqa: E402
 
+pytestmark = pytest.mark.dask_workers
+
 SCENE = REPO / "scenes" / "ship_stabilization.toml"
 METRICS = ["los_rms_mrad", "los_peak_mrad", "los_final_mrad", "i_peak_R1_A", "i_peak_R2_A", "i_peak_A", "events",
            "requirements_met"]

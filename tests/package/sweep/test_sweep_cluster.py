@@ -52,8 +52,9 @@ metrics_from_s = 0.02
 "body2.m" = { uniform = [1.5, 3.0] }
 """
 
-pytestmark = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
-                                reason="Dask processes under AddressSanitizer test nothing the release pass does not")
+pytestmark = [pytest.mark.dask_workers,
+              pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
+                                 reason="Dask processes under AddressSanitizer test nothing the release pass does not")]
 
 
 def pinned(names: list[str]) -> list[str]:

@@ -28,8 +28,9 @@ STEM = "shared__ship_stabilization"
 
 # The sweep commands in processes of their own: under the preloaded AddressSanitizer runtime they
 # test nothing the release pass does not (as in tests/package/sweep/test_sweep_messages.py).
-pytestmark = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
-                                reason="sweep processes under AddressSanitizer test nothing more")
+pytestmark = [pytest.mark.dask_workers,
+              pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
+                                 reason="sweep processes under AddressSanitizer test nothing more")]
 
 
 def sweep_file(tmp_path, file_name, parameter, values):

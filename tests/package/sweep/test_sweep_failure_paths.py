@@ -15,6 +15,8 @@ from gimbal2axis.sweep import SweepError, SweepOptions, load_sweep, run_sweep, s
 from gimbal2axis.sweep.runner import plan_sweep
 from gimbal2axis.sweep.table import read_rows
 
+pytestmark = pytest.mark.dask_workers
+
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 COMMAND = [sys.executable, "-m", "gimbal2axis"]
 

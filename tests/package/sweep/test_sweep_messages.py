@@ -25,6 +25,8 @@ from gimbal2axis.sweep import table  # noqa: E402
 from gimbal2axis.sweep.runner import SCHEDULER_TIMEOUT_S  # noqa: E402
 from gimbal2axis.sweep.table import read_rows  # noqa: E402
 
+pytestmark = pytest.mark.dask_workers
+
 SCENE = REPO / "scenes" / "ship_stabilization.toml"
 SWEEP = [sys.executable, "-m", "gimbal2axis", "sweep"]   # the installed package's command
 

@@ -13,6 +13,8 @@ from gimbal2axis.target import pointing
 from gimbal2axis.target.kinematics import PointingCommand, carrier_rate_and_acceleration, unit_and_derivatives
 from gimbal2axis.target.motion import Carrier, EarthPoint, Flyby
 
+pytestmark = pytest.mark.python_bound
+
 WGS84_A = 6378137.0
 
 

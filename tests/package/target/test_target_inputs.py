@@ -12,6 +12,8 @@ import pytest
 
 from gimbal2axis import SceneError, load_scene
 
+pytestmark = pytest.mark.python_bound
+
 POINT = """name = "point"
 stop_time = 1.0
 step_size = 1e-3

@@ -11,6 +11,8 @@ import pytest
 from gimbal2axis.tune import engine
 from gimbal2axis.tune.spec import TuneError, load_tuning
 
+pytestmark = pytest.mark.dask_workers
+
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 COMMAND = [sys.executable, "-m", "gimbal2axis"]
 
