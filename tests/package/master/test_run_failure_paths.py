@@ -20,25 +20,14 @@ import pytest
 
 from gimbal2axis.cli.main import main
 
+from support.scenes import cheap_scene
+
 pytestmark = pytest.mark.python_bound
 
 RUN = [sys.executable, "-m", "gimbal2axis", "run"]
 
-# A cheap gimbal on a fixed base, open loop or a user controller: these tests need the run's length
-# and its files, not its physics.
-CHEAP = """stop_time = {stop_time}
-step_size = 0.001
-output_interval = 0.001
-[fidelity]
-"gear1.model" = 0
-"gear2.model" = 0
-"motor1.model" = 0
-"motor2.model" = 0
-dry_friction = false
-"base.fixed" = true
-[base_motion]
-type = "fixed"
-"""
+# A cheap gimbal on a fixed base (support.scenes), open loop or a user controller: these tests need the
+# run's length and its files, not its physics.
 OPEN_LOOP = """[controller]
 type = "none"
 voltage_V = [0.2, -0.1]
@@ -113,7 +102,7 @@ def scene(folder: pathlib.Path, name: str = "cheap", stop_time: float = 0.2, con
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "user.py").write_text(CONTROLLERS)
     path = folder / f"{name}.toml"
-    path.write_text(CHEAP.format(stop_time=stop_time) + (USER.format(cls=controller) if controller else OPEN_LOOP)
+    path.write_text(cheap_scene(stop_time) + (USER.format(cls=controller) if controller else OPEN_LOOP)
                     + extra)
     return path
 

@@ -21,26 +21,15 @@ from gimbal2axis import FMU, load_scene, run
 from gimbal2axis.cli.failures import EXIT_FAILED_PARTIAL, EXIT_INTERRUPTED, EXIT_TERMINATED
 from gimbal2axis.master.units import split_label
 
+from support import scenes
+
 pytestmark = pytest.mark.python_bound
 
 RUN = [sys.executable, "-m", "gimbal2axis", "run"]
 
-# A cheap gimbal (rigid gears, motors without inductance, no dry friction) on a fixed base with an
-# open loop: what these tests need of the run is its length and its clock, not its physics.
-CHEAP = """name = "cheap"
-stop_time = {stop_time}
-step_size = {step_size}
-output_interval = {output_interval}
-[fidelity]
-"gear1.model" = 0
-"gear2.model" = 0
-"motor1.model" = 0
-"motor2.model" = 0
-dry_friction = false
-"base.fixed" = true
-[base_motion]
-type = "fixed"
-[controller]
+# A cheap gimbal on a fixed base (support.scenes) with an open loop: what these tests need of the run is
+# its length and its clock, not its physics.
+OPEN_LOOP = """[controller]
 type = "none"
 voltage_V = [0.2, -0.1]
 """
@@ -60,8 +49,7 @@ class FailsLater:
 
 def cheap_scene(tmp_path, stop_time=1.0, step_size=1e-3, output_interval=None, extra=""):
     path = tmp_path / "cheap.toml"
-    path.write_text(CHEAP.format(stop_time=stop_time, step_size=step_size,
-                                 output_interval=output_interval or step_size) + extra)
+    path.write_text(scenes.cheap_scene(stop_time, step_size, output_interval or step_size, name="cheap") + OPEN_LOOP + extra)
     return path
 
 

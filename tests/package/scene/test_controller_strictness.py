@@ -26,24 +26,9 @@ from gimbal2axis.cli.failures import EXIT_ERROR, EXIT_FAILED_PARTIAL
 from gimbal2axis.master.lockstep import run_lockstep
 from gimbal2axis.scene.controllers import ControllerError
 
-RUN = [sys.executable, "-m", "gimbal2axis", "run"]
+from support.scenes import cheap_scene
 
-# A cheap gimbal on a fixed base: what these tests need is the controller's plumbing, not physics.
-SCENE = """name = "strict"
-stop_time = 0.05
-step_size = 1e-3
-output_interval = 1e-3
-[fidelity]
-"gear1.model" = 0
-"gear2.model" = 0
-"motor1.model" = 0
-"motor2.model" = 0
-dry_friction = false
-"base.fixed" = true
-[base_motion]
-type = "fixed"
-[controller]
-"""
+RUN = [sys.executable, "-m", "gimbal2axis", "run"]
 
 # A controller whose helper method raises part-way (a KeyError two calls deep in the user's file).
 RAISES_IN_HELPER = '''\
@@ -91,7 +76,8 @@ def write_scene(tmp_path, controller: str, code: str | None = None, file_name: s
     if code is not None:
         (tmp_path / file_name).write_text(code)
     path = tmp_path / "strict.toml"
-    path.write_text(SCENE.replace("stop_time = 0.05", f"stop_time = {stop_time}") + controller + "\n")
+    # A cheap gimbal on a fixed base: what these tests need is the controller's plumbing, not physics.
+    path.write_text(cheap_scene(stop_time, name="strict") + "[controller]\n" + controller + "\n")
     return path
 
 

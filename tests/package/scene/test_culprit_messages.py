@@ -11,22 +11,12 @@ import pytest
 from gimbal2axis.cli.main import main
 from gimbal2axis.errors import EXCERPT_CHARS, LONGEST_MESSAGE_CHARS, excerpt, one_line, shown
 
+from support.scenes import cheap_scene
+
 pytestmark = pytest.mark.python_bound
 
 # A cheap gimbal on a fixed base: these runs need the controller's failure, not the physics.
-SCENE = """stop_time = 0.05
-step_size = 0.001
-output_interval = 0.001
-[fidelity]
-"gear1.model" = 0
-"gear2.model" = 0
-"motor1.model" = 0
-"motor2.model" = 0
-dry_friction = false
-"base.fixed" = true
-[base_motion]
-type = "fixed"
-[controller]
+SCENE = cheap_scene(stop_time=0.05) + """[controller]
 type = "python"
 file = "culprits.py"
 class = "{cls}"
