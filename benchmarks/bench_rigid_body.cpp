@@ -1,5 +1,5 @@
 // Micro-benchmark of the rigid-body part of the right-hand side: the generic implementation the
-// specialised one replaced (the reference copy in tests/test_rigid_body_fast.cpp) against the current
+// specialised one replaced (the reference copy in tests/model_core/multibody/test_rigid_body_fast.cpp) against the current
 // model_core code, in CPU nanoseconds per call.
 //
 //   build-rb/benchmarks/bench_rigid_body [calls per measurement, default 2000000]

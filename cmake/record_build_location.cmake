@@ -8,7 +8,7 @@
 #        names is gone (its folder has no CMakeCache.txt); otherwise leave it and say so;
 #   ON   write it: this build becomes the package's;
 #   OFF  never write it.
-# Kept apart from CMakeLists.txt so that tests/test_build_locations.py can run the decision in script
+# Kept apart from CMakeLists.txt so that tests/layout/test_build_locations.py can run the decision in script
 # mode (cmake -P) on files of its own.
 
 # Sets <out_var> to TRUE or FALSE, and <reason_var> to one sentence saying why when it is FALSE.

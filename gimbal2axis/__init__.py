@@ -6,7 +6,7 @@ gimbal2axis`).
     with FMU("build/Gimbal2Axis.fmu") as fmu:
         result = run(load_scene("scenes/free_swing.toml"), fmu)
 
-Layout, and the one direction imports go (tests/test_package_layout.py refuses any other):
+Layout, and the one direction imports go (tests/layout/test_package_layout.py refuses any other):
 
     cli                      the command and its subcommands, one module each
      -> tune                 tuning gains with Optuna over the sweep engine

@@ -7,7 +7,7 @@ the helpers' signatures and docstrings, each with the example below (HELPERS).
     .venv/bin/python scripts/controller_api_page.py            # rewrites docs/controller_api.md
     .venv/bin/python scripts/controller_api_page.py --check    # exit 1 if the page is out of date
 
-tests/test_controller_api_page.py checks that the committed page is what this renders and runs
+tests/docs/test_controller_api_page.py checks that the committed page is what this renders and runs
 every helper's example.
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs tests/test_hard_cases.py and prints the table of docs/hard_cases.md from its measurements.
+"""Runs tests/model_core/integrators/test_hard_cases.py and prints the table of docs/hard_cases.md from its measurements.
 
 Each test appends its measurements (case, what is asserted, measured error, solver.steps,
 solver.rhs_evaluations, wall time) to $HARD_CASES_JSON; this script sets that variable, runs pytest and
@@ -21,7 +21,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         path = pathlib.Path(tmp) / "hard_cases.jsonl"
         env = dict(os.environ, HARD_CASES_JSON=str(path))
-        run = subprocess.run([sys.executable, "-m", "pytest", str(REPO / "tests" / "test_hard_cases.py"), "-q",
+        run = subprocess.run([sys.executable, "-m", "pytest", str(REPO / "tests" / "model_core" / "integrators" / "test_hard_cases.py"), "-q",
                               "-p", "no:cacheprovider", "-rxXf"], cwd=REPO, env=env, capture_output=True, text=True)
         entries = [json.loads(line) for line in path.read_text().splitlines()] if path.exists() else []
     print("| case | asserted | measured | steps | RHS evaluations | wall [s] | note |")

@@ -5,7 +5,7 @@ parameter set (.ssv: the start values and structural switches), its stimuli (-in
 communication point; absent when the inputs stay at their start values) and its reference outputs
 (-ref.csv), described by experiments.xml and listed with their roles and SHA-256 checksums in
 fmi-ls-manifest.xml. An importer replays an experiment and compares its outputs with the reference
-within the stated tolerance; tests/test_reference_results.py does so with fmpy.
+within the stated tolerance; tests/fmu/test_reference_results.py does so with fmpy.
 
 Run it again after a change that is meant to change results (from the repository's root, after the
 build):   .venv/bin/python scripts/reference_results.py [--fmu build/Gimbal2Axis.fmu]

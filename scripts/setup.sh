@@ -89,7 +89,7 @@ if [ "$setup_for" = test ]; then
 else
   # Every FMU the README names (the gimbal, the ship-motion and the controller FMUs, each for FMI 2.0 and
   # 3.0; `gimbal2axis system` puts the latter two beside the gimbal) and the analysis library
-  # `gimbal2axis linearize` loads; no tests, no fuzzer, no benchmarks. One line: tests/test_main_job_builds.py
+  # `gimbal2axis linearize` loads; no tests, no fuzzer, no benchmarks. One line: tests/layout/test_main_job_builds.py
   # reads the targets from it.
   cmake --build "$build_dir" --target fmu fmu3 ship_motion_fmu ship_motion_fmu3 controller_fmu controller_fmu3 gimbal_probe
 fi

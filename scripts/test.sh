@@ -24,40 +24,18 @@ if [ "${GIMBAL_SKIP_SANITIZERS:-0}" != "1" ]; then
   export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   ctest --test-dir "$asan_dir" --output-on-failure --parallel "$test_jobs"
-  # Left out here: the tests whose time goes to Python (the independent reference solution, the run
-  # command's streaming, signals, failure paths and long runs, the fuzzing of the input files under a
-  # memory limit (RLIMIT_AS, which AddressSanitizer's shadow memory cannot live under), the input bounds, the sensors page's comparison of 36 runs: 369 s under the
-  # sanitizers; the README's commands and the reports, the notebook, the symbolic derivation, the
-  # 40-MB scene key, the gyro's Allan deviations, the target geometry in numpy; the documentation,
-  # layout and build checks; the command line's messages, exit statuses and progress; the frequency
-  # responses' and spectra's analysis, whose simulations the FMU tests here run alike), or to Dask
-  # worker processes (sweeps, tuning); they run in the release pass below, and the native code they
-  # call runs here in the other tests.
+  # Left out here, by their markers (registered in pyproject.toml, tests/README.md): the tests whose time
+  # goes to Python (python_bound: analysis, reports, documentation, layout and build checks, the command's
+  # messages, the independent reference solution), to Dask worker processes (dask_workers: sweeps,
+  # tuning), or that run under an address-space limit (memory_limit: RLIMIT_AS, which AddressSanitizer's
+  # shadow memory cannot live under). They run in the release pass below, and the native code they call
+  # runs here in the other tests.
   # libstdc++ is preloaded too: ASan's exception interceptor must find it at start-up, and Python
   # only loads it later (with matplotlib's C++ extensions, which throw).
   LD_PRELOAD="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libstdc++.so)" \
     GIMBAL_BUILD_DIR="$asan_dir" GIMBAL_SANITIZED=1 \
     "$repo/.venv/bin/python" -m pytest tests -q -p no:cacheprovider "${parallel[@]}" \
-    --deselect tests/test_reference_solution.py \
-    --ignore tests/test_report.py --ignore tests/test_readme_commands.py --ignore tests/test_example_notebook.py \
-    --ignore tests/test_rigid_body_symbolic.py --ignore tests/test_scene_input_checks.py \
-    --ignore tests/test_gyro_model.py --ignore tests/test_target_geometry.py \
-    --ignore tests/test_documentation.py --ignore tests/test_controller_api_page.py \
-    --ignore tests/test_package_layout.py --ignore tests/test_include_directions.py \
-    --ignore tests/test_model_core_layers.py --ignore tests/test_main_job_builds.py \
-    --ignore tests/test_build_locations.py --ignore tests/test_installed_package.py \
-    --ignore tests/test_cli_exit_statuses.py --ignore tests/test_cli_bench.py --ignore tests/test_progress.py \
-    --ignore tests/test_scene_messages.py --ignore tests/test_hostile_names.py --ignore tests/test_run_lock.py \
-    --ignore tests/test_frequency_response.py --ignore tests/test_freqresp_linearity.py \
-    --ignore tests/test_isolation_prediction.py --ignore tests/test_spectra.py --ignore tests/test_jitter.py \
-    --ignore tests/test_linearize_command.py --ignore tests/test_system_command.py \
-    --ignore tests/test_sweep.py --ignore tests/test_sweep_messages.py \
-    --ignore tests/test_sweep_concurrency.py --ignore tests/test_sweep_cluster.py \
-    --ignore tests/test_run_partial.py --ignore tests/test_long_run.py --ignore tests/test_tune.py \
-    --ignore tests/test_run_failure_paths.py --ignore tests/test_toml_fuzz.py --ignore tests/test_input_bounds.py \
-    --ignore tests/test_culprit_messages.py --ignore tests/test_target_inputs.py \
-    --ignore tests/test_sweep_failure_paths.py --ignore tests/test_html_escaping.py \
-    --ignore tests/test_lower_gain_margin.py --ignore tests/test_cumulative_rms.py
+    -m "not python_bound and not dask_workers and not memory_limit"
   unset ASAN_OPTIONS UBSAN_OPTIONS
   echo "[test] sanitizer pass clean; now the release build"
 fi

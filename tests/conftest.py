@@ -1,11 +1,19 @@
 """Shared fixtures: where the build lives and the artefacts the tests drive."""
 import os
 import pathlib
+import sys
 
 import pytest
 
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[1]
 BUILD_DIR = pathlib.Path(os.environ.get("GIMBAL_BUILD_DIR", REPO_ROOT / "build")).resolve()
+
+# Test modules import one another by name (`from test_linearization import RICH_POINT`), across the
+# folders (tests/README.md): every folder of test files is on sys.path, whichever of them a run collects
+# (pytest's default import mode adds only the folders of the files it collects). File names are unique.
+for _folder in sorted({path.parent for path in pathlib.Path(__file__).parent.rglob("test_*.py")}):
+    if str(_folder) not in sys.path:
+        sys.path.append(str(_folder))
 
 # The package finds the build through these when not told (gimbal2axis/locations.py): the tests' build,
 # GIMBAL_BUILD_DIR's (the sanitizer pass's), not the one the package was configured with; set here, they

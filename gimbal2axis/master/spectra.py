@@ -14,7 +14,7 @@ Conventions (docs/jitter.md):
   segment), sum(PSD) * df is the mean square of the samples weighted by welch_sample_weights: the
   segments' squared Hann windows summed, which taper over the first and last half segment and, at
   50 % overlap, swing between 1/2 and 1 of their peak once per step inside. For a stationary signal
-  that is its variance up to the estimate's statistics (within 1 % on noise: tests/test_cumulative_rms.py);
+  that is its variance up to the estimate's statistics (within 1 % on noise: tests/package/master/test_cumulative_rms.py);
   a window whose power is not evenly spread (a transient at its start, a sea of few long periods)
   gets a top of the cumulative RMS some per cent off the window's standard deviation (docs/jitter.md).
 - Integrals are sums over bins times the bin width df (a bin holds the power around its centre);
@@ -34,7 +34,7 @@ OVERLAP = 0.5
 
 def hann_window(n: int) -> np.ndarray:
     """scipy.signal.get_window(WINDOW, n), the periodic Hann window welch uses, computed as scipy
-    computes it (bit for bit: tests/test_package_layout.py) without importing scipy.signal, which
+    computes it (bit for bit: tests/layout/test_package_layout.py) without importing scipy.signal, which
     takes 0.5 s: `gimbal2axis run` needs the window and nothing else of it."""
     if n == 1:
         return np.ones(1)

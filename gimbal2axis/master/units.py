@@ -5,7 +5,7 @@ the mrad of the summary line, which writes its unit beside each number).
 
 One table for both kinds of signal:
 - the FMU's variables (outputs, and the inputs a run records): their units in the model description,
-  which model_core/include/gimbal/*_variables.def generates; tests/test_result_units.py holds the
+  which model_core/include/gimbal/*_variables.def generates; tests/package/master/test_result_units.py holds the
   table to the built FMU's modelDescription.xml, variable by variable;
 - the signals the runner adds (scene/scene.py DERIVED_SIGNALS and the master's records: commands,
   set points, line-of-sight angles and errors, heave, the carrier's rate in the payload frame).

@@ -45,7 +45,7 @@ CARRIER_KEYS = {"latitude_deg", "longitude_deg", "altitude_m", "course_deg", "sp
 DEFAULT_BEAM_WIDTH_MRAD = 1.0
 DEFAULT_KEYHOLE_DEG = 10.0
 # The FMU's default lever arm base.d_ab[1..3] [m] (model_core/include/gimbal/real_variables.def), for
-# a scene that does not set it; tests/test_target_lever_arm.py holds them equal.
+# a scene that does not set it; tests/package/target/test_target_lever_arm.py holds them equal.
 DEFAULT_LEVER_ARM_M = (0.0, 0.0, 0.25)
 LEVER_ARM_PARAMETERS = ("base.d_ab[1]", "base.d_ab[2]", "base.d_ab[3]")
 # The largest INS position error a scene may give [m] per component: larger is no navigation system.

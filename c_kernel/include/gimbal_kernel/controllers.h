@@ -8,7 +8,7 @@
  * the saturation in `asked`). Axis 0 is the azimuth
  * (alpha, motor 1), axis 1 the elevation (beta, motor 2). Every operation and its order is fixed
  * (Python's min/max semantics, sums in order; built with -ffp-contract=off): results keep the bits
- * they were recorded with (tests/golden), whichever loop runs them. */
+ * they were recorded with (tests/package/golden), whichever loop runs them. */
 #ifndef GIMBAL_KERNEL_CONTROLLERS_H
 #define GIMBAL_KERNEL_CONTROLLERS_H
 

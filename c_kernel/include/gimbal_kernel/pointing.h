@@ -4,7 +4,7 @@
  * (what the payload gyro reads when the line of sight follows the target). The controller FMU computes
  * it once per communication point from its target inputs; the scene runner's numpy form
  * (gimbal2axis/target/kinematics.py, vectorised over a run) is the same arithmetic in the same order,
- * and tests/test_pointing_kernel.py holds the two together.
+ * and tests/c_kernel/test_pointing_kernel.py holds the two together.
  *
  * Frames: G with z up; the base attitude 0TG = Ry(-gamma) Rz(-psi) Rx(-delta); the line of sight the
  * y axis of body 2, Rz(alpha) Rx(beta) [0, 1, 0] in frame 0. From the target's position relative to

@@ -7,7 +7,7 @@
  * default_rng(entropy) (numpy_random.h): first the frequencies' places, then the phases.
  *
  * The arithmetic follows the numpy code the scenes were made with (the reference kept in
- * tests/test_sea_state_kernel.py) operation by operation: np.linspace's edges (i * step + start, the
+ * tests/c_kernel/test_sea_state_kernel.py) operation by operation: np.linspace's edges (i * step + start, the
  * last edge the stop itself), the shape with libm's exp and pow, numpy's pairwise summation of the
  * bins' variances. One implementation for the scene runner and the FMU: the same parameters give
  * the same bits in both. (numpy's own exp and pow may be SIMD code that rounds the last bit

@@ -1,6 +1,6 @@
 // A non-owning reference to a callable, for callbacks on the hot path: std::function stores a lambda
 // with more than two captures on the heap, and the FMU allocates nothing inside doStep after the first
-// (docs/benchmarks.md; tests/test_no_allocation_in_do_step.py). The callable must outlive the call
+// (docs/benchmarks.md; tests/fmu/test_no_allocation_in_do_step.py). The callable must outlive the call
 // that receives the reference.
 #pragma once
 

@@ -7,7 +7,7 @@
 // struct). The rules that tie fields together or to the model (the interface the state was saved by,
 // time against epoch, modes against the fidelity) follow the table, in check_snapshot_content().
 //
-// Format 7's byte layout is asserted field by field in tests/test_snapshot_layout.cpp.
+// Format 7's byte layout is asserted field by field in tests/model_core/simulation/test_snapshot_layout.cpp.
 #include "gimbal/simulation/snapshot.hpp"
 
 #include <cmath>

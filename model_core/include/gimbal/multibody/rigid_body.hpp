@@ -1,7 +1,7 @@
 // Mass matrix J(q) and bias f(q, qd, base motion) of the four gimbal bodies (docs/physics.md section 3).
 //
 // Derived by projecting Newton-Euler equations on the partial velocities (Kane's method), which
-// equals Lagrange's equations for the energies of docs/physics.md section 3.2; tests/symbolic checks that claim.
+// equals Lagrange's equations for the energies of docs/physics.md section 3.2; tests/support/symbolic checks that claim.
 #pragma once
 
 #include <Eigen/Core>

@@ -83,7 +83,7 @@ std::string check_snapshot_content(const SnapshotContent& content, bool format_o
 // The model a snapshot's values define, validated as at initialization.
 bool snapshot_parameters(const SnapshotContent& content, ModelParameters& params, std::string& error);
 
-// One row of the table, for the layout test (tests/test_snapshot_layout.cpp): its member path and
+// One row of the table, for the layout test (tests/model_core/simulation/test_snapshot_layout.cpp): its member path and
 // where it lies in the bytes.
 struct SnapshotFieldPlace {
     const char* key;
