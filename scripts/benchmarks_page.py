@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes docs/benchmarks.md: the prose of benchmarks/page_template.md with every figure table
 rendered from the results files the benchmarks commit in benchmarks/results/, so that no figure on
-the page is typed by hand or older than its file (tests/test_benchmarks_page.py checks that the
+the page is typed by hand or older than its file (tests/docs/test_benchmarks_page.py checks that the
 committed page is what this writes).
 
     .venv/bin/python scripts/benchmarks_page.py            # after a benchmark wrote its results file

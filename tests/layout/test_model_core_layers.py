@@ -41,7 +41,7 @@ def layer_of(path: pathlib.Path, core: pathlib.Path = CORE) -> str:
 
 # The FMU's model table (simulation/fmu_model_table.cpp, compiled into the FMU only) includes the FMI
 # layer's headers and the build's GUID header besides the core's: those are no layer of the core
-# (tests/test_include_directions.py keeps which it may include).
+# (tests/layout/test_include_directions.py keeps which it may include).
 FMU_MODEL_TABLE_OUTSIDE = re.compile(r"^(fmi_layer/[\w.]+\.h|gimbal_guid\.h)$")
 
 

@@ -21,7 +21,10 @@ import re
 
 import pytest
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+# Reads docs and code: its time goes to Python.
+pytestmark = pytest.mark.python_bound
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
 DOC = REPO / "docs" / "architecture.md"
 GIMBAL_INCLUDE = REPO / "model_core" / "include" / "gimbal"
 CORE_SOURCES = REPO / "model_core" / "src"
