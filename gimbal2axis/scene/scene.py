@@ -53,6 +53,8 @@ import numpy as np
 from . import analysis, geometry
 from .base_motion import INPUTS as BASE_INPUT_NAMES, Recorded, make_base_motion
 from .controllers import make_controller
+from .drives import other_drive_columns, scene_drives
+from .parameters import parameter_value
 from .. import target as moving_targets
 from ..target import spec as target_spec_table
 from ..errors import (SceneError, SceneWarning, boolean, check_keys, did_you_mean, excerpt, is_number_text, number,
@@ -458,8 +460,6 @@ def check_against_fmu(scene: Scene, fmu: FMU) -> None:
                                  f"{did_you_mean(name, fmu.states + [a + '_deg' for a in ANGLE_STATES])}")
         fmu.check("initial", scene.initial, {"output", "local"})
         names = {n for names in scene.plot.values() for n in names}
-        from .drives import other_drive_columns, scene_drives
-
         drives = scene_drives(scene, fmu)
         recorded_inputs = set(BASE_INPUT_NAMES) | {drive.applied for drive in drives}
         for drive in drives:
@@ -503,15 +503,6 @@ def check_run_length(scene: Scene, t_end: float) -> None:
             target_spec_table.check_run(scene.moving_target, t_end)
         except SceneError as exc:
             raise SceneError(f"{scene.path}: {exc}") from None
-
-
-def parameter_value(scene: Scene, fmu: FMU, name: str):
-    """A parameter's value in this scene: the scene's, else the FMU's start value."""
-    if name in scene.parameters:
-        return scene.parameters[name]
-    if name in scene.fidelity:
-        return scene.fidelity[name]
-    return fmu.start(name) if fmu.has(name) else None
 
 
 def start_values(scene: Scene, fmu: FMU, base_row0: np.ndarray, base_row_eps: np.ndarray | None = None,
