@@ -141,10 +141,15 @@ def _run_scene(args, stop) -> int:
         # stopped before the first communication point (nothing recorded, nothing written)
         print(one_line(f"{PROG}: {STOP_KINDS[stop.kind]} before the run started: {exc}"), file=sys.stderr)
         return EXIT_FOR_STOP[stop.kind]
-    status_path = csv_path.with_name(scene.name + "_run.json")
     if not args.quiet:
         print(result.summary())
         print(f"wrote {', '.join(str(path) for path in result.files_written)}")
+    return _exit_status(args, stop, result, csv_path, csv_path.with_name(scene.name + "_run.json"))
+
+
+def _exit_status(args, stop, result, csv_path: pathlib.Path, status_path: pathlib.Path) -> int:
+    """What a run that recorded something says on stderr, and its exit status: stopped early, files not
+    written, requirements not met (with --check), or done."""
     if result.stopped is not None:
         stopped = result.stopped
         kept = (f"the results for [0, {stopped.time:g}] s are in {csv_path} and .parquet, marked partial in "

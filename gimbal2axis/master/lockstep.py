@@ -3,10 +3,10 @@ instance and one plan.Plan per case (its own base motion, sensors, records and d
 of the user's step() for all of them per communication point.
 
 Per communication point t_k: each case's outputs are read into its records and its sensors measure
-(the stepper's calls of a point, stepper.point_calls, as a single run's Python loop makes them); the measurements are stacked
-(alpha, beta: (N,); gyro, base_attitude, base_rates: (N, 3)); the user's step(t, measurements)
-returns (N, 2) voltages; then, case by case, the voltage (saturated at the case's +-U_L) goes into
-its record, the delayed one into its inputs, and its FMU takes the step.
+(the stepper's calls of a point, stepper.point_calls, as a single run's Python loop makes them); the
+measurements are stacked (alpha, beta: (N,); gyro, base_attitude, base_rates: (N, 3)); the user's
+step(t, measurements) returns (N, 2) voltages; then, case by case, the voltage (saturated at the
+case's +-U_L) goes into its record, the delayed one into its inputs, and its FMU takes the step.
 
 Cases run together when they share what the loop's one clock and the class's one object need
 (batch_key): the class, the step size, the number of steps, the delay, whether there is a target,
