@@ -117,6 +117,7 @@ class _Case:
 
     def result(self, wall: float, cpu: float, count: int) -> RunResult:
         """The case's RunResult, with its share of the batch's times."""
+        self.flush()
         signals = self.plan.chunk_signals(self.plan.n + 1)
         result = RunResult(self.scene, signals, wall / count, self.plan.t_end)
         result.voltage_clamp = clamp_count(signals)
@@ -129,8 +130,8 @@ class _Case:
         """Initializes the instance; False (the case failed) when it refuses."""
         try:
             initialize(self.slave, self.scene, self.fmu, self.plan)
-            self.read, self.store, self.apply = point_calls(self.slave, RawCalls(self.slave), self.plan,
-                                                            measure_ideal=False)
+            self.read, self.store, self.apply, self.flush = point_calls(self.slave, RawCalls(self.slave), self.plan,
+                                                                        measure_ideal=False)
         except Exception as exc:   # SceneError too
             self.fail(exc)
             return False
@@ -154,7 +155,7 @@ class _Case:
                                                   "the voltages must be finite"))
             return False
         limit1, limit2 = self.u_limit
-        self.store(k, (min(max(u1, -limit1), limit1), min(max(u2, -limit2), limit2)), tuple(reference), (u1, u2))
+        self.store((min(max(u1, -limit1), limit1), min(max(u2, -limit2), limit2)), tuple(reference), (u1, u2))
         if k == self.plan.n:
             return True
         try:

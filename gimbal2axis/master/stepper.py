@@ -62,17 +62,19 @@ def choose_loop(controller, compiled: bool | None) -> str:
 
 
 def point_calls(slave, calls: RawCalls, plan, measure_ideal: bool = True):
-    """The three calls of a communication point on the plan's current chunk (row = k - plan.first),
-    closures over its tables' addresses (a local costs less than an attribute per step; the plan keeps
-    the arrays alive, and the closures the plan):
+    """The calls of a communication point on the plan's current chunk (row = k - plan.first), closures
+    over its tables' addresses (a local costs less than an attribute per step; the plan keeps the arrays
+    alive, and the closures the plan):
       read(k, row) -> (alpha, beta, gyro, base attitude, base rates) as the controller sees them at t_k,
         the outputs read into the record first (FMUCallFailed when the FMU refuses);
-      store(row, u, reference, asked): the controller's output at t_k, its set point, what it asked;
-      apply(k, row): the delayed command and the base inputs set, the step over [t_k, t_k+1] made.
+      store(u, reference, asked): the controller's output at the chunk's next point, its set point, what
+        it asked before its clamp (kept in lists: appending costs less than writing a numpy row);
+      apply(k, row): the delayed command and the base inputs set, the step over [t_k, t_k+1] made;
+      flush(): the commands stored into the plan's tables (u_cmd, refs, u_asked), before they are read.
     `measure_ideal` False: ideal sensors pass the outputs on without the kernel's call."""
     (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
         [a.ctypes.data for a in plan.vr_arrays], [len(a) for a in plan.vr_arrays]
-    rec_real, inputs, u_cmd, refs, u_asked = plan.rec_real, plan.inputs, plan.u_cmd, plan.refs, plan.u_asked
+    rec_real, inputs = plan.rec_real, plan.inputs
     real_row, real_stride = rec_real.ctypes.data, rec_real.strides[0]
     mode_row, mode_stride = plan.rec_mode.ctypes.data, plan.rec_mode.strides[0]
     input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
@@ -84,6 +86,8 @@ def point_calls(slave, calls: RawCalls, plan, measure_ideal: bool = True):
     i_alpha, i_beta, (g1, g2, g3), (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, \
         plan.i_joint_rates
     h, delay, zero = plan.h, plan.delay, (0.0, 0.0)
+    commands, references, asked_commands = [], [], []   # the chunk's, from its row 0
+    carried = plan.u_cmd[:delay].tolist()   # the last `delay` commands of the chunk before (0 before the first)
 
     def read(k, row):
         plan.k = k
@@ -97,19 +101,31 @@ def point_calls(slave, calls: RawCalls, plan, measure_ideal: bool = True):
         alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]], y[i_alpha_dot], y[i_beta_dot])
         return alpha, beta, gyro, attitude_rows[row], rate_rows[row]
 
-    def store(row, u, reference, asked):
-        u_cmd[delay + row] = u
-        refs[row] = reference
-        u_asked[row] = asked
+    def store(u, reference, asked):
+        commands.append(u)
+        references.append(reference)
+        asked_commands.append(asked)
 
     def apply(k, row):
-        inputs[row, 0], inputs[row, 1] = u_cmd[delay + row] if delay == 0 else (u_cmd[row] if k >= delay else zero)
+        if delay == 0:
+            inputs[row, 0], inputs[row, 1] = commands[row]
+        elif k < delay:
+            inputs[row, 0], inputs[row, 1] = zero
+        else:   # the command of step k - delay: of this chunk, or carried over from the one before
+            inputs[row, 0], inputs[row, 1] = commands[row - delay] if row >= delay else carried[row]
         if set_real(component, input_refs, input_count, input_row + row * input_stride) > 1:
             raise FMUCallFailed("fmi2SetReal")
         if do_step(component, k * h, h, 1) > 1:
             raise FMUCallFailed("fmi2DoStep")
 
-    return read, store, apply
+    def flush():
+        count = len(commands)
+        if count:
+            plan.u_cmd[delay:delay + count] = commands
+            plan.refs[:count] = references
+            plan.u_asked[:count] = asked_commands
+
+    return read, store, apply, flush
 
 
 class Stepper:
@@ -141,7 +157,7 @@ class Stepper:
         """Locals only inside the loop: it is the Python runs' whole per-step cost. Ends early, before
         reading the outputs at t_k, when `stop` is requested."""
         plan = self.plan
-        read, store, apply = point_calls(self.slave, self.calls, plan)
+        read, store, apply, flush = point_calls(self.slave, self.calls, plan)
         controller, h, n, offset = plan.controller, plan.h, plan.n, plan.first
         recorded = first
         try:
@@ -151,7 +167,7 @@ class Stepper:
                 row = k - offset
                 alpha, beta, gyro, attitude, rates = read(k, row)
                 u = controller(k * h, h, alpha, beta, gyro, attitude, rates, step=k)
-                store(row, u, controller.reference, controller.asked)
+                store(u, controller.reference, controller.asked)
                 recorded = k + 1
                 if k == n:
                     break
@@ -159,6 +175,7 @@ class Stepper:
                 if k % PROGRESS_STEPS == 0:
                     bar.update((k + 1) * h)
         finally:
+            flush()
             plan.rows = recorded
 
     def compiled_steps(self, first: int, last: int, stop: StopRequest, bar) -> None:
