@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import FMUCallFailed, SceneError, StopSignal
 from ..scene.controllers import ControllerError
 from . import compiled_loop
+from .plan import initialize
 from .stopping import Stop, StopRequest
 
 # Steps of the compiled loop between progress updates and looks at a StopRequest: about 40 ms of
@@ -228,8 +229,6 @@ def failure_error(message: str, exc: BaseException) -> SceneError:
 def start(slave, scene, fmu, plan, log: list | None) -> None:
     """Initializes the instance (plan.initialize) and starts the controller; a refusal raises SceneError
     (the scene's, not the run's: nothing is recorded)."""
-    from .plan import initialize
-
     try:
         initialize(slave, scene, fmu, plan)
         plan.controller.start(plan.h, scene.name)
