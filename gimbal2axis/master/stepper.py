@@ -73,22 +73,21 @@ def point_calls(slave, calls: RawCalls, plan, measure_ideal: bool = True):
       apply(k, row): the delayed command and the base inputs set, the step over [t_k, t_k+1] made;
       flush(): the commands stored into the plan's tables (u_cmd, refs, u_asked), before they are read.
     `measure_ideal` False: ideal sensors pass the outputs on without the kernel's call."""
-    (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
-        [a.ctypes.data for a in plan.vr_arrays], [len(a) for a in plan.vr_arrays]
-    rec_real, inputs = plan.rec_real, plan.inputs
+    return (_reader(slave.component, calls, plan, measure_ideal),) + _commander(slave.component, calls, plan)
+
+
+def _reader(component, calls: RawCalls, plan, measure_ideal: bool):
+    """point_calls' read."""
+    (real_refs, mode_refs), (real_count, mode_count) = \
+        [a.ctypes.data for a in plan.vr_arrays[:2]], [len(a) for a in plan.vr_arrays[:2]]
+    rec_real, get_real, get_integer = plan.rec_real, calls.get_real, calls.get_integer
     real_row, real_stride = rec_real.ctypes.data, rec_real.strides[0]
     mode_row, mode_stride = plan.rec_mode.ctypes.data, plan.rec_mode.strides[0]
-    input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
-    component = slave.component
-    get_real, get_integer, set_real, do_step = calls.get_real, calls.get_integer, calls.set_real, calls.do_step
     measure = None if plan.sensors.ideal and not measure_ideal else plan.sensors.measure
     # Python floats: reading them per step costs less than indexing numpy rows
     attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
     i_alpha, i_beta, (g1, g2, g3), (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, \
         plan.i_joint_rates
-    h, delay, zero = plan.h, plan.delay, (0.0, 0.0)
-    commands, references, asked_commands = [], [], []   # the chunk's, from its row 0
-    carried = plan.u_cmd[:delay].tolist()   # the last `delay` commands of the chunk before (0 before the first)
 
     def read(k, row):
         plan.k = k
@@ -101,6 +100,18 @@ def point_calls(slave, calls: RawCalls, plan, measure_ideal: bool = True):
             return y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]], attitude_rows[row], rate_rows[row]
         alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]], y[i_alpha_dot], y[i_beta_dot])
         return alpha, beta, gyro, attitude_rows[row], rate_rows[row]
+
+    return read
+
+
+def _commander(component, calls: RawCalls, plan):
+    """point_calls' store, apply and flush."""
+    input_refs, input_count = plan.vr_arrays[2].ctypes.data, len(plan.vr_arrays[2])
+    inputs, set_real, do_step = plan.inputs, calls.set_real, calls.do_step
+    input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
+    h, delay, zero = plan.h, plan.delay, (0.0, 0.0)
+    commands, references, asked_commands = [], [], []   # the chunk's, from its row 0
+    carried = plan.u_cmd[:delay].tolist()   # the last `delay` commands of the chunk before (0 before the first)
 
     def store(u, reference, asked):
         commands.append(u)
@@ -126,7 +137,7 @@ def point_calls(slave, calls: RawCalls, plan, measure_ideal: bool = True):
             plan.refs[:count] = references
             plan.u_asked[:count] = asked_commands
 
-    return read, store, apply, flush
+    return store, apply, flush
 
 
 class Stepper:
