@@ -104,7 +104,7 @@ def execute(args) -> int:
 
 def _run(args) -> int:
     # here, not at the top: `gimbal2axis --help` and the other subcommands do without numpy and fmpy
-    from ..master.master import StopRequest
+    from ..master.stopping import StopRequest
 
     stop = StopRequest()
     with signals_end_the_run(stop):   # from the start: no phase of the run may ignore Ctrl-C
@@ -117,7 +117,7 @@ def _run(args) -> int:
 
 def _run_scene(args, stop) -> int:
     from ..master import run_scene_file
-    from ..master.master import STOP_KINDS
+    from ..master.stopping import STOP_KINDS
     from ..scene import load_scene
 
     scene_path = scene_file(args.scene, DEFAULT_SCENE, "the scene file: gimbal2axis run SCENE.toml")
@@ -141,10 +141,15 @@ def _run_scene(args, stop) -> int:
         # stopped before the first communication point (nothing recorded, nothing written)
         print(one_line(f"{PROG}: {STOP_KINDS[stop.kind]} before the run started: {exc}"), file=sys.stderr)
         return EXIT_FOR_STOP[stop.kind]
-    status_path = csv_path.with_name(scene.name + "_run.json")
     if not args.quiet:
         print(result.summary())
         print(f"wrote {', '.join(str(path) for path in result.files_written)}")
+    return _exit_status(args, stop, result, csv_path, csv_path.with_name(scene.name + "_run.json"))
+
+
+def _exit_status(args, stop, result, csv_path: pathlib.Path, status_path: pathlib.Path) -> int:
+    """What a run that recorded something says on stderr, and its exit status: stopped early, files not
+    written, requirements not met (with --check), or done."""
     if result.stopped is not None:
         stopped = result.stopped
         kept = (f"the results for [0, {stopped.time:g}] s are in {csv_path} and .parquet, marked partial in "
@@ -171,7 +176,7 @@ def _run_scene(args, stop) -> int:
 def _stopped_outside_steps(args, stop) -> int:
     """A signal raised where the run could not end at a step (loading, a repeated signal, the record's
     merge, the plots): the record as far as it was written is kept, and _run.json says how far."""
-    from ..master.master import STOP_KINDS
+    from ..master.stopping import STOP_KINDS
 
     status_path = getattr(stop, "record_status_path", None)   # set once this run's record took the name over
     where = f"; the record is kept as far as it goes, as {status_path} says" if status_path else \

@@ -1,7 +1,7 @@
 """The compiled communication loop (c_kernel/src/master_loop.c) for the built-in controllers,
 through ctypes.
 
-It does what master.step_loop does with a built-in controller, with the same kernel for the
+It does what stepper.Stepper.python_steps does with a built-in controller, with the same kernel for the
 controller and the sensors: the tests check both loops give the same bits. A scene with a user
 controller (type "python") runs the Python loop; so does everything when the kernel was not built
 (`available()` says why).
@@ -9,8 +9,6 @@ controller (type "python") runs the Python loop; so does everything when the ker
 from __future__ import annotations
 
 import ctypes
-
-import numpy as np
 
 from .. import native
 from ..errors import FMUCallFailed
@@ -27,26 +25,18 @@ def supports(controller) -> bool:
 
 
 class CompiledLoop:
-    """One run's loop state; `run(first, last)` steps k = first .. last like master.step_loop."""
+    """One run's loop state; `run(first, last)` steps k = first .. last like stepper.Stepper.python_steps,
+    on the plan's tables (point_at_chunk before each chunk)."""
 
-    def __init__(self, slave, calls, plan, chunked: bool = False):
-        """`chunked`: the plan's tables hold a chunk of the run at a time (streaming.py: point_at_chunk
-        before each); else they hold the whole run and the commands' tables are made here."""
+    def __init__(self, slave, calls, plan):
         self.library = native.kernel()
         self.plan = plan   # keeps every array the struct points into alive
-        self.vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
-        rows = 0 if chunked else plan.n + 1
-        self.u_cmd = np.zeros((rows, 2))
-        self.refs = np.full((rows, 2), np.nan)
-        self.u_asked = np.zeros((rows, 2))   # the controller's outputs before its clamp
         m = self.loop = native.struct("GimbalMasterLoop")()
         m.component = slave.component
         for name in ("get_real", "get_integer", "set_real", "do_step"):
             setattr(m, name, ctypes.cast(getattr(calls, name), ctypes.c_void_p).value)
-        m.real_vrs, m.mode_vrs, m.input_vrs = (a.ctypes.data for a in self.vr_arrays)
-        m.real_count, m.mode_count, m.input_count = (len(a) for a in self.vr_arrays)
-        m.rec_real, m.rec_mode, m.inputs = plan.rec_real.ctypes.data, plan.rec_mode.ctypes.data, plan.inputs.ctypes.data
-        m.u_cmd, m.refs, m.u_asked = self.u_cmd.ctypes.data, self.refs.ctypes.data, self.u_asked.ctypes.data
+        m.real_vrs, m.mode_vrs, m.input_vrs = (a.ctypes.data for a in plan.vr_arrays)
+        m.real_count, m.mode_count, m.input_count = (len(a) for a in plan.vr_arrays)
         m.h, m.n, m.delay = plan.h, plan.n, plan.delay
         m.i_alpha, m.i_beta = plan.i_alpha, plan.i_beta
         m.i_gyro[:] = plan.i_gyro
@@ -56,9 +46,9 @@ class CompiledLoop:
         m.controller = plan.controller.state
 
     def point_at_chunk(self, first: int, plan) -> None:
-        """For a run streamed in chunks (streaming.py): the kernel indexes every table by the run's
-        step k, so each table of the chunk whose row 0 is step `first` is given as the address its
-        row 0 of the run would have (sensors.SensorStream's _shifted); the commands' table starts
+        """Before each chunk (a run held in memory has one, first = 0): the kernel indexes every table by
+        the run's step k, so each table of the chunk whose row 0 is step `first` is given as the address
+        its row 0 of the run would have (sensors.SensorStream's _shifted); the commands' table starts
         `delay` rows earlier, with the commands of the chunk before (the delayed voltage reads them).
         The sensors' and controller's running states stay the loop's own."""
         from ..scene.sensors import _shifted

@@ -1,12 +1,12 @@
 """N cases of a user controller class with `batch = True`, stepped together (lockstep): one FMU
-instance and one master.Plan per case (its own base motion, sensors, records and delay), one call
+instance and one plan.Plan per case (its own base motion, sensors, records and delay), one call
 of the user's step() for all of them per communication point.
 
-Per communication point t_k: each case's outputs are read into its records through raw calls on
-preallocated arrays (as in master.step_loop) and its sensors measure; the measurements are stacked
-(alpha, beta: (N,); gyro, base_attitude, base_rates: (N, 3)); the user's step(t, measurements)
-returns (N, 2) voltages; then, case by case, the voltage (saturated at the case's +-U_L) goes into
-its record, the delayed one into its inputs, and its FMU takes the step.
+Per communication point t_k: each case's outputs are read into its records and its sensors measure
+(the stepper's calls of a point, stepper.point_calls, as a single run's Python loop makes them); the
+measurements are stacked (alpha, beta: (N,); gyro, base_attitude, base_rates: (N, 3)); the user's
+step(t, measurements) returns (N, 2) voltages; then, case by case, the voltage (saturated at the
+case's +-U_L) goes into its record, the delayed one into its inputs, and its FMU takes the step.
 
 Cases run together when they share what the loop's one clock and the class's one object need
 (batch_key): the class, the step size, the number of steps, the delay, whether there is a target,
@@ -33,10 +33,10 @@ import time
 import numpy as np
 
 from ..scene import controllers
-from ..errors import SceneError, StopSignal
-from .master import (FMUCallFailed, Plan, RawCalls, clamp_count, failure_error, failure_message, initialize,
-                     recorded_signals)
-from .results import RunResult
+from ..errors import FMUCallFailed, SceneError, StopSignal
+from .plan import Plan, initialize
+from .results import RunResult, clamp_count
+from .stepper import RawCalls, failure_error, failure_message, point_calls
 from ..scene.scene import Scene
 
 
@@ -95,27 +95,75 @@ def _per_case(values: list):
 
 
 class _Case:
-    """One case of the batch: its plan, its instance and the raw pointers its loop uses."""
+    """One case of the batch: its plan, its instance, the stepper's calls of a point on them, and its
+    last measurements (what the batch's arrays hold for it once it has dropped out)."""
 
     def __init__(self, index, position, scene, fmu, plan, u_limit):
         self.index, self.position = index, position   # in the scenes given; in the batch's arrays
         self.scene, self.fmu, self.plan, self.u_limit = scene, fmu, plan, u_limit
         self.slave = self.log = None
         self.error = None      # the SceneError once failed
+        self.measured = (0.0, 0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
 
-    def wire(self):
-        plan = self.plan
-        calls = RawCalls(self.slave)
-        self.get_real, self.get_integer = calls.get_real, calls.get_integer
-        self.set_real, self.do_step = calls.set_real, calls.do_step
-        self.vr_arrays = [np.array(v, dtype=np.uint32) for v in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
-        (self.real_refs, self.mode_refs, self.input_refs) = [a.ctypes.data for a in self.vr_arrays]
-        self.real_count, self.mode_count, self.input_count = [len(a) for a in self.vr_arrays]
-        self.real_row, self.real_stride = plan.rec_real.ctypes.data, plan.rec_real.strides[0]
-        self.mode_row, self.mode_stride = plan.rec_mode.ctypes.data, plan.rec_mode.strides[0]
-        self.input_row, self.input_stride = plan.inputs.ctypes.data, plan.inputs.strides[0]
-        self.component = self.slave.component
-        self.attitude_rows, self.rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
+    def take_instance(self, instance) -> None:
+        """`instance`: the (slave, log) to reuse, reset first (its log cleared); None: a fresh one."""
+        if instance is None:
+            self.log = []
+            self.slave = self.fmu.instantiate(self.scene.name, self.log)
+            return
+        self.slave, self.log = instance
+        self.log.clear()
+        self.slave.reset()
+
+    def result(self, wall: float, cpu: float, count: int) -> RunResult:
+        """The case's RunResult, with its share of the batch's times."""
+        self.flush()
+        signals = self.plan.chunk_signals(self.plan.n + 1)
+        result = RunResult(self.scene, signals, wall / count, self.plan.t_end)
+        result.voltage_clamp = clamp_count(signals)
+        result.loop_cpu_time = cpu / count   # the batch's set-up and loop, shared out evenly
+        result.loop = "lockstep"
+        result.batch_size = count
+        return result
+
+    def start(self) -> bool:
+        """Initializes the instance; False (the case failed) when it refuses."""
+        try:
+            initialize(self.slave, self.scene, self.fmu, self.plan)
+            self.read, self.store, self.apply, self.flush = point_calls(self.slave, RawCalls(self.slave), self.plan,
+                                                                        measure_ideal=False)
+        except Exception as exc:   # SceneError too
+            self.fail(exc)
+            return False
+        return True
+
+    def measure(self, k: int) -> bool:
+        """Reads the outputs at t_k and measures them; False (the case failed) when the FMU refuses."""
+        try:
+            self.measured = self.read(k, k)
+        except FMUCallFailed as exc:
+            self.fail(exc)
+            return False
+        return True
+
+    def step(self, k: int, u1: float, u2: float, reference, label: str, t: float) -> bool:
+        """Records the batch's voltages for this case (saturated at its +-U_L) and, before the last point,
+        steps its FMU with the delayed ones; False (the case failed) for voltages that are not finite or
+        an FMU that refuses."""
+        if not (math.isfinite(u1) and math.isfinite(u2)):
+            self.fail(controllers.ControllerError(f"{label}: step() at t = {t:.6g} s returned ({u1}, {u2}): "
+                                                  "the voltages must be finite"))
+            return False
+        limit1, limit2 = self.u_limit
+        self.store((min(max(u1, -limit1), limit1), min(max(u2, -limit2), limit2)), tuple(reference), (u1, u2))
+        if k == self.plan.n:
+            return True
+        try:
+            self.apply(k, k)
+        except FMUCallFailed as exc:
+            self.fail(exc)
+            return False
+        return True
 
     def fail(self, exc: Exception):
         """Ends the case with the SceneError of `exc` (a ControllerError, naming the scene, when the
@@ -137,6 +185,28 @@ def run_lockstep(scenes: list, fmu, instances: list | None = None) -> list:
     if len(keys) != 1 or None in keys:
         raise ValueError("run_lockstep needs scenes of one batch class that share batch_key()")
     outcomes: list = [None] * len(scenes)
+    cases = _planned_cases(scenes, fmu, outcomes)
+    if not cases:
+        return outcomes
+    owned = instances is None
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    try:
+        for case in cases:
+            case.take_instance(None if owned else instances[case.index])
+        _run(cases)
+    finally:
+        if owned:
+            for case in cases:
+                if case.slave is not None:
+                    case.slave.freeInstance()
+    wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    for case in cases:
+        outcomes[case.index] = case.error if case.error is not None else case.result(wall, cpu, len(cases))
+    return outcomes
+
+
+def _planned_cases(scenes: list, fmu, outcomes: list) -> list:
+    """A _Case per scene whose plan could be made; the SceneError of the others into `outcomes`."""
     cases = []
     for i, scene in enumerate(scenes):
         try:
@@ -146,52 +216,47 @@ def run_lockstep(scenes: list, fmu, instances: list | None = None) -> list:
             outcomes[i] = exc
             continue
         cases.append(_Case(i, len(cases), scene, fmu, plan, u_limit))
-    if not cases:
-        return outcomes
-    owned = instances is None
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    try:
-        for case in cases:
-            if owned:
-                case.log = []
-                case.slave = fmu.instantiate(case.scene.name, case.log)
-            else:
-                case.slave, case.log = instances[case.index]
-                case.log.clear()
-                case.slave.reset()
-        _run(cases)
-    finally:
-        if owned:
-            for case in cases:
-                if case.slave is not None:
-                    case.slave.freeInstance()
-    wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
-    for case in cases:
-        if case.error is not None:
-            outcomes[case.index] = case.error
-            continue
-        signals = recorded_signals(case.plan)
-        result = RunResult(case.scene, signals, wall / len(cases), case.plan.t_end)
-        result.voltage_clamp = clamp_count(signals)
-        result.loop_cpu_time = cpu / len(cases)   # the batch's set-up and loop, shared out evenly
-        result.loop = "lockstep"
-        result.batch_size = len(cases)
-        outcomes[case.index] = result
-    return outcomes
+    return cases
 
 
-def _make_user(cases: list):
-    first = cases[0].scene
-    spec = first.controller_spec
-    cls, path = controllers.load_user_class(spec, first.path.parent)
-    label = controllers.class_label(cls, path)
-    options = merge_options([case.scene.controller_spec.get("options", {}) for case in cases])
-    user = controllers.build_user(cls, label, path, options)
-    u_limit = tuple(_per_case([case.u_limit[j] for case in cases]) for j in (0, 1))
-    target = None if first.target is None else _per_case([case.scene.target for case in cases])
-    context = controllers.ControllerContext(first.step_size, u_limit, target, int(spec.get("delay_steps", 1)),
-                                            first.name, cases=len(cases))
-    return user, label, path, context
+class _Batch:
+    """The user's batch object for the cases, and its call per communication point."""
+
+    def __init__(self, cases: list):
+        first = cases[0].scene
+        spec = first.controller_spec
+        cls, self.path = controllers.load_user_class(spec, first.path.parent)
+        self.label = controllers.class_label(cls, self.path)
+        options = merge_options([case.scene.controller_spec.get("options", {}) for case in cases])
+        self.user = controllers.build_user(cls, self.label, self.path, options)
+        self.count = len(cases)
+        u_limit = tuple(_per_case([case.u_limit[j] for case in cases]) for j in (0, 1))
+        target = None if first.target is None else _per_case([case.scene.target for case in cases])
+        self.context = controllers.ControllerContext(first.step_size, u_limit, target,
+                                                     int(spec.get("delay_steps", 1)), first.name, cases=len(cases))
+
+    def reset(self) -> None:
+        try:
+            self.user.reset(self.context)
+        except StopSignal:
+            raise
+        except BaseException as exc:   # sys.exit, a KeyboardInterrupt of its own: the code's failure
+            raise controllers.user_exception(self.label, "reset()", exc, self.path, 0.0) from None
+
+    def step(self, t: float, cases: list) -> tuple[list, list]:
+        """The voltages and set points, (N, 2) lists, of the user's step() for the cases' measurements."""
+        rows, array = [case.measured for case in cases], np.array
+        m = controllers.Measurements(array([r[0] for r in rows]), array([r[1] for r in rows]),
+                                     array([r[2] for r in rows]), array([r[3] for r in rows]),
+                                     array([r[4] for r in rows]))
+        try:
+            returned = self.user.step(t, m)
+        except StopSignal:
+            raise
+        except BaseException as exc:
+            raise controllers.user_exception(self.label, "step()", exc, self.path, t) from None
+        return (controllers.batch_voltages(self.label, t, returned, self.count).tolist(),
+                controllers.batch_reference(self.label, self.user, self.count).tolist())
 
 
 def _fail_all(alive: list, exc: Exception):
@@ -202,110 +267,27 @@ def _fail_all(alive: list, exc: Exception):
 
 def _run(cases: list) -> None:
     """Initialization and the communication steps of the cases; failures go to case.error."""
-    alive = []
-    for case in cases:
-        try:
-            initialize(case.slave, case.scene, case.fmu, case.plan)
-            case.wire()
-            alive.append(case)
-        except Exception as exc:   # SceneError too
-            case.fail(exc)
+    alive = [case for case in cases if case.start()]
     if not alive:
         return
     try:
-        user, label, path, context = _make_user(cases)
-        try:
-            user.reset(context)
-        except StopSignal:
-            raise
-        except BaseException as exc:   # sys.exit, a KeyboardInterrupt of its own: the code's failure
-            raise controllers.user_exception(label, "reset()", exc, path, 0.0) from None
+        batch = _Batch(cases)
+        batch.reset()
     except Exception as exc:   # a SceneError as it is; others as master.run reports them, at t = 0
         return _fail_all(alive, exc)
-    first = cases[0].plan
-    h, n, delay, count = first.h, first.n, first.delay, len(cases)
-    zero = (0.0, 0.0)
-    rows = [[0.0, 0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]] for _ in cases]  # last measurements
-    # Per case the locals of its loop in one tuple (unpacking costs less than attribute look-ups).
-    slots = [(case, case.plan, case.component, case.get_real, case.real_refs, case.real_count, case.real_row,
-              case.real_stride, case.get_integer, case.mode_refs, case.mode_count, case.mode_row, case.mode_stride,
-              case.set_real, case.input_refs, case.input_count, case.input_row, case.input_stride, case.do_step,
-              case.plan.rec_real, case.plan.inputs, None if case.plan.sensors.ideal else case.plan.sensors.measure,
-              case.plan.i_alpha, case.plan.i_beta, case.plan.i_gyro, case.plan.i_joint_rates, case.attitude_rows,
-              case.rate_rows,
-              case.plan.u_cmd, case.plan.refs, case.u_limit[0], case.u_limit[1], rows[case.position],
-              case.plan.u_asked)
-             for case in alive]
-    isfinite, array, Measurements = math.isfinite, np.array, controllers.Measurements
+    h, n = cases[0].plan.h, cases[0].plan.n
     for k in range(n + 1):
         t = k * h
-        failed = []
-        for slot in slots:
-            (case, plan, component, get_real, real_refs, real_count, real_row, real_stride, get_integer, mode_refs,
-             mode_count, mode_row, mode_stride, _, _, _, _, _, _, rec_real, _, measure, i_alpha, i_beta, (g1, g2, g3),
-             (i_alpha_dot, i_beta_dot), attitude_rows, rate_rows, _, _, _, _, row, _) = slot
-            plan.k = k
-            if get_real(component, real_refs, real_count, real_row + k * real_stride) > 1:
-                case.fail(FMUCallFailed("fmi2GetReal"))
-                failed.append(slot)
-                continue
-            if mode_count and get_integer(component, mode_refs, mode_count, mode_row + k * mode_stride) > 1:
-                case.fail(FMUCallFailed("fmi2GetInteger"))
-                failed.append(slot)
-                continue
-            y = rec_real[k].tolist()
-            if measure is None:
-                row[0], row[1], row[2] = y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]]
-            else:
-                row[0], row[1], row[2] = measure(k, y[i_alpha], y[i_beta], [y[g1], y[g2], y[g3]], y[i_alpha_dot],
-                                                 y[i_beta_dot])
-            row[3], row[4] = attitude_rows[k], rate_rows[k]
-        if failed:
-            slots = [slot for slot in slots if slot not in failed]
-        if not slots:
+        alive = [case for case in alive if case.measure(k)]
+        if not alive:
             return
-        m = Measurements(array([r[0] for r in rows]), array([r[1] for r in rows]), array([r[2] for r in rows]),
-                         array([r[3] for r in rows]), array([r[4] for r in rows]))
         try:
-            try:
-                returned = user.step(t, m)
-            except StopSignal:
-                raise
-            except BaseException as exc:
-                raise controllers.user_exception(label, "step()", exc, path, t) from None
-            voltages = controllers.batch_voltages(label, t, returned, count).tolist()
-            references = controllers.batch_reference(label, user, count).tolist()
+            voltages, references = batch.step(t, cases)
         except Exception as exc:
-            return _fail_all([slot[0] for slot in slots], exc)
-        failed = []
-        for slot in slots:
-            (case, plan, component, _, _, _, _, _, _, _, _, _, _, set_real, input_refs, input_count, input_row,
-             input_stride, do_step, _, inputs, _, _, _, _, _, _, _, u_cmd, refs, limit1, limit2, _, u_asked) = slot
-            position = case.position
-            u1, u2 = voltages[position]
-            if not (isfinite(u1) and isfinite(u2)):
-                case.fail(controllers.ControllerError(f"{label}: step() at t = {t:.6g} s returned ({u1}, {u2}): "
-                                                      "the voltages must be finite"))
-                failed.append(slot)
-                continue
-            u = (min(max(u1, -limit1), limit1), min(max(u2, -limit2), limit2))
-            u_cmd.append(u)
-            refs.append(tuple(references[position]))
-            u_asked.append((u1, u2))
-            if k == n:
-                continue
-            applied = u if delay == 0 else (u_cmd[k - delay] if k >= delay else zero)
-            inputs[k, 0], inputs[k, 1] = applied
-            if set_real(component, input_refs, input_count, input_row + k * input_stride) > 1:
-                case.fail(FMUCallFailed("fmi2SetReal"))
-                failed.append(slot)
-            elif do_step(component, t, h, 1) > 1:
-                case.fail(FMUCallFailed("fmi2DoStep"))
-                failed.append(slot)
-        if failed:
-            slots = [slot for slot in slots if slot not in failed]
-    for slot in slots:
-        case = slot[0]
+            return _fail_all(alive, exc)
+        alive = [case for case in alive
+                 if case.step(k, *voltages[case.position], references[case.position], batch.label, t)]
+    for case in alive:
         try:
             case.slave.terminate()
         except Exception as exc:

@@ -9,7 +9,10 @@ import pathlib
 import numpy as np
 
 from ..scene import geometry
+from ..scene.controllers import AXES
+from ..scene.drives import command_columns
 from . import spectra, units
+from .stopping import STOP_KINDS
 
 # Per-axis signed pointing errors (line of sight minus target) [rad]: cross-elevation (the azimuth
 # error times cos of the target's elevation, an angle across the line of sight) and elevation.
@@ -39,7 +42,7 @@ def tracking_signals(moving, s: dict) -> dict:
 
 class RunResult:
     """`stop_time`: the end of the record (the last communication point recorded). `stopped`: None
-    for a whole run, else a master.Stop (kind, time, reason) of a run that ended early, whose record
+    for a whole run, else a stopping.Stop (kind, time, reason) of a run that ended early, whose record
     covers [0, stopped.time] (master.run(keep_partial=True)); `requested_stop_time` is where it was
     to end."""
 
@@ -252,45 +255,89 @@ class RunResult:
         np.savetxt(path, data, delimiter=",", header=units.csv_header(names), comments="", fmt="%.12g")
 
     def summary(self) -> str:
-        s = self.signals
-        rtf = self.stop_time / self.wall_time if self.wall_time > 0 else math.inf
-        parts = [f"{self.scene.name}: {self.stop_time:g} s simulated in {self.wall_time:.2f} s wall "
-                 f"({rtf:.1f}x real time)"]
-        if self.stopped is not None:
-            from .master import STOP_KINDS
-            parts[0] = (f"{self.scene.name}: PARTIAL, {STOP_KINDS[self.stopped.kind]} at t = {self.stopped.time:g} s "
-                        f"of {self.requested_stop_time:g} s; {self.stop_time:g} s simulated in {self.wall_time:.2f} s "
-                        f"wall ({rtf:.1f}x real time)")
-        if self.has_target:
-            m = self.los_metrics()
-            # the window the RMS and max were taken over as it was, not as asked: a run that ends before the
-            # requirements' from_s is measured over the whole run (metrics_window)
-            window = " over [{:g}, {:g}] s".format(*self.window_bounds())
-            parts.append(f"LOS error final {m['final'] * 1e3:.4g} mrad, RMS{window} {m['rms'] * 1e3:.4g} mrad "
-                         f"(max {m['max'] * 1e3:.4g} mrad)")
-        else:
-            parts.append(f"final alpha {math.degrees(self.final('alpha')):.4f} deg, "
-                         f"beta {math.degrees(self.final('beta')):.4f} deg")
+        """The summary line: how long the run took, the pointing, the tracking, the bands, the events,
+        the clamps and the requirements, each where the run has them."""
+        parts = [self._timing_summary(), self._pointing_summary()]
         tracking = self.tracking_metrics()
         if tracking is not None:
             parts.append(tracking.summary())
-        bands = self.scene.analysis.bands
-        if self.has_target and bands:
-            spectrum = next(iter(self.los_spectra().values()), None)
-            resolution = f"{spectrum.resolution:g} Hz resolution" if spectrum else "no spectrum"
-            rms = self.band_rms()
-            window = " over [{:g}, {:g}] s".format(*self.window_bounds())
-            parts.append(f"LOS RMS by band{window} ({resolution}): " + ", ".join(
-                f"{name} [{lo:g}, {hi:g}) Hz {rms[name] * 1e3:.4g} mrad" for name, (lo, hi) in bands.items()))
+        if self.has_target and self.scene.analysis.bands:
+            parts.append(self._band_summary())
         if self.final("events.total") is not None:
             parts.append(f"{int(self.final('events.total'))} events")
-        clamp = getattr(self, "voltage_clamp", None)   # master.ClampCount, set by the run
+        clamp = getattr(self, "voltage_clamp", None)   # results.ClampCount, set by the run
         if clamp is not None and clamp.summary():
             parts.append(clamp.summary())
         if self.scene.requirements and self.has_target:
-            failures = self.requirement_failures()
-            if self.window_start() >= self.stop_time:
-                parts.append("requirements not judged (run ends before their window)")
-            else:
-                parts.append("requirements met" if not failures else "REQUIREMENTS FAILED: " + "; ".join(failures))
+            parts.append(self._requirements_summary())
         return "; ".join(parts)
+
+    def _timing_summary(self) -> str:
+        rtf = self.stop_time / self.wall_time if self.wall_time > 0 else math.inf
+        timing = f"{self.stop_time:g} s simulated in {self.wall_time:.2f} s wall ({rtf:.1f}x real time)"
+        if self.stopped is None:
+            return f"{self.scene.name}: {timing}"
+        return (f"{self.scene.name}: PARTIAL, {STOP_KINDS[self.stopped.kind]} at t = {self.stopped.time:g} s "
+                f"of {self.requested_stop_time:g} s; {timing}")
+
+    def _pointing_summary(self) -> str:
+        if not self.has_target:
+            return (f"final alpha {math.degrees(self.final('alpha')):.4f} deg, "
+                    f"beta {math.degrees(self.final('beta')):.4f} deg")
+        m = self.los_metrics()
+        # the window the RMS and max were taken over as it was, not as asked: a run that ends before the
+        # requirements' from_s is measured over the whole run (metrics_window)
+        window = " over [{:g}, {:g}] s".format(*self.window_bounds())
+        return (f"LOS error final {m['final'] * 1e3:.4g} mrad, RMS{window} {m['rms'] * 1e3:.4g} mrad "
+                f"(max {m['max'] * 1e3:.4g} mrad)")
+
+    def _band_summary(self) -> str:
+        spectrum = next(iter(self.los_spectra().values()), None)
+        resolution = f"{spectrum.resolution:g} Hz resolution" if spectrum else "no spectrum"
+        rms = self.band_rms()
+        window = " over [{:g}, {:g}] s".format(*self.window_bounds())
+        bands = self.scene.analysis.bands
+        return f"LOS RMS by band{window} ({resolution}): " + ", ".join(
+            f"{name} [{lo:g}, {hi:g}) Hz {rms[name] * 1e3:.4g} mrad" for name, (lo, hi) in bands.items())
+
+    def _requirements_summary(self) -> str:
+        failures = self.requirement_failures()
+        if self.window_start() >= self.stop_time:
+            return "requirements not judged (run ends before their window)"
+        return "requirements met" if not failures else "REQUIREMENTS FAILED: " + "; ".join(failures)
+
+
+class ClampCount:
+    """How often the controller's commands were clamped (voltages to +-U_L, current commands to
+    +-i_L: scene/drives.py), per axis, accumulated over a run (or its chunks): the steps whose applied
+    command differs from what the controller asked, of all steps, and the largest |command| asked on
+    that axis."""
+
+    def __init__(self, drives=None):
+        self.clamped, self.steps, self.max_asked = [0, 0], 0, [0.0, 0.0]
+        self.kinds = [("voltage", "V") if drive is None or drive.kind == "voltage" else ("current command", "A")
+                      for drive in (drives or (None, None))]
+
+    def add(self, asked: np.ndarray, commanded: np.ndarray) -> None:
+        """`asked`, `commanded`: (rows, 2), the controller's outputs before and after the clamp."""
+        self.steps += len(asked)
+        for axis in (0, 1):
+            self.clamped[axis] += int(np.count_nonzero(asked[:, axis] != commanded[:, axis]))
+            if len(asked):
+                self.max_asked[axis] = max(self.max_asked[axis], float(np.max(np.abs(asked[:, axis]))))
+
+    def summary(self) -> str | None:
+        """"voltage clamped on 1,234 of 60,000 steps (azimuth), max asked 1e+06 V; ..." ("current command
+        clamped ..., max asked 12 A" for a motor in current drive) or None when nothing was clamped."""
+        parts = [f"{self.kinds[axis][0]} clamped on {self.clamped[axis]:,} of {self.steps:,} steps ({AXES[axis]}), "
+                 f"max asked {self.max_asked[axis]:.4g} {self.kinds[axis][1]}" for axis in (0, 1) if self.clamped[axis]]
+        return "; ".join(parts) or None
+
+
+def clamp_count(signals: dict) -> ClampCount:
+    """The ClampCount of a run's recorded signals (Plan.chunk_signals), each axis by the columns of its drive."""
+    drives = [command_columns(signals, motor) for motor in (1, 2)]
+    count = ClampCount(drives)
+    count.add(np.column_stack([signals[drive.asked] for drive in drives]),
+              np.column_stack([signals[drive.commanded] for drive in drives]))
+    return count

@@ -9,8 +9,9 @@ communication points at a time, with the same loops and the same bits:
 - the base motion, the sensors' noise (each random draw of Sensors.prepare from a generator placed
   at its start, scene/sensors.py SensorStream) and the controller's set points of a chunk only, all
   elementwise or carried over from the chunk before, so equal to the rows of the whole run's;
-- the loop (the compiled one for built-in controllers, else the Python one) on the chunk's tables:
-  the C kernel indexes by the run's step, and reads a chunk's rows through shifted addresses;
+- the loop (stepper.py: the compiled one for built-in controllers, else the Python one) on the
+  chunk's tables (plan.StreamPlan): the C kernel indexes by the run's step, and reads a chunk's rows
+  through shifted addresses; each chunk's record goes to a RecordSink;
 - each chunk's record (its derived line-of-sight signals included, RunResult's) appended to
   <name>.parquet (one row group per chunk: a columnar file, so the plots and spectra read back only
   the columns they need) and its rows at the output interval to <name>.csv;
@@ -35,19 +36,19 @@ from ..errors import SceneError, StopSignal
 from ..fmu import FMU
 from ..progress import Progress
 from ..scene.base_motion import INPUTS as BASE_INPUTS
-from ..scene.scene import TRACKING_SIGNALS, Scene, check_against_fmu, check_run_length
-from . import compiled_loop, spectra
-from ..scene.drives import command_signals, scene_drives
-from ..scene.controllers import ControllerError
-from .master import (ClampCount, FMUCallFailed, RawCalls, Stop, StopRequest, choose_loop, choose_records,
-                     failure_error, failure_message, initialize, moving_target_accelerations)
+from ..scene.scene import TRACKING_SIGNALS, Scene
+from . import spectra
+from .memory import available_memory, size_text
+from .plan import StreamPlan
+from .stepper import RecordWriteFailed, choose_loop, start, step_run
+from .stopping import StopRequest
 from .record_files import RunRecord, record_tables
-from .results import AXIS_ERRORS, CARRIER_RATES, ISOLATION_AXES, RunResult
+from .results import AXIS_ERRORS, CARRIER_RATES, ISOLATION_AXES, ClampCount, RunResult
 
 # Communication points per chunk: 2^14 rows of ~60 doubles are 7.9 MB of record, some 50 MB with
 # their copies (the columns, Arrow's table, the CSV's rows): the ship scene's hour stays under 300 MB
 # (docs/benchmarks.md). A row group per chunk: 220 for the hour, whose metadata the file carries.
-# The compiled loop returns to Python every CHUNK_STEPS (master.py) within a chunk to show progress
+# The compiled loop returns to Python every CHUNK_STEPS (stepper.py) within a chunk to show progress
 # and see a stop.
 CHUNK_ROWS = 1 << 14
 # Pixel columns the plots' signals are decimated to (the figure is 1200 pixels wide at 100 dpi):
@@ -55,144 +56,6 @@ CHUNK_ROWS = 1 << 14
 PLOT_COLUMNS = 2000
 # The widest a %.12g number and its comma can be in the CSV: sign, 12 digits, point, e-308, comma.
 CSV_FIELD_BYTES = 20
-
-
-class StreamPlan:
-    """master.Plan for one chunk at a time: the same attributes (the loops and initialize read
-    them), with the tables of CHUNK_ROWS rows; `load_chunk(first, count)` makes the inputs of rows
-    first .. first + count - 1."""
-
-    def __init__(self, scene: Scene, fmu: FMU, stop_time: float | None, controller, chunk_rows: int):
-        check_against_fmu(scene, fmu)
-        self.scene, self.h = scene, scene.step_size
-        self.t_end = scene.stop_time if stop_time is None else stop_time
-        self.n = int(round(self.t_end / self.h))
-        check_run_length(scene, self.t_end)
-        self.motion = scene.base_motion()
-        self.drives = scene_drives(scene, fmu)
-        self.controller = controller or scene.controller(tuple(drive.limit for drive in self.drives))
-        self.sensors = scene.sensors()
-        self.delay = scene.delay_steps
-        choose_records(self, fmu)
-        self.chunk_rows = min(chunk_rows, self.n + 1)
-        rows = self.chunk_rows
-        self.rec_real = np.zeros((rows, len(self.real_names)))
-        self.rec_mode = np.zeros((rows, len(self.mode_names)), dtype=np.int32)
-        self.inputs = np.zeros((rows, len(self.input_vrs)))
-        # the commands: `delay` rows of the chunk before, then this chunk's (the delayed voltage reads back)
-        self.u_cmd = np.zeros((self.delay + rows, 2))
-        self.refs = np.full((rows, 2), np.nan)
-        self.u_asked = np.zeros((rows, 2))   # the controller's outputs before its clamp
-        self.sensor_stream = self.sensors.stream(self.n + 1, self.h)
-        self.k, self.rows = 0, 0   # the step reached; the points recorded whole (as Plan's)
-        self.first = 0
-
-    def load_chunk(self, first: int, count: int) -> None:
-        self.first, h = first, self.h
-        if first > 0 and self.delay:   # the last `delay` commands carry over
-            self.u_cmd[:self.delay] = self.u_cmd[self.chunk_rows:self.chunk_rows + self.delay]
-        self.refs[:] = np.nan
-        self.times = np.arange(first, first + count) * h
-        self.base = self.motion.sample_rows(first, count, h)
-        if not self.motion.fixed:
-            self.inputs[:count, 2:] = self.base
-        self.measured_attitude = self.sensor_stream.rows(first, self.base)
-        self.controller.prepare(self.times, h, self.measured_attitude, self.base[:, 3:6],
-                                **moving_target_accelerations(self.scene, self.base))
-        state = getattr(self.controller, "state", None)   # a user controller has no kernel state
-        points = state.set_points if state is not None else None
-        if points is not None and points.values:   # the set points' tables of this chunk, addressed by the run's step
-            points.values -= first * 2 * 8
-            points.rates -= first * 2 * 8
-            for name in ("accelerations", "gyro_rates"):   # a moving target's
-                if getattr(points, name):
-                    setattr(points, name, getattr(points, name) - first * 2 * 8)
-
-    def chunk_signals(self, count: int) -> dict:
-        """master.recorded_signals of the chunk's first `count` rows."""
-        u_cmd = self.u_cmd[self.delay:self.delay + count]
-        u_applied = self.u_cmd[:count].copy()
-        early = np.arange(self.first, self.first + count) < self.delay
-        u_applied[early] = 0.0
-        times = self.times[:count]
-        signals = {"time": times}
-        signals.update({name: self.rec_real[:count, j].copy() for j, name in enumerate(self.real_names)})
-        signals.update({name: self.rec_mode[:count, j].astype(float) for j, name in enumerate(self.mode_names)})
-        signals.update(command_signals(self.drives, u_applied, u_cmd.copy(), self.u_asked[:count].copy()))
-        signals.update({"alpha_ref": self.refs[:count, 0].copy(), "beta_ref": self.refs[:count, 1].copy()})
-        signals.update({name: self.base[:count, j] for j, name in enumerate(BASE_INPUTS)})
-        signals["heave"] = self.motion.position_rows(self.first, count, self.h)[:, 2]
-        return signals
-
-
-def python_chunk(slave, calls: RawCalls, plan: StreamPlan, first: int, last: int, stop: StopRequest, bar) -> None:
-    """master.step_loop over steps first .. last of the chunk's tables (row k - first); plan.rows
-    says how many points are recorded whole, also when a call or the controller raises."""
-    vr_arrays = [np.array(vrs, dtype=np.uint32) for vrs in (plan.real_vrs, plan.mode_vrs, plan.input_vrs)]
-    (real_refs, mode_refs, input_refs), (real_count, mode_count, input_count) = \
-        [a.ctypes.data for a in vr_arrays], [len(a) for a in vr_arrays]
-    rec_real, inputs = plan.rec_real, plan.inputs
-    real_row, real_stride = rec_real.ctypes.data, rec_real.strides[0]
-    mode_row, mode_stride = plan.rec_mode.ctypes.data, plan.rec_mode.strides[0]
-    input_row, input_stride = inputs.ctypes.data, inputs.strides[0]
-    component = slave.component
-    get_real, get_integer, set_real, do_step = calls.get_real, calls.get_integer, calls.set_real, calls.do_step
-    measure, controller = plan.sensors.measure, plan.controller
-    h, n, delay = plan.h, plan.n, plan.delay
-    attitude_rows, rate_rows = plan.measured_attitude.tolist(), plan.base[:, 3:6].tolist()
-    i_alpha, i_beta, i_gyro, (i_alpha_dot, i_beta_dot) = plan.i_alpha, plan.i_beta, plan.i_gyro, plan.i_joint_rates
-    u_cmd, refs, u_asked = plan.u_cmd, plan.refs, plan.u_asked
-    zero = (0.0, 0.0)
-    recorded = first
-    try:
-        for k in range(first, last + 1):
-            if stop.kind is not None:
-                break
-            plan.k, row = k, k - first
-            t = k * h
-            if get_real(component, real_refs, real_count, real_row + row * real_stride) > 1:
-                raise FMUCallFailed("fmi2GetReal")
-            if mode_count and get_integer(component, mode_refs, mode_count, mode_row + row * mode_stride) > 1:
-                raise FMUCallFailed("fmi2GetInteger")
-            y = rec_real[row].tolist()
-            alpha, beta, gyro = measure(k, y[i_alpha], y[i_beta], [y[i] for i in i_gyro], y[i_alpha_dot],
-                                        y[i_beta_dot])
-            u = controller(t, h, alpha, beta, gyro, attitude_rows[row], rate_rows[row], step=k)
-            u_cmd[delay + row] = u
-            refs[row] = controller.reference
-            u_asked[row] = controller.asked
-            recorded = k + 1
-            applied = u if delay == 0 else (u_cmd[row] if k >= delay else zero)
-            if k == n:
-                break
-            inputs[row, 0], inputs[row, 1] = applied
-            if set_real(component, input_refs, input_count, input_row + row * input_stride) > 1:
-                raise FMUCallFailed("fmi2SetReal")
-            if do_step(component, t, h, 1) > 1:
-                raise FMUCallFailed("fmi2DoStep")
-            if k % 256 == 0:
-                bar.update((k + 1) * h)
-    finally:
-        plan.rows = recorded
-
-
-def compiled_chunk(loop: compiled_loop.CompiledLoop, plan: StreamPlan, first: int, last: int, stop: StopRequest,
-                   bar) -> None:
-    """master.compiled_step_loop over steps first .. last."""
-    from .master import CHUNK_STEPS
-
-    loop.point_at_chunk(first, plan)
-    try:
-        for start in range(first, last + 1, CHUNK_STEPS):
-            if stop.kind is not None:
-                break
-            end = min(start + CHUNK_STEPS - 1, last)
-            loop.run(start, end)
-            plan.rows = end + 1
-            bar.update(min(end + 1, plan.n) * plan.h)
-    except FMUCallFailed as failure:
-        plan.rows = plan.k + (failure.function in ("fmi2SetReal", "fmi2DoStep"))
-        raise
 
 
 class Metrics:
@@ -296,25 +159,6 @@ def record_needs(plan: StreamPlan, columns: int) -> tuple[int, int]:
     return disk, memory
 
 
-def available_memory() -> int | None:
-    """MemAvailable of /proc/meminfo in bytes; None where there is none."""
-    try:
-        with open("/proc/meminfo") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        return None
-    return None
-
-
-def size_text(size: float) -> str:
-    for unit, factor in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
-        if size >= factor:
-            return f"{size / factor:.3g} {unit}"
-    return f"{size / 1e3:.3g} kB"
-
-
 def column_count(plan: StreamPlan, scene: Scene) -> int:
     """The record's signals: time, outputs, modes, commands (applied, commanded, asked) and set points, base
     inputs and heave,
@@ -410,29 +254,37 @@ def spectra_from_file(parquet_path: pathlib.Path, scene: Scene, metrics: Metrics
     """The Welch accumulators of the line-of-sight error's spectra and of the isolation estimate over
     the metrics window, fed from the file a row group (a chunk) at a time, its spectral columns only;
     None where there is nothing to estimate."""
-    window_start = metrics.window_start if metrics.part() == "window" else -math.inf
     samples = metrics.count[metrics.part()]
     psd_names = list(AXIS_ERRORS) if has_target else []
     isolation_names = ([CARRIER_RATES[i - 1] for i in ISOLATION_AXES] + [f"los.omega[{i}]" for i in ISOLATION_AXES]) \
         if metrics.base_moves else []
     if samples < 2 or not psd_names + isolation_names:
         return None, None
-    fs = 1.0 / h
-    psd = spectra.WelchAccumulator(fs, scene.analysis.psd_resolution_hz, samples,
-                                   {name: metrics.mean(name) for name in psd_names}) if psd_names else None
     pairs = [(CARRIER_RATES[i - 1], f"los.omega[{i}]") for i in ISOLATION_AXES]
-    isolation = spectra.WelchAccumulator(fs, scene.analysis.isolation_resolution_hz, samples,
-                                         {name: metrics.mean(name) for name in isolation_names}, pairs) \
-        if isolation_names else None
-    wanted = ["time"] + psd_names + isolation_names
+    psd = _welch(h, scene.analysis.psd_resolution_hz, samples, metrics, psd_names)
+    isolation = _welch(h, scene.analysis.isolation_resolution_hz, samples, metrics, isolation_names, pairs)
+    _feed_from_file(parquet_path, metrics, [accumulator for accumulator in (psd, isolation) if accumulator is not None])
+    return psd, isolation
+
+
+def _welch(h: float, resolution: float, samples: int, metrics: Metrics, names: list, pairs=()):
+    """A Welch accumulator of `names` (their means over the window removed), None without names."""
+    if not names:
+        return None
+    means = {name: metrics.mean(name) for name in names}
+    return spectra.WelchAccumulator(1.0 / h, resolution, samples, means, pairs)
+
+
+def _feed_from_file(parquet_path: pathlib.Path, metrics: Metrics, accumulators: list) -> None:
+    """Feeds the accumulators their columns over the metrics window, read a row group at a time."""
+    window_start = metrics.window_start if metrics.part() == "window" else -math.inf
+    wanted = ["time"] + [name for accumulator in accumulators for name in accumulator.means]
     for batch in record_tables(parquet_path, wanted):
         columns = {name: batch.column(name).to_numpy() for name in wanted}
         del batch
         window = columns["time"] >= window_start - 1e-12
-        for accumulator in (psd, isolation):
-            if accumulator is not None:
-                accumulator.feed({name: columns[name][window] for name in accumulator.means})
-    return psd, isolation
+        for accumulator in accumulators:
+            accumulator.feed({name: columns[name][window] for name in accumulator.means})
 
 
 def release_freed_memory() -> None:
@@ -459,6 +311,63 @@ def record_for(scene: Scene, out: pathlib.Path, stop_time: float | None, stop: S
                                                "step_size_s": scene.step_size}, stop)
 
 
+class RecordSink:
+    """Where a streamed run's chunks go (stepper.step_run's sink): each chunk's record, with its derived
+    line-of-sight signals (RunResult's), appended to the RunRecord; the summary's metrics, the clamp
+    count and the plots' decimated signals accumulated from it."""
+
+    def __init__(self, scene: Scene, plan: StreamPlan, record: RunRecord):
+        self.scene, self.record = scene, record
+        self.metrics = Metrics(float(scene.requirements.get("from_s", 0.0)), spectral_names(scene, plan.motion.fixed),
+                               tracking_metrics(scene))
+        self.clamp = ClampCount(plan.drives)
+        self.decimator = None
+
+    def add(self, plan: StreamPlan, first: int, recorded: int) -> BaseException | None:
+        """None when the chunk's points are kept; else why not: a StopSignal (a repeated signal before the
+        chunk was written), a RecordWriteFailed (a full disk, say: the record ends at its last whole chunk).
+        Another scene's files where this one's would go (check_no_collision) raise SceneError."""
+        try:
+            columns = _derived_columns(self.scene, plan.chunk_signals(recorded), not plan.motion.fixed)
+            self.record.append(first, columns, plan.h)
+        except SceneError:
+            raise
+        except StopSignal as signal:
+            return signal
+        except Exception as exc:
+            return RecordWriteFailed(exc, first * plan.h)
+        self.metrics.add(columns)
+        self.clamp.add(plan.u_asked[:recorded], plan.u_cmd[plan.delay:plan.delay + recorded])
+        if self.decimator is None:
+            self.decimator = Decimator(plot_names(self.scene, list(columns)), plan.t_end, plan.n + 1)
+        self.decimator.add(columns)
+        return None
+
+    def abandon(self, message: str) -> None:
+        """The run failed before its first point: if the first chunk could not be written, the earlier
+        run's files are gone, and _run.json says why."""
+        if self.record.taken_over:
+            self.record.close_without_merge()
+            self.record.write_status({"status": "failed", "partial": True, "recorded_until_s": None,
+                                      "reason": message, "files": []})
+
+
+def spectral_names(scene: Scene, fixed_base: bool) -> list[str]:
+    """The columns whose means over the metrics window the spectra remove."""
+    return (list(AXIS_ERRORS) if scene.target_spec is not None else []) + \
+        ([] if fixed_base else [CARRIER_RATES[i - 1] for i in ISOLATION_AXES] +
+         [f"los.omega[{i}]" for i in ISOLATION_AXES])
+
+
+def tracking_metrics(scene: Scene):
+    """A target.metrics.TrackingMetrics with a moving target, else None."""
+    if scene.moving_target is None:
+        return None
+    from ..target.metrics import TrackingMetrics
+    return TrackingMetrics(scene.target_spec["beam_width_mrad"], scene.target_spec["keyhole_deg"],
+                           scene.step_size, float(scene.requirements.get("from_s", 0.0)))
+
+
 def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = False, stop_time: float | None = None,
                  controller=None, compiled: bool | None = None, stop: StopRequest | None = None,
                  chunk_rows: int = CHUNK_ROWS, record: RunRecord | None = None) -> StreamedResult:
@@ -472,85 +381,10 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     stop = stop or StopRequest()
     plan = StreamPlan(scene, fmu, stop_time, controller, chunk_rows)
     check_fits(plan, scene, out)
-    loop_kind = choose_loop(plan.controller, compiled)
-    record = record or record_for(scene, out, stop_time, stop)
-    has_target = scene.target_spec is not None
-    spectral = (list(AXIS_ERRORS) if has_target else []) + \
-        ([] if plan.motion.fixed else [CARRIER_RATES[i - 1] for i in ISOLATION_AXES] +
-         [f"los.omega[{i}]" for i in ISOLATION_AXES])
-    tracking = None
-    if scene.moving_target is not None:
-        from ..target.metrics import TrackingMetrics
-        tracking = TrackingMetrics(scene.target_spec["beam_width_mrad"], scene.target_spec["keyhole_deg"],
-                                   scene.step_size, float(scene.requirements.get("from_s", 0.0)))
-    metrics = Metrics(float(scene.requirements.get("from_s", 0.0)), spectral, tracking)
-    log: list = []
-    slave = fmu.instantiate(scene.name, log)
-    bar = Progress(plan.t_end, enabled=progress)
-    stopped, decimator, loop = None, None, None
-    clamp = ClampCount(plan.drives)
-    stop.stepping = True   # from here to the record's end, a first signal asks the run to end at its next step
-    try:
-        plan.load_chunk(0, plan.chunk_rows)
-        try:
-            initialize(slave, scene, fmu, plan)
-            plan.controller.start(plan.h, scene.name)
-        except ControllerError as exc:   # the user's reset() raised
-            raise failure_error(failure_message(scene, plan, exc, log), exc) from None
-        except (SceneError, StopSignal):
-            raise
-        except Exception as exc:
-            raise SceneError(failure_message(scene, plan, exc, log)) from None
-        calls = RawCalls(slave)
-        loop = compiled_loop.CompiledLoop(slave, calls, plan, chunked=True) if loop_kind == "compiled" else None
-        for first in range(0, plan.n + 1, plan.chunk_rows):
-            count = min(plan.chunk_rows, plan.n + 1 - first)
-            failure = step_chunk(plan, loop, slave, calls, first, count, stop, bar)
-            recorded = plan.rows - first
-            if recorded > 0:
-                try:
-                    columns = _derived_columns(scene, plan.chunk_signals(recorded), not plan.motion.fixed)
-                    record.append(first, columns, plan.h)
-                except SceneError:   # another scene's files are where this one's would go (check_no_collision)
-                    raise
-                except StopSignal:   # a repeated signal before the chunk was written: the record ends before it
-                    plan.rows, recorded = first, 0
-                except Exception as exc:   # a full disk, say: the record ends at its last whole chunk
-                    plan.rows, recorded = first, 0
-                    failure = failure or RecordWriteFailed(exc, first * plan.h)
-                else:
-                    metrics.add(columns)
-                    clamp.add(plan.u_asked[:recorded], plan.u_cmd[plan.delay:plan.delay + recorded])
-                    if decimator is None:
-                        decimator = Decimator(plot_names(scene, list(columns)), plan.t_end, plan.n + 1)
-                    decimator.add(columns)
-                    del columns
-            if failure is not None:
-                message = record_failure_message(scene, plan, failure, log)
-                if plan.rows == 0:
-                    if record.taken_over:   # the first chunk could not be written: the earlier run's files are gone
-                        record.close_without_merge()
-                        record.write_status({"status": "failed", "partial": True, "recorded_until_s": None,
-                                             "reason": message, "files": []})
-                    raise failure_error(message, failure)
-                stopped = Stop("failed", (plan.rows - 1) * plan.h, message, getattr(failure, "details", None))
-                break
-            if recorded < count or stop.kind is not None:
-                if plan.rows == 0:
-                    raise SceneError(f"{scene.name}: {stop.reason} before the first communication point: nothing "
-                                     "recorded")
-                if stop.kind is None:   # cannot be: a chunk ends short only when asked to stop
-                    raise AssertionError("a chunk ended short without a stop request")
-                stopped = Stop(stop.kind, (plan.rows - 1) * plan.h, f"{scene.name}: {stop.reason}")
-                break
-        bar.close(complete=stopped is None)
-        if stopped is None:
-            slave.terminate()
-    except BaseException:
-        stop.stepping = False
-        raise
-    finally:
-        slave.freeInstance()
+    loop = choose_loop(plan.controller, compiled)
+    sink = RecordSink(scene, plan, record or record_for(scene, out, stop_time, stop))
+    stopped = _step_streamed(scene, fmu, plan, loop, sink, stop, progress)
+    record, metrics = sink.record, sink.metrics
     end = plan.t_end if stopped is None else stopped.time
     status = {"status": "complete" if stopped is None else stopped.kind, "partial": stopped is not None,
               "stop_time_s": plan.t_end, "recorded_until_s": end, "reason": None if stopped is None else stopped.reason}
@@ -558,16 +392,47 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
     record.close(status)
     record.write_status({**status, "files": [record.csv_path.name, record.parquet_path.name]})
     wall = time.perf_counter() - wall0
-    del plan, loop   # the chunk's tables
+    del plan   # the chunk's tables
     release_freed_memory()
     if record.pending_signal is not None:   # a signal while merging: the folder of chunks is the record
         raise record.pending_signal
     if stop.kind is not None and (stop.signals > 1 or stopped is None):   # a signal the loop did not see
         stop.raise_stop()
     stop.phase = "computing the spectra and drawing the plots"
+    found, estimates, carrier = streamed_spectra(record.parquet_path, scene, metrics)
+    t_window = (metrics.first_in_window if metrics.part() == "window" else 0.0, end)
+    result = StreamedResult(scene, sink.decimator.signals(), wall, end, metrics, found, estimates, carrier, t_window)
+    result.stopped, result.requested_stop_time = stopped, status["stop_time_s"]
+    result.loop, result.parquet_path, result.csv_path = loop, record.parquet_path, record.csv_path
+    result.status = status
+    result.voltage_clamp = sink.clamp
+    return result
 
-    # The spectra, from the file (the plots' signals were decimated as the chunks came).
-    psd, isolation = spectra_from_file(record.parquet_path, scene, metrics, scene.step_size, has_target)
+
+def _step_streamed(scene: Scene, fmu: FMU, plan: StreamPlan, loop: str, sink: RecordSink, stop: StopRequest,
+                   progress: bool):
+    """The streamed run's instance made, started and stepped into `sink` (stepper.step_run): its Stop, or
+    None for a whole run. From here to the record's end, a first signal asks the run to end at its next
+    step (stop.stepping)."""
+    log: list = []
+    slave = fmu.instantiate(scene.name, log)
+    bar = Progress(plan.t_end, enabled=progress)
+    stop.stepping = True
+    try:
+        plan.load_chunk(0, plan.chunk_rows)
+        start(slave, scene, fmu, plan, log)
+        return step_run(scene, plan, slave, log, loop, sink, stop, bar)
+    except BaseException:
+        stop.stepping = False
+        raise
+    finally:
+        slave.freeInstance()
+
+
+def streamed_spectra(parquet_path: pathlib.Path, scene: Scene, metrics: Metrics) -> tuple[dict, dict, dict]:
+    """The line-of-sight error's spectra, the isolation estimates and the carrier's spectra from the
+    record's file (the plots' signals were decimated as the chunks came)."""
+    psd, isolation = spectra_from_file(parquet_path, scene, metrics, scene.step_size, scene.target_spec is not None)
     release_freed_memory()
     found = {name: psd.spectrum(name) for name in AXIS_ERRORS} if psd is not None and psd.segments else {}
     estimates, carrier = {}, {}
@@ -575,42 +440,4 @@ def run_streamed(scene: Scene, fmu: FMU, out: pathlib.Path, progress: bool = Fal
         for i in ISOLATION_AXES:
             estimates[i] = isolation.transfer(CARRIER_RATES[i - 1], f"los.omega[{i}]")
             carrier[i] = isolation.spectrum(CARRIER_RATES[i - 1]).psd
-    t_window = (metrics.first_in_window if metrics.part() == "window" else 0.0, end)
-    result = StreamedResult(scene, decimator.signals(), wall, end, metrics, found, estimates, carrier, t_window)
-    result.stopped, result.requested_stop_time = stopped, status["stop_time_s"]
-    result.loop, result.parquet_path, result.csv_path = loop_kind, record.parquet_path, record.csv_path
-    result.status = status
-    result.voltage_clamp = clamp
-    return result
-
-
-class RecordWriteFailed(Exception):
-    """Writing a chunk of the record failed (a full disk, a file system gone read-only)."""
-
-    def __init__(self, cause: Exception, time_s: float):
-        where = f"{cause.filename}: " if isinstance(cause, OSError) and cause.filename else ""
-        text = cause.strerror if isinstance(cause, OSError) and cause.strerror else f"{type(cause).__name__}: {cause}"
-        super().__init__(f"writing the record failed at t = {time_s:.6g} s: {where}{text}")
-
-
-def record_failure_message(scene: Scene, plan: StreamPlan, failure: Exception, log: list) -> str:
-    if isinstance(failure, RecordWriteFailed):
-        return f"{scene.name}: {failure}"
-    return failure_message(scene, plan, failure, log)
-
-
-def step_chunk(plan: StreamPlan, loop, slave, calls, first: int, count: int, stop: StopRequest, bar):
-    """Steps the chunk's rows first .. first + count - 1 (plan.rows: how many are recorded whole);
-    the exception that ended it early, None when it ran whole or was asked to stop (a signal: stop.kind)."""
-    try:
-        if first > 0:
-            plan.load_chunk(first, count)
-        if loop is not None:
-            compiled_chunk(loop, plan, first, first + count - 1, stop, bar)
-        else:
-            python_chunk(slave, calls, plan, first, first + count - 1, stop, bar)
-    except StopSignal:   # a repeated signal, raised inside the loop: the request is in stop.kind
-        pass
-    except BaseException as exc:   # the FMU's refusal, the controller's exception (any: sys.exit too), no memory
-        return exc
-    return None
+    return found, estimates, carrier

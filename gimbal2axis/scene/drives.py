@@ -19,6 +19,9 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+from ..errors import SceneError
+from .parameters import parameter_value
+
 VOLTAGE, CURRENT = 0, 1
 
 
@@ -54,9 +57,6 @@ def _drive(motor: int, kind: str, limit: float) -> Drive:
 
 def scene_drives(scene, fmu) -> tuple[Drive, Drive]:
     """Each motor's drive in `scene` run on `fmu`, with its limit (the scene's value, else the FMU's start)."""
-    from ..errors import SceneError
-    from .scene import parameter_value
-
     drives = []
     for motor in (1, 2):
         value = parameter_value(scene, fmu, f"motor{motor}.drive")

@@ -53,6 +53,8 @@ import numpy as np
 from . import analysis, geometry
 from .base_motion import INPUTS as BASE_INPUT_NAMES, Recorded, make_base_motion
 from .controllers import make_controller
+from .drives import other_drive_columns, scene_drives
+from .parameters import parameter_value
 from .. import target as moving_targets
 from ..target import spec as target_spec_table
 from ..errors import (SceneError, SceneWarning, boolean, check_keys, did_you_mean, excerpt, is_number_text, number,
@@ -294,6 +296,23 @@ def load_scene(path: pathlib.Path | str) -> Scene:
 
 
 def _validate(scene: Scene) -> None:
+    """Refuses what a scene cannot be run with, in this order: its time grid, its tables of FMU values,
+    its target, its controller and base motion, its requirements, [test] and [plot]; keeps the
+    warnings of a scene that runs, but probably not as meant (scene.warnings)."""
+    _validate_grid(scene)
+    _validate_values(scene)
+    _validate_target(scene)
+    found = _validate_controller(scene)
+    _validate_base_motion(scene)
+    scene.controller()
+    scene.warnings = found
+    scene.sensors()
+    _validate_requirements(scene)
+    _validate_outputs(scene)
+
+
+def _validate_grid(scene: Scene) -> None:
+    """stop_time, step_size and output_interval: a whole number of steps each."""
     # again here: with_changes (a sweep, --stop-time) brings values load_scene has not seen
     for key in ("stop_time", "step_size", "output_interval"):
         positive(key, getattr(scene, key))
@@ -310,6 +329,10 @@ def _validate(scene: Scene) -> None:
     if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
         raise SceneError(f"output_interval = {scene.output_interval:g} s must be a whole multiple of step_size = "
                          f"{scene.step_size:g} s")
+
+
+def _validate_values(scene: Scene) -> None:
+    """[fidelity] switches the FMU has, [initial] in radians, no variable set in two tables."""
     unknown = sorted(set(scene.fidelity) - set(FIDELITY))
     if unknown:
         raise SceneError(f"[fidelity]: unknown switch {shown(unknown[0])}{did_you_mean(unknown[0], FIDELITY)}; "
@@ -321,6 +344,9 @@ def _validate(scene: Scene) -> None:
         # start_values would let [parameters] win without a word
         raise SceneError(f"{', '.join(repr(n) for n in overlap)} set in both [fidelity] and [parameters]: "
                          "set each FMU variable in one table only")
+
+
+def _validate_target(scene: Scene) -> None:
     if scene.moving_target is not None:
         target_spec_table.check_run(scene.moving_target, scene.stop_time)
     elif scene.target_spec is not None:
@@ -329,6 +355,11 @@ def _validate(scene: Scene) -> None:
             raise SceneError(f"target.elevation_deg = {elevation:g} is outside [-90, 90] deg (0 = horizon, "
                              f"90 = straight up); the direction behind is azimuth_deg + 180 with elevation "
                              f"{math.copysign(180.0, elevation) - elevation:g}")
+
+
+def _validate_controller(scene: Scene) -> list[str]:
+    """The delay and the built-in controllers' gains (_check_controller); returns the warnings found,
+    also of a base motion the FMU is not set for."""
     delay = scene.controller_spec.get("delay_steps", 1)
     if not isinstance(delay, int) or isinstance(delay, bool) or delay < 0:
         raise SceneError("[controller] delay_steps must be an integer >= 0 (1 = a one-sample delay: the voltage "
@@ -341,15 +372,19 @@ def _validate(scene: Scene) -> None:
         found.append(f"no [base_motion] while [fidelity] base.fixed {setting}: the base stays still, but the FMU "
                      "runs its moving-base model; for a fixed base say [base_motion] type = \"fixed\" and "
                      "\"base.fixed\" = true, for a moving one give the motion")
+    return found
+
+
+def _validate_base_motion(scene: Scene) -> None:
     motion = scene.base_motion()
     if scene.fidelity.get("base.fixed") is True and not motion.fixed:
         raise SceneError("[fidelity] base.fixed = true needs a fixed base: [base_motion] type = 'fixed'")
     if isinstance(motion, Recorded) and (motion.t_start > 0 or motion.t_end < scene.stop_time):
         raise SceneError(f"[base_motion] the recording covers [{motion.t_start:g}, {motion.t_end:g}] s, "
                          f"not [0, {scene.stop_time:g}] s")
-    scene.controller()
-    scene.warnings = found
-    scene.sensors()
+
+
+def _validate_requirements(scene: Scene) -> None:
     check_keys("requirements", scene.requirements, {"los_rms_max_mrad", "los_final_max_mrad", "from_s"})
     for key, value in scene.requirements.items():
         positive(f"requirements.{key}", value) if key != "from_s" else number("requirements.from_s", value)
@@ -361,6 +396,10 @@ def _validate(scene: Scene) -> None:
                          "from then to the end of the run)")
     if scene.requirements and scene.target_spec is None:
         raise SceneError("[requirements] on the line of sight need a [target]")
+
+
+def _validate_outputs(scene: Scene) -> None:
+    """[test], [plot] and [analysis.bands]."""
     check_keys("test", scene.test, {"stop_time"})
     if "stop_time" in scene.test:
         positive("test.stop_time", scene.test["stop_time"])
@@ -401,85 +440,108 @@ def _check_controller(spec: dict) -> list[str]:
         where = "no [controller]" if not spec else "[controller] has no type"
         return [f"{where}: the gimbal runs open loop, both motors at 0 V (say [controller] type = \"none\" "
                 "if that is the point)"]
+    if spec["type"] == "pid":
+        return _check_pid(spec)
+    if spec["type"] == "state_feedback":
+        return _check_state_feedback(spec)
+    return []
+
+
+def _check_pid(spec: dict) -> list[str]:
     found = []
-    kind = spec["type"]
-    if kind == "pid":
-        for axis in AXIS_MOTOR:
-            table = spec.get(axis)
-            if table is None:
-                found.append(f"[controller] type = \"pid\" has no [controller.{axis}] table: the {axis} motor "
-                             f"({AXIS_MOTOR[axis]}) gets 0 V")
-                continue
-            if not isinstance(table, dict):
-                raise SceneError(f"[controller] '{axis}' must be a table ([controller.{axis}]), got {shown(table)}")
-            for key, why in WHY_NOT_NEGATIVE.items():
-                value = table.get(key, 0.0)
-                if _is_number(value) and value < 0:
-                    raise SceneError(f"controller.{axis}.{key} = {value:g} is negative: {why}")
-            if all(table.get(key, 0.0) == 0 for key in PID_GAINS):
-                found.append(f"[controller.{axis}] has no nonzero gain ({', '.join(PID_GAINS)}): the {axis} "
-                             f"motor ({AXIS_MOTOR[axis]}) gets 0 V")
-    elif kind == "state_feedback":
-        K, ki = spec.get("K"), spec.get("ki", [0.0, 0.0])
-        if not (isinstance(ki, list) and len(ki) == 2):
-            raise SceneError(f"controller.ki must be [ki of u_R1, ki of u_R2], got {shown(ki)}")
-        if not (isinstance(K, list) and len(K) == 2 and all(isinstance(row, list) and len(row) == 4 for row in K)):
-            return found
-        for i, axis in enumerate(AXIS_MOTOR):
-            motor = AXIS_MOTOR[axis]
-            # u = -K x: the gains of an axis's own angle error and rate must be >= 0 to pull it back
-            for j, what in ((i, "angle error"), (2 + i, "rate")):
-                if _is_number(K[i][j]) and K[i][j] < 0:
-                    raise SceneError(f"controller.K[{i}][{j}] = {K[i][j]:g} ({motor} per {axis} {what}) is negative: "
-                                     f"u = -K x then pushes the {axis} away from its set point")
-            if _is_number(ki[i]) and ki[i] < 0:
-                raise SceneError(f"controller.ki[{i}] = {ki[i]:g} ({motor}) is negative: "
-                                 f"{WHY_NOT_NEGATIVE['ki']}")
-            if all(k == 0 for k in K[i]) and ki[i] == 0:
-                found.append(f"[controller] K[{i}] and ki[{i}] are all zero: the {axis} motor ({motor}) gets 0 V")
+    for axis in AXIS_MOTOR:
+        table = spec.get(axis)
+        if table is None:
+            found.append(f"[controller] type = \"pid\" has no [controller.{axis}] table: the {axis} motor "
+                         f"({AXIS_MOTOR[axis]}) gets 0 V")
+            continue
+        if not isinstance(table, dict):
+            raise SceneError(f"[controller] '{axis}' must be a table ([controller.{axis}]), got {shown(table)}")
+        for key, why in WHY_NOT_NEGATIVE.items():
+            value = table.get(key, 0.0)
+            if _is_number(value) and value < 0:
+                raise SceneError(f"controller.{axis}.{key} = {value:g} is negative: {why}")
+        if all(table.get(key, 0.0) == 0 for key in PID_GAINS):
+            found.append(f"[controller.{axis}] has no nonzero gain ({', '.join(PID_GAINS)}): the {axis} "
+                         f"motor ({AXIS_MOTOR[axis]}) gets 0 V")
     return found
+
+
+def _check_state_feedback(spec: dict) -> list[str]:
+    found = []
+    K, ki = spec.get("K"), spec.get("ki", [0.0, 0.0])
+    if not (isinstance(ki, list) and len(ki) == 2):
+        raise SceneError(f"controller.ki must be [ki of u_R1, ki of u_R2], got {shown(ki)}")
+    if not (isinstance(K, list) and len(K) == 2 and all(isinstance(row, list) and len(row) == 4 for row in K)):
+        return found
+    for i, axis in enumerate(AXIS_MOTOR):
+        if _state_feedback_axis_is_zero(K, ki, i, axis):
+            found.append(f"[controller] K[{i}] and ki[{i}] are all zero: the {axis} motor ({AXIS_MOTOR[axis]}) "
+                         "gets 0 V")
+    return found
+
+
+def _state_feedback_axis_is_zero(K: list, ki: list, i: int, axis: str) -> bool:
+    """Refuses gains of row i (the motor of `axis`) that push the axis away; True when the row is all zero."""
+    motor = AXIS_MOTOR[axis]
+    # u = -K x: the gains of an axis's own angle error and rate must be >= 0 to pull it back
+    for j, what in ((i, "angle error"), (2 + i, "rate")):
+        if _is_number(K[i][j]) and K[i][j] < 0:
+            raise SceneError(f"controller.K[{i}][{j}] = {K[i][j]:g} ({motor} per {axis} {what}) is negative: "
+                             f"u = -K x then pushes the {axis} away from its set point")
+    if _is_number(ki[i]) and ki[i] < 0:
+        raise SceneError(f"controller.ki[{i}] = {ki[i]:g} ({motor}) is negative: {WHY_NOT_NEGATIVE['ki']}")
+    return all(k == 0 for k in K[i]) and ki[i] == 0
 
 
 def check_against_fmu(scene: Scene, fmu: FMU) -> None:
     """Refuses FMU variable names the FMU does not have, wrong causalities and wrong value types."""
-    parameters = [name for name, v in fmu.variables.items() if v.causality in ("parameter", "structuralParameter")]
     try:
-        for where, table in (("fidelity", scene.fidelity), ("parameters", scene.parameters)):
-            for name in table:   # named here with the close matches, before fmu.check quotes it whole
-                if not fmu.has(name):
-                    hint = did_you_mean(name, parameters) or "; is the FMU older than the scene?"
-                    raise SceneError(f"[{where}] '{excerpt(name)}' is not a variable of {fmu.path} (its "
-                                     f"modelDescription.xml is the truth){hint}")
-        fmu.check("fidelity", scene.fidelity, {"parameter", "structuralParameter"})
-        fmu.check("parameters", scene.parameters, {"parameter", "structuralParameter"})
-        for name in scene.initial:
-            if name not in fmu.states:
-                raise SceneError(f"[initial]: '{excerpt(name)}' is not a state (states: {fmu.states})"
-                                 f"{did_you_mean(name, fmu.states + [a + '_deg' for a in ANGLE_STATES])}")
-        fmu.check("initial", scene.initial, {"output", "local"})
-        names = {n for names in scene.plot.values() for n in names}
-        from .drives import other_drive_columns, scene_drives
-
-        drives = scene_drives(scene, fmu)
-        recorded_inputs = set(BASE_INPUT_NAMES) | {drive.applied for drive in drives}
-        for drive in drives:
-            for name, instead in other_drive_columns(drive).items():
-                if name in names:
-                    raise SceneError(f"[plot] '{name}': motor{drive.motor} is in {drive.kind} drive (motor{drive.motor}"
-                                     f".drive), so its record has '{instead}' instead ({drive.unit}; "
-                                     f"docs/scenes.md, \"Current-commanded drives\")")
-        for name in sorted(names):
-            if fmu.has(name) and name not in DERIVED_SIGNALS and (
-                    fmu.variables[name].type not in ("Real", "Integer", "Enumeration") or
-                    (fmu.variables[name].causality == "input" and name not in recorded_inputs)):
-                raise SceneError(f"[plot] '{excerpt(name)}' is an FMU {fmu.variables[name].causality} of type "
-                                 f"{fmu.variables[name].type} that a run does not record: a plot draws Real, "
-                                 f"Integer and Enumeration variables the FMU computes, and the runner's signals")
-            if not fmu.has(name) and name not in DERIVED_SIGNALS:
-                raise SceneError(f"[plot] '{excerpt(name)}' is neither an FMU variable nor a signal of the runner "
-                                 f"({sorted(DERIVED_SIGNALS)}){did_you_mean(name, list(fmu.variables) + sorted(DERIVED_SIGNALS))}")
+        _check_values(scene, fmu)
+        _check_plot(scene, fmu)
     except SceneError as exc:
         raise SceneError(f"{scene.path}: {exc}") from None
+
+
+def _check_values(scene: Scene, fmu: FMU) -> None:
+    """[fidelity], [parameters] and [initial]: variables of the FMU, of the right causality and type."""
+    parameters = [name for name, v in fmu.variables.items() if v.causality in ("parameter", "structuralParameter")]
+    for where, table in (("fidelity", scene.fidelity), ("parameters", scene.parameters)):
+        for name in table:   # named here with the close matches, before fmu.check quotes it whole
+            if not fmu.has(name):
+                hint = did_you_mean(name, parameters) or "; is the FMU older than the scene?"
+                raise SceneError(f"[{where}] '{excerpt(name)}' is not a variable of {fmu.path} (its "
+                                 f"modelDescription.xml is the truth){hint}")
+    fmu.check("fidelity", scene.fidelity, {"parameter", "structuralParameter"})
+    fmu.check("parameters", scene.parameters, {"parameter", "structuralParameter"})
+    for name in scene.initial:
+        if name not in fmu.states:
+            raise SceneError(f"[initial]: '{excerpt(name)}' is not a state (states: {fmu.states})"
+                             f"{did_you_mean(name, fmu.states + [a + '_deg' for a in ANGLE_STATES])}")
+    fmu.check("initial", scene.initial, {"output", "local"})
+
+
+def _check_plot(scene: Scene, fmu: FMU) -> None:
+    """[plot]: signals a run records, of the motors' drives as the scene sets them."""
+    names = {n for names in scene.plot.values() for n in names}
+    drives = scene_drives(scene, fmu)
+    recorded_inputs = set(BASE_INPUT_NAMES) | {drive.applied for drive in drives}
+    for drive in drives:
+        for name, instead in other_drive_columns(drive).items():
+            if name in names:
+                raise SceneError(f"[plot] '{name}': motor{drive.motor} is in {drive.kind} drive (motor{drive.motor}"
+                                 f".drive), so its record has '{instead}' instead ({drive.unit}; "
+                                 f"docs/scenes.md, \"Current-commanded drives\")")
+    for name in sorted(names):
+        if fmu.has(name) and name not in DERIVED_SIGNALS and (
+                fmu.variables[name].type not in ("Real", "Integer", "Enumeration") or
+                (fmu.variables[name].causality == "input" and name not in recorded_inputs)):
+            raise SceneError(f"[plot] '{excerpt(name)}' is an FMU {fmu.variables[name].causality} of type "
+                             f"{fmu.variables[name].type} that a run does not record: a plot draws Real, "
+                             f"Integer and Enumeration variables the FMU computes, and the runner's signals")
+        if not fmu.has(name) and name not in DERIVED_SIGNALS:
+            raise SceneError(f"[plot] '{excerpt(name)}' is neither an FMU variable nor a signal of the runner "
+                             f"({sorted(DERIVED_SIGNALS)}){did_you_mean(name, list(fmu.variables) + sorted(DERIVED_SIGNALS))}")
 
 
 # What a run with a moving target adds (master/results.py): the target's direction and range in G, the
@@ -505,62 +567,65 @@ def check_run_length(scene: Scene, t_end: float) -> None:
             raise SceneError(f"{scene.path}: {exc}") from None
 
 
-def parameter_value(scene: Scene, fmu: FMU, name: str):
-    """A parameter's value in this scene: the scene's, else the FMU's start value."""
-    if name in scene.parameters:
-        return scene.parameters[name]
-    if name in scene.fidelity:
-        return scene.fidelity[name]
-    return fmu.start(name) if fmu.has(name) else None
-
-
 def start_values(scene: Scene, fmu: FMU, base_row0: np.ndarray, base_row_eps: np.ndarray | None = None,
                  eps: float = 1e-6) -> dict:
     """All values to set before initialization: fidelity, parameters, initial state; rotors follow
     their loads when not given; start_on_target points the gimbal at the target for the base
     attitude at t = 0 (and gives it the rates that keep it there, from base_row_eps at t = eps)."""
     initial = dict(scene.initial)
-    if scene.moving_target is not None and scene.target_spec["start_on_target"]:
-        rows = np.asarray(base_row0, dtype=float).reshape(1, -1)
-        command = moving_targets.pointing(scene.moving_target, [0.0], rows[:, 0:3], rows[:, 3:6], rows[:, 6:9])
-        for name in ("alpha", "beta", "alpha_dot", "beta_dot"):
-            initial.setdefault(name, float(getattr(command, name)[0]))
-    elif scene.target_spec is not None and scene.target_spec["start_on_target"]:
-        a0, b0 = geometry.gimbal_angles_for(scene.target, *base_row0[:3])
-        initial.setdefault("alpha", a0)
-        initial.setdefault("beta", b0)
-        if base_row_eps is not None:
-            a1, b1 = geometry.gimbal_angles_for(scene.target, *base_row_eps[:3], alpha_near=a0)
-            initial.setdefault("alpha_dot", (a1 - a0) / eps)
-            initial.setdefault("beta_dot", (b1 - b0) / eps)
+    if scene.target_spec is not None and scene.target_spec["start_on_target"]:
+        for name, value in _on_target(scene, base_row0, base_row_eps, eps).items():
+            initial.setdefault(name, value)
     runner_starts_rotors = {}
     for axis, (load, rotor) in enumerate([("alpha", "alpha_m"), ("beta", "beta_m")], start=1):
-        gear_model = parameter_value(scene, fmu, f"gear{axis}.model")
-        if gear_model == 0:   # rigid gear: the FMU has no rotor state of its own
-            continue
-        ratio = float(parameter_value(scene, fmu, f"gear{axis}.N"))
-        if load in initial and rotor not in initial:
-            initial[rotor] = ratio * initial[load]
-        if load + "_dot" in initial and rotor + "_dot" not in initial:
-            initial[rotor + "_dot"] = ratio * initial[load + "_dot"]
-        # The runner has decided where the rotor starts (as the scene gives it, else N times its load).
-        # The FMU's default rule (gear<j>.start = in_mesh_unless_given) keeps that too, except for a
-        # rotor value of 0 whose value in mesh is not 0: then the runner asks for as_given, unless the
-        # scene chooses the rule itself. Only then: libcosim cannot set an Enumeration (gimbal2axis system).
-        rule = f"gear{axis}.start"
-        if fmu.has(rule) and rule not in scene.parameters:
-            def start(name):
-                return float(initial[name]) if name in initial else float(fmu.start(name))
-            backlash = start(f"theta_b{axis}") if gear_model == 2 else 0.0
-            moved_angle = start(rotor) == 0.0 and ratio * (start(load) + backlash) != 0.0
-            moved_rate = start(rotor + "_dot") == 0.0 and ratio * start(load + "_dot") != 0.0
-            if moved_angle or moved_rate:
-                runner_starts_rotors[rule] = gear_start_item(fmu, rule, "as_given")
+        runner_starts_rotors.update(_rotor_start(scene, fmu, initial, axis, load, rotor))
     values = dict(scene.fidelity)
     values.update(scene.parameters)
     values.update(runner_starts_rotors)
     values.update(initial)
     return values
+
+
+def _on_target(scene: Scene, base_row0: np.ndarray, base_row_eps: np.ndarray | None, eps: float) -> dict:
+    """The joint angles (and rates) that point at the target at t = 0: toward a moving target by the
+    pointing command; toward a fixed one by its angles at t = 0 and t = eps (rates only with base_row_eps)."""
+    if scene.moving_target is not None:
+        rows = np.asarray(base_row0, dtype=float).reshape(1, -1)
+        command = moving_targets.pointing(scene.moving_target, [0.0], rows[:, 0:3], rows[:, 3:6], rows[:, 6:9])
+        return {name: float(getattr(command, name)[0]) for name in ("alpha", "beta", "alpha_dot", "beta_dot")}
+    a0, b0 = geometry.gimbal_angles_for(scene.target, *base_row0[:3])
+    angles = {"alpha": a0, "beta": b0}
+    if base_row_eps is not None:
+        a1, b1 = geometry.gimbal_angles_for(scene.target, *base_row_eps[:3], alpha_near=a0)
+        angles.update({"alpha_dot": (a1 - a0) / eps, "beta_dot": (b1 - b0) / eps})
+    return angles
+
+
+def _rotor_start(scene: Scene, fmu: FMU, initial: dict, axis: int, load: str, rotor: str) -> dict:
+    """Where the rotor of gear `axis` starts, into `initial` (as the scene gives it, else N times its load);
+    returns {gear<j>.start: as_given} when the FMU's own rule would not keep that."""
+    gear_model = parameter_value(scene, fmu, f"gear{axis}.model")
+    if gear_model == 0:   # rigid gear: the FMU has no rotor state of its own
+        return {}
+    ratio = float(parameter_value(scene, fmu, f"gear{axis}.N"))
+    if load in initial and rotor not in initial:
+        initial[rotor] = ratio * initial[load]
+    if load + "_dot" in initial and rotor + "_dot" not in initial:
+        initial[rotor + "_dot"] = ratio * initial[load + "_dot"]
+    # The runner has decided where the rotor starts (as the scene gives it, else N times its load).
+    # The FMU's default rule (gear<j>.start = in_mesh_unless_given) keeps that too, except for a
+    # rotor value of 0 whose value in mesh is not 0: then the runner asks for as_given, unless the
+    # scene chooses the rule itself. Only then: libcosim cannot set an Enumeration (gimbal2axis system).
+    rule = f"gear{axis}.start"
+    if not fmu.has(rule) or rule in scene.parameters:
+        return {}
+
+    def start(name):
+        return float(initial[name]) if name in initial else float(fmu.start(name))
+    backlash = start(f"theta_b{axis}") if gear_model == 2 else 0.0
+    moved_angle = start(rotor) == 0.0 and ratio * (start(load) + backlash) != 0.0
+    moved_rate = start(rotor + "_dot") == 0.0 and ratio * start(load + "_dot") != 0.0
+    return {rule: gear_start_item(fmu, rule, "as_given")} if moved_angle or moved_rate else {}
 
 
 def gear_start_item(fmu: FMU, name: str, item: str) -> int:

@@ -1,14 +1,14 @@
 /* The scene runner's communication loop for the built-in controllers, compiled: per communication
  * point the FMU's outputs into the records, the sensors, the controller, and, before the last, the
- * delayed voltage and one doStep (the Python loop, master.step_loop, does the same for user
- * controllers).
+ * delayed voltage and one doStep (the Python loop, gimbal2axis/master/stepper.py, does the same for
+ * user controllers).
  *
  * Why it exists: the FMU takes about 8-10 us per 1 ms step of the ship scene; a loop in Python with
  * a PID added 3-6 us of its own (interpreter, ctypes), this one a fraction of a microsecond.
  *
  * Called through ctypes (gimbal2axis/master/compiled_loop.py, which builds its view of the struct from the
  * layout table) in chunks of steps, so that Python can show progress and take Ctrl-C between them.
- * The set points and the sensor noise of the whole run are computed before. */
+ * The set points and the sensor noise of the chunk are computed before. */
 #ifndef GIMBAL_KERNEL_MASTER_LOOP_H
 #define GIMBAL_KERNEL_MASTER_LOOP_H
 
