@@ -29,7 +29,7 @@ G2A = ".venv/bin/gimbal2axis"
 TUNE = f"{G2A} tune scenes/ship_stabilization.toml tunings/ship_pid.toml --workers 2"
 # Run only with GIMBAL_DOCS_SLOW=1, which also compares what they print with QUOTES.
 SLOW = {
-    TUNE: "96 candidates x 8 runs of 12 s: 131 s on 2 idle cores, 657 s measured at load average 16 (issue 46); "
+    TUNE: "96 candidates x 8 runs of 12 s: 95 s measured on 2 cores, 657 s at load average 16 (issue 46); "
           "its first 24 candidates run instead (PROSE_COMMANDS), whose figures docs/tuning.md gives too",
 }
 NOT_RUN = {
