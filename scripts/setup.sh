@@ -52,7 +52,7 @@ if [ "$setup_for" = test ]; then
 else
   requirements="$repo/requirements-run.txt"
   marker="$venv/.requirements-run-installed"
-  modules="fmpy, numpy, scipy, matplotlib, dask.distributed, pyarrow, tqdm, control"
+  modules="fmpy, numpy, scipy, matplotlib, dask.distributed, pyarrow, tqdm, control, libcosimpy"
 fi
 if ! "$venv/bin/python" -c "import $modules" >/dev/null 2>&1 || [ "$requirements" -nt "$marker" ] ||
    [ "$repo/requirements-run.txt" -nt "$marker" ]; then

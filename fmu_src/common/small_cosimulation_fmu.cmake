@@ -240,10 +240,10 @@ ${_source_entries}      <IncludeDirectory name=\".\"/>
     COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/LICENSE ${ARG_LICENSE_AS}
     ${_copy_source_description}
     ${_optional_commands}
-    COMMAND ${CMAKE_COMMAND} -E rm -f ${_fmu}
-    COMMAND ${CMAKE_COMMAND} -E tar cf ${_fmu} --format=zip ${_folders}
+    # reproducibly: the same staged files give the same bytes (scripts/package_fmu.py says why not tar)
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/scripts/package_fmu.py ${_fmu} ${_staging} ${_folders}
     WORKING_DIRECTORY ${_staging}
-    DEPENDS ${_binary} ${_staging}/modelDescription.xml ${PROJECT_SOURCE_DIR}/LICENSE ${ARG_RESOURCES}
+    DEPENDS ${_binary} ${PROJECT_SOURCE_DIR}/scripts/package_fmu.py ${_staging}/modelDescription.xml ${PROJECT_SOURCE_DIR}/LICENSE ${ARG_RESOURCES}
             ${ARG_WIN64_DLL} ${ARG_WIN64_DEPENDS} ${_sources_stamp} ${_source_description_depends}
     COMMENT "Packaging ${ARG_FMU}"
     VERBATIM)

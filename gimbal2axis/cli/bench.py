@@ -4,7 +4,8 @@
 
 1. runs the scene through the master (gimbal2axis.master.run: sensors, controller, delay, records),
    once with the compiled loop (the default for the built-in controllers) and once with the Python
-   loop (what a user controller runs in), and takes the CPU time of each loop;
+   loop (what a user controller runs in), and takes the CPU time of each loop; a scene with a Python
+   controller runs in the Python loop only, and its master's own cost includes the controller's;
 2. replays exactly the voltages that run commanded (a Replay controller, same delay) through the
    compiled loop: the FMU alone, with nothing of the master but the loop itself; and through the
    Python loop: the FMU plus the cost of calling it from Python;
@@ -56,10 +57,20 @@ def same_outputs(a, b, fmu) -> bool:
     return all(np.array_equal(a.signals[name], b.signals[name]) for name in real_outputs(fmu))
 
 
-def measure(scene, fmu, repeat: int) -> dict:
+def loops_of(scene, fmu) -> tuple:
+    """The loops the scene's controller runs in: both for a built-in controller, the Python loop only
+    for a Python one (the compiled loop runs the built-in controllers only)."""
+    from ..master import run
+
+    first = run(scene.with_changes(stop_time=scene.step_size), fmu)   # the loop the runner chooses
+    return LOOPS if first.loop == "compiled" else ("python",)
+
+
+def measure(scene, fmu, repeat: int, loops: tuple = LOOPS) -> dict:
     """Best-of-`repeat` CPU seconds: 'run_<loop>', 'whole_<loop>' and 'replay_<loop>' per loop, and
     'spread_<key>_<loop>' the largest minus the smallest of the repeats (the noise of the machine);
-    None when a replay did not reproduce its run."""
+    None when a replay did not reproduce its run. The compiled loop's replay is always measured: the
+    FMU alone, the reference of every loop."""
     import numpy as np
 
     from ..scene.drives import command_columns
@@ -67,13 +78,15 @@ def measure(scene, fmu, repeat: int) -> dict:
 
     samples: dict = {}
     for _ in range(repeat):
-        for loop in LOOPS:
+        for loop in loops:
             cpu, whole, result = loop_cpu(scene, fmu, loop == "compiled")
             commands = np.column_stack([result.signals[command_columns(result.signals, j).commanded] for j in (1, 2)])
-            replay, _, replayed = loop_cpu(scene, fmu, loop == "compiled", Replay(commands))
-            if not same_outputs(result, replayed, fmu):
-                return None
-            for key, value in (("run", cpu), ("whole", whole), ("replay", replay)):
+            for replay_loop in (loop,) if "compiled" in loops else ("compiled", loop):
+                replay, _, replayed = loop_cpu(scene, fmu, replay_loop == "compiled", Replay(commands))
+                if not same_outputs(result, replayed, fmu):
+                    return None
+                samples.setdefault(f"replay_{replay_loop}", []).append(replay)
+            for key, value in (("run", cpu), ("whole", whole)):
                 samples.setdefault(f"{key}_{loop}", []).append(value)
     best = {key: min(values) for key, values in samples.items()}
     best.update({f"spread_{key}": max(values) - min(values) for key, values in samples.items()})
@@ -122,7 +135,8 @@ def execute(args) -> int:
                                                                                      "SCENE.toml"))
         scene = scene.with_changes(stop_time=args.stop_time)
         with FMU(fmu_path(args.fmu)) as fmu:
-            best = measure(scene, fmu, args.repeat)
+            loops = loops_of(scene, fmu)
+            best = measure(scene, fmu, args.repeat, loops)
     except SceneError as exc:
         print(one_line(f"{PROG}: error: {exc}"), file=sys.stderr)
         return 2
@@ -139,7 +153,7 @@ def execute(args) -> int:
         "note": "loop CPU time includes the instance's set-up and initialization and the recording; the base "
                 "motion and the set points of the whole run, evaluated before the loop, are in whole_run_cpu_s only",
     }
-    for loop in LOOPS:
+    for loop in loops:
         # the differences' noise: the repeats' spread of each of the two times subtracted
         own_noise = (best[f"spread_run_{loop}"] + best["spread_replay_compiled"]) * per_step
         alone_noise = (best[f"spread_replay_{loop}"] + best["spread_replay_compiled"]) * per_step
@@ -163,11 +177,12 @@ def execute(args) -> int:
           f"controller {figures['controller']}, CPU time, best of {args.repeat}:")
     print(f"  FMU alone (compiled replay)  {best['replay_compiled']:.3f} s = "
           f"{figures['fmu_alone_real_time_factor']:.0f}x real time, {figures['fmu_us_per_step']:.2f} us per step")
-    for loop in LOOPS:
+    for loop in loops:
         f = figures[loop]
         alone = "the reference" if loop == "compiled" else cost_text(f["loop_alone_us_per_step"],
                                                                      f["loop_alone_noise_us_per_step"])
-        print(f"  {loop + ' loop':<28} {f['loop_cpu_s']:.3f} s = {f['real_time_factor_cpu']:.0f}x real time; master's own "
+        own = "master's own (with the Python controller)" if len(loops) == 1 else "master's own"
+        print(f"  {loop + ' loop':<28} {f['loop_cpu_s']:.3f} s = {f['real_time_factor_cpu']:.0f}x real time; {own} "
               f"{cost_text(f['master_own_us_per_step'], f['master_own_noise_us_per_step'])} (the loop alone, without "
               f"the controller: {alone}); "
               f"whole run {f['whole_run_cpu_s']:.3f} s")

@@ -9,13 +9,15 @@ voltages applied from T on and the carrier's motion at T (--set may change these
 
 Writes <out> (.npz or .mat: A, B, C, D, the names of states, inputs and outputs, the modes and the
 point) and prints the states, the modes and the poles. With --bode INPUT:OUTPUT (repeatable) it also
-writes <out stem>_bode.png and .csv of those transfer functions, and warns (one line each on stderr)
+writes <out stem>_bode.png and .csv of those transfer functions, prints each one's DC gain and -3 dB
+frequency (pair_line), and warns (one line each on stderr)
 where one of them is identically zero because of a mode the model holds in at the point (a body stuck
 by dry friction, a gear in its backlash gap, a limited current, a clamped voltage), naming the setting
 that frees it: the linear model holds within those modes (docs/linearization.md).
 
   # the rigid azimuth axis with a quasi-static motor, without dry friction, on a fixed base: from
-  # u_R1 to alpha_dot a first-order lag, 0.206 rad/s per V, its pole at -26.2 1/s (4.18 Hz)
+  # u_R1 to alpha_dot a first-order lag: it prints DC gain 0.2063 (rad/s per V), -3 dB at 4.175 Hz,
+  # the pole -26.23 1/s
   gimbal2axis linearize --set gear1.model=0 --set motor1.model=0 --set dry_friction=false \\
       --set base.fixed=true --out results/azimuth.npz --bode u_R1:alpha_dot
   gimbal2axis linearize --scene scenes/ship_stabilization.toml --at-time 5 --out results/ship_5s.mat
@@ -170,6 +172,41 @@ def write_bode(model, pairs: list[tuple[str, str]], stem: pathlib.Path, f_min: f
     return [png, csv_path]
 
 
+# Where the DC gain is read: well below any pole of the gimbal's models (the slowest, gravity's on a
+# payload off its axis, is near 0.5 Hz), and a decade lower to tell a free integrator (gain x 10) from
+# a finite gain.
+DC_FREQUENCY_HZ = 1e-4
+
+
+def pair_line(model, source: str, target: str, f_max: float) -> str | None:
+    """One line for a --bode pair: its DC gain (with its sign) and the frequency where the gain has
+    dropped by 3 dB from it (for a first-order lag, its pole), or that the path integrates; None for a
+    path that is identically zero (zero_path_warning says why)."""
+    import numpy as np
+
+    if model.zero_path_warning(source, target):
+        return None
+    low, lower = model.frequency_response([DC_FREQUENCY_HZ, DC_FREQUENCY_HZ / 10], source, target)
+    if abs(low) == 0.0:
+        return None
+    if abs(lower) > 5 * abs(low):
+        return f"{source} -> {target}: integrates at low frequency (the gain rises as 1/f below the poles): no DC gain"
+    dc = float(np.real(low)) if abs(np.imag(low)) < 1e-3 * abs(low) else abs(low)
+    text = f"{source} -> {target}: DC gain {dc:.4g} ({20 * math.log10(abs(low)):.2f} dB)"
+    frequencies = np.logspace(math.log10(DC_FREQUENCY_HZ), math.log10(max(f_max, 1.0)), 2000)
+    below = np.nonzero(np.abs(model.frequency_response(frequencies, source, target)) < abs(low) / math.sqrt(2))[0]
+    if len(below) == 0:
+        return text + f", no -3 dB point up to {f_max:g} Hz"
+    a, b = math.log10(frequencies[below[0] - 1]), math.log10(frequencies[below[0]])
+    for _ in range(50):   # bisection in log f: to far below the 4 digits printed
+        middle = (a + b) / 2
+        if abs(model.frequency_response([10 ** middle], source, target)[0]) < abs(low) / math.sqrt(2):
+            b = middle
+        else:
+            a = middle
+    return text + f", -3 dB at {10 ** b:.4g} Hz"
+
+
 def add_arguments(parser) -> None:
     parser.add_argument("--scene", default=None, help="take parameters, fidelity and initial state from this scene")
     parser.add_argument("--at-time", type=float, default=None,
@@ -237,6 +274,10 @@ def linearize_and_write(args) -> int:
     if bode_pairs:
         written += write_bode(model, bode_pairs, out.with_suffix(""), args.fmin, args.fmax)
     print(model.summary())
+    for source, target in bode_pairs:
+        line = pair_line(model, source, target, args.fmax)
+        if line:
+            print(line)
     print("wrote " + ", ".join(str(p) for p in written))
     for source, target in bode_pairs:   # after the summary: the last lines a user reads
         warning = model.zero_path_warning(source, target)

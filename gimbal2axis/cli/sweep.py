@@ -74,6 +74,32 @@ def add_arguments(parser) -> None:
                         help="run the failed cases (or all cases) again, although the table has them")
 
 
+def requirements_note(scene_path, rows: list) -> str | None:
+    """Why the column requirements_met is empty in every case of the scene that ran, or None where a
+    case was judged: a case is judged only by a scene with [requirements] and a [target] whose window
+    (requirements.from_s) starts before the case's stop time (sweep.worker.metrics)."""
+    import warnings
+
+    from ..scene import load_scene
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # the scene's advice was given when the sweep loaded it
+        scene = load_scene(scene_path)
+    ok = [r for r in rows if r.get("scene") == scene.name and r.get("status") == "ok"]
+    if not ok or any(r.get("requirements_met") is not None for r in ok):
+        return None
+    if not scene.requirements:
+        why = "the scene has no [requirements]"
+    elif scene.target_spec is None:
+        why = "the scene has no [target]: no line-of-sight error to judge"
+    else:
+        from_s = float(scene.requirements.get("from_s", 0.0))
+        stop = max(float(r["stop_time"]) for r in ok)
+        why = (f"the scene's requirements window starts at {from_s:g} s (requirements.from_s), at or after the "
+               f"cases' stop time {stop:g} s" if stop <= from_s else "no case was judged")
+    return f"requirements_met is empty in every case: {why}"
+
+
 def execute(args) -> int:
     if args.workers < 1:
         args.command_parser.error("--workers must be >= 1")
@@ -101,6 +127,9 @@ def execute(args) -> int:
     if not args.quiet:
         print(f"{total} cases ({outcome.ran} run, {outcome.skipped} already done): {total - outcome.failed} ok, "
               f"{outcome.failed} failed; {outcome.wall_time:.1f} s")
+        note = requirements_note(args.scene, outcome.rows)
+        if note:
+            print(note)
         print(f"wrote {outcome.parquet}, {outcome.csv} and {outcome.png}")
     if not outcome.failed:
         return 0

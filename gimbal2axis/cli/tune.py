@@ -77,6 +77,20 @@ def add_arguments(parser) -> None:
                         help="no report page (nor its runs of the best and the scene's gains, nor the held-out check)")
 
 
+def against_the_start(tuning, trials: list, best: dict) -> str | None:
+    """The best against trial 0 where trial 0 is the tuning file's start (every parameter has a start):
+    how much the search gained, or that it has not left the start yet (too few --trials)."""
+    if not trials or any(p.start is None for p in tuning.parameters):
+        return None
+    start = next((t for t in trials if t.get("trial") == 0), None)
+    if start is None or not start.get("objective_mrad"):
+        return None
+    gain = 1.0 - best["objective_mrad"] / start["objective_mrad"]
+    verdict = (f"{gain:.1%} lower" if gain >= 0.01 else
+               "not 1 % lower: the search has not left the start yet; give it more --trials")
+    return f"start (trial 0, the tuning file's start values): objective {start['objective_mrad']:.5g} mrad; the best {verdict}"
+
+
 def check_options(args) -> None:
     """What argparse cannot say: the ranges of the numeric options (refused as usage errors, status 2)."""
     from ..limits import MAX_TUNE_TRIALS
@@ -163,6 +177,9 @@ def _print_outcome(problem, result, report_path) -> None:
     best = result.best or result.least_violating
     if best is not None:
         print(_best_line(problem, result, best))
+    start_line = against_the_start(problem.tuning, result.trials, best) if result.best is not None else None
+    if start_line:
+        print(start_line)
     if result.holdout:
         h = result.holdout
         print(f"held out ({h['runs']} runs): best {h['best_mrad']:.5g} mrad, scene's own {h['own_mrad']:.5g} mrad")

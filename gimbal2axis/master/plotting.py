@@ -169,6 +169,20 @@ def plot(result, path: pathlib.Path, limits: dict | None = None) -> None:
     figure(result, limits).savefig(path, dpi=100)   # no pyplot figure to close: it goes with its last reference
 
 
+# How far below its peak the carrier's rate PSD still counts as input to the isolation estimate: the sea's
+# band (in the ship scene it is 50 to 70 dB down from 0.5 Hz on, and 10 to 20 decades down above 20 Hz,
+# at round-off).
+CARRIER_RANGE_DB = 60.0
+
+
+def carrier_has_power(carrier_psd: np.ndarray) -> np.ndarray:
+    """The bins where the carrier's rate PSD is within CARRIER_RANGE_DB of its peak."""
+    carrier_psd = np.asarray(carrier_psd, dtype=float)
+    peak = float(np.nanmax(carrier_psd)) if carrier_psd.size else 0.0
+    return np.nan_to_num(carrier_psd, nan=0.0) >= peak * 10 ** (-CARRIER_RANGE_DB / 10) if peak > 0 else \
+        np.zeros(carrier_psd.shape, dtype=bool)
+
+
 def spectrum_figure(result):
     """The line-of-sight error in the frequency domain (spectra.py, docs/jitter.md), drawn beside the
     time plot: per axis the Welch PSD [mrad^2/Hz] and the cumulative RMS [mrad] on log-log axes, the
@@ -181,7 +195,9 @@ def spectrum_figure(result):
     found = result.los_spectra()
     if not found:
         return None
-    isolation = result.isolation_estimates()
+    # A tracking scene's line of sight turns on purpose: its gyro rate is the target's, not what the
+    # carrier's motion leaves, and the ratio is no isolation.
+    isolation = result.isolation_estimates() if result.scene.moving_target is None else {}
     rows = 2 + (2 if isolation else 0)
     fig = Figure(figsize=(10, 2.6 * rows + 0.8))
     axes = fig.subplots(rows, 1, sharex=True, squeeze=False)
@@ -215,12 +231,15 @@ def spectrum_figure(result):
             f = estimate.frequency
             gain = np.abs(estimate.response)
             shown = (f > 0) & np.isfinite(gain) & (gain > 0)
-            # bins whose H1 is not known to spectra.H1_RANDOM_ERROR (low coherence: the carrier has no energy
-            # there, or the gyro something else) are drawn light grey: the gain there is the estimate's noise
-            known = shown & estimate.coherent
+            # bins whose H1 is not known are drawn light grey: the gain there is the estimate's noise. Known
+            # needs both the coherence (random error within spectra.H1_RANDOM_ERROR) and input: where the
+            # carrier's rate has no power, some of thousands of bins pass the coherence bound by chance and
+            # show a gain of 1e4 to 1e6 (a ratio of two spectra at round-off level)
+            known = shown & estimate.coherent & carrier_has_power(result.carrier_spectrum(i))
             axes[2].loglog(f[shown], gain[shown], lw=0.7, color="0.8",
-                           label=None if index else f"coherence < {estimate.coherence_bound:.2g}: gain not known "
-                                                    f"(random error > {spectra.H1_RANDOM_ERROR:.0%})")
+                           label=None if index else f"gain not known: coherence < {estimate.coherence_bound:.2g} "
+                                                    f"(random error > {spectra.H1_RANDOM_ERROR:.0%}), or the carrier's "
+                                                    f"rate more than {CARRIER_RANGE_DB:.0f} dB below its peak")
             axes[2].loglog(f[shown], np.where(known, gain, np.nan)[shown], lw=0.9, marker=".", ms=3,
                            color=f"C{index + 2}",
                            label=f"los.omega[{i}] / carrier rate about payload axis {i} ({ISOLATION_LABELS[i]}): "

@@ -31,22 +31,41 @@ def only_writer(out: pathlib.Path, name: str):
     """Holds `<out>/.<name>.run.lock` for the whole run, or refuses: two runs of one scene into one
     folder would write the same files at once and mix them (a CSV of one run, a plot of the other, a
     Parquet file of both). The lock is the operating system's (released when the process ends, however
-    it ends); its empty file stays, as the sweep store's does."""
-    handle = open(out / f".{name}.run.lock", "a+b")
-    try:
+    it ends). At the end the lock file is removed while still held, so no empty file stays: a run that
+    locked a file since removed (it opened the path before the removal) takes the lock again on the
+    file now at the path, so two runs never hold two different files. Windows cannot remove an open
+    file: there the empty file stays."""
+    path = out / f".{name}.run.lock"
+    while True:
+        handle = open(path, "a+b")
         try:
             if os.name == "nt":
                 import msvcrt
                 msvcrt.locking(handle.fileno(), msvcrt.LK_NBLCK, 1)
-            else:
-                import fcntl
-                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            import fcntl
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
+            handle.close()
             raise SceneError(f"another gimbal2axis run is writing {name}'s files into {out}: wait for it to end or "
                              f"give this one another --out (two runs into the same files would mix them)") from None
+        if _same_file(handle, path):
+            break
+        handle.close()   # the run before removed it after this one opened it: lock the path's file
+    try:
         yield
     finally:
+        if os.name != "nt":
+            with contextlib.suppress(OSError):
+                path.unlink()
         handle.close()
+
+
+def _same_file(handle, path: pathlib.Path) -> bool:
+    try:
+        return os.path.samestat(os.fstat(handle.fileno()), os.stat(path))
+    except FileNotFoundError:
+        return False
 
 
 def run_scene_file(scene_path, fmu_path, out_dir, progress: bool = False, stop_time: float | None = None,

@@ -44,3 +44,14 @@ def test_the_run_setup_builds_every_fmu_named(build_dir):
     needed |= {name.replace(".fmu", "-fmi3.fmu") for name in FMUS.values()}   # every FMU for FMI 3.0 too
     missing = sorted(name for name in needed if name not in commands)
     assert not missing, f"the main job does not build {missing} (targets {run_setup_targets()})"
+
+
+def test_the_main_job_installs_the_engine_the_systems_page_runs_with():
+    """docs/systems.md runs a scene's system in libcosim (libcosimpy): the main job's set-up installs it
+    (requirements-run.txt) and checks it is importable, as it does the other packages running needs."""
+    run_requirements = (REPO / "requirements-run.txt").read_text()
+    assert re.search(r"^libcosimpy==", run_requirements, re.M)
+    assert "libcosimpy" in (REPO / "docs" / "systems.md").read_text()
+    setup = (REPO / "scripts" / "setup.sh").read_text()
+    run_modules = re.search(r'^\s*requirements="\$repo/requirements-run.txt"\n.*?modules="([^"]+)"', setup, re.M | re.S)
+    assert run_modules and "libcosimpy" in run_modules.group(1).split(", ")

@@ -32,4 +32,31 @@ def test_a_second_run_of_the_same_scene_into_the_same_folder_is_refused_while_th
     done = run(out)   # the first run ended: its lock went with it
     assert done.returncode == 0, done.stderr
     assert (out / "free_swing.csv").is_file() and (out / "free_swing_run.json").is_file()
+    assert not (out / ".free_swing.run.lock").exists(), "the run left its empty lock file"
+
+
+def test_a_run_waiting_on_a_removed_lock_file_locks_the_one_at_the_path(tmp_path, monkeypatch):
+    """The lock file is removed at the end of a run, while held. A run that opened it before the
+    removal holds a file no longer at the path; it must lock the path's file instead, or a third run
+    could lock a new file and write at the same time."""
+    import os
+
+    from gimbal2axis.master import scene_files
+
+    path = tmp_path / ".s.run.lock"
+    opened = []
+    real_open = open
+
+    def open_then_removed(file, *args, **kwargs):   # the first open sees the file the run before removes
+        handle = real_open(file, *args, **kwargs)
+        if not opened:
+            os.unlink(file)
+        opened.append(handle)
+        return handle
+
+    monkeypatch.setattr(scene_files, "open", open_then_removed, raising=False)
+    with scene_files.only_writer(tmp_path, "s"):
+        assert len(opened) == 2 and path.exists()
+        assert os.path.samestat(os.fstat(opened[1].fileno()), os.stat(path))
+    assert not path.exists()
 

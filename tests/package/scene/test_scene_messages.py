@@ -265,7 +265,7 @@ def test_results_are_named_after_the_scene_file_not_its_name(tmp_path, fmu_path)
     out = tmp_path / "out"
     done = run_cli(copy, "--fmu", fmu_path, "--out", out, "--stop-time", "0.01", cwd=tmp_path)   # the "wrote" line
     assert done.returncode == 0, done.stderr
-    assert sorted(p.name for p in out.iterdir()) == [".my_copy.run.lock", "my_copy.csv", "my_copy.parquet", "my_copy.png",
+    assert sorted(p.name for p in out.iterdir()) == ["my_copy.csv", "my_copy.parquet", "my_copy.png",
                                                       "my_copy_run.json"]
     assert f"wrote {out / 'my_copy.csv'}" in done.stdout
 

@@ -284,3 +284,19 @@ def test_a_serial_sweep_leaves_no_temporary_folder(fmu_path, tmp_path):
                           env={**os.environ, "TMPDIR": str(scratch)})
     assert done.returncode == 0, done.stderr
     assert list(scratch.iterdir()) == []
+
+
+def test_the_summary_says_why_requirements_met_is_empty_in_every_case():
+    """The README's sweep runs 0.5 s per case on a scene whose requirements window starts at 1 s: the
+    column requirements_met is empty in every row, and the summary says why (cli.sweep.requirements_note)."""
+    from gimbal2axis.cli.sweep import requirements_note
+
+    scene = REPO / "scenes" / "ship_stabilization.toml"
+    unjudged = [{"scene": "ship_stabilization", "status": "ok", "requirements_met": None, "stop_time": 0.5}] * 3
+    note = requirements_note(scene, unjudged)
+    assert note == ("requirements_met is empty in every case: the scene's requirements window starts at 1 s "
+                    "(requirements.from_s), at or after the cases' stop time 0.5 s"), note
+    judged = unjudged + [{"scene": "ship_stabilization", "status": "ok", "requirements_met": True, "stop_time": 3.0}]
+    assert requirements_note(scene, judged) is None
+    no_requirements = REPO / "scenes" / "free_swing.toml"
+    assert "no [requirements]" in requirements_note(no_requirements, [{**row, "scene": "free_swing"} for row in unjudged])
