@@ -1,7 +1,7 @@
 """The README as a newcomer reads it: the two commands first, a tour of every subcommand, short enough
 to read in five minutes; its python blocks run; its frequency response is one where the linear curve is
 measured. Every README and docs command is run, and what it prints compared with what the pages say, by
-tests/test_docs_commands.py (each command once, whichever pages show it)."""
+tests/docs/test_docs_commands.py (each command once, whichever pages show it)."""
 import os
 import pathlib
 import re

@@ -1,5 +1,5 @@
 """`gimbal2axis linearize --bode` prints each pair's DC gain and -3 dB frequency (cli.linearize.pair_line):
-the figures the README quotes of the azimuth axis (tests/test_docs_commands.py runs that command). Here
+the figures the README quotes of the azimuth axis (tests/docs/test_docs_commands.py runs that command). Here
 on transfer functions whose answers are known: a first-order lag, an integrator, a zero path."""
 import math
 

@@ -6,7 +6,7 @@ import pathlib
 from gimbal2axis.cli.tune import against_the_start
 from gimbal2axis.tune.spec import load_tuning
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[3]
 
 
 def rows(*objectives):

@@ -21,7 +21,7 @@ import sys
 
 import pytest
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[2]
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
 G2A = ".venv/bin/gimbal2axis"
@@ -38,7 +38,7 @@ NOT_RUN = {
     "cp results/ship_jitter_20min.png results/ship_jitter_20min_spectrum.png docs/figures/":
         "the maintainer's update of the figures in git: the run before it is tested",
     ".venv/bin/python -m fmpy compile Gimbal2Axis.fmu":
-        "compiles the core from the FMU's sources (minutes on 2 cores; tests/test_fmi3.py builds a source FMU)",
+        "compiles the core from the FMU's sources (minutes on 2 cores; tests/fmu/test_fmi3.py builds a source FMU)",
     'gcc -c -O2 -fPIC -I. -I"$FMI2_HEADERS" gimbal_fmu/*.c fmi_layer/*.c fmu_state.c':
         "inside an extracted FMU's sources/: the source build, as above",
     "g++ -shared -O2 -fPIC -std=c++17 -I. */*.cpp *.o -o ../binaries/linux64/Gimbal2Axis.so":
@@ -154,8 +154,10 @@ def run(command: str) -> subprocess.CompletedProcess:
                           timeout=900)
 
 
-pytestmark = pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
-                                reason="documentation commands: the release pass runs them")
+# Runs the commands the pages show: its time goes to Python and the commands' processes.
+pytestmark = [pytest.mark.python_bound,
+              pytest.mark.skipif(os.environ.get("GIMBAL_SANITIZED") == "1",
+                                 reason="documentation commands: the release pass runs them")]
 
 
 def test_every_command_is_run_or_declared_not_run_with_its_reason():
@@ -180,7 +182,7 @@ def test_each_command_runs_and_prints_what_the_pages_say(command):
 
 def python_blocks() -> list[tuple[str, int, str]]:
     blocks = []
-    for page in PAGES[1:]:   # the README's python example: tests/test_readme_commands.py, tests/test_relaxed_start.py
+    for page in PAGES[1:]:   # the README's python example: tests/docs/test_readme_commands.py, tests/model_core/model/test_relaxed_start.py
         bodies = [body for language, body in FENCE.findall(page.read_text(encoding="utf-8")) if language == "python"]
         blocks += [(page.name, index, body) for index, body in enumerate(bodies)]
     return blocks

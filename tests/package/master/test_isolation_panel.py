@@ -12,7 +12,10 @@ from gimbal2axis.master import run
 from gimbal2axis.master.plotting import CARRIER_RANGE_DB, carrier_has_power, spectrum_figure
 from gimbal2axis.scene import load_scene
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+# Spectra and figures: its time goes to Python.
+pytestmark = pytest.mark.python_bound
+
+REPO = pathlib.Path(__file__).resolve().parents[3]
 
 
 def test_the_carrier_has_power_within_its_range_of_the_peak_only():
