@@ -27,6 +27,9 @@ using namespace gimbal;
 
 namespace {
 
+// The elevation stop's slot among the axis stops (switching_elements.def).
+constexpr int kElevationStop = axis_stop_of(ElementKind::elevation_stop);
+
 template <class Variable>
 Variable find_variable(const VariableInfo* table, unsigned count, const std::string& name) {
     for (unsigned v = 0; v < count; ++v)
@@ -175,11 +178,11 @@ std::vector<RealParameter> real_parameters() {
         list.push_back(
             {motor + "cogging_phase", d.cogging_phase, [j](const ModelParameters& m) { return m.disturbances.cogging[j].phase; }});
     }
-    // The elevation end stop (switching_elements/elevation_stop.hpp).
-    list.push_back({"elevation_stop.beta_min", -1.21, [](const ModelParameters& m) { return m.elevation_stop.lower; }});
-    list.push_back({"elevation_stop.beta_max", 1.31, [](const ModelParameters& m) { return m.elevation_stop.upper; }});
-    list.push_back({"elevation_stop.e", 0.61, [](const ModelParameters& m) { return m.elevation_stop.restitution; }});
-    list.push_back({"elevation_stop.w_rest", 0.0017, [](const ModelParameters& m) { return m.elevation_stop.rest_rate; }});
+    // The elevation end stop (switching_elements/axis_stop.hpp).
+    list.push_back({"elevation_stop.beta_min", -1.21, [](const ModelParameters& m) { return m.axis_stop[kElevationStop].lower; }});
+    list.push_back({"elevation_stop.beta_max", 1.31, [](const ModelParameters& m) { return m.axis_stop[kElevationStop].upper; }});
+    list.push_back({"elevation_stop.e", 0.61, [](const ModelParameters& m) { return m.axis_stop[kElevationStop].restitution; }});
+    list.push_back({"elevation_stop.w_rest", 0.0017, [](const ModelParameters& m) { return m.axis_stop[kElevationStop].rest_rate; }});
     // The current amplifiers (switching_elements/amplifier_saturation.hpp): gains given, not derived.
     for (int j = 0; j < 2; ++j) {
         const std::string amplifier = "amplifier" + std::to_string(j + 1) + ".";
@@ -220,7 +223,7 @@ const std::map<std::string, BooleanField>& boolean_parameter_fields() {
         {"energy_accounting", [](const ModelParameters& m) { return m.energy_accounting; }},
         {"dry_friction", [](const ModelParameters& m) { return m.fidelity.dry_friction; }},
         {"base.fixed", [](const ModelParameters& m) { return m.fidelity.fixed_base; }},
-        {"elevation_stop", [](const ModelParameters& m) { return m.elevation_stop.present; }},
+        {"elevation_stop", [](const ModelParameters& m) { return m.axis_stop[kElevationStop].present; }},
         {"amplifier1.back_emf_feedforward", [](const ModelParameters& m) { return m.amplifier[0].back_emf_feedforward; }},
         {"amplifier2.back_emf_feedforward", [](const ModelParameters& m) { return m.amplifier[1].back_emf_feedforward; }},
     };

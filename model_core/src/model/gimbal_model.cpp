@@ -187,7 +187,7 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     // reflected inertia N^2 J_rotor on the diagonal.
     friction_torques(params, modes, reduced_mass, applied, qd, out);
     out.acceleration = solve_mass_matrix(reduced_mass, Vec4(applied + out.friction_torque));
-    hold_at_elevation_stop(modes, out);  // the end stop's reaction while the payload rests on it
+    hold_at_axis_stops(modes, out);  // the end stops' reactions while a body rests on one
     out.full_acceleration = out.acceleration;
     if (reduced) rigid_axis_outputs(params, mass_matrix, force, bias, out);
 }

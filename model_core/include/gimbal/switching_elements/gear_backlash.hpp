@@ -91,6 +91,10 @@ bool backlash_state_row(const ModelParameters& params, const Modes& modes, int a
 class BacklashElement final : public SwitchingElement {
 public:
     BacklashElement(int axis, int first_guard);
+    explicit BacklashElement(const ElementSlot& slot) : BacklashElement(slot.instance, slot.first_guard) {}
+    // A backlash gear's only.
+    static bool present(const ModelParameters& params, const ElementSlot& slot) { return params.layout.backlash_slot[slot.instance] >= 0; }
+    static constexpr DecisionStage kStage = DecisionStage::contact;
     static constexpr int kGuards = 2;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
