@@ -25,7 +25,7 @@ struct Modes10 {
     int motor_limited[2];
     int voltage_clamped[2];
     FrictionMode friction[4];
-    int axis_stop;  // the elevation stop's mode (Modes::axis_stop, one int per AXIS_STOP row: one then)
+    int axis_stop[kAxisStopCount];  // one per AXIS_STOP row, as the reals are one per Real variable
 };
 
 struct Format7 {
