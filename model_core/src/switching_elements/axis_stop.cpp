@@ -63,6 +63,21 @@ void hold_together_derivatives(const int* resting, int count, const Mat4& reduce
     for (int i = 0; i < count; ++i) acceleration.row(kAxisStops[resting[i]].coordinate).setZero();
 }
 
+Vec4 impact_while_held(int coordinate, double jump, const int* resting, int count, const Mat4& reduced_mass) {
+    int coordinates[kAxisStopCount + 1];
+    coordinates[0] = coordinate;
+    for (int i = 0; i < count; ++i) coordinates[i + 1] = kAxisStops[resting[i]].coordinate;
+    const int n = count + 1;
+    Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kAxisStopCount + 1> responses(4, n);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kAxisStopCount + 1, kAxisStopCount + 1> coupling(n, n);
+    for (int j = 0; j < n; ++j) responses.col(j) = solve_mass_matrix(reduced_mass, Vec4(Vec4::Unit(coordinates[j])));
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) coupling(i, j) = responses(coordinates[i], j);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kAxisStopCount + 1, 1> change = decltype(change)::Zero(n);
+    change[0] = jump;
+    return responses * coupling.partialPivLu().solve(change);
+}
+
 }  // namespace axis_stop_detail
 
 AxisStopElement::AxisStopElement(const ElementSlot& slot)
@@ -120,16 +135,42 @@ void AxisStopElement::decide(const SwitchingContext& context, const Modes& previ
     if (hit == 0) return;
     angle = hit > 0 ? stop.upper : stop.lower;
     // Newton's law on the relative rate: q_s_dot+ = -e q_s_dot-, unless the rebound is too slow to leave
-    // (the Zeno limit of the bounces): then q_s_dot+ = 0. The impulse P on e_s changes the rates by
-    // M^-1 e_s P: the coordinates the mass matrix couples to q_s (the housing, a rigid gear's rotor through
-    // its reflected inertia) take their share; a compliant gear's rotor is held only by its spring, which
-    // carries no impulse, and the backlash and the currents do not jump.
+    // (the Zeno limit of the bounces): then q_s_dot+ = 0.
     const double rebound = stop.restitution * std::fabs(rate) >= stop.rest_rate ? -stop.restitution * rate : 0.0;
-    const Vec4 response = solve_mass_matrix(d.reduced_mass, Vec4(Vec4::Unit(coordinate_)));
+    apply_impulse(context, modes, state, rebound);
+}
+
+// The impulse P on e_s changes the rates by M^-1 e_s P: the coordinates the mass matrix couples to q_s (the
+// housing, a rigid gear's rotor through its reflected inertia) take their share; a compliant gear's rotor
+// is held only by its spring, which carries no impulse, and the backlash and the currents do not jump.
+// Another body resting on its stop meanwhile keeps its rate (0): that stop's impulse acts too.
+void AxisStopElement::apply_impulse(const SwitchingContext& context, const Modes& modes, double* state,
+                                    double rebound) const {
+    const StateLayout& layout = context.params.layout;
+    const Mat4& reduced_mass = context.dynamics.reduced_mass;
+    double& rate = state[layout.rate_slot[coordinate_]];
+    int held[kAxisStopCount];
+    int held_count = 0;
+    bool is_held[4] = {false, false, false, false};
+    for (int other = 0; other < kAxisStopCount; ++other) {
+        if (other == stop_ || modes.axis_stop[other] == 0) continue;
+        held[held_count++] = other;
+        is_held[kAxisStops[other].coordinate] = true;
+    }
+    if (held_count > 0) {
+        const Vec4 change =
+            axis_stop_detail::impact_while_held(coordinate_, rebound - rate, held, held_count, reduced_mass);
+        for (int body = 0; body < 4; ++body)
+            if (layout.independent(body) && body != coordinate_ && !is_held[body])
+                state[layout.rate_slot[body]] += change[body];
+        rate = rebound;
+        return;
+    }
+    const Vec4 response = solve_mass_matrix(reduced_mass, Vec4(Vec4::Unit(coordinate_)));
     const double impulse = (rebound - rate) / response[coordinate_];
     for (int body = 0; body < 4; ++body)
         if (layout.independent(body) && body != coordinate_) state[layout.rate_slot[body]] += impulse * response[body];
-    state[layout.rate_slot[coordinate_]] = rebound;
+    rate = rebound;
 }
 
 void AxisStopElement::settle(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,

@@ -52,6 +52,9 @@ namespace axis_stop_detail {
 // Two or more stops resting at once (rare): the joint solve of hold_at_axis_stops and its derivatives.
 void hold_together(const int* resting, int count, Dynamics& out);
 void hold_together_derivatives(const int* resting, int count, const Mat4& reduced_mass, Mat4x12& acceleration);
+// The rates' change at an impact on `coordinate` that changes its rate by `jump` while the stops `resting`
+// hold theirs: impulses on the impacting and the held coordinates, through the mass matrix.
+Vec4 impact_while_held(int coordinate, double jump, const int* resting, int count, const Mat4& reduced_mass);
 }  // namespace axis_stop_detail
 
 // Force pass, after the accelerations: while a body rests on a stop, the stop's reaction is the torque that
@@ -115,6 +118,8 @@ public:
 
 private:
     std::string side_name(int side) const;
+    // The impact's jump of q_s's rate to `rebound`, and the rates the mass matrix couples to it.
+    void apply_impulse(const SwitchingContext& context, const Modes& modes, double* state, double rebound) const;
 
     int stop_;        // in kAxisStops and the per-stop arrays
     int coordinate_;  // the stopped coordinate
