@@ -25,6 +25,27 @@ def event_indicators() -> int:
     return sum(instances * guards for _, instances, guards in elements())
 
 
+def real_units() -> list[str]:
+    """The unit of every Real variable, in real_variables.def's order."""
+    return re.findall(r'^X\(\w+, "[^"]*", \w+, \w+, \w+, "[^"]*", "([^"]*)",', (GIMBAL / "real_variables.def").read_text(),
+                      re.MULTILINE)
+
+
+def axis_stops() -> list[dict[str, str]]:
+    """The AXIS_STOP rows of switching_elements.def: each axis stop's element and its variables' identifiers
+    (lower, upper, restitution, rest_rate, contact)."""
+    text = (GIMBAL / "switching_elements.def").read_text()
+    rows = re.findall(r"^AXIS_STOP\((\w+),\s*(\w+),\s*(\w+),\s*(\w+),\s*(\w+),\s*(\w+),\s*(\w+)\)", text, re.MULTILINE)
+    keys = ("element", "coordinate", "lower", "upper", "restitution", "rest_rate", "contact")
+    return [dict(zip(keys, row)) for row in rows]
+
+
+def real_name(identifier: str) -> str:
+    """A Real variable's FMI name from its identifier in real_variables.def."""
+    match = re.search(rf'^X\({identifier}, "([^"]*)"', (GIMBAL / "real_variables.def").read_text(), re.MULTILINE)
+    return match.group(1)
+
+
 def indicators_of(element: str) -> range:
     """The event indicators (from 0) of one element kind's instances."""
     first = 0
