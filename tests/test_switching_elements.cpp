@@ -238,12 +238,36 @@ void test_axis_stop_hold() {
     CHECK(untouched == derivative);
 }
 
+// A restored state's modes against the elements the parameters define (impossible_mode, each class's
+// rule): a mode of an element the model lacks is refused, naming it; the model's own modes are not.
+void test_impossible_modes() {
+    ModelParameters params = default_parameters();
+    Modes modes;
+    CHECK(impossible_mode(params, modes).empty());
+    modes.gear_contact[0] = 1;
+    modes.friction[2] = FrictionMode::hold;
+    CHECK(impossible_mode(params, modes).empty());  // backlash gears and dry friction by default
+    modes.axis_stop[0] = -1;
+    CHECK(impossible_mode(params, modes) == "the elevation_stop mode is set but the stop is off (elevation_stop = false)");
+    params.axis_stop[0].present = true;
+    CHECK(impossible_mode(params, modes).empty());
+    modes.amplifier_saturated[1] = 1;
+    CHECK(impossible_mode(params, modes) == "motor 2 is in voltage drive but has an amplifier saturation mode");
+    params.fidelity.drive[1] = DriveMode::current;
+    CHECK(impossible_mode(params, modes).empty());
+    params.fidelity.dry_friction = false;
+    CHECK(impossible_mode(params, modes) == "a friction mode is set but dry friction is off");
+    params.fidelity.gear[0] = GearModel::rigid;
+    CHECK(impossible_mode(params, modes) == "gear 1 has no backlash but a contact mode");
+}
+
 int main() {
     test_gear_backlash();
     test_voltage_clamp();
     test_current_limiter();
     test_dry_friction();
     test_axis_stop_hold();
+    test_impossible_modes();
     test_registry();
     return check_report("switching_elements");
 }

@@ -17,6 +17,7 @@
 
 #include "gimbal/simulation/parameter_building.hpp"
 #include "gimbal/model/variable_groups.hpp"
+#include "gimbal/switching_elements/element_registry.hpp"
 
 namespace gimbal {
 namespace {
@@ -408,23 +409,9 @@ void check_against_model(const SnapshotContent& content, SnapshotCheck& check) {
     ModelParameters params;
     std::string error;
     if (!snapshot_parameters(content, params, error)) check.fail(error);
-    for (int axis = 0; axis < 2 && check.ok(); ++axis) {
-        if (params.fidelity.gear[axis] != GearModel::backlash && content.modes.gear_contact[axis] != 0)
-            check.fail("gear " + std::to_string(axis + 1) + " has no backlash but a contact mode");
-    }
-    for (int stop = 0; stop < kAxisStopCount && check.ok(); ++stop) {
-        if (!params.axis_stop[stop].present && content.modes.axis_stop[stop] != 0)
-            check.fail(std::string("the ") + declaration_of(kAxisStops[stop].element).identifier +
-                       " mode is set but the stop is off (" + declaration_of(kAxisStops[stop].element).element_switch +
-                       " = false)");
-    }
-    for (int axis = 0; axis < 2 && check.ok(); ++axis) {
-        if (params.fidelity.drive[axis] != DriveMode::current && content.modes.amplifier_saturated[axis] != 0)
-            check.fail("motor " + std::to_string(axis + 1) + " is in voltage drive but has an amplifier saturation mode");
-    }
-    for (int body = 0; body < 4 && check.ok(); ++body) {
-        if (!params.fidelity.dry_friction && content.modes.friction[body] != FrictionMode::none)
-            check.fail("a friction mode is set but dry friction is off");
+    if (check.ok()) {
+        const std::string impossible = impossible_mode(params, content.modes);
+        if (!impossible.empty()) check.fail(impossible);
     }
     for (int k = params.layout.size; k < kMaxStateSize && check.ok(); ++k)
         if (content.state[k] != 0.0)

@@ -85,6 +85,15 @@ AxisStopElement::AxisStopElement(const ElementSlot& slot)
       stop_(axis_stop_of(slot.kind)),
       coordinate_(kAxisStops[axis_stop_of(slot.kind)].coordinate) {}
 
+std::string AxisStopElement::impossible_mode(const ModelParameters& params, const Modes& modes,
+                                             const ElementSlot& slot) {
+    const int stop = axis_stop_of(slot.kind);
+    if (params.axis_stop[stop].present || modes.axis_stop[stop] == 0) return {};
+    const ElementDeclaration& declared = declaration_of(slot.kind);
+    return std::string("the ") + declared.identifier + " mode is set but the stop is off (" + declared.element_switch +
+           " = false)";
+}
+
 std::string AxisStopElement::side_name(int side) const {
     if (side == 0) return "free";
     return "resting on " + limit_name(side > 0 ? kAxisStops[stop_].upper : kAxisStops[stop_].lower);

@@ -36,6 +36,18 @@ SwitchingElementSet::SwitchingElementSet(const ModelParameters& params) : state_
     stage_start_[kDecisionStageCount] = static_cast<int>(elements_.size());
 }
 
+std::string impossible_mode(const ModelParameters& params, const Modes& modes) {
+    std::string why;
+#define ELEMENT(identifier, instances, guards, element_switch, element_class)                                  \
+    for (int instance = 0; instance < (instances) && why.empty(); ++instance)                                  \
+        why = element_class::impossible_mode(params, modes, ElementSlot{ElementKind::identifier, instance, 0});
+#define MODE_OUTPUT(element, output, lowest, highest)
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+    return why;
+}
+
 void SwitchingElementSet::guards(const SwitchingContext& context, const Modes& modes, double* values) const {
     for (const auto& element : elements_) element->guards(context, modes, values);
 }

@@ -100,6 +100,7 @@ public:
         return params.axis_stop[axis_stop_of(slot.kind)].present;
     }
     static constexpr DecisionStage kStage = DecisionStage::impact;
+    static std::string impossible_mode(const ModelParameters& params, const Modes& modes, const ElementSlot& slot);
     static constexpr int kGuards = 2;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;

@@ -62,6 +62,10 @@ public:
     // A coordinate with dry friction only.
     static bool present(const ModelParameters& params, const ElementSlot& slot) { return params.coordinate_friction[slot.instance].present(); }
     static constexpr DecisionStage kStage = DecisionStage::friction;
+    static std::string impossible_mode(const ModelParameters& params, const Modes& modes, const ElementSlot& slot) {
+        if (params.fidelity.dry_friction || modes.friction[slot.instance] == FrictionMode::none) return {};
+        return "a friction mode is set but dry friction is off";
+    }
     static constexpr int kGuards = 6;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;

@@ -20,6 +20,10 @@
 
 namespace gimbal {
 
+// Why `modes` is impossible for the elements `params` defines ("" when possible): the first element
+// instance, in the declaration's order, whose class refuses it (a restored FMU state's check).
+std::string impossible_mode(const ModelParameters& params, const Modes& modes);
+
 class SwitchingElementSet {
 public:
     // The registration: one element per switching part the model has.

@@ -97,6 +97,14 @@ public:
     SwitchingElement(std::string name, int first_guard) : name_(std::move(name)), first_guard_(first_guard) {}
     virtual ~SwitchingElement() = default;
 
+    // Why `modes` is impossible for instance `slot.instance` of this kind under `params` (a restored FMU
+    // state's check), "" when it is possible: a class whose mode needs the element hides this. Called
+    // for every instance, present or not.
+    static std::string impossible_mode(const ModelParameters& params, const Modes& modes, const ElementSlot& slot) {
+        (void)params, (void)modes, (void)slot;
+        return std::string();
+    }
+
     const std::string& name() const { return name_; }
     int first_guard() const { return first_guard_; }
     virtual int guard_count() const = 0;
