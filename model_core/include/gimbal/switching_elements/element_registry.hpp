@@ -1,14 +1,13 @@
 // The switching elements a model has (docs/architecture.md), generated from their one declaration,
 // gimbal/switching_elements.def: each ELEMENT row's class, made once per instance its present() accepts, in
 // the order their modes are decided (DecisionStage), with each one's guards' place among the FMU's event
-// indicators. The hybrid system (hybrid_system/gimbal_hybrid_system.hpp) holds one set; neither knows any
-// element by name.
+// indicators. The registry names no element; the hybrid system (hybrid_system/gimbal_hybrid_system.hpp)
+// holds one set.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
-
-#include <memory>
 
 #include "gimbal/function_ref.hpp"
 #include "gimbal/switching_elements/amplifier_saturation.hpp"
@@ -28,7 +27,7 @@ class SwitchingElementSet {
 public:
     // The registration: one element per switching part the model has.
     explicit SwitchingElementSet(const ModelParameters& params);
-    // The element list points into the element vectors: not copyable.
+    // Owns its elements (each by its own pointer): not copyable.
     SwitchingElementSet(const SwitchingElementSet&) = delete;
     SwitchingElementSet& operator=(const SwitchingElementSet&) = delete;
 
