@@ -114,7 +114,7 @@ struct ElementText {
     const char* element_switch;
 };
 constexpr ElementText kElements[] = {
-#define ELEMENT(identifier, instances, guards, element_switch) {#identifier, instances, guards, element_switch},
+#define ELEMENT(identifier, instances, guards, element_switch, element_class) {#identifier, instances, guards, element_switch},
 #define MODE_OUTPUT(element, output, lowest, highest)
 #include "gimbal/switching_elements.def"
 #undef MODE_OUTPUT
@@ -125,7 +125,7 @@ struct ModeOutputText {
     gimbal::IntegerVariable output;
 };
 constexpr ModeOutputText kModeOutputs[] = {
-#define ELEMENT(identifier, instances, guards, element_switch)
+#define ELEMENT(identifier, instances, guards, element_switch, element_class)
 #define MODE_OUTPUT(element, output, lowest, highest) {#element, gimbal::vi_##output},
 #include "gimbal/switching_elements.def"
 #undef MODE_OUTPUT

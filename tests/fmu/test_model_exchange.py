@@ -12,7 +12,6 @@
 from __future__ import annotations
 
 import ctypes
-import re
 import math
 import pathlib
 import tomllib
@@ -21,6 +20,7 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
+from support import declared_counts
 from support.model_exchange_host import ModelExchangeInstance, simulate_model_exchange
 from gimbal2axis.fmu import simulate
 
@@ -291,10 +291,11 @@ def test_refusals_name_the_function_and_the_culprit(gimbal_fmu):
 
         small = np.zeros(3)
         refused(lambda: model.getDerivatives(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
-                "fmi2GetDerivatives", "nx = 3", "19")
+                "fmi2GetDerivatives", "nx = 3", str(gimbal_fmu.model_description.numberOfContinuousStates))
         refused(lambda: model.getEventIndicators(small.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 3),
                 "fmi2GetEventIndicators", "ni = 3", str(gimbal_fmu.model_description.numberOfEventIndicators))
-        refused(lambda: model.getDerivatives(None, 19), "fmi2GetDerivatives", "derivatives", "null")
+        refused(lambda: model.getDerivatives(None, gimbal_fmu.model_description.numberOfContinuousStates),
+                "fmi2GetDerivatives", "derivatives", "null")
         bad = states(instance)
         bad[9] = float("nan")
         refused(lambda: set_states(instance, bad), "fmi2SetContinuousStates", "i_R2", "finite")
@@ -328,11 +329,12 @@ def test_the_model_description_declares_model_exchange(gimbal_fmu):
     assert md.modelExchange.modelIdentifier == md.coSimulation.modelIdentifier
     # The indicators: every switching element's guards, as declared once (switching_elements.def), whose
     # sum gimbal_c_api.h's GIMBAL_EVENT_INDICATORS is.
-    declared = (REPO / "model_core" / "include" / "gimbal" / "switching_elements.def").read_text()
-    guards = sum(int(n) * int(g) for n, g in re.findall(r"^ELEMENT\(\w+, (\d+), (\d+),", declared, re.MULTILINE))
-    assert md.numberOfContinuousStates == 19 and md.numberOfEventIndicators == guards >= 36
+    guards = declared_counts.event_indicators()
+    states = declared_counts.continuous_states()
+    assert md.numberOfContinuousStates == states and md.numberOfEventIndicators == guards >= 36
     header = (REPO / "model_core" / "include" / "gimbal" / "gimbal_c_api.h").read_text()
-    assert '#include "gimbal/switching_elements.def"' in header and "#define GIMBAL_CONTINUOUS_STATES 19" in header
+    assert '#include "gimbal/switching_elements.def"' in header
+    assert f"#define GIMBAL_CONTINUOUS_STATES {states}\n" in header
     states = [d.variable.derivative.name for d in md.derivatives]
     assert states == ANGLES + ["alpha_dot", "alpha_m_dot", "beta_dot", "beta_m_dot", "i_R1", "i_R2", "theta_b1",
                                "theta_b2", "energy.electrical_in", "energy.resistive", "energy.viscous",
@@ -441,14 +443,14 @@ def test_states_and_indicators_in_initialization_mode_are_those_of_the_start(gim
         gimbal_fmu.set_values(model, {"gear1.model": 0, "alpha": 0.2, "alpha_m": 5.0, "beta": 0.3, "i_R2": 0.5})
         model.enterInitializationMode()
         gimbal_fmu.set_values(model, {"u_R1": 30.0})
-        indicators = md.numberOfEventIndicators
-        x0, z0 = np.zeros(19), np.zeros(indicators)
+        indicators, states = md.numberOfEventIndicators, md.numberOfContinuousStates
+        x0, z0 = np.zeros(states), np.zeros(indicators)
         pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))  # noqa: E731
-        model.getContinuousStates(pointer(x0), 19)
+        model.getContinuousStates(pointer(x0), states)
         model.getEventIndicators(pointer(z0), indicators)
         model.exitInitializationMode()
-        x1, z1 = np.zeros(19), np.zeros(indicators)
-        model.getContinuousStates(pointer(x1), 19)
+        x1, z1 = np.zeros(states), np.zeros(indicators)
+        model.getContinuousStates(pointer(x1), states)
         model.getEventIndicators(pointer(z1), indicators)
         assert np.array_equal(x0, x1) and np.array_equal(z0, z1)
         assert x0[0] == 0.2 and x0[1] == 0.2 * gimbal_fmu.start("gear1.N") and x0[9] == 0.5
@@ -465,8 +467,9 @@ def test_model_exchange_functions_refuse_a_co_simulation_instance(gimbal_fmu):
     try:
         get_nominals = slave.dll.fmi2GetNominalsOfContinuousStates
         get_nominals.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t]
-        nominals = np.zeros(19)
-        assert get_nominals(slave.component, nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 19) == 3
+        states = gimbal_fmu.model_description.numberOfContinuousStates
+        nominals = np.zeros(states)
+        assert get_nominals(slave.component, nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), states) == 3
         assert any("fmi2GetNominalsOfContinuousStates is a Model Exchange function" in e.text for e in log)
     finally:
         slave.freeInstance()

@@ -8,6 +8,8 @@ import math
 import pytest
 from fmpy.fmi1 import FMICallException
 
+from support import declared_counts
+
 ERROR = 3
 
 # A bound alone may not be enough to make a set of values valid: rules that tie variables together
@@ -31,8 +33,9 @@ EXPECTED_REAL_BOUNDS = {
     **{f"cable{j}.{p}": (0.0, None) for j in (1, 2) for p in ("k", "c")},
     **{f"motor{j}.T_cogging": (0.0, None) for j in (1, 2)},
     "solver.rtol": (ABOVE_ZERO, math.nextafter(1.0, 0.0)),
-    "elevation_stop.e": (0.0, 1.0),
-    "elevation_stop.w_rest": (ABOVE_ZERO, None),
+    # Every axis stop's restitution in [0, 1] and rest rate > 0 (its AXIS_STOP row of switching_elements.def).
+    **{declared_counts.real_name(stop["restitution"]): (0.0, 1.0) for stop in declared_counts.axis_stops()},
+    **{declared_counts.real_name(stop["rest_rate"]): (ABOVE_ZERO, None) for stop in declared_counts.axis_stops()},
     **{f"amplifier{j}.{p}": (0.0, None) for j in (1, 2) for p in ("K_p", "K_i")},
     "amplifier1.f_c": (ABOVE_ZERO, None),
     "amplifier2.f_c": (ABOVE_ZERO, None),

@@ -115,7 +115,7 @@ GimbalStatus gimbal_core_restore(GimbalCore* core, const void* buffer);
 /* Each switching element's guards, summed from their one declaration (gimbal/switching_elements.def). */
 enum {
     GIMBAL_EVENT_INDICATORS = 0
-#define ELEMENT(identifier, instances, guards, element_switch) + (instances) * (guards)
+#define ELEMENT(identifier, instances, guards, element_switch, element_class) + (instances) * (guards)
 #define MODE_OUTPUT(element, output, lowest, highest)
 #include "gimbal/switching_elements.def"
 #undef MODE_OUTPUT

@@ -7,8 +7,10 @@
 
 namespace gimbal {
 
-StateLayout StateLayout::from(const Fidelity& fidelity, bool energy_accounting) {
-    StateLayout layout;
+namespace {
+
+// The angles' and rates' slots (a rigid gear's rotor has none); returns the number of coordinates kept.
+int assign_coordinate_slots(const Fidelity& fidelity, StateLayout& layout) {
     int coordinates = 0;
     for (int body = 0; body < 4; ++body) {
         const bool rigid_rotor = (body == rotor_index(0) && fidelity.gear[0] == GearModel::rigid) ||
@@ -17,21 +19,26 @@ StateLayout StateLayout::from(const Fidelity& fidelity, bool energy_accounting) 
     }
     for (int body = 0; body < 4; ++body)
         layout.rate_slot[body] = layout.angle_slot[body] < 0 ? -1 : coordinates + layout.angle_slot[body];
-    int slot = 2 * coordinates;
-    for (int axis = 0; axis < 2; ++axis)
-        layout.current_slot[axis] = fidelity.motor[axis] == MotorModel::inductive ? slot++ : -1;
-    for (int axis = 0; axis < 2; ++axis)
-        layout.backlash_slot[axis] = fidelity.gear[axis] == GearModel::backlash ? slot++ : -1;
-    bool amplifiers = false;
-    for (int axis = 0; axis < 2; ++axis) {
-        const bool integrator =
-            fidelity.drive[axis] == DriveMode::current && fidelity.motor[axis] == MotorModel::inductive;
-        layout.amplifier_slot[axis] = integrator ? slot++ : -1;
-        amplifiers = amplifiers || integrator;
-    }
+    return coordinates;
+}
+
+// One element state per axis where `has_state(axis)`, in the next free slots; -1 elsewhere.
+template <class HasState>
+void assign_axis_slots(int (&slots)[2], int& slot, HasState has_state) {
+    for (int axis = 0; axis < 2; ++axis) slots[axis] = has_state(axis) ? slot++ : -1;
+}
+
+}  // namespace
+
+StateLayout StateLayout::from(const Fidelity& fidelity, bool energy_accounting) {
+    StateLayout layout;
+    int slot = 2 * assign_coordinate_slots(fidelity, layout);
+    assign_axis_slots(layout.current_slot, slot, [&](int axis) { return fidelity.motor[axis] == MotorModel::inductive; });
+    assign_axis_slots(layout.backlash_slot, slot, [&](int axis) { return fidelity.gear[axis] == GearModel::backlash; });
+    assign_axis_slots(layout.amplifier_slot, slot, [&](int axis) { return amplifier_integrates(fidelity, axis); });
     layout.energy_slot = energy_accounting ? slot : -1;
     layout.size = slot + (energy_accounting ? kEnergyFlowCount : 0);
-    layout.canonical = slot == kStateSize && !amplifiers;
+    layout.canonical = slot == kStateSize && layout.amplifier_slot[0] < 0 && layout.amplifier_slot[1] < 0;
     return layout;
 }
 
@@ -187,7 +194,7 @@ void evaluate_dynamics(const ModelParameters& params, const StepInputs& inputs, 
     // reflected inertia N^2 J_rotor on the diagonal.
     friction_torques(params, modes, reduced_mass, applied, qd, out);
     out.acceleration = solve_mass_matrix(reduced_mass, Vec4(applied + out.friction_torque));
-    hold_at_elevation_stop(modes, out);  // the end stop's reaction while the payload rests on it
+    hold_at_axis_stops(modes, out);  // the end stops' reactions while a body rests on one
     out.full_acceleration = out.acceleration;
     if (reduced) rigid_axis_outputs(params, mass_matrix, force, bias, out);
 }

@@ -1,7 +1,7 @@
 // d(dx/dt)/dx (gimbal_model.hpp, evaluate_jacobian), from the same passes as the dynamics: the
 // drive train's elements (gear_backlash, current_limiter), the disturbance elements (cable, cogging),
-// the multibody terms, the dry friction element's hold torques, the elevation end stop's reaction while
-// the payload rests on it, and the state rows of the elements with states of their own.
+// the multibody terms, the dry friction element's hold torques, the axis end stops' reactions while a
+// body rests on one, and the state rows of the elements with states of their own.
 #include "gimbal/model/gimbal_model.hpp"
 
 #include <algorithm>
@@ -86,7 +86,8 @@ Mat4x12 to_padded(const Mat4& T, const Mat4x12& force, const Mat4 (&inertia_deri
 }
 
 // The integrated state's rows: the kinematic identities, the accelerations, and the rows of the
-// elements with a state of their own (the inductive current, the backlash), in the layout's slots.
+// elements with a state of their own (the inductive current, the backlash, the amplifier's integrator), in
+// the layout's slots.
 void write_state_rows(const ModelParameters& params, const Modes& modes, const Mat4& T, const Mat4x12& acceleration,
                       double* column_major) {
     const StateLayout& layout = params.layout;
@@ -118,15 +119,7 @@ void write_state_rows(const ModelParameters& params, const Modes& modes, const M
     for (int axis = 0; axis < 2; ++axis) {
         if (current_state_row(params, modes, axis, T, row)) fill_row(layout.current_slot[axis], row);
         if (backlash_state_row(params, modes, axis, T, row)) fill_row(layout.backlash_slot[axis], row);
-    }
-    // The current amplifiers' integrators (amplifier_saturation.hpp), while the output is free: x_I drives
-    // the current through 1/L, and integrates K_i (i_cmd - i) unless the limiter holds i.
-    for (int axis = 0; axis < 2; ++axis) {
-        const int slot = layout.amplifier_slot[axis], current = layout.current_slot[axis];
-        if (slot < 0 || modes.amplifier_saturated[axis] != 0) continue;
-        if (modes.motor_limited[axis] != 0) continue;
-        jac(current, slot) = amplifier_slopes(params, modes, axis).integrator / params.motor[axis].inductance;
-        jac(slot, current) = -params.amplifier[axis].integral_gain;
+        add_amplifier_state_entries(params, modes, axis, jac);
     }
 }
 
@@ -148,7 +141,7 @@ void evaluate_jacobian(const ModelParameters& params, const Modes& modes, const 
     Mat4x12 acceleration_rhs = applied + friction;
     for (int k = 0; k < 4; ++k) acceleration_rhs.col(k) -= padded_inertia_derivative[k] * d.acceleration;
     Mat4x12 acceleration = solve_mass_matrix<12>(d.reduced_mass, acceleration_rhs);
-    hold_at_elevation_stop_derivatives(modes, d.reduced_mass, acceleration);
+    hold_at_axis_stops_derivatives(modes, d.reduced_mass, acceleration);
 
     write_state_rows(params, modes, T, acceleration, column_major);
 }

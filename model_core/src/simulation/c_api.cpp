@@ -221,7 +221,7 @@ GimbalStatus gimbal_core_linearize(GimbalCore* core, GimbalLinearModel* model) {
             model->voltage_clamped[axis] = linear.modes.voltage_clamped[axis];
         }
         for (int body = 0; body < 4; ++body) model->friction[body] = static_cast<int>(linear.modes.friction[body]);
-        model->elevation_stop = linear.modes.elevation_stop;
+        model->elevation_stop = linear.modes.axis_stop[gimbal::axis_stop_of(gimbal::ElementKind::elevation_stop)];
         for (int axis = 0; axis < 2; ++axis) model->amplifier_saturated[axis] = linear.modes.amplifier_saturated[axis];
         model->time = core->instance.time();
         return GIMBAL_OK;

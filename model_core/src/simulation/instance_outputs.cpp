@@ -80,7 +80,7 @@ void publish_outputs(const OutputPoint& point, double (&reals)[kRealVariableCoun
     integers[vi_gear2_contact] = modes.gear_contact[1];
     integers[vi_motor1_limited] = modes.motor_limited[0];
     integers[vi_motor2_limited] = modes.motor_limited[1];
-    integers[vi_elevation_stop_contact] = modes.elevation_stop;
+    for (int stop = 0; stop < kAxisStopCount; ++stop) integers[kAxisStops[stop].contact] = modes.axis_stop[stop];
     integers[vi_motor1_amplifier_saturated] = modes.amplifier_saturated[0];
     integers[vi_motor2_amplifier_saturated] = modes.amplifier_saturated[1];
     for (int body = 0; body < 4; ++body)

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 namespace gimbal {
@@ -304,17 +305,27 @@ void read_disturbances(const double (&values)[kRealVariableCount], const int (&i
     }
 }
 
-// The elevation end stop (switching_elements/elevation_stop.hpp). e in [0, 1] and w_rest > 0 are the
-// variables' own bounds; the order of the stops is checked whether or not the stop is on, so that a value
-// set for it is refused when it is set, not when the stop is switched on later.
-bool read_elevation_stop(Checker& check, const bool (&flags)[kBooleanVariableCount], ElevationStopParameters& stop) {
-    stop.present = flags[vb_elevation_stop];
-    stop.lower = check.get(vr_elevation_stop_beta_min);
-    stop.upper = check.get(vr_elevation_stop_beta_max);
-    stop.restitution = check.get(vr_elevation_stop_e);
-    stop.rest_rate = check.get(vr_elevation_stop_w_rest);
-    return check.require(vr_elevation_stop_beta_min, stop.lower < stop.upper,
-                         "it must be below elevation_stop.beta_max");
+// The axis end stops (switching_elements/axis_stop.hpp), one per AXIS_STOP row of switching_elements.def,
+// each switched on by its ELEMENT row's Boolean. e in [0, 1] and w_rest > 0 are the variables' own bounds;
+// the order of the stops is checked whether or not the stop is on, so that a value set for it is refused
+// when it is set, not when the stop is switched on later.
+bool read_axis_stops(Checker& check, const bool (&flags)[kBooleanVariableCount],
+                     AxisStopParameters (&stops)[kAxisStopCount]) {
+    for (int k = 0; k < kAxisStopCount; ++k) {
+        const AxisStopDeclaration& declared = kAxisStops[k];
+        const char* element_switch = declaration_of(declared.element).element_switch;
+        AxisStopParameters& stop = stops[k];
+        stop.present = false;
+        for (unsigned vb = 0; vb < kBooleanVariableCount; ++vb)
+            if (std::strcmp(kBooleanVariables[vb].name, element_switch) == 0) stop.present = flags[vb];
+        stop.lower = check.get(declared.lower);
+        stop.upper = check.get(declared.upper);
+        stop.restitution = check.get(declared.restitution);
+        stop.rest_rate = check.get(declared.rest_rate);
+        const std::string rule = std::string("it must be below ") + kRealVariables[declared.upper].name;
+        if (!check.require(declared.lower, stop.lower < stop.upper, rule.c_str())) return false;
+    }
+    return true;
 }
 
 // solver.*: the method (its range checked from the table; here: one this binary has), its step limit and
@@ -362,7 +373,7 @@ bool build_model_parameters(const double (&values)[kRealVariableCount], const in
         !read_solver(integers, params, error))
         return false;
     read_disturbances(values, integers, params.disturbances);
-    if (!read_elevation_stop(check, flags, params.elevation_stop)) return false;
+    if (!read_axis_stops(check, flags, params.axis_stop)) return false;
     read_fidelity(integers, flags, params);
     // Checked against its Enumeration items with the other single-variable rules.
     params.gear_start[0] = static_cast<GearStart>(integers[vi_gear1_start]);
@@ -389,11 +400,16 @@ bool validate_start_state(const double (&values)[kRealVariableCount], const Mode
                            "a start backlash state must lie within +-eta"))
             return false;
     }
-    const ElevationStopParameters& stop = params.elevation_stop;
-    if (stop.present && !check.require(vr_beta, values[vr_beta] >= stop.lower && values[vr_beta] <= stop.upper,
-                                       "the start value must lie within the elevation stops, "
-                                       "[elevation_stop.beta_min, elevation_stop.beta_max]"))
-        return false;
+    for (int k = 0; k < kAxisStopCount; ++k) {
+        const AxisStopParameters& stop = params.axis_stop[k];
+        const AxisStopDeclaration& declared = kAxisStops[k];
+        const RealVariable angle = kStartState[kAngles + declared.coordinate];
+        const std::string rule = "the start value must lie within the " + axis_stop_name(k) + "s, [" +
+                                 kRealVariables[declared.lower].name + ", " + kRealVariables[declared.upper].name + "]";
+        if (stop.present &&
+            !check.require(angle, values[angle] >= stop.lower && values[angle] <= stop.upper, rule.c_str()))
+            return false;
+    }
     return true;
 }
 

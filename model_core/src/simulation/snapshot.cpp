@@ -17,6 +17,7 @@
 
 #include "gimbal/simulation/parameter_building.hpp"
 #include "gimbal/model/variable_groups.hpp"
+#include "gimbal/switching_elements/element_registry.hpp"
 
 namespace gimbal {
 namespace {
@@ -173,7 +174,7 @@ ElementRule integer_variable_rule(std::size_t k) {
         std::int64_t lowest, highest;
     };
     static constexpr ModeOutputRange kModeOutputs[] = {
-#define ELEMENT(identifier, instances, guards, element_switch)
+#define ELEMENT(identifier, instances, guards, element_switch, element_class)
 #define MODE_OUTPUT(element, output, lowest, highest) {vi_##output, lowest, highest},
 #include "gimbal/switching_elements.def"
 #undef MODE_OUTPUT
@@ -216,8 +217,8 @@ constexpr Field kFields[] = {
     field<&C::modes, &Modes::friction>("modes.friction", "friction mode", kInit,
                                        range(static_cast<long>(FrictionMode::none),
                                              static_cast<long>(FrictionMode::at_max_negative))),
-    // In what was the tail padding of Modes in format 9: no later field moves.
-    field<&C::modes, &Modes::elevation_stop>("modes.elevation_stop", "elevation stop mode", kInit, range(-1, 1)),
+    // In what was the tail padding of Modes in format 9: no later field moves. One int per axis stop.
+    field<&C::modes, &Modes::axis_stop>("modes.axis_stop", "axis stop mode", kInit, range(-1, 1)),
     field<&C::counters, &EventCounters::total>("counters.total", "event counter", kInit, count()),
     field<&C::counters, &EventCounters::backlash>("counters.backlash", "event counter", kInit, count()),
     field<&C::counters, &EventCounters::current_limit>("counters.current_limit", "event counter", kInit, count()),
@@ -408,19 +409,9 @@ void check_against_model(const SnapshotContent& content, SnapshotCheck& check) {
     ModelParameters params;
     std::string error;
     if (!snapshot_parameters(content, params, error)) check.fail(error);
-    for (int axis = 0; axis < 2 && check.ok(); ++axis) {
-        if (params.fidelity.gear[axis] != GearModel::backlash && content.modes.gear_contact[axis] != 0)
-            check.fail("gear " + std::to_string(axis + 1) + " has no backlash but a contact mode");
-    }
-    if (check.ok() && !params.elevation_stop.present && content.modes.elevation_stop != 0)
-        check.fail("an elevation stop mode is set but the elevation stop is off");
-    for (int axis = 0; axis < 2 && check.ok(); ++axis) {
-        if (params.fidelity.drive[axis] != DriveMode::current && content.modes.amplifier_saturated[axis] != 0)
-            check.fail("motor " + std::to_string(axis + 1) + " is in voltage drive but has an amplifier saturation mode");
-    }
-    for (int body = 0; body < 4 && check.ok(); ++body) {
-        if (!params.fidelity.dry_friction && content.modes.friction[body] != FrictionMode::none)
-            check.fail("a friction mode is set but dry friction is off");
+    if (check.ok()) {
+        const std::string impossible = impossible_mode(params, content.modes);
+        if (!impossible.empty()) check.fail(impossible);
     }
     for (int k = params.layout.size; k < kMaxStateSize && check.ok(); ++k)
         if (content.state[k] != 0.0)

@@ -24,6 +24,7 @@
 #include "core_settings.hpp"
 #include "gimbal/gimbal_c_api.h"
 #include "gimbal/model/variables.hpp"
+#include "gimbal/switching_elements/switching_element.hpp"
 
 using namespace gimbal;
 
@@ -342,8 +343,8 @@ void refusals() {
     gimbal_core_destroy(core);
 }
 
-// Voltage drive: the amplifiers' indicators are constants 1 after every earlier one; the states 18 and
-// 19 of the continuous-time interface are held at 0.
+// Voltage drive: the amplifiers' indicators (their place in switching_elements.def) are constants 1; their
+// integrators' states of the continuous-time interface (kAmplifierStates on) are held at 0.
 void voltage_drive_indicators() {
     GimbalCore* core = gimbal_core_create(record, always, nullptr);
     gimbal_core_use_continuous_time(core);
@@ -351,12 +352,18 @@ void voltage_drive_indicators() {
     CHECK(gimbal_core_initialize(core, 0.0) == GIMBAL_OK);
     double indicators[GIMBAL_EVENT_INDICATORS], states[GIMBAL_CONTINUOUS_STATES], derivatives[GIMBAL_CONTINUOUS_STATES];
     CHECK(gimbal_core_get_event_indicators(core, indicators) == GIMBAL_OK);
-    CHECK(GIMBAL_EVENT_INDICATORS == 42 && GIMBAL_CONTINUOUS_STATES == 19);
-    for (int k = 38; k < 42; ++k) CHECK(indicators[k] == 1.0);
+    CHECK(GIMBAL_EVENT_INDICATORS == kEventIndicatorCount && GIMBAL_CONTINUOUS_STATES == kMaxStateSize);
+    constexpr ElementKind kAmplifier = ElementKind::amplifier_saturation;
+    const int first = first_indicator_of(kAmplifier);
+    CHECK(first > 0);
+    for (int k = first; k < first + declaration_of(kAmplifier).instances * declaration_of(kAmplifier).guards; ++k)
+        CHECK(indicators[k] == 1.0);
     CHECK(gimbal_core_get_continuous_states(core, states) == GIMBAL_OK);
     CHECK(gimbal_core_get_derivatives(core, derivatives) == GIMBAL_OK);
-    CHECK(states[17] == 0.0 && states[18] == 0.0 && derivatives[17] == 0.0 && derivatives[18] == 0.0);
-    CHECK(gimbal_continuous_state_vr(17) == vr_amplifier1_x_I && gimbal_state_derivative_vr(18) == vr_der_amplifier2_x_I);
+    for (int axis = 0; axis < kAmplifierIntegratorCount; ++axis)
+        CHECK(states[kAmplifierStates + axis] == 0.0 && derivatives[kAmplifierStates + axis] == 0.0);
+    CHECK(gimbal_continuous_state_vr(kAmplifierStates) == vr_amplifier1_x_I &&
+          gimbal_state_derivative_vr(kAmplifierStates + 1) == vr_der_amplifier2_x_I);
     gimbal_core_destroy(core);
 }
 

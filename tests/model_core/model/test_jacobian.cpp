@@ -18,6 +18,9 @@ using namespace gimbal;
 
 namespace {
 
+// The elevation stop's slot among the axis stops (switching_elements.def).
+constexpr int kElevationStop = axis_stop_of(ElementKind::elevation_stop);
+
 struct Values {
     double reals[kRealVariableCount];
     int integers[kIntegerVariableCount];
@@ -167,7 +170,7 @@ int main() {
                                 for (int body = 0; body < 4; ++body)
                                     if (params.coordinate_friction[body].present())
                                         modes.friction[body] = kFrictionModes[(repeat + body + contact + 1) % 5];
-                                modes.elevation_stop = repeat == 1 ? contact : 0;
+                                modes.axis_stop[kElevationStop] = repeat == 1 ? contact : 0;
                                 if (drive != 0)
                                     for (int axis = 0; axis < 2; ++axis)
                                         modes.amplifier_saturated[axis] = axis == 0 ? repeat - 1 : (repeat + contact + 3) % 3 - 1;
@@ -177,7 +180,7 @@ int main() {
                                                           std::to_string(fixed_base) + ", disturbances " +
                                                           std::to_string(disturbed) + ", contact " + std::to_string(contact) +
                                                           ", limited " + std::to_string(limited) + ", elevation stop " +
-                                                          std::to_string(modes.elevation_stop) + ", drive " +
+                                                          std::to_string(modes.axis_stop[kElevationStop]) + ", drive " +
                                                           std::to_string(drive) + ", amplifiers " +
                                                           std::to_string(modes.amplifier_saturated[0]) + " " +
                                                           std::to_string(modes.amplifier_saturated[1]);

@@ -175,11 +175,18 @@ std::vector<RealParameter> real_parameters() {
         list.push_back(
             {motor + "cogging_phase", d.cogging_phase, [j](const ModelParameters& m) { return m.disturbances.cogging[j].phase; }});
     }
-    // The elevation end stop (switching_elements/elevation_stop.hpp).
-    list.push_back({"elevation_stop.beta_min", -1.21, [](const ModelParameters& m) { return m.elevation_stop.lower; }});
-    list.push_back({"elevation_stop.beta_max", 1.31, [](const ModelParameters& m) { return m.elevation_stop.upper; }});
-    list.push_back({"elevation_stop.e", 0.61, [](const ModelParameters& m) { return m.elevation_stop.restitution; }});
-    list.push_back({"elevation_stop.w_rest", 0.0017, [](const ModelParameters& m) { return m.elevation_stop.rest_rate; }});
+    // The axis end stops (switching_elements/axis_stop.hpp), each AXIS_STOP row's variables into its slot.
+    for (int s = 0; s < kAxisStopCount; ++s) {
+        const AxisStopDeclaration& stop = kAxisStops[s];
+        list.push_back({kRealVariables[stop.lower].name, -1.21 - 0.01 * s,
+                        [s](const ModelParameters& m) { return m.axis_stop[s].lower; }});
+        list.push_back({kRealVariables[stop.upper].name, 1.31 + 0.01 * s,
+                        [s](const ModelParameters& m) { return m.axis_stop[s].upper; }});
+        list.push_back({kRealVariables[stop.restitution].name, 0.61 + 0.01 * s,
+                        [s](const ModelParameters& m) { return m.axis_stop[s].restitution; }});
+        list.push_back({kRealVariables[stop.rest_rate].name, 0.0017 + 0.0001 * s,
+                        [s](const ModelParameters& m) { return m.axis_stop[s].rest_rate; }});
+    }
     // The current amplifiers (switching_elements/amplifier_saturation.hpp): gains given, not derived.
     for (int j = 0; j < 2; ++j) {
         const std::string amplifier = "amplifier" + std::to_string(j + 1) + ".";
@@ -215,15 +222,23 @@ const std::map<std::string, IntegerField>& integer_parameter_fields() {
 }
 
 using BooleanField = std::function<bool(const ModelParameters&)>;
-const std::map<std::string, BooleanField>& boolean_parameter_fields() {
-    static const std::map<std::string, BooleanField> fields = {
+std::map<std::string, BooleanField> listed_boolean_fields() {
+    std::map<std::string, BooleanField> fields = {
         {"energy_accounting", [](const ModelParameters& m) { return m.energy_accounting; }},
         {"dry_friction", [](const ModelParameters& m) { return m.fidelity.dry_friction; }},
         {"base.fixed", [](const ModelParameters& m) { return m.fidelity.fixed_base; }},
-        {"elevation_stop", [](const ModelParameters& m) { return m.elevation_stop.present; }},
         {"amplifier1.back_emf_feedforward", [](const ModelParameters& m) { return m.amplifier[0].back_emf_feedforward; }},
         {"amplifier2.back_emf_feedforward", [](const ModelParameters& m) { return m.amplifier[1].back_emf_feedforward; }},
     };
+    // Each axis stop's switch, its ELEMENT row's.
+    for (int s = 0; s < kAxisStopCount; ++s)
+        fields[declaration_of(kAxisStops[s].element).element_switch] = [s](const ModelParameters& m) {
+            return m.axis_stop[s].present;
+        };
+    return fields;
+}
+const std::map<std::string, BooleanField>& boolean_parameter_fields() {
+    static const std::map<std::string, BooleanField> fields = listed_boolean_fields();
     return fields;
 }
 

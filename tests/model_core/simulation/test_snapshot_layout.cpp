@@ -25,7 +25,7 @@ struct Modes10 {
     int motor_limited[2];
     int voltage_clamped[2];
     FrictionMode friction[4];
-    int elevation_stop;
+    int axis_stop[kAxisStopCount];  // one per AXIS_STOP row, as the reals are one per Real variable
 };
 
 struct Format7 {
@@ -80,7 +80,7 @@ const Place kFormat7[] = {
     PLACE(reals), PLACE(integers), PLACE(booleans), PLACE(initialized), PLACE(integrator_running), PLACE(at_rest),
     PLACE(rtol_set), PLACE(master_tolerance_defined), PLACE(master_tolerance), PLACE(time), PLACE(clock), PLACE(state),
     PLACE_IN(modes, gear_contact), PLACE_IN(modes, motor_limited), PLACE_IN(modes, voltage_clamped),
-    PLACE_IN(modes, friction), PLACE_IN(modes, elevation_stop), PLACE_IN(counters, total), PLACE_IN(counters, backlash),
+    PLACE_IN(modes, friction), PLACE_IN(modes, axis_stop), PLACE_IN(counters, total), PLACE_IN(counters, backlash),
     PLACE_IN(counters, current_limit), PLACE_IN(counters, stick_slip), PLACE_IN(counters, last_event_time),
     PLACE_IN(statistics, steps), PLACE_IN(statistics, rhs_evaluations), PLACE_IN(statistics, jacobian_evaluations),
     PLACE_IN(statistics, events), PLACE_IN(statistics, zeno_holds), PLACE_IN(statistics, method_switches),

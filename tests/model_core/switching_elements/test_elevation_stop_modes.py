@@ -44,7 +44,7 @@ def fmu(fmu_path):
 def test_the_mode_outputs_are_the_declared_ones(fmu):
     declared = (REPO / "model_core" / "include" / "gimbal" / "switching_elements.def").read_text()
     switches = {element: switch for element, switch in
-                re.findall(r'^ELEMENT\((\w+), \d+, \d+, "([\w.<>]*)"\)', declared, re.MULTILINE)}
+                re.findall(r'^ELEMENT\((\w+), \d+, \d+, "([\w.<>]*)", \w+\)', declared, re.MULTILINE)}
     rows = re.findall(r"^MODE_OUTPUT\((\w+), (\w+), -?\d+, -?\d+\)", declared, re.MULTILINE)
     names = {v.name.replace(".", "_").replace("[", "_").replace("]", ""): v.name for v in fmu.variables.values()}
     # "<j>" in a switch is the instance's number: the element's mode outputs are in instance order.

@@ -199,11 +199,75 @@ void test_registry() {
 
 }  // namespace
 
+// An axis stop's hold (axis_stop.hpp): the reaction that keeps the stopped coordinate's acceleration at 0
+// is a torque on that coordinate alone (M (qdd_held - qdd_free) = e_s torque); the joint solve of several
+// resting stops, given one, is the single stop's hold, and so is its Jacobian projection.
+void test_axis_stop_hold() {
+    const ModelParameters params = default_parameters();
+    const StepInputs inputs;
+    double state[kMaxStateSize] = {};
+    state[params.layout.angle_slot[kAxisStops[0].coordinate]] = 0.3;
+    state[params.layout.rate_slot[kAzimuthBody]] = 0.2;
+    Modes free_modes, resting;
+    resting.axis_stop[0] = 1;
+    const Dynamics free = dynamics_at(params, inputs, free_modes, 0.0, state);
+    const Dynamics held = dynamics_at(params, inputs, resting, 0.0, state);
+    const int s = kAxisStops[0].coordinate;
+    CHECK(free.stop_torque[0] == 0.0 && held.stop_torque[0] != 0.0 && held.acceleration[s] == 0.0);
+    const Vec4 reaction = held.reduced_mass * (held.acceleration - free.acceleration);
+    for (int k = 0; k < 4; ++k)
+        CHECK(std::fabs(reaction[k] - (k == s ? held.stop_torque[0] : 0.0)) <= 1e-9 * std::fabs(held.stop_torque[0]));
+
+    Dynamics joint = free;
+    const int stops[1] = {0};
+    axis_stop_detail::hold_together(stops, 1, joint);
+    CHECK(joint.acceleration[s] == 0.0);
+    CHECK(std::fabs(joint.stop_torque[0] - held.stop_torque[0]) <= 1e-12 * std::fabs(held.stop_torque[0]));
+    CHECK((joint.acceleration - held.acceleration).cwiseAbs().maxCoeff() <= 1e-12 * held.acceleration.cwiseAbs().maxCoeff());
+
+    Mat4x12 derivative;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 12; ++c) derivative(r, c) = std::sin(1.0 + r + 4.0 * c);
+    Mat4x12 single = derivative, together = derivative;
+    hold_at_axis_stops_derivatives(resting, free.reduced_mass, single);
+    axis_stop_detail::hold_together_derivatives(stops, 1, free.reduced_mass, together);
+    CHECK(single.row(s).isZero(0.0) && together.row(s).isZero(0.0));
+    CHECK((single - together).cwiseAbs().maxCoeff() <= 1e-12 * derivative.cwiseAbs().maxCoeff());
+    Mat4x12 untouched = derivative;
+    hold_at_axis_stops_derivatives(free_modes, free.reduced_mass, untouched);
+    CHECK(untouched == derivative);
+}
+
+// A restored state's modes against the elements the parameters define (impossible_mode, each class's
+// rule): a mode of an element the model lacks is refused, naming it; the model's own modes are not.
+void test_impossible_modes() {
+    ModelParameters params = default_parameters();
+    Modes modes;
+    CHECK(impossible_mode(params, modes).empty());
+    modes.gear_contact[0] = 1;
+    modes.friction[2] = FrictionMode::hold;
+    CHECK(impossible_mode(params, modes).empty());  // backlash gears and dry friction by default
+    modes.axis_stop[0] = -1;
+    CHECK(impossible_mode(params, modes) == "the elevation_stop mode is set but the stop is off (elevation_stop = false)");
+    params.axis_stop[0].present = true;
+    CHECK(impossible_mode(params, modes).empty());
+    modes.amplifier_saturated[1] = 1;
+    CHECK(impossible_mode(params, modes) == "motor 2 is in voltage drive but has an amplifier saturation mode");
+    params.fidelity.drive[1] = DriveMode::current;
+    CHECK(impossible_mode(params, modes).empty());
+    params.fidelity.dry_friction = false;
+    CHECK(impossible_mode(params, modes) == "a friction mode is set but dry friction is off");
+    params.fidelity.gear[0] = GearModel::rigid;
+    CHECK(impossible_mode(params, modes) == "gear 1 has no backlash but a contact mode");
+}
+
 int main() {
     test_gear_backlash();
     test_voltage_clamp();
     test_current_limiter();
     test_dry_friction();
+    test_axis_stop_hold();
+    test_impossible_modes();
     test_registry();
     return check_report("switching_elements");
 }

@@ -4,9 +4,10 @@
 #pragma once
 
 #include "gimbal/model/model_types.hpp"
+#include "gimbal/switching_elements/amplifier_saturation.hpp"
+#include "gimbal/switching_elements/axis_stop.hpp"
 #include "gimbal/switching_elements/current_limiter.hpp"
 #include "gimbal/switching_elements/dry_friction.hpp"
-#include "gimbal/switching_elements/elevation_stop.hpp"
 #include "gimbal/switching_elements/gear_backlash.hpp"
 #include "gimbal/switching_elements/voltage_clamp.hpp"
 

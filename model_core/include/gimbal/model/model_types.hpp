@@ -52,13 +52,20 @@ struct Fidelity {
 // Rotor coordinate of axis j in q order (alpha_m, beta_m) and its load coordinate (alpha, beta).
 constexpr int rotor_index(int axis) { return axis == 0 ? 1 : 3; }
 constexpr int load_index(int axis) { return axis == 0 ? 0 : 2; }
-// The payload's elevation angle beta, the coordinate the elevation end stop limits.
-constexpr int kElevation = load_index(1);
-
-// The elevation end stop (switching_elements/elevation_stop.hpp): hard stops at beta = lower and upper,
-// Newton's impact law with the coefficient of restitution, rest on a stop below the rebound rate
-// rest_rate. Off by default: no guard, no mode, no term in any sum.
-struct ElevationStopParameters {
+// The axis end stops (switching_elements/axis_stop.hpp), one per AXIS_STOP row of
+// gimbal/switching_elements.def, in its order: hard stops of one coordinate at lower and upper, Newton's
+// impact law with the coefficient of restitution, rest on a stop below the rebound rate rest_rate. Off by
+// default: no guard, no mode, no term in any sum.
+constexpr int kAxisStopCount = 0
+#define AXIS_STOP(element, coordinate, lower, upper, restitution, rest_rate, contact) +1
+#define ELEMENT(identifier, instances, guards, element_switch, element_class)
+#define MODE_OUTPUT(element, output, lowest, highest)
+#include "gimbal/switching_elements.def"
+#undef MODE_OUTPUT
+#undef ELEMENT
+#undef AXIS_STOP
+    ;
+struct AxisStopParameters {
     bool present = false;
     double lower = -1.5707963267948966;  // rad
     double upper = 1.5707963267948966;   // rad
@@ -91,7 +98,7 @@ struct ModelParameters {
     double viscous_friction[4] = {0, 0, 0, 0};  // per body, q order
     DryFrictionParameters dry_friction[4];      // per body, as given
     DisturbanceParameters disturbances;         // cable restraints and cogging; `active` set by finalize()
-    ElevationStopParameters elevation_stop;
+    AxisStopParameters axis_stop[kAxisStopCount];
     Fidelity fidelity;
     // Where the compliant gears' rotors start (gear<j>.start): used only by the start state.
     GearStart gear_start[2] = {GearStart::in_mesh_unless_given, GearStart::in_mesh_unless_given};
@@ -132,7 +139,7 @@ struct Modes {
     int motor_limited[2] = {0, 0};   // -1 held at -i_L, 0 free, +1 held at +i_L
     int voltage_clamped[2] = {0, 0}; // a ramped voltage held at -U_L / +U_L (0: follows the ramp)
     FrictionMode friction[4] = {FrictionMode::none, FrictionMode::none, FrictionMode::none, FrictionMode::none};
-    int elevation_stop = 0;          // -1 resting on the lower stop, 0 free (or no stop), +1 resting on the upper
+    int axis_stop[kAxisStopCount] = {};  // per axis stop: -1 resting on the lower stop, 0 free (or off), +1 on the upper
     int amplifier_saturated[2] = {0, 0};  // current drive: -1 output held at -U_L, 0 free, +1 held at +U_L
 };
 
@@ -172,7 +179,7 @@ struct Dynamics {
     Vec4 other_torque;              // T_outros, meaningful for low-speed coordinates only
     double voltage[2];              // applied
     Mat4 reduced_mass;              // padded coordinates
-    double stop_torque;             // the elevation end stop's reaction on the payload while it rests there
+    double stop_torque[kAxisStopCount];  // each axis stop's reaction on its coordinate while it rests on it
     double amplifier_demand[2];     // current drive: the amplifier's output before its bus limit (u_unsat), else 0
     double amplifier_rate[2];       // dx_I/dt (0 while saturated, without an integrator, or in voltage drive)
 };

@@ -24,6 +24,12 @@ inline bool current_driven(const ModelParameters& params, int axis) {
     return params.fidelity.drive[axis] == DriveMode::current;
 }
 
+// Whether the amplifier has its integrator x_I as a state (StateLayout::amplifier_slot): a current-driven
+// inductive motor's only (a quasi-static motor's amplifier is an ideal current source).
+inline bool amplifier_integrates(const Fidelity& fidelity, int axis) {
+    return fidelity.drive[axis] == DriveMode::current && fidelity.motor[axis] == MotorModel::inductive;
+}
+
 // u_unsat of a current-driven motor at the current i, the integrator x_I and the rotor speed w.
 inline double amplifier_demand(const ModelParameters& params, const StepInputs& inputs, int axis, double current,
                                double integrator, double rotor_rate) {
@@ -69,9 +75,28 @@ inline AmplifierSlopes amplifier_slopes(const ModelParameters& params, const Mod
     return slopes;
 }
 
+// Jacobian pass of the amplifier's own state x_I (layout.amplifier_slot), into the integrated state's
+// Jacobian `jac` (slot by slot): while the output is free, x_I drives the current through 1/L, and
+// integrates K_i (i_cmd - i) unless the limiter holds i. No entry without an integrator, or while held.
+template <class SlotMatrix>
+void add_amplifier_state_entries(const ModelParameters& params, const Modes& modes, int axis, SlotMatrix& jac) {
+    const int slot = params.layout.amplifier_slot[axis], current = params.layout.current_slot[axis];
+    if (slot < 0 || modes.amplifier_saturated[axis] != 0 || modes.motor_limited[axis] != 0) return;
+    jac(current, slot) = amplifier_slopes(params, modes, axis).integrator / params.motor[axis].inductance;
+    jac(slot, current) = -params.amplifier[axis].integral_gain;
+}
+
 class AmplifierSaturationElement final : public SwitchingElement {
 public:
     AmplifierSaturationElement(int axis, int first_guard);
+    explicit AmplifierSaturationElement(const ElementSlot& slot) : AmplifierSaturationElement(slot.instance, slot.first_guard) {}
+    // A current-driven motor's only; in voltage drive its indicators are constants 1.
+    static bool present(const ModelParameters& params, const ElementSlot& slot) { return current_driven(params, slot.instance); }
+    static constexpr DecisionStage kStage = DecisionStage::supply;
+    static std::string impossible_mode(const ModelParameters& params, const Modes& modes, const ElementSlot& slot) {
+        if (current_driven(params, slot.instance) || modes.amplifier_saturated[slot.instance] == 0) return {};
+        return "motor " + std::to_string(slot.instance + 1) + " is in voltage drive but has an amplifier saturation mode";
+    }
     static constexpr int kGuards = 2;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;

@@ -80,6 +80,12 @@ bool current_state_row(const ModelParameters& params, const Modes& modes, int ax
 class CurrentLimiterElement final : public SwitchingElement {
 public:
     CurrentLimiterElement(int axis, int first_guard);
+    explicit CurrentLimiterElement(const ElementSlot& slot) : CurrentLimiterElement(slot.instance, slot.first_guard) {}
+    // A voltage-driven motor's only: a current-driven motor's current is limited by its amplifier, which
+    // clamps the command to +-i_L; an ideal limiter at the same level would only meet a current the loop
+    // brings onto it tangentially.
+    static bool present(const ModelParameters& params, const ElementSlot& slot) { return !current_driven(params, slot.instance); }
+    static constexpr DecisionStage kStage = DecisionStage::current;
     static constexpr int kGuards = 2;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;

@@ -58,6 +58,14 @@ int friction_mode_indicator(FrictionMode mode, double rate);
 class DryFrictionElement final : public SwitchingElement {
 public:
     DryFrictionElement(int body, int first_guard);
+    explicit DryFrictionElement(const ElementSlot& slot) : DryFrictionElement(slot.instance, slot.first_guard) {}
+    // A coordinate with dry friction only.
+    static bool present(const ModelParameters& params, const ElementSlot& slot) { return params.coordinate_friction[slot.instance].present(); }
+    static constexpr DecisionStage kStage = DecisionStage::friction;
+    static std::string impossible_mode(const ModelParameters& params, const Modes& modes, const ElementSlot& slot) {
+        if (params.fidelity.dry_friction || modes.friction[slot.instance] == FrictionMode::none) return {};
+        return "a friction mode is set but dry friction is off";
+    }
     static constexpr int kGuards = 6;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
@@ -66,6 +74,12 @@ public:
                 const int* crossings) const override;
     void decide_torque(const SwitchingContext& context, const Modes& previous, Modes& modes,
                        const int* crossings) const;
+    // At low speed the torque's decision reads the other torques under the modes and the state chosen so far.
+    bool settles_on_dynamics(const Modes& modes) const override { return low_speed(modes.friction[body_]); }
+    void settle(const SwitchingContext& context, const Modes& previous, Modes& modes, double*,
+                const int* crossings) const override {
+        decide_torque(context, previous, modes, crossings);
+    }
     bool changed(const Modes& before, const Modes& after) const override {
         return before.friction[body_] != after.friction[body_];
     }

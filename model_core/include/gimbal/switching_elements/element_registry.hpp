@@ -1,62 +1,33 @@
-// The one place where the switching elements are registered (docs/architecture.md): which elements a
-// model has, in the order their modes are decided, and where each one's guards sit among the FMU's
-// event indicators. The hybrid system (hybrid_system/gimbal_hybrid_system.hpp) holds one set and
-// knows no element by name.
+// The switching elements a model has (docs/architecture.md), generated from their one declaration,
+// gimbal/switching_elements.def: each ELEMENT row's class, made once per instance its present() accepts, in
+// the order their modes are decided (DecisionStage), with each one's guards' place among the FMU's event
+// indicators. The registry names no element; the hybrid system (hybrid_system/gimbal_hybrid_system.hpp)
+// holds one set.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "gimbal/function_ref.hpp"
 #include "gimbal/switching_elements/amplifier_saturation.hpp"
+#include "gimbal/switching_elements/axis_stop.hpp"
 #include "gimbal/switching_elements/current_limiter.hpp"
 #include "gimbal/switching_elements/dry_friction.hpp"
-#include "gimbal/switching_elements/elevation_stop.hpp"
 #include "gimbal/switching_elements/gear_backlash.hpp"
 #include "gimbal/switching_elements/voltage_clamp.hpp"
 
 namespace gimbal {
 
-// The kinds of switching element, as declared once in gimbal/switching_elements.def.
-enum class ElementKind : int {
-#define ELEMENT(identifier, instances, guards, element_switch) identifier,
-#define MODE_OUTPUT(element, output, lowest, highest)
-#include "gimbal/switching_elements.def"
-#undef MODE_OUTPUT
-#undef ELEMENT
-};
-
-struct ElementDeclaration {
-    int instances;
-    int guards;  // per instance
-};
-
-inline constexpr ElementDeclaration kElementDeclarations[] = {
-#define ELEMENT(identifier, instances, guards, element_switch) {instances, guards},
-#define MODE_OUTPUT(element, output, lowest, highest)
-#include "gimbal/switching_elements.def"
-#undef MODE_OUTPUT
-#undef ELEMENT
-};
-
-// Where a kind's first instance's guards sit among the event indicators: after every kind declared before.
-constexpr int first_indicator_of(ElementKind kind) {
-    int first = 0;
-    for (int k = 0; k < static_cast<int>(kind); ++k) first += kElementDeclarations[k].instances * kElementDeclarations[k].guards;
-    return first;
-}
-
-// The guards of every switching element the model can have, in the fixed order of the declaration whatever
-// the fidelity (Model Exchange's event indicators, GIMBAL_EVENT_INDICATORS of gimbal_c_api.h, summed from
-// the same table). An element this fidelity lacks contributes constants 1.
-constexpr int kEventIndicatorCount =
-    first_indicator_of(static_cast<ElementKind>(sizeof(kElementDeclarations) / sizeof(kElementDeclarations[0])));
+// Why `modes` is impossible for the elements `params` defines ("" when possible): the first element
+// instance, in the declaration's order, whose class refuses it (a restored FMU state's check).
+std::string impossible_mode(const ModelParameters& params, const Modes& modes);
 
 class SwitchingElementSet {
 public:
     // The registration: one element per switching part the model has.
     explicit SwitchingElementSet(const ModelParameters& params);
-    // The element list points into the element vectors: not copyable.
+    // Owns its elements (each by its own pointer): not copyable.
     SwitchingElementSet(const SwitchingElementSet&) = delete;
     SwitchingElementSet& operator=(const SwitchingElementSet&) = delete;
 
@@ -66,11 +37,11 @@ public:
     // Every element's guards under `modes`, each in its slice of `values` (guard_count() of them).
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const;
 
-    // Re-selects every element's mode, in dependency order: the contacts first (the end stop, whose
-    // impulse moves the rates every other element reads, before the gears), then the voltage
-    // clamps and the current amplifiers' bus limits, the limiters (whose steady current depends on the clamped voltage), then friction
-    // (whose torques depend on everything before). `refresh` re-evaluates context.dynamics at
-    // (time, state) under the modes chosen so far, where a later decision depends on them.
+    // Re-selects every element's mode, stage by stage (DecisionStage): an impact stop's impulse moves the
+    // rates, and its rest is settled on the dynamics after it; a change of the voltage sources is seen by
+    // the limiters; the low-speed bodies' friction torques are settled on the dynamics under every mode
+    // chosen before. `refresh` re-evaluates context.dynamics at (time, state) under the modes chosen so far,
+    // where a later decision depends on them.
     void decide(const SwitchingContext& context, const Modes& previous, Modes& modes, double* state,
                 const int* crossings, FunctionRef<void()> refresh) const;
 
@@ -83,18 +54,22 @@ public:
     std::string describe(const Modes& before, const Modes& after) const;
 
 private:
-    // Instance `index` of a kind; its guards' indicators follow from the declaration.
+    // Every instance of a kind its class's present() accepts; its guards' indicators follow from the
+    // declaration.
     template <ElementKind Kind, class Element>
-    void add(std::vector<Element>& kind, int index);
+    void add(const ModelParameters& params);
+    void add_stage(const ModelParameters& params, DecisionStage stage);
     bool any_changed(const Modes& before, const Modes& after) const;
+    // The elements of one stage, in decision order.
+    const std::unique_ptr<SwitchingElement>* stage_begin(DecisionStage stage) const {
+        return elements_.data() + stage_start_[static_cast<int>(stage)];
+    }
+    const std::unique_ptr<SwitchingElement>* stage_end(DecisionStage stage) const {
+        return elements_.data() + stage_start_[static_cast<int>(stage) + 1];
+    }
 
-    std::vector<ElevationStopElement> stops_;
-    std::vector<BacklashElement> backlash_;
-    std::vector<VoltageClampElement> clamps_;
-    std::vector<AmplifierSaturationElement> amplifiers_;
-    std::vector<CurrentLimiterElement> limiters_;
-    std::vector<DryFrictionElement> friction_;
-    std::vector<const SwitchingElement*> elements_;  // all of them, in decision order
+    std::vector<std::unique_ptr<SwitchingElement>> elements_;  // all of them, in decision order
+    int stage_start_[kDecisionStageCount + 1] = {};
     std::vector<int> guard_indicator_;
     int guard_count_ = 0;
     int state_size_ = 0;

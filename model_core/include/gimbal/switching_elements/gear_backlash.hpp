@@ -91,6 +91,14 @@ bool backlash_state_row(const ModelParameters& params, const Modes& modes, int a
 class BacklashElement final : public SwitchingElement {
 public:
     BacklashElement(int axis, int first_guard);
+    explicit BacklashElement(const ElementSlot& slot) : BacklashElement(slot.instance, slot.first_guard) {}
+    // A backlash gear's only.
+    static bool present(const ModelParameters& params, const ElementSlot& slot) { return params.layout.backlash_slot[slot.instance] >= 0; }
+    static constexpr DecisionStage kStage = DecisionStage::contact;
+    static std::string impossible_mode(const ModelParameters& params, const Modes& modes, const ElementSlot& slot) {
+        if (params.fidelity.gear[slot.instance] == GearModel::backlash || modes.gear_contact[slot.instance] == 0) return {};
+        return "gear " + std::to_string(slot.instance + 1) + " has no backlash but a contact mode";
+    }
     static constexpr int kGuards = 2;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;

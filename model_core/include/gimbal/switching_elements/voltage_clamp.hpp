@@ -37,6 +37,10 @@ inline int held_clamp_side(const MotorParameters& motor, double commanded_voltag
 class VoltageClampElement final : public SwitchingElement {
 public:
     VoltageClampElement(int axis, int first_guard);
+    explicit VoltageClampElement(const ElementSlot& slot) : VoltageClampElement(slot.instance, slot.first_guard) {}
+    // Every motor's.
+    static bool present(const ModelParameters&, const ElementSlot&) { return true; }
+    static constexpr DecisionStage kStage = DecisionStage::supply;
     static constexpr int kGuards = 2;
     int guard_count() const override { return kGuards; }
     void guards(const SwitchingContext& context, const Modes& modes, double* values) const override;
