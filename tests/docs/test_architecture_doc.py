@@ -232,7 +232,7 @@ def test_every_path_the_page_names_exists(page):
     ("There are six kinds", "There are five kinds", count_problems),
     ("| 2 (38-41) |", "| 2 (38-40) |", element_table_problems),
     ("| `amplifier_saturation` |", "| `amplifier` |", element_table_problems),
-    (", `elevation_stop`, `amplifier_saturation`, `element_registry` |", ", `elevation_stop`, `element_registry` |",
+    (", `axis_stop`, `amplifier_saturation`, `element_registry` |", ", `axis_stop`, `element_registry` |",
      folder_table_problems),
     ("`probe_api.cpp`, `fmu_model_table.cpp`,", "`probe_api.cpp`, `fmu_table.cpp`,", folder_table_problems),
 ])

@@ -13,7 +13,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 CORE = ROOT / "model_core"
 ARCHITECTURE = ROOT / "docs" / "architecture.md"
 
-# Bottom to top. A layer is a folder of include/gimbal/ and src/, except model/model_types.hpp: the
+# Bottom to top. A layer is a folder of include/gimbal/ and src/, except model/variables.hpp (the
+# variable tables' enumerations, in the shared base) and model/model_types.hpp: the
 # parameter, state and mode types sit below the switching elements (which read them), the dynamics
 # of model/ above (which call the elements). The files at include/gimbal/ itself (the C interface,
 # the variable tables, function_ref.hpp, hot_path.hpp) are the shared base: they include no layer.
@@ -30,6 +31,8 @@ def layer_of(path: pathlib.Path, core: pathlib.Path = CORE) -> str:
         if base in path.parents:
             parts = path.relative_to(base).parts
             if len(parts) == 1:
+                return "shared"
+            if parts[:2] == ("model", "variables.hpp"):   # the .def tables' enumerations: no layer included
                 return "shared"
             if parts[:2] == ("model", "model_types.hpp"):
                 return "model/model_types.hpp"

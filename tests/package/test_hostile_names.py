@@ -27,8 +27,8 @@ def test_a_scene_file_with_markup_in_its_name_writes_its_files_in_the_folder_ask
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     written = sorted(p.name for p in out.iterdir())
-    assert written == sorted([f".{HOSTILE}.run.lock"] + [f"{HOSTILE}{suffix}" for suffix in (".csv", ".parquet", ".png",
-                                                                                              "_run.json")]), written
+    # No lock file is left behind (the run removes it while it holds it).
+    assert written == sorted(f"{HOSTILE}{suffix}" for suffix in (".csv", ".parquet", ".png", "_run.json")), written
     assert not any("escaped" in p.name for p in tmp_path.rglob("*")), "the title became a path"
     status = json.loads((out / f"{HOSTILE}_run.json").read_text())
     assert status["scene"] == HOSTILE and status["files"] == [f"{HOSTILE}{s}" for s in (".csv", ".parquet", ".png")]

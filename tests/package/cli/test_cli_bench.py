@@ -27,7 +27,7 @@ def test_a_scene_with_a_python_controller_is_measured_in_the_python_loop(fmu_pat
     import subprocess
     import sys
 
-    scene = pathlib.Path(__file__).resolve().parents[1] / "examples" / "user_controller.toml"
+    scene = pathlib.Path(__file__).resolve().parents[3] / "examples" / "user_controller.toml"
     done = subprocess.run([sys.executable, "-m", "gimbal2axis", "bench", str(scene), "--fmu", str(fmu_path),
                            "--stop-time", "0.2", "--repeat", "1", "--out", str(tmp_path / "bench.json")],
                           capture_output=True, text=True, timeout=300)
