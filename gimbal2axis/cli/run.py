@@ -66,8 +66,13 @@ def check_output_directory(out: pathlib.Path, stem: str) -> None:
             pass
     except OSError as exc:
         raise SceneError(f"--out {out}: cannot write there: {exc.strerror or exc}") from None
+    from ..master.record_files import is_record_folder
+
     for suffix in (".csv", ".parquet", ".png", "_run.json"):
         target = out / f"{stem}{suffix}"
+        # A folder of chunks: a run writing it (the run lock refuses this one by name) or a killed run's.
+        if suffix == ".parquet" and is_record_folder(target):
+            continue
         if target.is_dir() or (target.exists() and not os.access(target, os.W_OK)):
             raise SceneError(f"cannot write {target}: {'it is a directory' if target.is_dir() else 'not writable'}")
 

@@ -31,6 +31,7 @@ import io
 import json
 import os
 import pathlib
+import re
 import shutil
 
 import numpy as np
@@ -101,6 +102,15 @@ def write_atomically(path: pathlib.Path, data: bytes) -> None:
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+
+
+def is_record_folder(path: pathlib.Path) -> bool:
+    """A folder of a run's chunks (a run in progress, or one killed before its merge), which the next run
+    of the scene replaces; any other folder of that name is the user's and stays untouched."""
+    if not path.is_dir() or path.is_symlink():
+        return False
+    chunk = re.compile(r"^\.?part-\d{6}\.parquet(\.tmp)?$")
+    return all(chunk.match(entry.name) and entry.is_file() for entry in path.iterdir())
 
 
 def remove_path(path: pathlib.Path) -> None:

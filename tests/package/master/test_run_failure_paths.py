@@ -333,6 +333,34 @@ def test_a_killed_run_leaves_its_chunks_readable_and_says_it_was_running(tmp_pat
     t = record_times(out)
     assert np.array_equal(t, np.arange(len(t)) * 0.001) and t[-1] >= run_status["recorded_until_s"] >= 16.383
     csv_rows(out)
+    # The killed run's folder of chunks is no obstacle: the next run of the scene replaces it.
+    status, err = run_in_process(capsys, scene(tmp_path / "s"), "--out", out)
+    assert status == 0, err
+    assert (out / "cheap.parquet").is_file() and status_of(out)["status"] == "complete"
+
+
+def test_a_second_run_of_a_scene_while_the_first_writes_is_refused_by_name(tmp_path, capsys):
+    out = tmp_path / "out"
+    path = scene(tmp_path / "s", stop_time=600.0, controller="Steady")
+    process = subprocess.Popen([*RUN, str(path), "--out", str(out), "--quiet"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        wait_for(lambda: len(chunks(out)) >= 1, process, "a chunk")
+        status, err = run_in_process(capsys, scene(tmp_path / "s"), "--out", out)
+        assert status == 2 and "another gimbal2axis run is writing cheap's files" in err, err
+        assert process.poll() is None and len(chunks(out)) >= 1, "the first run was disturbed"
+    finally:
+        process.kill()
+        process.wait(timeout=60)
+
+
+def test_a_folder_of_the_records_name_that_is_not_a_record_is_refused_and_kept(tmp_path, capsys):
+    out = tmp_path / "out"
+    (out / "cheap.parquet").mkdir(parents=True)
+    (out / "cheap.parquet" / "notes.txt").write_text("the user's\n")
+    status, err = run_in_process(capsys, scene(tmp_path / "s"), "--out", out)
+    assert status == 2 and "cheap.parquet: it is a directory" in err, err
+    assert (out / "cheap.parquet" / "notes.txt").read_text() == "the user's\n"
 
 
 # --- item 6: derived files never collide with a record --------------------------------------------
